@@ -1,0 +1,128 @@
+/** @file cli.c @brief Implementation of cli.h. */
+#include "cli.h"
+
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "error.h"
+#include "run.h"
+#include "timers.h"
+
+void cli_usage(void) {
+  printf(
+      "usage:\n"
+      "  chansph run SCENE.ini [--out DIR] [--set section.key=value ...] [--overwrite] [--fpe]\n"
+      "  chansph bench [SCENE.ini] [--steps N] [--set section.key=value ...]\n"
+      "  chansph scene-doc            print the scene key reference (docs/scenes.md)\n"
+      "  chansph --version | --help\n"
+      "run writes DIR/log.txt, scene.used.ini, stats.nc, particles.nc (default DIR:\n"
+      "runs/<scene name>). Threads: OMP_NUM_THREADS or run.threads. Exit codes: 0 done,\n"
+      "1 input error, 2 internal error, 3 numerical failure (health check).\n");
+}
+
+int cli_parse(int argc, char **argv, struct cli *c) {
+  memset(c, 0, sizeof *c);
+  c->set = calloc((size_t)argc + 1, sizeof *c->set);
+  c->steps = 50;
+  if (argc < 2) {
+    c->cmd = CMD_HELP;
+    return CHANSPH_OK;
+  }
+  const char *cmd = argv[1];
+  if (!strcmp(cmd, "run")) c->cmd = CMD_RUN;
+  else if (!strcmp(cmd, "bench")) c->cmd = CMD_BENCH;
+  else if (!strcmp(cmd, "scene-doc")) c->cmd = CMD_SCENE_DOC;
+  else if (!strcmp(cmd, "--help") || !strcmp(cmd, "-h") || !strcmp(cmd, "help")) c->cmd = CMD_HELP;
+  else if (!strcmp(cmd, "--version")) c->cmd = CMD_VERSION;
+  else {
+    error_input("unknown command '%s'", cmd);
+    cli_usage();
+    return CHANSPH_ERR;
+  }
+  for (int i = 2; i < argc; i++) {
+    const char *a = argv[i];
+    const int has_next = i + 1 < argc;
+    if (!strcmp(a, "--set") && has_next) c->set[c->n_set++] = argv[++i];
+    else if (!strncmp(a, "--set=", 6)) c->set[c->n_set++] = argv[i] + 6;
+    else if (!strcmp(a, "--out") && has_next) snprintf(c->out, sizeof c->out, "%s", argv[++i]);
+    else if (!strcmp(a, "--steps") && has_next) {
+      char *end;
+      c->steps = strtol(argv[++i], &end, 10);
+      if (*end || c->steps < 1) {
+        error_input("--steps %s: expected a positive integer", argv[i]);
+        return CHANSPH_ERR;
+      }
+    } else if (!strcmp(a, "--overwrite")) c->overwrite = 1;
+    else if (!strcmp(a, "--fpe")) c->fpe = 1;
+    else if (!strcmp(a, "--debug")) chansph_debug = 1;
+    else if (a[0] != '-' && !c->scene) c->scene = a;
+    else {
+      error_input("unexpected argument '%s'%s", a,
+                  (!strcmp(a, "--set") || !strcmp(a, "--out") || !strcmp(a, "--steps"))
+                      ? " (missing value)" : "");
+      cli_usage();
+      return CHANSPH_ERR;
+    }
+  }
+  if (c->cmd == CMD_RUN && !c->scene) {
+    error_input("run: missing SCENE.ini");
+    cli_usage();
+    return CHANSPH_ERR;
+  }
+  if (c->cmd == CMD_RUN && !c->out[0]) {
+    const char *base = strrchr(c->scene, '/');
+    base = base ? base + 1 : c->scene;
+    const char *dot = strrchr(base, '.');
+    snprintf(c->out, sizeof c->out, "runs/%.*s", dot ? (int)(dot - base) : (int)strlen(base),
+             base);
+  }
+  return CHANSPH_OK;
+}
+
+int cli_bench_scene(struct scene *sc, const struct cli *c) {
+  static char *defaults[] = {"domain.dimension=3", "domain.lx=1.6",   "domain.delta=0.5",
+                             "domain.lz=1.0",      "domain.dr=0.025", "sph.h_over_dr=1.3",
+                             "fluid.nu=0.1",       "fluid.c0=10",     "fluid.rho0=1000",
+                             "drive.force=0.8",    "time.t_end=1e6"};
+  enum { ND = sizeof defaults / sizeof defaults[0] };
+  char **set = calloc((size_t)(ND + c->n_set), sizeof *set);
+  int n = 0;
+  if (!c->scene)
+    for (int i = 0; i < ND; i++) set[n++] = defaults[i];
+  for (int i = 0; i < c->n_set; i++) set[n++] = c->set[i];
+  const int rc = scene_load(sc, c->scene, n, set);
+  free(set);
+  return rc;
+}
+
+int cli_bench(const struct scene *sc, long steps) {
+  struct sim S;
+  const double t_setup = timer_now();
+  sim_init(&S, sc);
+  const double setup = timer_now() - t_setup;
+  long nbr = 0;
+  for (size_t a = 0; a < S.P.n; a++)
+    if (S.P.kind[a] == KIND_FLUID) nbr += S.nb.count[a];
+  const int warm = 3;
+  for (int i = 0; i < warm; i++) sim_step(&S);
+  timer_reset();
+  const double t0 = timer_now(), sim0 = S.t;
+  for (long i = 0; i < steps; i++) sim_step(&S);
+  const double wall = timer_now() - t0, simt = S.t - sim0;
+  printf("chansph bench: %dD, %zu fluid + %zu vertex particles, %d threads\n", sc->dim,
+         S.P.n_fluid, S.P.n_vertex, omp_get_max_threads());
+  printf("neighbours per fluid particle (within 2h, self excluded): %.2f\n",
+         (double)nbr / (double)S.P.n_fluid);
+  printf("set-up %.3f s; %d warm-up steps, then %ld timed steps in %.3f s (%.3f ms/step)\n",
+         setup, warm, steps, wall, 1e3 * wall / steps);
+  printf("dt = %.4e s (limits: acoustic %.3e, viscous %.3e, force %.3e, wall %.3e)\n", S.dt,
+         S.dt_limits[0], S.dt_limits[1], S.dt_limits[2], S.dt_limits[3]);
+  printf("wall seconds per simulated second: %.1f\n", simt > 0 ? wall / simt : 0.0);
+  timer_report(stdout, wall);
+  part_memory_report(stdout);
+  printf("particle-steps/s: %.0f\n", (double)S.P.n_fluid * steps / wall);
+  sim_free(&S);
+  return 0;
+}

@@ -1,0 +1,46 @@
+/** @file health.c @brief Implementation of health.h. */
+#include "health.h"
+
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+
+#include "timers.h"
+
+enum { OK = 0, NOT_FINITE = 1, THROUGH_WALL = 2, SUPERSONIC = 3 };
+
+static int classify(const struct model *M, const struct particles *P, size_t a) {
+  const double vals[] = {P->x[a], P->y[a], P->z[a], P->u[a], P->v[a], P->w[a], P->rho[a]};
+  for (size_t k = 0; k < sizeof vals / sizeof vals[0]; k++)
+    if (!isfinite(vals[k])) return NOT_FINITE;
+  if (P->y[a] <= 0.0 || P->y[a] >= M->ly) return THROUGH_WALL;
+  const double s2 = P->u[a] * P->u[a] + P->v[a] * P->v[a] + P->w[a] * P->w[a];
+  if (s2 >= M->e.c0 * M->e.c0) return SUPERSONIC;
+  return OK;
+}
+
+int health_check(const struct model *M, const struct particles *P, long step, double t,
+                 struct health_report *rep) {
+  timer_push("health");
+  long long worst = LLONG_MAX;
+#pragma omp parallel for schedule(static) reduction(min : worst)
+  for (size_t a = 0; a < P->n; a++) {
+    if (P->kind[a] != KIND_FLUID || classify(M, P, a) == OK) continue;
+    if (P->id[a] < worst) worst = P->id[a];
+  }
+  int rc = OK;
+  for (size_t a = 0; worst != LLONG_MAX && a < P->n; a++) {
+    if (P->id[a] != worst || P->kind[a] != KIND_FLUID) continue;
+    rc = classify(M, P, a);
+    static const char *names[] = {"", "non-finite value", "particle through a wall",
+                                  "particle faster than the speed of sound c0"};
+    snprintf(rep->what, sizeof rep->what,
+             "%s at step %ld (t = %.9g): particle id %lld at (%.9g, %.9g, %.9g), velocity "
+             "(%.6g, %.6g, %.6g), density %.6g",
+             names[rc], step, t, (long long)P->id[a], P->x[a], P->y[a], P->z[a], P->u[a],
+             P->v[a], P->w[a], P->rho[a]);
+    break;
+  }
+  timer_pop();
+  return rc;
+}

@@ -1,0 +1,54 @@
+/**
+ * @file output.h
+ * @brief The run directory: log.txt, scene.used.ini, stats.nc (profiles and time series,
+ *        rewritten atomically) and particles.nc (final particle state, sorted by id).
+ */
+#ifndef CHANSPH_OUTPUT_H
+#define CHANSPH_OUTPUT_H
+
+#include <stdio.h>
+
+#include "health.h"
+#include "profile.h"
+#include "run.h"
+
+/** Output state of a run. */
+struct output {
+  char dir[2048];       /*!< run directory */
+  FILE *log;            /*!< DIR/log.txt */
+  char *scene_text;     /*!< resolved scene */
+  struct profile prof;  /*!< binned profiles over the averaging window */
+  struct series ts;     /*!< time series */
+  double next_write;    /*!< simulated time of the next stats.nc rewrite [s] */
+  double wall0;         /*!< wall clock at the start of the loop [s] */
+  double t0;            /*!< simulated time at the start of the loop [s] */
+  double last_wall;     /*!< wall clock of the last log line [s] */
+  long last_step;       /*!< step of the last log line */
+};
+
+/**
+ * @brief Create (or check) the run directory before anything is computed. Refuses a directory
+ *        holding results of an earlier run unless overwrite is set, so nothing is lost.
+ * @return CHANSPH_OK or CHANSPH_ERR with a message
+ */
+int output_open(struct output *o, const char *dir, const struct scene *sc, int overwrite);
+
+/** @brief Record the initial state and start the clocks. */
+void output_begin(struct output *o, struct sim *S);
+
+/** @brief After each step: sample statistics, record the series, log, rewrite stats.nc. */
+void output_step(struct output *o, struct sim *S);
+
+/**
+ * @brief Final log line, stats.nc and particles.nc, phase timing report.
+ * @return CHANSPH_OK or CHANSPH_ERR (a file could not be written; message printed)
+ */
+int output_finish(struct output *o, struct sim *S);
+
+/** @brief Report a failed health check to stdout, stderr and log.txt; keeps earlier files. */
+void output_fail(struct output *o, struct sim *S, const struct health_report *rep);
+
+/** @brief Release the output state. */
+void output_close(struct output *o);
+
+#endif

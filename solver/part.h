@@ -1,0 +1,89 @@
+/**
+ * @file part.h
+ * @brief Particles (fluid and wall vertices) as structure-of-arrays, and the wall lattice.
+ *
+ * Hot fields are separate arrays; every array is allocated through part_alloc() with a label,
+ * so part_memory_report() gives the memory per array. After each neighbour sort the arrays are
+ * ordered by cell, and by id within a cell.
+ */
+#ifndef CHANSPH_PART_H
+#define CHANSPH_PART_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#include "scene.h"
+
+enum part_kind { KIND_FLUID = 0, KIND_VERTEX = 1 };
+
+/** All particles of this rank. Vertex particles sit on the walls and never move. */
+struct particles {
+  size_t n;        /*!< fluid + vertex particles */
+  size_t n_fluid;  /*!< fluid particles */
+  size_t n_vertex; /*!< vertex particles (both walls) */
+  /* hot, permuted with the particles */
+  double *x, *y, *z;  /*!< position [m] */
+  double *u, *v, *w;  /*!< velocity [m/s] */
+  double *rho;        /*!< density [kg/m^3] */
+  double *m;          /*!< mass [kg] */
+  double *gam;        /*!< renormalisation gamma [-] (fluid) */
+  double *ksum;       /*!< kernel sum S_a = sum_b m_b w_ab at the current positions [kg/m^dim] */
+  double *ddiff;      /*!< volume-diffusion sum D_a of thesis Eq. 3.64 [kg/m^dim/s] */
+  int64_t *id;        /*!< global particle id */
+  uint8_t *kind;      /*!< enum part_kind */
+  /* recomputed every step, not permuted */
+  double *p;          /*!< pressure [Pa] */
+  double *c;          /*!< local speed of sound [m/s] */
+  double *ax, *ay, *az; /*!< acceleration without the driving force [m/s^2] */
+  /* sort scratch */
+  double *tmp;
+  int64_t *tmp_i;
+};
+
+/** Wall values on the vertex lattice: index (wall * nx + i) * nz + k, wall 0 at y = 0. */
+struct walls {
+  int nx, nz;     /*!< vertices per wall along x and z */
+  double *rho;    /*!< wall density [kg/m^3] */
+  double *p;      /*!< wall pressure [Pa] */
+};
+
+/**
+ * @brief Allocate zeroed, 64-byte aligned memory and record it under a label.
+ * @param[in] label name in the memory report
+ * @param[in] bytes size
+ * @return the memory (dies on failure, naming the label)
+ */
+void *part_alloc(const char *label, size_t bytes);
+
+/** @brief Free memory from part_alloc(). */
+void part_free(void *ptr);
+
+/** @brief Print memory per label and the total. */
+void part_memory_report(FILE *f);
+
+/**
+ * @brief Create the fluid lattice (x = (i+1/2) dr, y = j dr for j = 1..2delta/dr-1,
+ *        z = (k+1/2) dr) and the vertex particles on both walls (volume dr^dim / 2).
+ * @param[out] P particles
+ * @param[out] W wall lattice
+ * @param[in] s scene
+ */
+void part_create(struct particles *P, struct walls *W, const struct scene *s);
+
+/** @brief Free everything part_create() allocated. */
+void part_destroy(struct particles *P, struct walls *W);
+
+/**
+ * @brief Reorder the permuted arrays: new index i takes old index perm[i].
+ * @param[in,out] P particles
+ * @param[in] perm permutation of 0..n-1
+ */
+void part_permute(struct particles *P, const size_t *perm);
+
+/** @brief Wall-lattice index of a vertex particle from its id. */
+static inline size_t part_vertex_slot(const struct particles *P, int64_t id) {
+  return (size_t)(id - (int64_t)P->n_fluid);
+}
+
+#endif

@@ -1,0 +1,124 @@
+/** @file run.c @brief Implementation of run.h. */
+#include "run.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "error.h"
+#include "reduce.h"
+#include "timers.h"
+
+/** Laminar Poiseuille velocity of a body acceleration f: u = f y (2 delta - y) / (2 nu). */
+static double laminar_u(const struct scene *sc, double y) {
+  double f = sc->force;
+  if (sc->drive_mode == DRIVE_FLUX) f = 3.0 * sc->nu * sc->u_bulk / (sc->delta * sc->delta);
+  return f * y * (2.0 * sc->delta - y) / (2.0 * sc->nu);
+}
+
+void sim_init(struct sim *S, const struct scene *sc) {
+  memset(S, 0, sizeof *S);
+  S->sc = sc;
+  sph_model_init(&S->M, sc);
+  part_create(&S->P, &S->W, sc);
+  if (sc->init_profile == INIT_LAMINAR)
+    for (size_t a = 0; a < S->P.n_fluid; a++) S->P.u[a] = laminar_u(sc, S->P.y[a]);
+  for (int k = 0; k < 4; k++) S->scratch[k] = part_alloc("diag_scratch", S->P.n * sizeof(double));
+  nbr_init(&S->nb, sc, S->P.n);
+  drive_init(&S->drive, sc);
+  S->fx = S->drive.force;
+  nbr_sort(&S->nb, &S->P);
+  nbr_build(&S->nb, &S->P);
+  sph_density(&S->M, &S->P, &S->nb, 0.0);
+  sph_walls(&S->M, &S->P, &S->nb, &S->W);
+}
+
+void sim_free(struct sim *S) {
+  nbr_free(&S->nb);
+  for (int k = 0; k < 4; k++) part_free(S->scratch[k]);
+  part_destroy(&S->P, &S->W);
+}
+
+/* Time step of thesis Eq. 2.160-2.164, or the fixed one. */
+static double time_step(struct sim *S, const struct force_info *fi) {
+  const struct scene *sc = S->sc;
+  const double h = S->M.h;
+  S->dt_limits[0] = sc->cfl * h / sc->c0;
+  S->dt_limits[1] = sc->c_visc * h * h / sc->nu;
+  S->dt_limits[2] = fi->amax > 0.0 ? sc->c_force * sqrt(h / fi->amax) : INFINITY;
+  S->dt_limits[3] = sc->c_gamma > 0.0 && fi->gvmax > 0.0 ? sc->c_gamma / fi->gvmax : INFINITY;
+  if (sc->dt_fixed > 0.0) return sc->dt_fixed;
+  double dt = S->dt_limits[0];
+  for (int k = 1; k < 4; k++) dt = fmin(dt, S->dt_limits[k]);
+  return dt;
+}
+
+static double bulk_velocity(struct sim *S) {
+  const struct particles *P = &S->P;
+  double *vu = S->scratch[0], *vol = S->scratch[1];
+#pragma omp parallel for schedule(static)
+  for (size_t a = 0; a < P->n; a++) {
+    const double V = P->kind[a] == KIND_FLUID ? P->m[a] / P->rho[a] : 0.0;
+    vu[a] = V * P->u[a], vol[a] = V;
+  }
+  double s[2];
+  const double *arrs[2] = {vu, vol};
+  reduce_sums(2, arrs, P->n, s);
+  return s[0] / s[1];
+}
+
+void sim_step(struct sim *S) {
+  struct particles *P = &S->P;
+  struct force_info fi;
+  const double ub = S->drive.mode == DRIVE_FLUX ? bulk_velocity(S) : 0.0;
+  sph_forces(&S->M, P, &S->nb, &S->W, S->fx, &fi);
+  const double dt = time_step(S, &fi);
+  const double fx = drive_force(&S->drive, ub, dt);
+  timer_push("integrate");
+#pragma omp parallel for schedule(static)
+  for (size_t a = 0; a < P->n; a++) {
+    if (P->kind[a] != KIND_FLUID) continue;
+    P->u[a] += dt * (P->ax[a] + fx);
+    P->v[a] += dt * P->ay[a];
+    P->w[a] += dt * P->az[a];
+    P->x[a] += dt * P->u[a];
+    P->y[a] += dt * P->v[a];
+    P->z[a] += dt * P->w[a];
+  }
+  timer_pop();
+  S->t += dt, S->dt = dt, S->fx = fx, S->step++;
+  nbr_sort(&S->nb, P);
+  nbr_build(&S->nb, P);
+  sph_density(&S->M, P, &S->nb, dt);
+  sph_walls(&S->M, P, &S->nb, &S->W);
+}
+
+void sim_diag(struct sim *S, struct diag *d) {
+  const struct particles *P = &S->P;
+  double *vu = S->scratch[0], *vol = S->scratch[1], *ke = S->scratch[2], *mass = S->scratch[3];
+  double rmin = INFINITY, rmax = -INFINITY, smax = 0.0, gmin = INFINITY;
+#pragma omp parallel for schedule(static) reduction(min : rmin, gmin) reduction(max : rmax, smax)
+  for (size_t a = 0; a < P->n; a++) {
+    if (P->kind[a] != KIND_FLUID) {
+      vu[a] = vol[a] = ke[a] = mass[a] = 0.0;
+      continue;
+    }
+    const double V = P->m[a] / P->rho[a];
+    const double s2 = P->u[a] * P->u[a] + P->v[a] * P->v[a] + P->w[a] * P->w[a];
+    vu[a] = V * P->u[a], vol[a] = V, ke[a] = 0.5 * P->m[a] * s2, mass[a] = P->m[a];
+    rmin = fmin(rmin, P->rho[a]), rmax = fmax(rmax, P->rho[a]);
+    smax = fmax(smax, s2), gmin = fmin(gmin, P->gam[a]);
+  }
+  double s[4];
+  const double *arrs[4] = {vu, vol, ke, mass};
+  reduce_sums(4, arrs, P->n, s);
+  double mx[2] = {rmax, smax}, mn[2] = {rmin, gmin};
+  reduce_global_max(mx, 2);
+  reduce_global_min(mn, 2);
+  d->u_bulk = s[0] / s[1], d->volume = s[1], d->kinetic_energy = s[2], d->mass = s[3];
+  d->rho_min = mn[0], d->rho_max = mx[0], d->max_speed = sqrt(mx[1]), d->min_gamma = mn[1];
+}
+
+int sim_done(const struct sim *S) {
+  if (S->sc->max_steps > 0 && S->step >= S->sc->max_steps) return 1;
+  return S->t >= S->sc->t_end * (1.0 - 1e-12);
+}

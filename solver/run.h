@@ -1,0 +1,64 @@
+/**
+ * @file run.h
+ * @brief The simulation state and one time step (thesis Eq. 2.159 with the continuity
+ *        equation 3.64), plus diagnostics. The step loop itself is in chansph.c.
+ */
+#ifndef CHANSPH_RUN_H
+#define CHANSPH_RUN_H
+
+#include "forcing.h"
+#include "nbr.h"
+#include "part.h"
+#include "scene.h"
+#include "sph.h"
+
+/** Everything a running simulation holds. */
+struct sim {
+  const struct scene *sc; /*!< the validated scene */
+  struct model M;         /*!< discretisation constants */
+  struct particles P;     /*!< particles */
+  struct walls W;         /*!< wall values on the vertex lattice */
+  struct nbr nb;          /*!< cells and neighbour list */
+  struct drive drive;     /*!< driving force state */
+  long step;              /*!< steps taken */
+  double t;               /*!< simulated time [s] */
+  double dt;              /*!< last time step [s] */
+  double fx;              /*!< last streamwise body acceleration [m/s^2] */
+  double dt_limits[4];    /*!< last limits: acoustic, viscous, force, wall [s] */
+  double *scratch[4];     /*!< per-particle scratch for deterministic sums */
+};
+
+/** Global diagnostics of the current state (all fluid particles). */
+struct diag {
+  double u_bulk;          /*!< volume-weighted mean streamwise velocity [m/s] */
+  double kinetic_energy;  /*!< sum of m |v|^2 / 2 [J, or J/m in 2-D] */
+  double mass;            /*!< sum of m [kg] */
+  double volume;          /*!< sum of m / rho [m^dim] */
+  double rho_min, rho_max;/*!< density range [kg/m^3] */
+  double max_speed;       /*!< [m/s] */
+  double min_gamma;       /*!< [-] */
+};
+
+/**
+ * @brief Create particles from the scene, sort them, compute kernel sums, gamma and wall values.
+ * @param[out] S simulation
+ * @param[in] sc validated scene (kept by pointer)
+ */
+void sim_init(struct sim *S, const struct scene *sc);
+
+/** @brief Free the simulation. */
+void sim_free(struct sim *S);
+
+/**
+ * @brief Advance one step: forces at t^n, dt (Eq. 2.160-2.164), driving force, symplectic
+ *        update of velocity then position (Eq. 2.159), re-sort, density (Eq. 3.64), walls.
+ */
+void sim_step(struct sim *S);
+
+/** @brief Diagnostics of the current state (deterministic sums). */
+void sim_diag(struct sim *S, struct diag *d);
+
+/** @brief True when t_end or max_steps is reached. */
+int sim_done(const struct sim *S);
+
+#endif

@@ -1,0 +1,461 @@
+/**
+ * @file scene.c
+ * @brief Table-driven scene parsing (inih), validation and documentation (STYLE items 9-11).
+ */
+#include "scene.h"
+
+#include <ini.h>
+#include <math.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "error.h"
+
+enum key_type { T_INT, T_LONG, T_DOUBLE, T_CHOICE };
+enum { REQUIRED = 1, LO_OPEN = 2 };
+
+/** One scene key: where it lives, its type, default, range and documentation. */
+struct key {
+  const char *section, *name;
+  enum key_type type;
+  const char *def;     /*!< default as text; NULL for required keys */
+  double lo, hi;       /*!< allowed range (inclusive unless LO_OPEN) */
+  int flags;
+  const char *choices; /*!< "a|b|c" for T_CHOICE; the value stored is the index */
+  const char *unit, *help;
+  size_t offset;
+};
+
+#define OFF(f) offsetof(struct scene, f)
+#define BIG 1e300
+
+static const struct key keys[] = {
+    {"domain", "dimension", T_INT, NULL, 2, 3, REQUIRED, NULL, "-",
+     "Spatial dimension: 2 (x-y plane) or 3.", OFF(dim)},
+    {"domain", "delta", T_DOUBLE, "0.5", 0, BIG, LO_OPEN, NULL, "m",
+     "Channel half-width; the walls are at y = 0 and y = 2 delta.", OFF(delta)},
+    {"domain", "lx", T_DOUBLE, NULL, 0, BIG, REQUIRED | LO_OPEN, NULL, "m",
+     "Periodic length in the streamwise direction x; a multiple of dr, at least 6h.", OFF(lx)},
+    {"domain", "lz", T_DOUBLE, "0", 0, BIG, 0, NULL, "m",
+     "Periodic length in the spanwise direction z (3-D only; required there).", OFF(lz)},
+    {"domain", "dr", T_DOUBLE, NULL, 0, BIG, REQUIRED | LO_OPEN, NULL, "m",
+     "Initial particle spacing; 2 delta, lx and lz must be multiples of it.", OFF(dr)},
+    {"sph", "h_over_dr", T_DOUBLE, "1.3", 1.0, 2.5, 0, NULL, "-",
+     "Smoothing length over particle spacing (kernel support radius is 2h).", OFF(h_over_dr)},
+    {"sph", "xi", T_DOUBLE, "0", 0, BIG, 0, NULL, "-",
+     "Volume-diffusion constant xi of thesis Eq. 3.34; 0 selects the mixing-length value "
+     "1000 dr / (2 delta) (thesis Sec. 3.2, 6.1.1).",
+     OFF(xi)},
+    {"sph", "viscous", T_CHOICE, "morris", 0, 0, 0, "morris|violeau", "-",
+     "Viscous operator: Morris (thesis Eq. 2.147) or Violeau (Eq. 2.100), both with the wall "
+     "shear term.",
+     OFF(viscous)},
+    {"sph", "laplacian_norm", T_INT, "1", 0, 1, 0, NULL, "-",
+     "Normalise the viscous particle sum by its discrete second moment (plus the analytic "
+     "part behind the walls), removing the lattice error of the Laplacian at fixed h/dr "
+     "(docs/theory.md); 0 gives the plain operator of the thesis.",
+     OFF(lap_norm)},
+    {"sph", "wall_shear_weight", T_CHOICE, "discrete", 0, 0, 0, "discrete|analytic", "-",
+     "Weight of the wall shear term of the Morris operator: |grad gamma_as| (analytic, thesis "
+     "Eq. 2.147) or the discrete first moment sum_b V_b (r_ab . n) F_ab, which makes the "
+     "operator exact for a linear velocity profile (docs/theory.md). Violeau always uses "
+     "the analytic weight.",
+     OFF(wall_weight)},
+    {"sph", "wall_dmin", T_DOUBLE, "1", 0, BIG, LO_OPEN, NULL, "dr",
+     "Lower bound delta r of the wall distance in the wall shear term (thesis Eq. 2.148), in "
+     "units of dr.",
+     OFF(wall_dmin)},
+    {"sph", "eta2", T_DOUBLE, "1e-4", 0, 1, 0, NULL, "h^2",
+     "Regularisation added to r^2 in the viscous term (thesis Sec. 2.3.3), in units of h^2.",
+     OFF(eta2)},
+    {"fluid", "nu", T_DOUBLE, NULL, 0, BIG, REQUIRED | LO_OPEN, NULL, "m^2/s",
+     "Kinematic viscosity.", OFF(nu)},
+    {"fluid", "rho0", T_DOUBLE, "1000", 0, BIG, LO_OPEN, NULL, "kg/m^3", "Reference density.",
+     OFF(rho0)},
+    {"fluid", "c0", T_DOUBLE, NULL, 0, BIG, REQUIRED | LO_OPEN, NULL, "m/s",
+     "Numerical speed of sound (about 10 times the largest velocity).", OFF(c0)},
+    {"fluid", "zeta", T_DOUBLE, "7", 1, 10, 0, NULL, "-",
+     "Exponent of the Tait equation of state (thesis Eq. 2.11).", OFF(zeta)},
+    {"fluid", "gravity_y", T_DOUBLE, "0", -BIG, BIG, 0, NULL, "m/s^2",
+     "Wall-normal body acceleration; enters the momentum equation, the wall pressure "
+     "(thesis Eq. 2.143, 3.63) and the volume diffusion (Eq. 3.61).",
+     OFF(gravity_y)},
+    {"drive", "mode", T_CHOICE, "force", 0, 0, 0, "force|flux", "-",
+     "Drive the flow by a constant body force or by a controlled volume flux.", OFF(drive_mode)},
+    {"drive", "force", T_DOUBLE, "0", -BIG, BIG, 0, NULL, "m/s^2",
+     "Streamwise body acceleration in force mode (tau_w = rho delta force, thesis Eq. 5.14); "
+     "initial value in flux mode.",
+     OFF(force)},
+    {"drive", "u_bulk", T_DOUBLE, "0", -BIG, BIG, 0, NULL, "m/s",
+     "Target bulk velocity in flux mode.", OFF(u_bulk)},
+    {"drive", "controller", T_CHOICE, "eq3.43", 0, 0, 0, "eq3.43|eq3.38", "-",
+     "Flux controller: thesis Eq. 3.43 (new, generalised to variable dt by Eq. 3.42) or the "
+     "older Eq. 3.38.",
+     OFF(controller)},
+    {"time", "t_end", T_DOUBLE, NULL, 0, BIG, REQUIRED | LO_OPEN, NULL, "s", "End time.",
+     OFF(t_end)},
+    {"time", "dt", T_DOUBLE, "0", 0, BIG, 0, NULL, "s",
+     "Fixed time step; 0 selects the adaptive step of thesis Eq. 2.160-2.164.", OFF(dt_fixed)},
+    {"time", "cfl", T_DOUBLE, "0.8", 0, 2, LO_OPEN, NULL, "-",
+     "Factor of the acoustic limit dt <= cfl h / c0 (thesis Eq. 2.160; 0.8 after Violeau & "
+     "Leroy 2014).",
+     OFF(cfl)},
+    {"time", "c_visc", T_DOUBLE, "0.125", 0, 1, LO_OPEN, NULL, "-",
+     "Factor of the viscous limit dt <= c_visc h^2 / nu (thesis Eq. 2.161).", OFF(c_visc)},
+    {"time", "c_force", T_DOUBLE, "0.25", 0, 1, LO_OPEN, NULL, "-",
+     "Factor of the force limit dt <= c_force sqrt(h / |a|) (thesis Eq. 2.162).", OFF(c_force)},
+    {"time", "c_gamma", T_DOUBLE, "0.005", 0, 1, 0, NULL, "-",
+     "Factor of the wall limit dt <= c_gamma / max|grad gamma . v| (thesis Eq. 2.163); 0 "
+     "disables it.",
+     OFF(c_gamma)},
+    {"time", "max_steps", T_LONG, "0", 0, 1e18, 0, NULL, "-",
+     "Stop after this many steps even if t_end is not reached (0 = no limit).", OFF(max_steps)},
+    {"init", "profile", T_CHOICE, "rest", 0, 0, 0, "rest|laminar", "-",
+     "Initial velocity: at rest, or the laminar Poiseuille profile of the force (force mode) "
+     "or of the target bulk velocity (flux mode).",
+     OFF(init_profile)},
+    {"output", "log_every", T_INT, "100", 1, 1e9, 0, NULL, "steps",
+     "Steps between progress lines (stdout and DIR/log.txt).", OFF(log_every)},
+    {"output", "series_every", T_INT, "10", 1, 1e9, 0, NULL, "steps",
+     "Steps between records of the time series in stats.nc.", OFF(series_every)},
+    {"output", "stats_every", T_INT, "10", 1, 1e9, 0, NULL, "steps",
+     "Steps between samples of the binned profiles.", OFF(stats_every)},
+    {"output", "write_every", T_DOUBLE, "0", 0, BIG, 0, NULL, "s",
+     "Simulated time between rewrites of stats.nc (0 = only at the end).", OFF(write_every)},
+    {"output", "t_average_start", T_DOUBLE, "0", 0, BIG, 0, NULL, "s",
+     "Start of the averaging window of the profiles (ends at t_end).", OFF(t_average_start)},
+    {"output", "n_bins", T_INT, "0", 0, 1e7, 0, NULL, "-",
+     "Wall-normal bins of the profiles; 0 = 2 delta / dr - 1 (one particle layer per bin).",
+     OFF(n_bins)},
+    {"output", "particles", T_INT, "1", 0, 1, 0, NULL, "-",
+     "Write the final particle state to DIR/particles.nc (1) or not (0).", OFF(particles)},
+    {"health", "every", T_INT, "1", 1, 1e9, 0, NULL, "steps",
+     "Steps between full health checks (NaN, wall crossing, CFL); 1 checks every step.",
+     OFF(health_every)},
+    {"run", "threads", T_INT, "0", 0, 4096, 0, NULL, "-",
+     "OpenMP threads; 0 keeps OMP_NUM_THREADS (or all cores).", OFF(threads)},
+};
+enum { N_KEYS = sizeof keys / sizeof keys[0] };
+
+/** Parser state: where each key was set, and the error count. */
+struct parse_state {
+  struct scene *s;
+  const char *file;
+  int line;            /*!< current line, counted by the reader */
+  int where[N_KEYS];   /*!< 0 = default, >0 = file line, -1 = --set */
+  int errors;
+  FILE *fp;
+};
+
+static int find_key(const char *section, const char *name) {
+  for (int i = 0; i < N_KEYS; i++)
+    if (!strcmp(keys[i].section, section) && !strcmp(keys[i].name, name)) return i;
+  return -1;
+}
+
+static int known_section(const char *section) {
+  for (int i = 0; i < N_KEYS; i++)
+    if (!strcmp(keys[i].section, section)) return 1;
+  return 0;
+}
+
+static void location(const struct parse_state *ps, int where, char *buf, size_t n) {
+  if (where > 0)
+    snprintf(buf, n, "%s:%d", ps->file, where);
+  else if (where < 0)
+    snprintf(buf, n, "--set");
+  else
+    snprintf(buf, n, "%s", ps->file);
+}
+
+/** Parse text into the field of key k; returns a message on failure, NULL on success. */
+static const char *set_value(struct scene *s, int k, const char *text) {
+  const struct key *K = &keys[k];
+  char *end = NULL;
+  void *field = (char *)s + K->offset;
+  if (K->type == T_CHOICE) {
+    const size_t len = strlen(text);
+    int idx = 0;
+    for (const char *c = K->choices; *c; idx++) {
+      const char *bar = strchr(c, '|');
+      const size_t clen = bar ? (size_t)(bar - c) : strlen(c);
+      if (clen == len && !strncmp(c, text, len)) {
+        *(int *)field = idx;
+        return NULL;
+      }
+      if (!bar) break;
+      c = bar + 1;
+    }
+    return "is not one of the allowed choices";
+  }
+  const double v = strtod(text, &end);
+  if (end == text || *end != '\0') return "is not a number";
+  if (!isfinite(v)) return "is not finite";
+  if (K->type != T_DOUBLE && v != floor(v)) return "is not an integer";
+  if (v < K->lo || v > K->hi || ((K->flags & LO_OPEN) && v == K->lo))
+    return "is out of range";
+  if (K->type == T_INT)
+    *(int *)field = (int)v;
+  else if (K->type == T_LONG)
+    *(long *)field = (long)v;
+  else
+    *(double *)field = v;
+  return NULL;
+}
+
+static void range_text(const struct key *K, char *buf, size_t n) {
+  if (K->type == T_CHOICE) {
+    snprintf(buf, n, "%s", K->choices);
+    return;
+  }
+  char lo[32] = "-inf", hi[32] = "inf";
+  if (K->lo > -BIG) snprintf(lo, sizeof lo, "%g", K->lo);
+  if (K->hi < BIG) snprintf(hi, sizeof hi, "%g", K->hi);
+  snprintf(buf, n, "%s%s, %s]", (K->flags & LO_OPEN) ? "(" : "[", lo, hi);
+}
+
+static void report_value(struct parse_state *ps, int k, int where, const char *value,
+                         const char *why) {
+  char loc[600], range[128];
+  location(ps, where, loc, sizeof loc);
+  range_text(&keys[k], range, sizeof range);
+  error_input("%s: key '%s.%s': value '%s' %s (allowed: %s %s)", loc, keys[k].section,
+              keys[k].name, value, why, range, keys[k].unit);
+  ps->errors++;
+}
+
+static int apply(struct parse_state *ps, const char *section, const char *name,
+                 const char *value, int where) {
+  char loc[600];
+  location(ps, where, loc, sizeof loc);
+  const int k = find_key(section, name);
+  if (k < 0) {
+    if (!known_section(section))
+      error_input("%s: unknown section [%s] (key '%s')", loc, section, name);
+    else
+      error_input("%s: unknown key '%s' in section [%s] (see docs/scenes.md)", loc, name,
+                  section);
+    ps->errors++;
+    return 0;
+  }
+  if (where > 0 && ps->where[k] > 0) {
+    error_input("%s: key '%s.%s' is set twice (first at line %d)", loc, section, name,
+                ps->where[k]);
+    ps->errors++;
+    return 0;
+  }
+  const char *why = set_value(ps->s, k, value);
+  if (why) {
+    report_value(ps, k, where, value, why);
+    return 0;
+  }
+  ps->where[k] = where;
+  return 1;
+}
+
+static int handler(void *user, const char *section, const char *name, const char *value) {
+  struct parse_state *ps = user;
+  return apply(ps, section, name, value, ps->line);
+}
+
+static char *reader(char *str, int num, void *stream) {
+  struct parse_state *ps = stream;
+  char *r = fgets(str, num, ps->fp);
+  if (r) ps->line++;
+  return r;
+}
+
+/** Report a geometry or combination problem at the line of the first key involved. */
+static void inconsistent(struct parse_state *ps, const char *key, const char *fmt, double a,
+                         double b) {
+  const char *dot = strchr(key, '.');
+  char sec[32];
+  snprintf(sec, sizeof sec, "%.*s", (int)(dot - key), key);
+  const int k = find_key(sec, dot + 1);
+  char loc[600], text[400];
+  location(ps, k >= 0 ? ps->where[k] : 0, loc, sizeof loc);
+  snprintf(text, sizeof text, fmt, a, b);
+  error_input("%s: key '%s': %s", loc, key, text);
+  ps->errors++;
+}
+
+static int is_multiple(double len, double dr) {
+  const double n = len / dr;
+  return n >= 1.0 && fabs(n - floor(n + 0.5)) < 1e-9 * n;
+}
+
+static void validate(struct parse_state *ps) {
+  const struct scene *s = ps->s;
+  const double h = scene_h(s), two_delta = 2.0 * s->delta;
+  if (!is_multiple(two_delta, s->dr))
+    inconsistent(ps, "domain.delta", "2 delta = %g is not a multiple of dr = %g", two_delta,
+                 s->dr);
+  else if (two_delta / s->dr < 4.0 - 1e-9)
+    inconsistent(ps, "domain.delta", "2 delta = %g must be at least 4 dr = %g", two_delta,
+                 4.0 * s->dr);
+  if (!is_multiple(s->lx, s->dr))
+    inconsistent(ps, "domain.lx", "lx = %g is not a multiple of dr = %g", s->lx, s->dr);
+  if (s->lx < 6.0 * h * (1.0 - 1e-12))
+    inconsistent(ps, "domain.lx", "lx = %g is shorter than 3 kernel supports (6h = %g)", s->lx,
+                 6.0 * h);
+  if (s->dim == 3) {
+    if (s->lz <= 0.0)
+      inconsistent(ps, "domain.lz", "a 3-D scene needs lz > 0 (got %g)%.0s", s->lz, 0.0);
+    else if (!is_multiple(s->lz, s->dr))
+      inconsistent(ps, "domain.lz", "lz = %g is not a multiple of dr = %g", s->lz, s->dr);
+    else if (s->lz < 6.0 * h * (1.0 - 1e-12))
+      inconsistent(ps, "domain.lz", "lz = %g is shorter than 3 kernel supports (6h = %g)",
+                   s->lz, 6.0 * h);
+  } else if (s->lz != 0.0) {
+    inconsistent(ps, "domain.lz", "lz = %g is given for a 2-D scene (dimension = %g)", s->lz,
+                 2.0);
+  }
+  if (s->drive_mode == DRIVE_FLUX && s->u_bulk == 0.0)
+    inconsistent(ps, "drive.mode", "flux mode needs drive.u_bulk != 0 (got %g)%.0s", s->u_bulk,
+                 0.0);
+  if (s->t_average_start > s->t_end)
+    inconsistent(ps, "output.t_average_start", "averaging start %g is after t_end = %g",
+                 s->t_average_start, s->t_end);
+  if (s->dt_fixed > 0.0 && s->dt_fixed > s->t_end)
+    inconsistent(ps, "time.dt", "fixed dt = %g is larger than t_end = %g", s->dt_fixed,
+                 s->t_end);
+}
+
+int scene_load(struct scene *s, const char *path, int n_set, char *const *set) {
+  memset(s, 0, sizeof *s);
+  struct parse_state ps = {.s = s, .file = path ? path : "(defaults)"};
+  for (int k = 0; k < N_KEYS; k++)
+    if (keys[k].def && set_value(s, k, keys[k].def)) die("bad default of key %s", keys[k].name);
+  if (path) {
+    snprintf(s->path, sizeof s->path, "%s", path);
+    ps.fp = fopen(path, "r");
+    if (!ps.fp) {
+      error_input("%s: cannot open scene file", path);
+      return CHANSPH_ERR;
+    }
+    const int rc = ini_parse_stream(reader, &ps, handler, &ps);
+    fclose(ps.fp);
+    if (rc > 0 && ps.errors == 0) {
+      error_input("%s:%d: syntax error (expected '[section]' or 'key = value')", path, rc);
+      ps.errors++;
+    }
+  }
+  for (int i = 0; i < n_set; i++) {
+    const char *eq = strchr(set[i], '='), *dot = strchr(set[i], '.');
+    if (!eq || !dot || dot > eq) {
+      error_input("--set %s: expected section.key=value", set[i]);
+      ps.errors++;
+      continue;
+    }
+    char sec[64], name[64];
+    snprintf(sec, sizeof sec, "%.*s", (int)(dot - set[i]), set[i]);
+    snprintf(name, sizeof name, "%.*s", (int)(eq - dot - 1), dot + 1);
+    apply(&ps, sec, name, eq + 1, -1);
+  }
+  for (int k = 0; k < N_KEYS; k++)
+    if ((keys[k].flags & REQUIRED) && ps.where[k] == 0) {
+      error_input("%s: missing required key '%s' in section [%s] (%s)", ps.file, keys[k].name,
+                  keys[k].section, keys[k].help);
+      ps.errors++;
+    }
+  if (ps.errors == 0) validate(&ps);
+  return ps.errors ? CHANSPH_ERR : CHANSPH_OK;
+}
+
+double scene_h(const struct scene *s) { return s->h_over_dr * s->dr; }
+
+double scene_xi(const struct scene *s) {
+  return s->xi > 0.0 ? s->xi : 1000.0 * s->dr / (2.0 * s->delta);
+}
+
+int scene_bins(const struct scene *s) {
+  return s->n_bins > 0 ? s->n_bins : (int)floor(2.0 * s->delta / s->dr + 0.5) - 1;
+}
+
+const char *scene_choice(const char *key, int value) {
+  static char buf[64];
+  const char *dot = strchr(key, '.');
+  char sec[32];
+  snprintf(sec, sizeof sec, "%.*s", (int)(dot - key), key);
+  const int k = find_key(sec, dot + 1);
+  if (k < 0 || keys[k].type != T_CHOICE) return "?";
+  const char *c = keys[k].choices;
+  for (int i = 0; i < value && c; i++) {
+    c = strchr(c, '|');
+    if (c) c++;
+  }
+  if (!c) return "?";
+  const char *bar = strchr(c, '|');
+  snprintf(buf, sizeof buf, "%.*s", bar ? (int)(bar - c) : (int)strlen(c), c);
+  return buf;
+}
+
+static void value_text(const struct scene *s, int k, char *buf, size_t n) {
+  const void *field = (const char *)s + keys[k].offset;
+  switch (keys[k].type) {
+    case T_INT: snprintf(buf, n, "%d", *(const int *)field); break;
+    case T_LONG: snprintf(buf, n, "%ld", *(const long *)field); break;
+    case T_DOUBLE: snprintf(buf, n, "%.17g", *(const double *)field); break;
+    case T_CHOICE: {
+      char key[80];
+      snprintf(key, sizeof key, "%s.%s", keys[k].section, keys[k].name);
+      snprintf(buf, n, "%s", scene_choice(key, *(const int *)field));
+      break;
+    }
+  }
+}
+
+char *scene_text(const struct scene *s) {
+  size_t cap = 8192, len = 0;
+  char *out = malloc(cap);
+  if (!out) die("out of memory");
+  out[0] = '\0';
+  const char *section = "";
+  for (int k = 0; k < N_KEYS; k++) {
+    char val[64], line[256];
+    value_text(s, k, val, sizeof val);
+    int m = 0;
+    if (strcmp(section, keys[k].section)) {
+      section = keys[k].section;
+      m = snprintf(line, sizeof line, "%s[%s]\n", len ? "\n" : "", section);
+    }
+    m += snprintf(line + m, sizeof line - m, "%s = %s\n", keys[k].name, val);
+    if (len + (size_t)m + 1 > cap) {
+      cap *= 2;
+      out = realloc(out, cap);
+      if (!out) die("out of memory");
+    }
+    memcpy(out + len, line, (size_t)m + 1);
+    len += (size_t)m;
+  }
+  return out;
+}
+
+void scene_write_doc(FILE *f) {
+  fprintf(f,
+          "# Scene reference\n\n"
+          "<!-- generated by `build/chansph scene-doc`; do not edit, edit solver/scene.c -->\n\n"
+          "A scene is an INI file (parsed with inih). Comments start with `#` or `;` at the "
+          "start of a line, or `;` after a value.\n"
+          "Any key can be overridden on the command line with `--set section.key=value`.\n"
+          "Unknown keys, keys set twice, values out of range and inconsistent geometry are "
+          "errors that name the file, line and key.\n"
+          "The fully resolved scene (defaults included) is written to `DIR/scene.used.ini` "
+          "and into the `scene` attribute of `stats.nc`.\n");
+  const char *section = "";
+  for (int k = 0; k < N_KEYS; k++) {
+    if (strcmp(section, keys[k].section)) {
+      section = keys[k].section;
+      fprintf(f, "\n## [%s]\n\n| key | default | allowed | unit | meaning |\n|---|---|---|---|---|\n",
+              section);
+    }
+    char range[128];
+    range_text(&keys[k], range, sizeof range);
+    for (char *c = range; *c; c++)
+      if (*c == '|') *c = '/';
+    fprintf(f, "| `%s` | %s | %s | %s | %s |\n", keys[k].name,
+            keys[k].def ? keys[k].def : "**required**", range, keys[k].unit, keys[k].help);
+  }
+}

@@ -1,0 +1,214 @@
+/**
+ * @file sph.c
+ * @brief Implementation of sph.h. All loops are gathers over the neighbour list.
+ *
+ * Per-segment boundary sums. For a plane wall, sum_s f_s grad gamma_as = int_wall f w n dS.
+ * We evaluate it as f(foot_a) grad gamma_a(d), with grad gamma_a the exact closed form for the
+ * whole plane (wall.h) and f(foot_a) the (bi)linear interpolation of the vertex values at the
+ * foot of the perpendicular from a. This is exact for f varying linearly along the wall
+ * (the kernel is symmetric about the foot) and second order otherwise.
+ */
+#include "sph.h"
+
+#include <math.h>
+
+#include "timers.h"
+#include "wall.h"
+
+void sph_model_init(struct model *M, const struct scene *s) {
+  M->dim = s->dim;
+  M->viscous = s->viscous;
+  M->h = scene_h(s);
+  M->dr = s->dr;
+  M->k = kernel_make(s->dim, M->h);
+  M->e.rho0 = s->rho0, M->e.c0 = s->c0, M->e.zeta = s->zeta;
+  M->lx = s->lx, M->ly = 2.0 * s->delta, M->lz = s->dim == 3 ? s->lz : 1.0;
+  M->nu = s->nu;
+  M->inv_xi = 1.0 / scene_xi(s);
+  M->gy = s->gravity_y;
+  M->wall_dmin = s->wall_dmin * s->dr;
+  M->eta2 = s->eta2 * M->h * M->h;
+  M->lap_norm = s->lap_norm;
+  M->wall_weight = s->wall_weight;
+}
+
+/** gamma of the channel: both walls' missing parts subtracted (they never overlap). */
+static inline double channel_gamma(const struct model *M, double y) {
+  const double ih = M->k.inv_h;
+  return wall_gamma(M->dim, y * ih) + wall_gamma(M->dim, (M->ly - y) * ih) - 1.0;
+}
+
+void sph_density(const struct model *M, struct particles *P, const struct nbr *nb, double dt) {
+  timer_push("density");
+  const struct kernel *K = &M->k;
+  const double w0 = kernel_w(K, 0.0);
+  const double *restrict x = P->x, *restrict y = P->y, *restrict z = P->z, *restrict m = P->m;
+  const uint8_t *restrict kind = P->kind;
+#pragma omp parallel for schedule(static)
+  for (size_t a = 0; a < P->n; a++) {
+    if (kind[a] != KIND_FLUID) continue;
+    const int32_t *nl = nb->list + a * (size_t)nb->stride;
+    const int cnt = nb->count[a];
+    double s = m[a] * w0;
+    for (int j = 0; j < cnt; j++) {
+      const int32_t b = nl[j];
+      const double dx = nbr_wrap(x[a] - x[b], M->lx), dy = y[a] - y[b];
+      const double dz = M->dim == 3 ? nbr_wrap(z[a] - z[b], M->lz) : 0.0;
+      s += m[b] * kernel_w(K, sqrt(dx * dx + dy * dy + dz * dz));
+    }
+    const double gam = channel_gamma(M, y[a]);
+    if (dt > 0.0)
+      P->rho[a] = (P->gam[a] * P->rho[a] + s - P->ksum[a] + dt * P->ddiff[a]) / gam;
+    P->ksum[a] = s;
+    P->gam[a] = gam;
+    P->p[a] = eos_pressure(&M->e, P->rho[a]);
+    P->c[a] = eos_sound(&M->e, P->rho[a]);
+  }
+  timer_pop();
+}
+
+void sph_walls(const struct model *M, struct particles *P, const struct nbr *nb,
+               struct walls *W) {
+  timer_push("walls");
+  const struct kernel *K = &M->k;
+  const double *restrict x = P->x, *restrict y = P->y, *restrict z = P->z, *restrict m = P->m;
+  const double *restrict rho = P->rho, *restrict p = P->p;
+  const uint8_t *restrict kind = P->kind;
+#pragma omp parallel for schedule(static)
+  for (size_t v = 0; v < P->n; v++) {
+    if (kind[v] != KIND_VERTEX) continue;
+    const int32_t *nl = nb->list + v * (size_t)nb->stride;
+    double alpha = 0.0, mw = 0.0, pw = 0.0;
+    for (int j = 0; j < nb->count[v]; j++) {
+      const int32_t b = nl[j];
+      if (kind[b] != KIND_FLUID) continue;
+      const double dx = nbr_wrap(x[v] - x[b], M->lx), dy = y[v] - y[b];
+      const double dz = M->dim == 3 ? nbr_wrap(z[v] - z[b], M->lz) : 0.0;
+      const double wvb = kernel_w(K, sqrt(dx * dx + dy * dy + dz * dz));
+      const double vol = m[b] / rho[b];
+      alpha += vol * wvb;
+      mw += m[b] * wvb;
+      pw += vol * (p[b] / rho[b] + M->gy * (y[v] - y[b])) * wvb;
+    }
+    double rv = M->e.rho0, pv = 0.0;
+    if (alpha > 0.0) rv = mw / alpha, pv = rv * pw / alpha;
+    P->rho[v] = rv, P->p[v] = pv;
+    P->c[v] = eos_sound(&M->e, rv);
+    const size_t slot = part_vertex_slot(P, P->id[v]);
+    W->rho[slot] = rv, W->p[slot] = pv;
+  }
+  timer_pop();
+}
+
+double sph_wall_value(const struct model *M, const struct walls *W, const double *f, int wall,
+                      double x, double z) {
+  const double fx = x / M->dr - 0.5;
+  const double ix = floor(fx), tx = fx - ix;
+  int i0 = (int)ix % W->nx;
+  if (i0 < 0) i0 += W->nx;
+  const int i1 = (i0 + 1) % W->nx;
+  const double *fw = f + (size_t)wall * W->nx * W->nz;
+  if (M->dim == 2) return (1.0 - tx) * fw[i0] + tx * fw[i1];
+  const double fz = z / M->dr - 0.5;
+  const double iz = floor(fz), tz = fz - iz;
+  int k0 = (int)iz % W->nz;
+  if (k0 < 0) k0 += W->nz;
+  const int k1 = (k0 + 1) % W->nz;
+  const int nz = W->nz;
+  return (1.0 - tx) * ((1.0 - tz) * fw[i0 * nz + k0] + tz * fw[i0 * nz + k1]) +
+         tx * ((1.0 - tz) * fw[i1 * nz + k0] + tz * fw[i1 * nz + k1]);
+}
+
+void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb,
+                const struct walls *W, double fx, struct force_info *info) {
+  timer_push("forces");
+  const struct kernel *K = &M->k;
+  const double *restrict x = P->x, *restrict y = P->y, *restrict z = P->z;
+  const double *restrict u = P->u, *restrict v = P->v, *restrict w = P->w;
+  const double *restrict m = P->m, *restrict rho = P->rho, *restrict p = P->p;
+  const double *restrict c = P->c;
+  const uint8_t *restrict kind = P->kind;
+  const double nu = M->nu, eta2 = M->eta2, inv_xi = M->inv_xi, ih = K->inv_h;
+  const double dgrav = M->e.rho0 / (M->e.c0 * M->e.c0) * M->gy; /* Eq. 3.61 */
+  const double dplus2 = M->dim + 2.0;
+  const int violeau = M->viscous == VISCOUS_VIOLEAU;
+  const int discrete = !violeau && M->wall_weight == WALL_WEIGHT_DISCRETE;
+  double amax2 = 0.0, gvmax = 0.0;
+#pragma omp parallel for schedule(static) reduction(max : amax2, gvmax)
+  for (size_t a = 0; a < P->n; a++) {
+    if (kind[a] != KIND_FLUID) continue;
+    const int32_t *nl = nb->list + a * (size_t)nb->stride;
+    const int cnt = nb->count[a];
+    const double ra = rho[a], pa = p[a] / (ra * ra), ca = c[a];
+    double gpx = 0, gpy = 0, gpz = 0; /* sum m_b (p_a/rho_a^2 + p_b/rho_b^2) grad w */
+    double vx = 0, vy = 0, vz = 0;    /* viscous sum */
+    double diff = 0;                  /* volume diffusion */
+    double mom2 = 0;                  /* sum V_b r_ab . grad w_ab, Laplacian normalisation */
+    double mom1 = 0;                  /* sum V_b y_ab f_ab, discrete wall weight */
+    for (int j = 0; j < cnt; j++) {
+      const int32_t b = nl[j];
+      const double dx = nbr_wrap(x[a] - x[b], M->lx), dy = y[a] - y[b];
+      const double dz = M->dim == 3 ? nbr_wrap(z[a] - z[b], M->lz) : 0.0;
+      const double r2 = dx * dx + dy * dy + dz * dz, r = sqrt(r2);
+      const double f = kernel_f(K, r); /* grad_a w_ab = f r_ab */
+      const double rb = rho[b], mb = m[b];
+      const double pp = mb * (pa + p[b] / (rb * rb)) * f;
+      gpx += pp * dx, gpy += pp * dy, gpz += pp * dz;
+      const double ux = u[a] - u[b], uy = v[a] - v[b], uz = w[a] - w[b];
+      mom2 += mb / rb * f * r2;
+      mom1 += mb / rb * f * dy;
+      if (violeau) {
+        const double coef = mb / rb * 0.5 * (ra + rb) * f / (r2 + eta2);
+        const double vr = dplus2 * (ux * dx + uy * dy + uz * dz);
+        vx += coef * (vr * dx + r2 * ux), vy += coef * (vr * dy + r2 * uy);
+        vz += coef * (vr * dz + r2 * uz);
+      } else {
+        const double coef = mb * (ra + rb) / (ra * rb) * f * r2 / (r2 + eta2);
+        vx += coef * ux, vy += coef * uy, vz += coef * uz;
+      }
+      if (kind[b] == KIND_FLUID) {
+        const double cab = ca > c[b] ? ca : c[b];
+        const double vrho = ra - rb - dgrav * dy; /* varrho_ab of Eq. 3.61 */
+        diff += mb * cab * inv_xi * vrho / rb * f * r;
+      }
+    }
+    const double ig = 1.0 / P->gam[a];
+    double axa = -ig * gpx, aya = -ig * gpy, aza = -ig * gpz;
+    double kappa = 1.0;
+    if (M->lap_norm) { /* kappa_a = -dim / (discrete + analytic missing second moment) */
+      const double qb = y[a] * ih, qt = (M->ly - y[a]) * ih;
+      kappa = -M->dim / (mom2 + wall_moment2(M->dim, qb) + wall_moment2(M->dim, qt));
+    }
+    const double lap = nu * ig * kappa; /* nu / gamma_a, normalised */
+    const double vis = violeau ? lap / ra : lap;
+    axa += vis * vx, aya += vis * vy, aza += vis * vz;
+    /* wall terms: pressure (Eq. 3.17, k = 1) and wall shear (Eq. 2.147-2.148) */
+    double gv = 0.0;
+    for (int wall = 0; wall < 2; wall++) {
+      const double d = wall ? M->ly - y[a] : y[a];
+      const double q = d * ih;
+      if (q >= 2.0) continue;
+      const double dg = wall_dgamma(M->dim, q) * ih; /* |grad gamma_as| */
+      const double ny = wall ? -1.0 : 1.0;           /* inward normal */
+      const double rs = sph_wall_value(M, W, W->rho, wall, x[a], z[a]);
+      const double ps = sph_wall_value(M, W, W->p, wall, x[a], z[a]);
+      aya += ig * rs * (pa + ps / (rs * rs)) * dg * ny;
+      /* |grad gamma_as|, or the discrete first moment that makes the Morris operator exact
+         for a velocity varying linearly with the wall distance (docs/theory.md) */
+      const double weight = discrete ? fmax(0.0, ny * mom1) : dg;
+      const double shear = 2.0 * lap * weight / (d > M->wall_dmin ? d : M->wall_dmin);
+      axa -= shear * u[a], aza -= shear * w[a];
+      const double g = fabs(dg * v[a]);
+      if (g > gv) gv = g;
+    }
+    aya += M->gy;
+    P->ax[a] = axa, P->ay[a] = aya, P->az[a] = aza;
+    P->ddiff[a] = diff; /* enters gamma rho directly (Eq. 3.64): no 1/gamma */
+    const double ax2 = (axa + fx) * (axa + fx) + aya * aya + aza * aza;
+    if (ax2 > amax2) amax2 = ax2;
+    if (gv > gvmax) gvmax = gv;
+  }
+  info->amax = sqrt(amax2);
+  info->gvmax = gvmax;
+  timer_pop();
+}

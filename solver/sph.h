@@ -1,0 +1,86 @@
+/**
+ * @file sph.h
+ * @brief The SPH operators of the channel with unified semi-analytical plane walls:
+ *        density (continuity with volume diffusion), wall values, and forces.
+ */
+#ifndef CHANSPH_SPH_H
+#define CHANSPH_SPH_H
+
+#include "eos.h"
+#include "kernel.h"
+#include "nbr.h"
+#include "part.h"
+#include "scene.h"
+
+/** Constants of the discretisation, derived once from the scene. */
+struct model {
+  int dim;            /*!< 2 or 3 */
+  int viscous;        /*!< enum viscous_form */
+  struct kernel k;    /*!< Wendland kernel */
+  struct eos e;       /*!< Tait equation of state */
+  double lx, ly, lz;  /*!< domain [m]; ly = 2 delta */
+  double dr, h;       /*!< spacing and smoothing length [m] */
+  double nu;          /*!< kinematic viscosity [m^2/s] */
+  double inv_xi;      /*!< 1 / xi of the volume diffusion [-] */
+  double gy;          /*!< wall-normal body acceleration [m/s^2] */
+  double wall_dmin;   /*!< delta r of Eq. 2.148 [m] */
+  double eta2;        /*!< regularisation of r^2 in the viscous term [m^2] */
+  int lap_norm;       /*!< normalise the viscous sum by its discrete second moment */
+  int wall_weight;    /*!< enum wall_weight: weight of the wall shear term */
+};
+
+/** Per-step maxima from the force pass, for the time-step limits. */
+struct force_info {
+  double amax;        /*!< max |a| including the body forces [m/s^2] */
+  double gvmax;       /*!< max over particles and walls of |grad gamma_as . v_a| [1/s] */
+};
+
+/** @brief Derive the model constants from the scene. */
+void sph_model_init(struct model *M, const struct scene *s);
+
+/**
+ * @brief Kernel sums at the current positions and the density update of thesis Eq. 3.64:
+ *        gamma^n rho^n = gamma^(n-1) rho^(n-1) + S^n - S^(n-1) + dt D^(n-1),
+ *        with gamma of the plane walls in closed form; then pressure and sound speed (Eq. 2.11).
+ * @param[in] M model
+ * @param[in,out] P particles (ksum, gam, rho, p, c of fluid particles)
+ * @param[in] nb neighbour list at the current positions
+ * @param[in] dt the step that led here [s]; dt <= 0 only initialises S and gamma
+ */
+void sph_density(const struct model *M, struct particles *P, const struct nbr *nb, double dt);
+
+/**
+ * @brief Wall values of the vertex particles by Shepard interpolation of the fluid:
+ *        rho_v (thesis Eq. 2.136-2.137) and p_v / rho_v with the wall-normal body force
+ *        (Eq. 2.143, 3.63; Ferrand Eq. 30); copied to the wall lattice.
+ * @param[in] M model
+ * @param[in,out] P particles (rho, p of vertex particles)
+ * @param[in] nb neighbour list
+ * @param[out] W wall lattice values
+ */
+void sph_walls(const struct model *M, struct particles *P, const struct nbr *nb,
+               struct walls *W);
+
+/**
+ * @brief Accelerations of the fluid particles (pressure gradient Grad^{gamma,1} of thesis
+ *        Eq. 3.17, viscous term Eq. 2.147 or 2.100 with the wall shear term, wall-normal body
+ *        force) and the volume-diffusion sum D of Eq. 3.64.
+ * @param[in] M model
+ * @param[in,out] P particles (ax, ay, az, ddiff)
+ * @param[in] nb neighbour list
+ * @param[in] W wall values
+ * @param[in] fx current driving acceleration, only for the time-step limit [m/s^2]
+ * @param[out] info maxima for the time-step limits
+ */
+void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb,
+                const struct walls *W, double fx, struct force_info *info);
+
+/**
+ * @brief Value of the wall lattice field f at the foot of a particle on a wall: bilinear (3-D)
+ *        or linear (2-D) interpolation of the vertex values, the generalisation of thesis
+ *        Eq. 2.138 used for the per-segment boundary sums (see docs/theory.md).
+ */
+double sph_wall_value(const struct model *M, const struct walls *W, const double *f, int wall,
+                      double x, double z);
+
+#endif

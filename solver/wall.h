@@ -1,0 +1,119 @@
+/**
+ * @file wall.h
+ * @brief Renormalisation gamma and its gradient for a plane wall (line wall in 2-D), closed form.
+ *
+ * For a particle at distance d = q h from an infinite plane wall, with the Wendland kernel:
+ * - 3-D: gamma(q) = 1 - (2 - q)^6 (4 + 6q + 3q^2) / 512 and |grad gamma| = I_full(q) / h with
+ *   I_full(q) = 3/8 (2 + 5q + 4q^2)(1 - q/2)^5 (thesis Eq. 4.9-4.11, alpha_3 = 21/(16 pi)).
+ * - 2-D (derived for chansph, see docs/theory.md; checked against Ferrand Eq. 51-52 summed over
+ *   segments and against quadrature in tests/test_wall.c), with S = sqrt(4 - q^2) and
+ *   L = ln((2 + S)/q):
+ *     |grad gamma| h = 7/(768 pi) [(15 q^6 + 360 q^4) L + (128 - 224 q^2 - 162 q^4) S]
+ *     gamma = 1/2 + [(15 q^7 + 504 q^5) L + (704 q - 480 q^3 - 194 q^5) S + 768 asin(q/2)]
+ *             / (768 pi)
+ * grad gamma points into the fluid (the inward wall normal), gamma = 1 for q >= 2.
+ */
+#ifndef CHANSPH_WALL_H
+#define CHANSPH_WALL_H
+
+#include <math.h>
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+/**
+ * @brief gamma of a plane wall at normalised distance q = d/h.
+ * @param[in] dim 2 or 3
+ * @param[in] q distance over h, q >= 0
+ * @return gamma in [1/2, 1]. Implements: thesis Eq. 4.10 (3-D), its 2-D analogue.
+ */
+static inline double wall_gamma(const int dim, const double q) {
+  if (q >= 2.0) return 1.0;
+  if (dim == 3) {
+    const double t = 2.0 - q, t2 = t * t;
+    return 1.0 - t2 * t2 * t2 * (4.0 + 6.0 * q + 3.0 * q * q) / 512.0;
+  }
+  if (q <= 0.0) return 0.5;
+  const double q2 = q * q, q4 = q2 * q2;
+  const double s = sqrt(4.0 - q2), l = log((2.0 + s) / q);
+  return 0.5 + ((15.0 * q2 + 504.0) * q4 * q * l + (704.0 - 480.0 * q2 - 194.0 * q4) * q * s +
+                768.0 * asin(0.5 * q)) /
+                   (768.0 * M_PI);
+}
+
+/**
+ * @brief |grad gamma| of a plane wall times h, at normalised distance q = d/h.
+ * @param[in] dim 2 or 3
+ * @param[in] q distance over h, q >= 0
+ * @return h |grad gamma| (multiply by 1/h for [1/m]). Implements: thesis Eq. 4.9, 4.11 (3-D),
+ *         Ferrand Eq. 51 over an infinite line (2-D).
+ */
+static inline double wall_dgamma(const int dim, const double q) {
+  if (q >= 2.0) return 0.0;
+  if (dim == 3) {
+    const double t = 1.0 - 0.5 * q, t2 = t * t;
+    return 0.375 * (2.0 + 5.0 * q + 4.0 * q * q) * t2 * t2 * t;
+  }
+  const double q2 = q * q, q4 = q2 * q2;
+  const double s = sqrt(4.0 - q2);
+  const double lterm = q > 0.0 ? (15.0 * q2 + 360.0) * q4 * log((2.0 + s) / q) : 0.0;
+  return 7.0 / (768.0 * M_PI) * (lterm + (128.0 - 224.0 * q2 - 162.0 * q4) * s);
+}
+
+/**
+ * @brief Second moment of the kernel gradient over the half-space behind a plane wall:
+ *        M(q) = int_{behind} r_ab . grad_a w_ab dV, dimensionless; M(0) = -dim/2, M(2) = 0.
+ *
+ * The full-space value is -dim (integration by parts), so the discrete sum over the particles
+ * plus M of both walls estimates -dim; its deviation measures the lattice error of the
+ * Laplacian (used by the Laplacian normalisation in sph.c, docs/theory.md).
+ * 3-D: M = 3 (q - 2)^5 (5q^3 + 10q^2 + 12q + 8) / 512.
+ * 2-D: M = -1 - [(75q^7 + 1512q^5) L - (746q^5 + 608q^3 + 512q) S - 1536 asin(q/2)] / (768 pi).
+ */
+static inline double wall_moment2(const int dim, const double q) {
+  if (q >= 2.0) return 0.0;
+  if (dim == 3) {
+    const double t = q - 2.0, t2 = t * t;
+    return 3.0 * t2 * t2 * t * (((5.0 * q + 10.0) * q + 12.0) * q + 8.0) / 512.0;
+  }
+  if (q <= 0.0) return -1.0;
+  const double q2 = q * q, q4 = q2 * q2;
+  const double s = sqrt(4.0 - q2), l = log((2.0 + s) / q);
+  return -1.0 - ((75.0 * q2 + 1512.0) * q4 * q * l - (746.0 * q4 + 608.0 * q2 + 512.0) * q * s -
+                 1536.0 * asin(0.5 * q)) /
+                    (768.0 * M_PI);
+}
+
+/**
+ * @brief Ferrand's polynomial P_{q0}(X) of the 2-D segment integral. Implements: Ferrand Eq. 52
+ *        (thesis Eq. 2.108 misprints the first coefficient as 7/129; 7/192 is right).
+ */
+static inline double wall_ferrand_p(const double q0, const double x) {
+  const double x2 = x * x, x3 = x2 * x, q02 = q0 * q0;
+  return 7.0 / 192.0 * x3 * x2 - 21.0 / 64.0 * x2 * x2 + 35.0 / 32.0 * x3 - 35.0 / 24.0 * x2 +
+         7.0 / 4.0 + q02 * (35.0 / 768.0 * x3 - 7.0 / 16.0 * x2 + 105.0 / 64.0 * x - 35.0 / 12.0) +
+         q02 * q02 * (35.0 / 512.0 * x - 7.0 / 8.0);
+}
+
+/**
+ * @brief h times the integral of w along a 2-D segment, for a particle at normal distance q0 > 0.
+ *
+ * The segment runs from tangential coordinate s1 to s2 (normalised by h, measured from the foot
+ * of the perpendicular); ends outside the support are clipped to it, so that q_i <= 2.
+ * Implements: Ferrand Eq. 51 with q_i cos(alpha_i) the signed tangential distance of end i.
+ */
+static inline double wall_segment_2d(const double q0, double s1, double s2) {
+  if (q0 >= 2.0) return 0.0;
+  const double smax = sqrt(4.0 - q0 * q0);
+  s1 = fmax(-smax, fmin(smax, s1));
+  s2 = fmax(-smax, fmin(smax, s2));
+  const double q1 = sqrt(q0 * q0 + s1 * s1), q2 = sqrt(q0 * q0 + s2 * s2);
+  const double sg1 = s1 > 0 ? 1.0 : s1 < 0 ? -1.0 : 0.0, sg2 = s2 > 0 ? 1.0 : s2 < 0 ? -1.0 : 0.0;
+  const double q04 = q0 * q0 * q0 * q0;
+  return s2 / M_PI * wall_ferrand_p(q0, q2) - s1 / M_PI * wall_ferrand_p(q0, q1) +
+         q04 / M_PI * (105.0 / 64.0 + 35.0 / 512.0 * q0 * q0) *
+             (sg2 * log((q2 + fabs(s2)) / q0) - sg1 * log((q1 + fabs(s1)) / q0));
+}
+
+#endif

@@ -1,0 +1,163 @@
+/** @file ncout.c @brief Implementation of ncout.h. */
+#include "ncout.h"
+
+#include <fcntl.h>
+#include <netcdf.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+/* On any netCDF failure: record the message, close, remove the temporary file, return 1. */
+#define NC(call)                                                                  \
+  do {                                                                            \
+    const int nc_rc_ = (call);                                                    \
+    if (nc_rc_ != NC_NOERR) {                                                     \
+      snprintf(err, errlen, "cannot write %s: %s (in %s)", tmp, nc_strerror(nc_rc_), #call); \
+      if (ncid >= 0) nc_close(ncid);                                              \
+      remove(tmp);                                                                \
+      return 1;                                                                   \
+    }                                                                             \
+  } while (0)
+
+static int put_attrs(int ncid, const struct nc_attr *attrs, int nattrs) {
+  for (int i = 0; i < nattrs; i++) {
+    const int rc = attrs[i].text
+                       ? nc_put_att_text(ncid, NC_GLOBAL, attrs[i].name, strlen(attrs[i].text),
+                                         attrs[i].text)
+                       : nc_put_att_double(ncid, NC_GLOBAL, attrs[i].name, NC_DOUBLE, 1,
+                                           &attrs[i].value);
+    if (rc != NC_NOERR) return rc;
+  }
+  return NC_NOERR;
+}
+
+static int def_var(int ncid, const char *name, nc_type type, int ndim, const int *dims,
+                   const char *units, const char *long_name, int *varid) {
+  int rc = nc_def_var(ncid, name, type, ndim, dims, varid);
+  if (rc == NC_NOERR && units) rc = nc_put_att_text(ncid, *varid, "units", strlen(units), units);
+  if (rc == NC_NOERR && long_name)
+    rc = nc_put_att_text(ncid, *varid, "long_name", strlen(long_name), long_name);
+  return rc;
+}
+
+/* Make the data durable, then move it into place. */
+static int commit(const char *tmp, const char *path, char *err, size_t errlen) {
+  const int fd = open(tmp, O_RDONLY);
+  if (fd < 0 || fsync(fd) != 0) {
+    snprintf(err, errlen, "cannot sync %s", tmp);
+    if (fd >= 0) close(fd);
+    remove(tmp);
+    return 1;
+  }
+  close(fd);
+  if (rename(tmp, path) != 0) {
+    snprintf(err, errlen, "cannot rename %s to %s", tmp, path);
+    remove(tmp);
+    return 1;
+  }
+  return 0;
+}
+
+int ncout_stats(const char *path, const struct profile *pr, const struct series *ts,
+                const struct nc_attr *attrs, int nattrs, char *err, size_t errlen) {
+  char tmp[4096];
+  snprintf(tmp, sizeof tmp, "%s.tmp", path);
+  int ncid = -1;
+  NC(nc_create(tmp, NC_NETCDF4 | NC_CLOBBER, &ncid));
+  int dy, dt, vy, vym, vu, vv, vw, vn;
+  NC(nc_def_dim(ncid, "y", (size_t)pr->nb, &dy));
+  NC(nc_def_dim(ncid, "time", NC_UNLIMITED, &dt));
+  NC(def_var(ncid, "y", NC_DOUBLE, 1, &dy, "m", "wall-normal bin centre (walls at 0 and 2 delta)",
+             &vy));
+  NC(def_var(ncid, "y_mean", NC_DOUBLE, 1, &dy, "m", "mean position of the samples in the bin",
+             &vym));
+  NC(def_var(ncid, "u_mean", NC_DOUBLE, 1, &dy, "m/s", "mean streamwise velocity", &vu));
+  NC(def_var(ncid, "v_mean", NC_DOUBLE, 1, &dy, "m/s", "mean wall-normal velocity", &vv));
+  NC(def_var(ncid, "w_mean", NC_DOUBLE, 1, &dy, "m/s", "mean spanwise velocity", &vw));
+  NC(def_var(ncid, "n_samples", NC_INT64, 1, &dy, "1", "particle samples in the bin", &vn));
+  int *vts = malloc((size_t)ts->ncol * sizeof *vts);
+  if (!vts) {
+    snprintf(err, errlen, "out of memory writing %s", path);
+    nc_close(ncid), remove(tmp);
+    return 1;
+  }
+  for (int c = 0; c < ts->ncol; c++) {
+    const int rc = def_var(ncid, ts->names[c], NC_DOUBLE, 1, &dt, ts->units[c], NULL, &vts[c]);
+    if (rc != NC_NOERR) free(vts);
+    NC(rc);
+  }
+  NC(nc_put_att_text(ncid, NC_GLOBAL, "Conventions", 6, "CF-1.8"));
+  NC(nc_put_att_text(ncid, NC_GLOBAL, "source", 7, "chansph"));
+  NC(put_attrs(ncid, attrs, nattrs));
+  NC(nc_enddef(ncid));
+
+  const size_t nb = (size_t)pr->nb;
+  double *buf = malloc(3 * (nb ? nb : 1) * sizeof *buf);
+  if (!buf) {
+    free(vts);
+    snprintf(err, errlen, "out of memory writing %s", path);
+    nc_close(ncid), remove(tmp);
+    return 1;
+  }
+  double *yc = buf, *ym = buf + nb, *um = buf + 2 * nb;
+  int rc = NC_NOERR;
+  for (size_t i = 0; i < nb; i++) yc[i] = profile_centre(pr, (int)i);
+  rc = nc_put_var_double(ncid, vy, yc);
+  for (size_t i = 0; i < nb; i++)
+    ym[i] = pr->count[i] ? pr->sum_y[i] / (double)pr->count[i] : yc[i];
+  if (rc == NC_NOERR) rc = nc_put_var_double(ncid, vym, ym);
+  const double *sums[3] = {pr->sum_u, pr->sum_v, pr->sum_w};
+  const int vids[3] = {vu, vv, vw};
+  for (int k = 0; k < 3 && rc == NC_NOERR; k++) {
+    for (size_t i = 0; i < nb; i++)
+      um[i] = pr->count[i] ? sums[k][i] / (double)pr->count[i] : NC_FILL_DOUBLE;
+    rc = nc_put_var_double(ncid, vids[k], um);
+  }
+  if (rc == NC_NOERR) rc = nc_put_var_longlong(ncid, vn, (const long long *)pr->count);
+  /* time series, column by column */
+  double *col = ts->n ? malloc(ts->n * sizeof *col) : NULL;
+  for (int c = 0; c < ts->ncol && rc == NC_NOERR && ts->n; c++) {
+    if (!col) break;
+    for (size_t r = 0; r < ts->n; r++) col[r] = ts->data[r * (size_t)ts->ncol + c];
+    const size_t start = 0, count = ts->n;
+    rc = nc_put_vara_double(ncid, vts[c], &start, &count, col);
+  }
+  free(col), free(buf), free(vts);
+  NC(rc);
+  NC(nc_close(ncid));
+  ncid = -1;
+  return commit(tmp, path, err, errlen);
+}
+
+int ncout_columns(const char *path, const char *dim, size_t n, int ncol,
+                  const char *const *names, const char *const *units, const double *const *cols,
+                  const long long *ids, const struct nc_attr *attrs, int nattrs, char *err,
+                  size_t errlen) {
+  char tmp[4096];
+  snprintf(tmp, sizeof tmp, "%s.tmp", path);
+  int ncid = -1, d, vid = -1;
+  NC(nc_create(tmp, NC_NETCDF4 | NC_CLOBBER, &ncid));
+  NC(nc_def_dim(ncid, dim, n, &d));
+  if (ids) NC(def_var(ncid, "id", NC_INT64, 1, &d, "1", "particle id", &vid));
+  int *v = malloc((size_t)ncol * sizeof *v);
+  if (!v) {
+    snprintf(err, errlen, "out of memory writing %s", path);
+    nc_close(ncid), remove(tmp);
+    return 1;
+  }
+  for (int c = 0; c < ncol; c++) {
+    const int rc = def_var(ncid, names[c], NC_DOUBLE, 1, &d, units[c], NULL, &v[c]);
+    if (rc != NC_NOERR) free(v);
+    NC(rc);
+  }
+  int rc = put_attrs(ncid, attrs, nattrs);
+  if (rc == NC_NOERR) rc = nc_enddef(ncid);
+  if (rc == NC_NOERR && ids) rc = nc_put_var_longlong(ncid, vid, ids);
+  for (int c = 0; c < ncol && rc == NC_NOERR; c++) rc = nc_put_var_double(ncid, v[c], cols[c]);
+  free(v);
+  NC(rc);
+  NC(nc_close(ncid));
+  ncid = -1;
+  return commit(tmp, path, err, errlen);
+}

@@ -1,0 +1,52 @@
+/**
+ * @file ncout.h
+ * @brief netCDF-4 output: stats.nc (profiles + time series + run attributes) and column files
+ *        (particle snapshots). Files are written to NAME.tmp, synced and renamed, so a reader
+ *        or a crash never sees a half-written file and the previous version survives a failure.
+ */
+#ifndef CHANSPH_NCOUT_H
+#define CHANSPH_NCOUT_H
+
+#include <stddef.h>
+
+#include "profile.h"
+
+/** A global attribute: text if text != NULL, else a double. */
+struct nc_attr {
+  const char *name;
+  const char *text;
+  double value;
+};
+
+/**
+ * @brief Write stats.nc atomically.
+ * @param[in] path final file name
+ * @param[in] pr profiles (dimension y)
+ * @param[in] ts time series (unlimited dimension time; column 0 must be the time)
+ * @param[in] attrs,nattrs global attributes
+ * @param[out] err message buffer (filled on failure)
+ * @param[in] errlen its size
+ * @return 0 on success, nonzero on failure (the previous file is left untouched)
+ */
+int ncout_stats(const char *path, const struct profile *pr, const struct series *ts,
+                const struct nc_attr *attrs, int nattrs, char *err, size_t errlen);
+
+/**
+ * @brief Write named double columns along one dimension atomically (e.g. particles.nc).
+ * @param[in] path file name
+ * @param[in] dim dimension name
+ * @param[in] n rows
+ * @param[in] ncol columns
+ * @param[in] names,units column names and units
+ * @param[in] cols column data
+ * @param[in] ids optional int64 ids written as variable "id" (may be NULL)
+ * @param[in] attrs,nattrs global attributes
+ * @param[out] err,errlen message on failure
+ * @return 0 on success
+ */
+int ncout_columns(const char *path, const char *dim, size_t n, int ncol,
+                  const char *const *names, const char *const *units, const double *const *cols,
+                  const long long *ids, const struct nc_attr *attrs, int nattrs, char *err,
+                  size_t errlen);
+
+#endif
