@@ -12,6 +12,7 @@ struct eos {
   double rho0; /*!< reference density [kg/m^3] */
   double c0;   /*!< numerical speed of sound [m/s] */
   double zeta; /*!< Tait exponent [-] (7) */
+  double pb;   /*!< background pressure [Pa] */
 };
 
 /** Integer power for the common exponents, exact and fast; pow() otherwise. */
@@ -25,13 +26,13 @@ static inline double eos_ipow(const double x, const double e) {
 }
 
 /**
- * @brief Pressure p = rho0 c0^2 / zeta ((rho/rho0)^zeta - 1).
+ * @brief Pressure p = rho0 c0^2 / zeta ((rho/rho0)^zeta - 1) + p_b.
  * @param[in] e constants
  * @param[in] rho density [kg/m^3]
  * @return pressure [Pa]. Implements: thesis Eq. 2.11.
  */
 static inline double eos_pressure(const struct eos *e, const double rho) {
-  return e->rho0 * e->c0 * e->c0 / e->zeta * (eos_ipow(rho / e->rho0, e->zeta) - 1.0);
+  return e->rho0 * e->c0 * e->c0 / e->zeta * (eos_ipow(rho / e->rho0, e->zeta) - 1.0) + e->pb;
 }
 
 /**
@@ -51,7 +52,7 @@ static inline double eos_sound(const struct eos *e, const double rho) {
  * @return rho [kg/m^3]
  */
 static inline double eos_density(const struct eos *e, const double p) {
-  return e->rho0 * pow(1.0 + e->zeta * p / (e->rho0 * e->c0 * e->c0), 1.0 / e->zeta);
+  return e->rho0 * pow(1.0 + e->zeta * (p - e->pb) / (e->rho0 * e->c0 * e->c0), 1.0 / e->zeta);
 }
 
 #endif

@@ -78,6 +78,9 @@ static const struct key keys[] = {
      "Numerical speed of sound (about 10 times the largest velocity).", OFF(c0)},
     {"fluid", "zeta", T_DOUBLE, "7", 1, 10, 0, NULL, "-",
      "Exponent of the Tait equation of state (thesis Eq. 2.11).", OFF(zeta)},
+    {"fluid", "p_background", T_DOUBLE, "0", 0, 10, 0, NULL, "rho0 c0^2",
+     "Background pressure added to the Tait equation of state, in units of rho0 c0^2.",
+     OFF(p_background)},
     {"fluid", "gravity_y", T_DOUBLE, "0", -BIG, BIG, 0, NULL, "m/s^2",
      "Wall-normal body acceleration; enters the momentum equation, the wall pressure "
      "(thesis Eq. 2.143, 3.63) and the volume diffusion (Eq. 3.61).",
@@ -145,6 +148,8 @@ struct parse_state {
   const char *file;
   int line;            /*!< current line, counted by the reader */
   int where[N_KEYS];   /*!< 0 = default, >0 = file line, -1 = --set */
+  int seen[N_KEYS];    /*!< given with an invalid value */
+  const char *set_text;/*!< the --set argument being applied */
   int errors;
   FILE *fp;
 };
@@ -165,7 +170,7 @@ static void location(const struct parse_state *ps, int where, char *buf, size_t 
   if (where > 0)
     snprintf(buf, n, "%s:%d", ps->file, where);
   else if (where < 0)
-    snprintf(buf, n, "--set");
+    snprintf(buf, n, "--set %s", ps->set_text ? ps->set_text : "");
   else
     snprintf(buf, n, "%s", ps->file);
 }
@@ -249,6 +254,7 @@ static int apply(struct parse_state *ps, const char *section, const char *name,
   const char *why = set_value(ps->s, k, value);
   if (why) {
     report_value(ps, k, where, value, why);
+    ps->seen[k] = 1; /* present, though invalid: do not also report it as missing */
     return 0;
   }
   ps->where[k] = where;
@@ -352,10 +358,12 @@ int scene_load(struct scene *s, const char *path, int n_set, char *const *set) {
     char sec[64], name[64];
     snprintf(sec, sizeof sec, "%.*s", (int)(dot - set[i]), set[i]);
     snprintf(name, sizeof name, "%.*s", (int)(eq - dot - 1), dot + 1);
+    ps.set_text = set[i];
     apply(&ps, sec, name, eq + 1, -1);
+    ps.set_text = NULL;
   }
   for (int k = 0; k < N_KEYS; k++)
-    if ((keys[k].flags & REQUIRED) && ps.where[k] == 0) {
+    if ((keys[k].flags & REQUIRED) && ps.where[k] == 0 && !ps.seen[k]) {
       error_input("%s: missing required key '%s' in section [%s] (%s)", ps.file, keys[k].name,
                   keys[k].section, keys[k].help);
       ps.errors++;

@@ -35,6 +35,7 @@ struct scene {
   double rho0;        /*!< reference density [kg/m^3] */
   double c0;          /*!< numerical speed of sound [m/s] */
   double zeta;        /*!< Tait exponent [-] */
+  double p_background;/*!< background pressure over rho0 c0^2 [-] */
   double gravity_y;   /*!< wall-normal body acceleration [m/s^2] */
   /* [drive] */
   int drive_mode;     /*!< enum drive_mode */

@@ -22,6 +22,7 @@ void sph_model_init(struct model *M, const struct scene *s) {
   M->dr = s->dr;
   M->k = kernel_make(s->dim, M->h);
   M->e.rho0 = s->rho0, M->e.c0 = s->c0, M->e.zeta = s->zeta;
+  M->e.pb = s->p_background * s->rho0 * s->c0 * s->c0;
   M->lx = s->lx, M->ly = 2.0 * s->delta, M->lz = s->dim == 3 ? s->lz : 1.0;
   M->nu = s->nu;
   M->inv_xi = 1.0 / scene_xi(s);

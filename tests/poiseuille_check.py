@@ -1,0 +1,228 @@
+#!/usr/bin/python3
+"""Laminar channel validation of chansph against the analytical Poiseuille solutions.
+
+Subcommands (each runs chansph, reads its netCDF output, prints the numbers, exits 1 on failure):
+  steady SCENE --max-l2 E      steady u_mean against u = f y (2 delta - y) / (2 nu)
+  startup SCENE --max-l2 E     u(y, t) from rest against the Fourier series at three times
+  flux SCENE --max-rel E       bulk velocity of the flux controller Eq. 3.43 (and Eq. 3.38)
+  longrun SCENE --steps N      N steps: no particle lost or through a wall, density drift, gamma
+  convergence SCENE            error at 2 delta/dr = 20, 40, 80 and the observed order
+  study SCENE2D SCENE3D --doc DIR   error against wall-clock time for four resolutions (PNG + table)
+"""
+import argparse
+import math
+import os
+import subprocess
+import sys
+import time
+
+import netCDF4
+import numpy as np
+
+
+def run(args, scene, name, sets, threads=None):
+    out = os.path.join(args.runs, name)
+    cmd = [args.chansph, "run", scene, "--out", out, "--overwrite"]
+    for s in sets:
+        cmd += ["--set", s]
+    env = dict(os.environ)
+    if threads:
+        env["OMP_NUM_THREADS"] = str(threads)
+    t0 = time.time()
+    res = subprocess.run(cmd, capture_output=True, text=True, env=env)
+    wall = time.time() - t0
+    if res.returncode != 0:
+        sys.stdout.write(res.stdout[-3000:] + res.stderr[-3000:])
+        sys.exit("FAIL: chansph exited with %d: %s" % (res.returncode, " ".join(cmd)))
+    return out, wall
+
+
+def attrs(path):
+    with netCDF4.Dataset(path) as d:
+        return {k: d.getncattr(k) for k in d.ncattrs()}
+
+
+def laminar(a, y, force=None):
+    f = a["body_force"] if force is None else force
+    return f * y * (2 * a["delta"] - y) / (2 * a["nu"])
+
+
+def steady_error(out):
+    with netCDF4.Dataset(os.path.join(out, "stats.nc")) as d:
+        a = {k: d.getncattr(k) for k in d.ncattrs()}
+        y, u = d["y_mean"][:].filled(np.nan), d["u_mean"][:].filled(np.nan)
+    ua = laminar(a, y)
+    ok = np.isfinite(u)
+    return math.sqrt(np.sum((u[ok] - ua[ok]) ** 2) / np.sum(ua[ok] ** 2)), a
+
+
+def cmd_steady(args):
+    out, wall = run(args, args.scene, "steady_" + os.path.basename(args.scene)[:-4], args.set)
+    err, a = steady_error(out)
+    print("steady Poiseuille %dD, 2 delta/dr = %g: relative L2 error of u_mean = %.3e "
+          "(limit %.3g), %.1f s wall" % (a["dimension"], 2 * a["delta"] / a["dr"], err,
+                                         args.max_l2, wall))
+    return err <= args.max_l2
+
+
+def fourier(a, y, t, nterms=2001):
+    H, nu, f = 2 * a["delta"], a["nu"], a["body_force"]
+    u = laminar(a, y)
+    for n in range(1, nterms, 2):
+        u -= 4 * f * H * H / (nu * math.pi ** 3 * n ** 3) * np.sin(n * math.pi * y / H) * \
+            math.exp(-n * n * math.pi ** 2 * nu * t / (H * H))
+    return u
+
+
+def cmd_startup(args):
+    ok = True
+    for t in (0.2, 0.5, 2.0):
+        out, _ = run(args, args.scene, "startup_t%g" % t,
+                     ["time.t_end=%g" % t, "init.profile=rest"] + args.set)
+        with netCDF4.Dataset(os.path.join(out, "particles.nc")) as d:
+            a = attrs(os.path.join(out, "stats.nc"))
+            tr, y, u = d.getncattr("time"), d["y"][:], d["u"][:]
+        ua = fourier(a, y, tr)
+        err = math.sqrt(np.sum((u - ua) ** 2) / np.sum(ua ** 2))
+        print("start-up Poiseuille at t = %.4f s: relative L2 error %.3e (limit %.3g)" %
+              (tr, err, args.max_l2))
+        ok &= err <= args.max_l2
+    return ok
+
+
+def bulk_error(out):
+    with netCDF4.Dataset(os.path.join(out, "stats.nc")) as d:
+        a = {k: d.getncattr(k) for k in d.ncattrs()}
+        t, ub = d["time"][:], d["u_bulk"][:]
+    target = a["u_bulk_target"]
+    late = t >= t[-1] - 0.2 * t[-1]
+    rel = np.abs(ub[late] - target) / abs(target)
+    return rel.max(), rel.mean(), a
+
+
+def cmd_flux(args):
+    out, _ = run(args, args.scene, "flux_eq343", ["drive.controller=eq3.43"] + args.set)
+    e343, m343, a = bulk_error(out)
+    out, _ = run(args, args.scene, "flux_eq338", ["drive.controller=eq3.38"] + args.set)
+    e338, m338, _ = bulk_error(out)
+    print("flux-driven Poiseuille, target u_bulk = %g, last 20%% of the run:" % a["u_bulk_target"])
+    print("  Eq. 3.43: max relative error %.3e, mean %.3e (limit %.3g)" % (e343, m343, args.max_rel))
+    print("  Eq. 3.38: max relative error %.3e, mean %.3e" % (e338, m338))
+    print("  ratio of mean errors (3.38 / 3.43): %.3g" % (m338 / max(m343, 1e-300)))
+    return e343 <= args.max_rel
+
+
+def cmd_longrun(args):
+    out, wall = run(args, args.scene, "longrun",
+                    ["time.max_steps=%d" % args.steps, "time.t_end=1e9", "output.log_every=2000",
+                     "output.series_every=100"] + args.set)
+    with netCDF4.Dataset(os.path.join(out, "stats.nc")) as d:
+        a = {k: d.getncattr(k) for k in d.ncattrs()}
+        mass, vol, gmin = d["mass"][:], d["volume"][:], d["min_gamma"][:]
+    with netCDF4.Dataset(os.path.join(out, "particles.nc")) as d:
+        y, g, n = d["y"][:], d["gamma"][:], d.dimensions["particle"].size
+    rho = mass / vol
+    drift = abs(rho[-1] / rho[0] - 1)
+    inside = np.all((y > 0) & (y < 2 * a["delta"]))
+    print("%d steps (t = %.4g s, %.1f s wall): %d of %d particles inside the walls; mean "
+          "density drift %.3e (limit 1e-3); gamma in [%.4f, %.4f] over the run, final max %.6f" %
+          (a["steps"], a["t_reached"], wall, int(np.sum((y > 0) & (y < 2 * a["delta"]))),
+           a["n_fluid"], drift, gmin.min(), np.max(g), np.max(g)))
+    return (a["steps"] == args.steps and n == a["n_fluid"] and inside and drift < 1e-3 and
+            gmin.min() >= 0.5 and np.max(g) <= 1.0)
+
+
+def resolution_sets(scene_attrs_dim, dr0, lx0, lz0, k, laminar_start):
+    """Scene overrides for 2 delta/dr = 20 * 2^k: lx, lz scaled with dr (flow is x-invariant)."""
+    dr = dr0 / 2 ** k
+    s = ["domain.dr=%.17g" % dr, "domain.lx=%.17g" % (lx0 / 2 ** k)]
+    if scene_attrs_dim == 3:
+        s.append("domain.lz=%.17g" % (lz0 / 2 ** k))
+    if laminar_start:
+        s += ["init.profile=laminar", "time.t_end=4", "output.t_average_start=3"]
+    return s
+
+
+def scene_values(scene):
+    import configparser
+    c = configparser.ConfigParser(inline_comment_prefixes=(";",))
+    c.read(scene)
+    d = c["domain"]
+    return int(d["dimension"]), float(d["dr"]), float(d["lx"]), float(d.get("lz", "0"))
+
+
+def cmd_convergence(args):
+    dim, dr0, lx0, lz0 = scene_values(args.scene)
+    errs = []
+    for k in range(3):
+        out, wall = run(args, args.scene, "conv%dd_%d" % (dim, k),
+                        resolution_sets(dim, dr0, lx0, lz0, k, True) + args.set)
+        e, a = steady_error(out)
+        errs.append(e)
+        print("%dD 2 delta/dr = %4d: relative L2 error %.3e  (%.1f s wall)" %
+              (dim, round(2 * a["delta"] / a["dr"]), e, wall))
+    orders = [math.log(errs[i] / errs[i + 1], 2) for i in range(2)]
+    print("observed order: %.2f (20 -> 40), %.2f (40 -> 80)" % tuple(orders))
+    return errs[1] < errs[0] and errs[2] < errs[1]
+
+
+def cmd_study(args):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    rows = []
+    for scene in (args.scene, args.scene3d):
+        dim, dr0, lx0, lz0 = scene_values(scene)
+        for k in range(4):
+            sets = resolution_sets(dim, dr0, lx0, lz0, k, False)
+            if k == 3 and dim == 3:
+                pass
+            out, wall = run(args, scene, "study%dd_%d" % (dim, k), sets + args.set)
+            e, a = steady_error(out)
+            rows.append((dim, round(2 * a["delta"] / a["dr"]), int(a["n_fluid"]), int(a["steps"]),
+                         wall, e))
+            print("%dD 2delta/dr=%d particles=%d steps=%d wall=%.1f s L2=%.3e" % rows[-1])
+    os.makedirs(args.doc, exist_ok=True)
+    fig, ax = plt.subplots(figsize=(6, 4.2))
+    for dim, mk in ((2, "o-"), (3, "s-")):
+        r = [x for x in rows if x[0] == dim]
+        ax.loglog([x[4] for x in r], [x[5] for x in r], mk, label="%d-D" % dim)
+        for x in r:
+            ax.annotate("%d" % x[1], (x[4], x[5]), textcoords="offset points", xytext=(4, 4),
+                        fontsize=8)
+    ax.set_xlabel("wall-clock time on 2 cores [s]")
+    ax.set_ylabel("relative L2 error of u_mean")
+    ax.set_title("Poiseuille, Re = 10, from rest to t = 12 (labels: 2 delta / dr)")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(os.path.join(args.doc, "poiseuille_error_vs_time.png"), dpi=120)
+    with open(os.path.join(args.doc, "poiseuille_study.md"), "w") as f:
+        f.write("| dim | 2 delta/dr | fluid particles | steps | wall [s] | rel. L2 error |\n")
+        f.write("|---|---|---|---|---|---|\n")
+        for x in rows:
+            f.write("| %d | %d | %d | %d | %.1f | %.3e |\n" % x)
+    return True
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
+    p.add_argument("--chansph", default="build/chansph")
+    p.add_argument("--runs", default="build/test-runs")
+    p.add_argument("what", choices=["steady", "startup", "flux", "longrun", "convergence", "study"])
+    p.add_argument("scene")
+    p.add_argument("scene3d", nargs="?")
+    p.add_argument("--max-l2", type=float, default=0.01)
+    p.add_argument("--max-rel", type=float, default=1e-5)
+    p.add_argument("--steps", type=int, default=20000)
+    p.add_argument("--doc", default="docs/validation")
+    p.add_argument("--set", action="append", default=[])
+    args = p.parse_args()
+    os.makedirs(args.runs, exist_ok=True)
+    ok = globals()["cmd_" + args.what](args)
+    print("PASS" if ok else "FAIL")
+    sys.exit(0 if ok else 1)
+
+
+if __name__ == "__main__":
+    main()
