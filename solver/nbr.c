@@ -51,8 +51,16 @@ void nbr_sort(struct nbr *nb, struct particles *P) {
 #pragma omp parallel for schedule(static)
   for (size_t a = 0; a < n; a++) {
     double x = P->x[a], z = P->z[a];
-    if (x < 0.0 || x >= nb->lx) x -= nb->lx * floor(x / nb->lx), P->x[a] = x;
-    if (nb->dim == 3 && (z < 0.0 || z >= nb->lz)) z -= nb->lz * floor(z / nb->lz), P->z[a] = z;
+    if (x < 0.0 || x >= nb->lx) {
+      x -= nb->lx * floor(x / nb->lx);
+      if (x >= nb->lx) x -= nb->lx; /* a tiny negative x rounds to lx above */
+      P->x[a] = x;
+    }
+    if (nb->dim == 3 && (z < 0.0 || z >= nb->lz)) {
+      z -= nb->lz * floor(z / nb->lz);
+      if (z >= nb->lz) z -= nb->lz;
+      P->z[a] = z;
+    }
     const int ix = clampi((int)(x * nb->cx), nb->nx);
     const int iy = clampi((int)(P->y[a] * nb->cy), nb->ny);
     const int iz = nb->dim == 3 ? clampi((int)(z * nb->cz), nb->nz) : 0;

@@ -51,8 +51,7 @@ struct scene {
   double c_gamma;     /*!< factor of Eq. 2.163 [-]; 0 disables */
   long max_steps;     /*!< stop after this many steps (0 = no limit) */
   /* [init] */
-  int init_profile;   /*!< enum wall_weight { WALL_WEIGHT_DISCRETE = 0, WALL_WEIGHT_ANALYTIC = 1 };
-enum init_profile */
+  int init_profile;   /*!< enum init_profile */
   /* [output] */
   int log_every;      /*!< steps between log lines */
   int series_every;   /*!< steps between time-series records */
