@@ -69,7 +69,11 @@ int output_open(struct output *o, const char *dir, const struct scene *sc, int o
     error_input("%s: cannot write (%s)", path, strerror(errno));
     return CHANSPH_ERR;
   }
-  profile_init(&o->prof, scene_bins(sc), 0.0, 2.0 * sc->delta);
+  /* default: one bin of width dr around each particle layer y = j dr (j = 1 .. 2delta/dr-1),
+     the thin strips next to the walls joining the first and last bins; with n_bins set:
+     uniform bins between the walls */
+  const double edge = sc->n_bins > 0 ? 0.0 : 0.5 * sc->dr;
+  profile_init(&o->prof, scene_bins(sc), edge, 2.0 * sc->delta - edge);
   series_init(&o->ts, N_SERIES, series_names, series_units);
   o->next_write = sc->write_every > 0.0 ? sc->write_every : INFINITY;
   return CHANSPH_OK;

@@ -145,6 +145,7 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
     double vx = 0, vy = 0, vz = 0;    /* viscous sum */
     double diff = 0;                  /* volume diffusion */
     double mom2 = 0;                  /* sum V_b r_ab . grad w_ab, Laplacian normalisation */
+    double momyy = 0;                 /* sum V_b y_ab^2 F_ab, wall-normal normalisation */
     double mom1 = 0;                  /* sum V_b y_ab f_ab, discrete wall weight */
     for (int j = 0; j < cnt; j++) {
       const int32_t b = nl[j];
@@ -157,6 +158,7 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
       gpx += pp * dx, gpy += pp * dy, gpz += pp * dz;
       const double ux = u[a] - u[b], uy = v[a] - v[b], uz = w[a] - w[b];
       mom2 += mb / rb * f * r2;
+      momyy += mb / rb * f * dy * dy;
       mom1 += mb / rb * f * dy;
       if (violeau) {
         const double coef = mb / rb * 0.5 * (ra + rb) * f / (r2 + eta2);
@@ -176,9 +178,12 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
     const double ig = 1.0 / P->gam[a];
     double axa = -ig * gpx, aya = -ig * gpy, aza = -ig * gpz;
     double kappa = 1.0;
-    if (M->lap_norm) { /* kappa_a = -dim / (discrete + analytic missing second moment) */
+    if (M->lap_norm != LAPNORM_NONE) { /* discrete + analytic part behind the walls */
       const double qb = y[a] * ih, qt = (M->ly - y[a]) * ih;
-      kappa = -M->dim / (mom2 + wall_moment2(M->dim, qb) + wall_moment2(M->dim, qt));
+      if (M->lap_norm == LAPNORM_TRACE)
+        kappa = -M->dim / (mom2 + wall_moment2(M->dim, qb) + wall_moment2(M->dim, qt));
+      else
+        kappa = -1.0 / (momyy + wall_moment_yy(M->dim, qb) + wall_moment_yy(M->dim, qt));
     }
     const double lap = nu * ig * kappa; /* nu / gamma_a, normalised */
     const double vis = violeau ? lap / ra : lap;

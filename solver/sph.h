@@ -25,7 +25,7 @@ struct model {
   double gy;          /*!< wall-normal body acceleration [m/s^2] */
   double wall_dmin;   /*!< delta r of Eq. 2.148 [m] */
   double eta2;        /*!< regularisation of r^2 in the viscous term [m^2] */
-  int lap_norm;       /*!< normalise the viscous sum by its discrete second moment */
+  int lap_norm;       /*!< enum laplacian_norm */
   int wall_weight;    /*!< enum wall_weight: weight of the wall shear term */
 };
 

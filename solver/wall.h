@@ -104,6 +104,28 @@ static inline double wall_moment2(const int dim, const double q) {
 }
 
 /**
+ * @brief Wall-normal second moment behind a plane wall: M_yy(q) = int_{behind} F r_y^2 dV with
+ *        grad_a w_ab = F r_ab, dimensionless; the full-space value is -1, M_yy(0) = -1/2.
+ *
+ * 3-D: M_yy = (q - 2)^5 (21 q^3 + 30 q^2 + 20 q + 8) / 512.
+ * 2-D: M_yy = [-(3/128) q^5 (5 q^2 + 112) L + q S (235 q^4 + 272 q^2 - 48) / 192
+ *              + asin(q/2) - pi/2] / pi.
+ */
+static inline double wall_moment_yy(const int dim, const double q) {
+  if (q >= 2.0) return 0.0;
+  if (dim == 3) {
+    const double t = q - 2.0, t2 = t * t;
+    return t2 * t2 * t * (((21.0 * q + 30.0) * q + 20.0) * q + 8.0) / 512.0;
+  }
+  if (q <= 0.0) return -0.5;
+  const double q2 = q * q, q4 = q2 * q2;
+  const double s = sqrt(4.0 - q2), l = log((2.0 + s) / q);
+  return (-3.0 / 128.0 * q4 * q * (5.0 * q2 + 112.0) * l +
+          q * s * (235.0 * q4 + 272.0 * q2 - 48.0) / 192.0 + asin(0.5 * q) - 0.5 * M_PI) /
+         M_PI;
+}
+
+/**
  * @brief Ferrand's polynomial P_{q0}(X) of the 2-D segment integral. Implements: Ferrand Eq. 52
  *        (thesis Eq. 2.108 misprints the first coefficient as 7/129; 7/192 is right).
  */

@@ -36,7 +36,7 @@ void profile_add(struct profile *pr, size_t n, const double *y, const double *u,
   for (size_t i = 0; i < n; i++) {
     if (skip && skip[i]) continue;
     int b = (int)floor((y[i] - pr->y0) * scale);
-    if (b < 0 || b >= pr->nb) continue;
+    b = b < 0 ? 0 : b >= pr->nb ? pr->nb - 1 : b; /* samples outside [y0, y1]: end bins */
     pr->sum_u[b] += u[i], pr->sum_v[b] += v[i], pr->sum_w[b] += w[i], pr->sum_y[b] += y[i];
     pr->count[b]++;
   }

@@ -14,7 +14,7 @@
 /** Time- and plane-averaged profiles over wall-normal bins. */
 struct profile {
   int nb;            /*!< number of bins */
-  double y0, y1;     /*!< bin range [m] (the walls) */
+  double y0, y1;     /*!< range of the uniform bins [m] */
   double *sum_u, *sum_v, *sum_w; /*!< sums of velocity samples per bin [m/s] */
   double *sum_y;     /*!< sum of sample positions per bin [m] */
   int64_t *count;    /*!< samples per bin */
@@ -33,7 +33,8 @@ void profile_init(struct profile *pr, int nb, double y0, double y1);
 void profile_free(struct profile *pr);
 
 /**
- * @brief Add one snapshot: every particle with skip[i] == 0 adds its velocity to its bin.
+ * @brief Add one snapshot: every particle with skip[i] == 0 adds its velocity to its bin;
+ *        particles below y0 or above y1 count in the first or last bin.
  * @param[in,out] pr profile
  * @param[in] n particles
  * @param[in] y,u,v,w position and velocity arrays

@@ -1,0 +1,40 @@
+"""Readers for the netCDF files chansph writes (stats.nc, particles.nc).
+
+Usage:
+    from chansph_nc import read_stats, read_particles
+    s = read_stats("runs/quickstart/stats.nc")
+    s["y"], s["u_mean"], s["attrs"]["nu"], s["series"]["u_bulk"]
+Needs python3-netcdf4 and python3-numpy (Debian packages).
+"""
+import netCDF4
+import numpy as np
+
+PROFILE_VARS = ("y", "y_mean", "u_mean", "v_mean", "w_mean", "n_samples")
+
+
+def read_stats(path):
+    """Profiles, time series (every variable on the time dimension) and global attributes."""
+    with netCDF4.Dataset(path) as d:
+        out = {"attrs": {k: d.getncattr(k) for k in d.ncattrs()}, "series": {}}
+        for name, var in d.variables.items():
+            data = var[:]
+            data = data.filled(np.nan) if np.ma.isMaskedArray(data) and data.dtype.kind == "f" \
+                else np.asarray(data)
+            if var.dimensions == ("time",):
+                out["series"][name] = data
+            else:
+                out[name] = data
+    return out
+
+
+def read_particles(path):
+    """Particle columns (id, x, y, z, u, v, w, rho, p, gamma, mass) and attributes."""
+    with netCDF4.Dataset(path) as d:
+        out = {name: np.asarray(var[:]) for name, var in d.variables.items()}
+        out["attrs"] = {k: d.getncattr(k) for k in d.ncattrs()}
+    return out
+
+
+def laminar_profile(attrs, y):
+    """Analytical Poiseuille velocity for the run's body force: f y (2 delta - y) / (2 nu)."""
+    return attrs["body_force"] * y * (2 * attrs["delta"] - y) / (2 * attrs["nu"])

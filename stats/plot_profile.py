@@ -1,0 +1,47 @@
+#!/usr/bin/python3
+"""Plot u_mean of a chansph stats.nc against its reference profile.
+
+For a laminar run the reference is the analytical Poiseuille profile of the run's body force.
+usage: stats/plot_profile.py runs/quickstart/stats.nc [-o profile.png]
+"""
+import argparse
+import os
+import sys
+
+import matplotlib
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from chansph_nc import laminar_profile, read_stats  # noqa: E402
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__)
+    p.add_argument("stats")
+    p.add_argument("-o", "--output", default=None)
+    a = p.parse_args()
+    s = read_stats(a.stats)
+    at = s["attrs"]
+    y, u = s["y_mean"], s["u_mean"]
+    ok = np.isfinite(u)
+    ref = laminar_profile(at, y)
+    err = np.sqrt(np.sum((u[ok] - ref[ok]) ** 2) / np.sum(ref[ok] ** 2))
+    yy = np.linspace(0, 2 * at["delta"], 201)
+    fig, ax = plt.subplots(figsize=(5, 4))
+    ax.plot(laminar_profile(at, yy), yy, "k-", label="analytical Poiseuille")
+    ax.plot(u[ok], y[ok], "o", ms=4, label="chansph u_mean")
+    ax.set_xlabel("u [m/s]")
+    ax.set_ylabel("y [m]")
+    ax.set_title("%dD channel, 2 delta/dr = %g, rel. L2 error %.2e" %
+                 (at["dimension"], 2 * at["delta"] / at["dr"], err), fontsize=9)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    out = a.output or os.path.join(os.path.dirname(a.stats) or ".", "profile.png")
+    fig.savefig(out, dpi=110)
+    print("profile plot: %s (relative L2 error against the analytical profile %.3e)" % (out, err))
+
+
+if __name__ == "__main__":
+    main()
