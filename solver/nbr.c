@@ -90,23 +90,28 @@ void nbr_sort(struct nbr *nb, struct particles *P) {
   timer_pop();
 }
 
-/* Append the neighbours of a found in particles [b0, b1) shifted by (sx, 0, sz). */
-static inline int scan(const struct particles *restrict P, size_t a, size_t b0, size_t b1,
-                       double sx, double sz, double support2, int32_t *restrict out, int cnt,
-                       int stride) {
+/* Append the neighbours of a found in particles [b0, b1) shifted by (sx, 0, sz), and add
+   their m_b w_ab to *sum. */
+static inline int scan(const struct particles *restrict P, const struct kernel *K, size_t a,
+                       size_t b0, size_t b1, double sx, double sz, double support2,
+                       int32_t *restrict out, int cnt, int stride, double *sum) {
   const double xa = P->x[a] - sx, ya = P->y[a], za = P->z[a] - sz;
+  double s = *sum;
   for (size_t b = b0; b < b1; b++) {
     const double dx = xa - P->x[b], dy = ya - P->y[b], dz = za - P->z[b];
     const double r2 = dx * dx + dy * dy + dz * dz;
     if (r2 < support2 && b != a) {
       if (cnt < stride) out[cnt] = (int32_t)b;
       cnt++;
+      s += P->m[b] * kernel_w(K, sqrt(r2));
     }
   }
+  *sum = s;
   return cnt;
 }
 
-void nbr_build(struct nbr *nb, const struct particles *P) {
+void nbr_build(struct nbr *nb, const struct particles *P, const struct kernel *K, double *ksum) {
+  const double w0 = kernel_w(K, 0.0);
   timer_push("neighbours");
   if (P->n > (size_t)INT32_MAX) die("more than 2^31 particles on one rank");
   for (;;) {
@@ -121,6 +126,7 @@ void nbr_build(struct nbr *nb, const struct particles *P) {
       for (size_t a = nb->start[c]; a < nb->start[c + 1]; a++) {
         int32_t *out = nb->list + a * (size_t)stride;
         int cnt = 0;
+        double sum = P->m[a] * w0;
         for (int dz = dz_lo; dz <= dz_hi; dz++) {
           int jz = iz + dz;
           double sz = 0.0;
@@ -131,8 +137,8 @@ void nbr_build(struct nbr *nb, const struct particles *P) {
             if (jy < 0 || jy >= nb->ny) continue;
             const size_t row = ((size_t)jz * nb->ny + jy) * nb->nx;
             if (ix > 0 && ix < nb->nx - 1) { /* the three x cells are contiguous */
-              cnt = scan(P, a, nb->start[row + ix - 1], nb->start[row + ix + 2], 0.0, sz,
-                         nb->support2, out, cnt, stride);
+              cnt = scan(P, K, a, nb->start[row + ix - 1], nb->start[row + ix + 2], 0.0, sz,
+                         nb->support2, out, cnt, stride, &sum);
               continue;
             }
             for (int dx = -1; dx <= 1; dx++) {
@@ -140,12 +146,13 @@ void nbr_build(struct nbr *nb, const struct particles *P) {
               double sx = 0.0;
               if (jx < 0) jx += nb->nx, sx = -nb->lx;
               else if (jx >= nb->nx) jx -= nb->nx, sx = nb->lx;
-              cnt = scan(P, a, nb->start[row + jx], nb->start[row + jx + 1], sx, sz,
-                         nb->support2, out, cnt, stride);
+              cnt = scan(P, K, a, nb->start[row + jx], nb->start[row + jx + 1], sx, sz,
+                         nb->support2, out, cnt, stride, &sum);
             }
           }
         }
         nb->count[a] = cnt;
+        ksum[a] = sum;
         if (cnt > stride && cnt > overflow) overflow = cnt;
       }
     }

@@ -13,6 +13,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "kernel.h"
 #include "part.h"
 
 /** Cell grid and neighbour list. */
@@ -52,11 +53,14 @@ void nbr_free(struct nbr *nb);
 void nbr_sort(struct nbr *nb, struct particles *P);
 
 /**
- * @brief Build the neighbour list of every particle (pairs closer than 2h, self excluded).
+ * @brief Build the neighbour list of every particle (pairs closer than 2h, self excluded) and,
+ *        in the same pass, the kernel sums S_a = sum_b m_b w_ab (self included).
  * @param[in,out] nb grid and list; the stride grows if a particle has more neighbours
  * @param[in] P particles, sorted by nbr_sort()
+ * @param[in] K kernel
+ * @param[out] ksum kernel sum of every particle [kg/m^dim]
  */
-void nbr_build(struct nbr *nb, const struct particles *P);
+void nbr_build(struct nbr *nb, const struct particles *P, const struct kernel *K, double *ksum);
 
 /** @brief Minimum-image separation in a periodic direction of length l (|d| < l/2 after). */
 static inline double nbr_wrap(double d, const double l) {

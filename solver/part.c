@@ -63,6 +63,7 @@ void part_create(struct particles *P, struct walls *W, const struct scene *s) {
   P->rho = part_alloc("rho", nd), P->m = part_alloc("mass", nd), P->gam = part_alloc("gamma", nd);
   P->ksum = part_alloc("kernel_sum", nd), P->ddiff = part_alloc("diffusion", nd);
   P->p = part_alloc("pressure", nd), P->c = part_alloc("sound", nd);
+  P->pr2 = part_alloc("p_over_rho2", nd), P->vol = part_alloc("volume", nd);
   P->ax = part_alloc("ax", nd), P->ay = part_alloc("ay", nd), P->az = part_alloc("az", nd);
   P->id = part_alloc("id", P->n * sizeof(int64_t));
   P->kind = part_alloc("kind", P->n);
@@ -94,7 +95,7 @@ void part_create(struct particles *P, struct walls *W, const struct scene *s) {
 
 void part_destroy(struct particles *P, struct walls *W) {
   double **d[] = {&P->x, &P->y, &P->z, &P->u, &P->v, &P->w, &P->rho, &P->m, &P->gam,
-                  &P->ksum, &P->ddiff, &P->p, &P->c, &P->ax, &P->ay, &P->az, &P->tmp,
+                  &P->ksum, &P->ddiff, &P->p, &P->c, &P->pr2, &P->vol, &P->ax, &P->ay, &P->az, &P->tmp,
                   &W->rho, &W->p};
   for (size_t i = 0; i < sizeof d / sizeof d[0]; i++) part_free(*d[i]), *d[i] = NULL;
   part_free(P->id), part_free(P->kind), part_free(P->tmp_i);

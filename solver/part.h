@@ -35,6 +35,8 @@ struct particles {
   /* recomputed every step, not permuted */
   double *p;          /*!< pressure [Pa] */
   double *c;          /*!< local speed of sound [m/s] */
+  double *pr2;        /*!< p / rho^2 [m^5/(kg s^2)] */
+  double *vol;        /*!< volume m / rho [m^dim] */
   double *ax, *ay, *az; /*!< acceleration without the driving force [m/s^2] */
   /* sort scratch */
   double *tmp;

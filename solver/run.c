@@ -27,8 +27,8 @@ void sim_init(struct sim *S, const struct scene *sc) {
   drive_init(&S->drive, sc);
   S->fx = S->drive.force;
   nbr_sort(&S->nb, &S->P);
-  nbr_build(&S->nb, &S->P);
-  sph_density(&S->M, &S->P, &S->nb, 0.0);
+  nbr_build(&S->nb, &S->P, &S->M.k, S->scratch[0]);
+  sph_density(&S->M, &S->P, S->scratch[0], 0.0);
   sph_walls(&S->M, &S->P, &S->nb, &S->W);
 }
 
@@ -87,8 +87,8 @@ void sim_step(struct sim *S) {
   timer_pop();
   S->t += dt, S->dt = dt, S->fx = fx, S->step++;
   nbr_sort(&S->nb, P);
-  nbr_build(&S->nb, P);
-  sph_density(&S->M, P, &S->nb, dt);
+  nbr_build(&S->nb, P, &S->M.k, S->scratch[0]);
+  sph_density(&S->M, P, S->scratch[0], dt);
   sph_walls(&S->M, P, &S->nb, &S->W);
 }
 

@@ -39,31 +39,22 @@ static inline double channel_gamma(const struct model *M, double y) {
   return wall_gamma(M->dim, y * ih) + wall_gamma(M->dim, (M->ly - y) * ih) - 1.0;
 }
 
-void sph_density(const struct model *M, struct particles *P, const struct nbr *nb, double dt) {
+void sph_density(const struct model *M, struct particles *P, const double *ksum_new,
+                 double dt) {
   timer_push("density");
-  const struct kernel *K = &M->k;
-  const double w0 = kernel_w(K, 0.0);
-  const double *restrict x = P->x, *restrict y = P->y, *restrict z = P->z, *restrict m = P->m;
+  const double *restrict y = P->y, *restrict m = P->m;
   const uint8_t *restrict kind = P->kind;
 #pragma omp parallel for schedule(static)
   for (size_t a = 0; a < P->n; a++) {
     if (kind[a] != KIND_FLUID) continue;
-    const int32_t *nl = nb->list + a * (size_t)nb->stride;
-    const int cnt = nb->count[a];
-    double s = m[a] * w0;
-    for (int j = 0; j < cnt; j++) {
-      const int32_t b = nl[j];
-      const double dx = nbr_wrap(x[a] - x[b], M->lx), dy = y[a] - y[b];
-      const double dz = M->dim == 3 ? nbr_wrap(z[a] - z[b], M->lz) : 0.0;
-      s += m[b] * kernel_w(K, sqrt(dx * dx + dy * dy + dz * dz));
-    }
-    const double gam = channel_gamma(M, y[a]);
+    const double s = ksum_new[a], gam = channel_gamma(M, y[a]);
     if (dt > 0.0)
       P->rho[a] = (P->gam[a] * P->rho[a] + s - P->ksum[a] + dt * P->ddiff[a]) / gam;
     P->ksum[a] = s;
     P->gam[a] = gam;
-    P->p[a] = eos_pressure(&M->e, P->rho[a]);
-    P->c[a] = eos_sound(&M->e, P->rho[a]);
+    const double r = P->rho[a], pa = eos_pressure(&M->e, r);
+    P->p[a] = pa, P->c[a] = eos_sound(&M->e, r);
+    P->pr2[a] = pa / (r * r), P->vol[a] = m[a] / r;
   }
   timer_pop();
 }
@@ -95,6 +86,7 @@ void sph_walls(const struct model *M, struct particles *P, const struct nbr *nb,
     if (alpha > 0.0) rv = mw / alpha, pv = rv * pw / alpha;
     P->rho[v] = rv, P->p[v] = pv;
     P->c[v] = eos_sound(&M->e, rv);
+    P->pr2[v] = pv / (rv * rv), P->vol[v] = m[v] / rv;
     const size_t slot = part_vertex_slot(P, P->id[v]);
     W->rho[slot] = rv, W->p[slot] = pv;
   }
@@ -126,8 +118,8 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
   const struct kernel *K = &M->k;
   const double *restrict x = P->x, *restrict y = P->y, *restrict z = P->z;
   const double *restrict u = P->u, *restrict v = P->v, *restrict w = P->w;
-  const double *restrict m = P->m, *restrict rho = P->rho, *restrict p = P->p;
-  const double *restrict c = P->c;
+  const double *restrict m = P->m, *restrict rho = P->rho;
+  const double *restrict c = P->c, *restrict pr2 = P->pr2, *restrict vol = P->vol;
   const uint8_t *restrict kind = P->kind;
   const double nu = M->nu, eta2 = M->eta2, inv_xi = M->inv_xi, ih = K->inv_h;
   const double dgrav = M->e.rho0 / (M->e.c0 * M->e.c0) * M->gy; /* Eq. 3.61 */
@@ -140,7 +132,7 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
     if (kind[a] != KIND_FLUID) continue;
     const int32_t *nl = nb->list + a * (size_t)nb->stride;
     const int cnt = nb->count[a];
-    const double ra = rho[a], pa = p[a] / (ra * ra), ca = c[a];
+    const double ra = rho[a], pa = pr2[a], ca = c[a], ira = 1.0 / ra;
     double gpx = 0, gpy = 0, gpz = 0; /* sum m_b (p_a/rho_a^2 + p_b/rho_b^2) grad w */
     double vx = 0, vy = 0, vz = 0;    /* viscous sum */
     double diff = 0;                  /* volume diffusion */
@@ -153,26 +145,25 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
       const double dz = M->dim == 3 ? nbr_wrap(z[a] - z[b], M->lz) : 0.0;
       const double r2 = dx * dx + dy * dy + dz * dz, r = sqrt(r2);
       const double f = kernel_f(K, r); /* grad_a w_ab = f r_ab */
-      const double rb = rho[b], mb = m[b];
-      const double pp = mb * (pa + p[b] / (rb * rb)) * f;
+      const double rb = rho[b], mb = m[b], vb = vol[b];
+      const double pp = mb * (pa + pr2[b]) * f;
       gpx += pp * dx, gpy += pp * dy, gpz += pp * dz;
       const double ux = u[a] - u[b], uy = v[a] - v[b], uz = w[a] - w[b];
-      mom2 += mb / rb * f * r2;
-      momyy += mb / rb * f * dy * dy;
-      mom1 += mb / rb * f * dy;
+      const double vf = vb * f;
+      mom2 += vf * r2, momyy += vf * dy * dy, mom1 += vf * dy;
       if (violeau) {
-        const double coef = mb / rb * 0.5 * (ra + rb) * f / (r2 + eta2);
+        const double coef = vb * 0.5 * (ra + rb) * f / (r2 + eta2);
         const double vr = dplus2 * (ux * dx + uy * dy + uz * dz);
         vx += coef * (vr * dx + r2 * ux), vy += coef * (vr * dy + r2 * uy);
         vz += coef * (vr * dz + r2 * uz);
       } else {
-        const double coef = mb * (ra + rb) / (ra * rb) * f * r2 / (r2 + eta2);
+        const double coef = (mb * ira + vb) * f * r2 / (r2 + eta2); /* m_b (1/rho_a + 1/rho_b) */
         vx += coef * ux, vy += coef * uy, vz += coef * uz;
       }
       if (kind[b] == KIND_FLUID) {
         const double cab = ca > c[b] ? ca : c[b];
         const double vrho = ra - rb - dgrav * dy; /* varrho_ab of Eq. 3.61 */
-        diff += mb * cab * inv_xi * vrho / rb * f * r;
+        diff += vb * cab * vrho * f * r;
       }
     }
     const double ig = 1.0 / P->gam[a];
@@ -209,7 +200,7 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
     }
     aya += M->gy;
     P->ax[a] = axa, P->ay[a] = aya, P->az[a] = aza;
-    P->ddiff[a] = diff; /* enters gamma rho directly (Eq. 3.64): no 1/gamma */
+    P->ddiff[a] = diff * inv_xi; /* enters gamma rho directly (Eq. 3.64): no 1/gamma */
     const double ax2 = (axa + fx) * (axa + fx) + aya * aya + aza * aza;
     if (ax2 > amax2) amax2 = ax2;
     if (gv > gvmax) gvmax = gv;

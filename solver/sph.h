@@ -39,15 +39,15 @@ struct force_info {
 void sph_model_init(struct model *M, const struct scene *s);
 
 /**
- * @brief Kernel sums at the current positions and the density update of thesis Eq. 3.64:
+ * @brief Density update of thesis Eq. 3.64 from the kernel sums at the current positions:
  *        gamma^n rho^n = gamma^(n-1) rho^(n-1) + S^n - S^(n-1) + dt D^(n-1),
  *        with gamma of the plane walls in closed form; then pressure and sound speed (Eq. 2.11).
  * @param[in] M model
  * @param[in,out] P particles (ksum, gam, rho, p, c of fluid particles)
- * @param[in] nb neighbour list at the current positions
+ * @param[in] ksum_new kernel sums at the current positions (from nbr_build)
  * @param[in] dt the step that led here [s]; dt <= 0 only initialises S and gamma
  */
-void sph_density(const struct model *M, struct particles *P, const struct nbr *nb, double dt);
+void sph_density(const struct model *M, struct particles *P, const double *ksum_new, double dt);
 
 /**
  * @brief Wall values of the vertex particles by Shepard interpolation of the fluid:

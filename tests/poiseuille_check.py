@@ -78,7 +78,7 @@ def cmd_startup(args):
     ok = True
     for t in (0.2, 0.5, 2.0):
         out, _ = run(args, args.scene, "startup_t%g" % t,
-                     ["time.t_end=%g" % t, "init.profile=rest"] + args.set)
+                     ["time.t_end=%g" % t, "init.profile=rest", "output.t_average_start=0"] + args.set)
         with netCDF4.Dataset(os.path.join(out, "particles.nc")) as d:
             a = attrs(os.path.join(out, "stats.nc"))
             tr, y, u = d.getncattr("time"), d["y"][:], d["u"][:]
@@ -184,10 +184,8 @@ def cmd_study(args):
     rows = []
     for scene in (args.scene, args.scene3d):
         dim, dr0, lx0, lz0 = scene_values(scene)
-        for k in range(4):
+        for k in (range(4) if dim == 2 else range(-1, 3)):  # 3-D: 2 delta/dr = 10 .. 80
             sets = resolution_sets(dim, dr0, lx0, lz0, k, False)
-            if k == 3 and dim == 3:
-                pass
             out, wall = run(args, scene, "study%dd_%d" % (dim, k), sets + args.set)
             e, a = steady_error(out)
             rows.append((dim, round(2 * a["delta"] / a["dr"]), int(a["n_fluid"]), int(a["steps"]),

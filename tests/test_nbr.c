@@ -21,6 +21,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "kernel.h"
 #include "nbr.h"
 #include "part.h"
 #include "scene.h"
@@ -138,7 +139,9 @@ static int check_round(const char *name0, int round, const struct scene *sc,
   for (size_t a = 0; a < n; a++) snap.kind[P->id[a]] = P->kind[a];
 
   nbr_sort(nb, P);
-  nbr_build(nb, P);
+  const struct kernel K = kernel_make(s.dim, h);
+  double *ksum = calloc(n, sizeof *ksum);
+  nbr_build(nb, P, &K, ksum);
 
   /* --- the sort: a permutation, arrays moved consistently, positions wrapped */
   char *seen = calloc(n, 1);
@@ -192,6 +195,23 @@ static int check_round(const char *name0, int round, const struct scene *sc,
     printf("FAIL: %s: %zu particles out of cell/id order\n", name, order_bad);
     fails++;
   }
+
+  /* --- kernel sums of the same pass against a brute-force sum (self included) */
+  double ksum_err = 0.0;
+  for (size_t a = 0; a < n; a++) {
+    double want_s = 0.0;
+    for (size_t b = 0; b < n; b++) {
+      const double dx = min_image(P->x[a] - P->x[b], lx), dy = P->y[a] - P->y[b];
+      const double dz = s.dim == 3 ? min_image(P->z[a] - P->z[b], lz) : P->z[a] - P->z[b];
+      want_s += P->m[b] * kernel_w(&K, sqrt(dx * dx + dy * dy + dz * dz));
+    }
+    const double e = fabs(ksum[a] - want_s) / want_s;
+    if (e > ksum_err) ksum_err = e;
+  }
+  free(ksum);
+  printf("%s: kernel sums against brute force: max rel error %.3e (tol 1e-13)\n", name,
+         ksum_err);
+  if (!(ksum_err <= 1e-13)) fails++;
 
   /* --- neighbour sets against brute force */
   size_t max_nbr = 0, total = 0, ambiguous = 0, set_bad = 0;
@@ -253,7 +273,9 @@ static int check_round(const char *name0, int round, const struct scene *sc,
   for (int variant = 0; variant < 2; variant++) {
     if (variant == 0) omp_set_num_threads(1);
     else nb->stride = 3; /* smaller than the allocation: nbr_build must detect and grow */
-    nbr_build(nb, P);
+    double *ks = calloc(n, sizeof *ks);
+    nbr_build(nb, P, &K, ks);
+    free(ks);
     omp_set_num_threads(threads);
     if (variant == 1 && nb->stride < (int)max_nbr) repeat_bad++;
     for (size_t a = 0; a < n; a++) {
