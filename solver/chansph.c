@@ -26,7 +26,9 @@ static int run(const struct scene *sc, const struct cli *c) {
   while (!sim_done(&S)) {
     sim_step(&S);
     struct health_report rep;
-    if (S.step % sc->health_every == 0 && health_check(&S.M, &S.P, S.step, S.t, &rep)) {
+    if (S.violation[0]) snprintf(rep.what, sizeof rep.what, "%s", S.violation);
+    if (S.violation[0] ||
+        (S.step % sc->health_every == 0 && health_check(&S.M, &S.P, S.step, S.t, &rep))) {
       output_fail(&out, &S, &rep);
       rc = 3;
       break;

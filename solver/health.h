@@ -11,7 +11,7 @@
 
 /** What went wrong, and where. */
 struct health_report {
-  char what[256];
+  char what[400];
 };
 
 /**

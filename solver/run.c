@@ -38,6 +38,34 @@ void sim_free(struct sim *S) {
   part_destroy(&S->P, &S->W);
 }
 
+/* A fixed time step above a stability limit is a numerical failure: name the limit and the
+   particle that sets it (largest acceleration, or fastest particle for the acoustic limit). */
+static void check_fixed_dt(struct sim *S, double dt) {
+  static const char *const names[4] = {"acoustic (Eq. 2.160)", "viscous (Eq. 2.161)",
+                                       "force (Eq. 2.162)", "wall (Eq. 2.163)"};
+  int worst = -1;
+  for (int k = 0; k < 4; k++)
+    if (dt > S->dt_limits[k] * (1.0 + 1e-12) &&
+        (worst < 0 || S->dt_limits[k] < S->dt_limits[worst]))
+      worst = k;
+  if (worst < 0) return;
+  const struct particles *P = &S->P;
+  size_t who = 0;
+  double best = -1.0;
+  for (size_t a = 0; a < P->n; a++) {
+    if (P->kind[a] != KIND_FLUID) continue;
+    const double ax = P->ax[a] + S->fx, v2 = P->u[a] * P->u[a] + P->v[a] * P->v[a] +
+                                             P->w[a] * P->w[a];
+    const double key = worst == 0 ? v2 : ax * ax + P->ay[a] * P->ay[a] + P->az[a] * P->az[a];
+    if (key > best || (key == best && P->id[a] < P->id[who])) best = key, who = a;
+  }
+  snprintf(S->violation, sizeof S->violation,
+           "CFL violation at step %ld (t = %.9g): fixed dt = %.6g s exceeds the %s limit "
+           "%.6g s; particle id %lld at (%.9g, %.9g, %.9g) with %s %.6g",
+           S->step, S->t, dt, names[worst], S->dt_limits[worst], (long long)P->id[who], P->x[who],
+           P->y[who], P->z[who], worst == 0 ? "speed" : "acceleration", sqrt(best));
+}
+
 /* Time step of thesis Eq. 2.160-2.164, or the fixed one. */
 static double time_step(struct sim *S, const struct force_info *fi) {
   const struct scene *sc = S->sc;
@@ -46,7 +74,10 @@ static double time_step(struct sim *S, const struct force_info *fi) {
   S->dt_limits[1] = sc->c_visc * h * h / sc->nu;
   S->dt_limits[2] = fi->amax > 0.0 ? sc->c_force * sqrt(h / fi->amax) : INFINITY;
   S->dt_limits[3] = sc->c_gamma > 0.0 && fi->gvmax > 0.0 ? sc->c_gamma / fi->gvmax : INFINITY;
-  if (sc->dt_fixed > 0.0) return sc->dt_fixed;
+  if (sc->dt_fixed > 0.0) {
+    check_fixed_dt(S, sc->dt_fixed);
+    return sc->dt_fixed;
+  }
   double dt = S->dt_limits[0];
   for (int k = 1; k < 4; k++) dt = fmin(dt, S->dt_limits[k]);
   return dt;
@@ -71,6 +102,9 @@ void sim_step(struct sim *S) {
   struct force_info fi;
   const double ub = S->drive.mode == DRIVE_FLUX ? bulk_velocity(S) : 0.0;
   sph_forces(&S->M, P, &S->nb, &S->W, S->fx, &fi);
+  double maxima[2] = {fi.amax, fi.gvmax};
+  reduce_global_max(maxima, 2);
+  fi.amax = maxima[0], fi.gvmax = maxima[1];
   const double dt = time_step(S, &fi);
   const double fx = drive_force(&S->drive, ub, dt);
   timer_push("integrate");
