@@ -56,9 +56,10 @@ int main(int argc, char **argv) {
   } else if (c.cmd == CMD_SCENE_DOC) {
     scene_write_doc(stdout);
   } else if (size > 1) {
-    error_input("this version runs on one MPI rank (got %d); domain decomposition is not "
-                "implemented yet",
-                size);
+    error_input(
+        "this version runs on one MPI rank (got %d); domain decomposition is not "
+        "implemented yet",
+        size);
     rc = 1;
   } else if ((c.cmd == CMD_BENCH ? cli_bench_scene(&sc, &c)
                                  : scene_load(&sc, c.scene, c.n_set, c.set))) {

@@ -31,11 +31,16 @@ int cli_parse(int argc, char **argv, struct cli *c) {
     return CHANSPH_OK;
   }
   const char *cmd = argv[1];
-  if (!strcmp(cmd, "run")) c->cmd = CMD_RUN;
-  else if (!strcmp(cmd, "bench")) c->cmd = CMD_BENCH;
-  else if (!strcmp(cmd, "scene-doc")) c->cmd = CMD_SCENE_DOC;
-  else if (!strcmp(cmd, "--help") || !strcmp(cmd, "-h") || !strcmp(cmd, "help")) c->cmd = CMD_HELP;
-  else if (!strcmp(cmd, "--version")) c->cmd = CMD_VERSION;
+  if (!strcmp(cmd, "run"))
+    c->cmd = CMD_RUN;
+  else if (!strcmp(cmd, "bench"))
+    c->cmd = CMD_BENCH;
+  else if (!strcmp(cmd, "scene-doc"))
+    c->cmd = CMD_SCENE_DOC;
+  else if (!strcmp(cmd, "--help") || !strcmp(cmd, "-h") || !strcmp(cmd, "help"))
+    c->cmd = CMD_HELP;
+  else if (!strcmp(cmd, "--version"))
+    c->cmd = CMD_VERSION;
   else {
     error_input("unknown command '%s'", cmd);
     cli_usage();
@@ -44,9 +49,12 @@ int cli_parse(int argc, char **argv, struct cli *c) {
   for (int i = 2; i < argc; i++) {
     const char *a = argv[i];
     const int has_next = i + 1 < argc;
-    if (!strcmp(a, "--set") && has_next) c->set[c->n_set++] = argv[++i];
-    else if (!strncmp(a, "--set=", 6)) c->set[c->n_set++] = argv[i] + 6;
-    else if (!strcmp(a, "--out") && has_next) snprintf(c->out, sizeof c->out, "%s", argv[++i]);
+    if (!strcmp(a, "--set") && has_next)
+      c->set[c->n_set++] = argv[++i];
+    else if (!strncmp(a, "--set=", 6))
+      c->set[c->n_set++] = argv[i] + 6;
+    else if (!strcmp(a, "--out") && has_next)
+      snprintf(c->out, sizeof c->out, "%s", argv[++i]);
     else if (!strcmp(a, "--steps") && has_next) {
       char *end;
       c->steps = strtol(argv[++i], &end, 10);
@@ -54,14 +62,19 @@ int cli_parse(int argc, char **argv, struct cli *c) {
         error_input("--steps %s: expected a positive integer", argv[i]);
         return CHANSPH_ERR;
       }
-    } else if (!strcmp(a, "--overwrite")) c->overwrite = 1;
-    else if (!strcmp(a, "--fpe")) c->fpe = 1;
-    else if (!strcmp(a, "--debug")) chansph_debug = 1;
-    else if (a[0] != '-' && !c->scene) c->scene = a;
+    } else if (!strcmp(a, "--overwrite"))
+      c->overwrite = 1;
+    else if (!strcmp(a, "--fpe"))
+      c->fpe = 1;
+    else if (!strcmp(a, "--debug"))
+      chansph_debug = 1;
+    else if (a[0] != '-' && !c->scene)
+      c->scene = a;
     else {
       error_input("unexpected argument '%s'%s", a,
                   (!strcmp(a, "--set") || !strcmp(a, "--out") || !strcmp(a, "--steps"))
-                      ? " (missing value)" : "");
+                      ? " (missing value)"
+                      : "");
       cli_usage();
       return CHANSPH_ERR;
     }
@@ -75,8 +88,7 @@ int cli_parse(int argc, char **argv, struct cli *c) {
     const char *base = strrchr(c->scene, '/');
     base = base ? base + 1 : c->scene;
     const char *dot = strrchr(base, '.');
-    snprintf(c->out, sizeof c->out, "runs/%.*s", dot ? (int)(dot - base) : (int)strlen(base),
-             base);
+    snprintf(c->out, sizeof c->out, "runs/%.*s", dot ? (int)(dot - base) : (int)strlen(base), base);
   }
   return CHANSPH_OK;
 }
@@ -111,12 +123,12 @@ int cli_bench(const struct scene *sc, long steps) {
   const double t0 = timer_now(), sim0 = S.t;
   for (long i = 0; i < steps; i++) sim_step(&S);
   const double wall = timer_now() - t0, simt = S.t - sim0;
-  printf("chansph bench: %dD, %zu fluid + %zu vertex particles, %d threads\n", sc->dim,
-         S.P.n_fluid, S.P.n_vertex, omp_get_max_threads());
+  printf("chansph bench: %dD, %zu fluid + %zu vertex particles, %d threads\n", sc->dim, S.P.n_fluid,
+         S.P.n_vertex, omp_get_max_threads());
   printf("neighbours per fluid particle (within 2h, self excluded): %.2f\n",
          (double)nbr / (double)S.P.n_fluid);
-  printf("set-up %.3f s; %d warm-up steps, then %ld timed steps in %.3f s (%.3f ms/step)\n",
-         setup, warm, steps, wall, 1e3 * wall / steps);
+  printf("set-up %.3f s; %d warm-up steps, then %ld timed steps in %.3f s (%.3f ms/step)\n", setup,
+         warm, steps, wall, 1e3 * wall / steps);
   printf("dt = %.4e s (limits: acoustic %.3e, viscous %.3e, force %.3e, wall %.3e)\n", S.dt,
          S.dt_limits[0], S.dt_limits[1], S.dt_limits[2], S.dt_limits[3]);
   printf("wall seconds per simulated second: %.1f\n", simt > 0 ? wall / simt : 0.0);

@@ -37,9 +37,9 @@ void error_input(const char *fmt, ...);
 #define msg(...) error_msg(__VA_ARGS__)
 
 /** Propagate a non-zero status from an I/O or input function to the caller. */
-#define TRY(call)              \
-  do {                         \
-    const int try_rc_ = (call); \
+#define TRY(call)                \
+  do {                           \
+    const int try_rc_ = (call);  \
     if (try_rc_) return try_rc_; \
   } while (0)
 

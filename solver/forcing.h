@@ -10,13 +10,13 @@
 
 /** State of the driver; everything the next force depends on. */
 struct drive {
-  int mode;          /*!< enum drive_mode */
-  int controller;    /*!< enum flux_controller */
-  double target;     /*!< target bulk velocity v [m/s] (flux mode) */
-  double force;      /*!< force of the last step, F^(n-1) [m/s^2] */
-  double ub_prev;    /*!< bulk velocity one step earlier, v~^(n-2) [m/s] */
-  double dt_prev;    /*!< previous time step dt^(n-1) [s] */
-  int started;       /*!< 0 until the first step has been taken */
+  int mode;       /*!< enum drive_mode */
+  int controller; /*!< enum flux_controller */
+  double target;  /*!< target bulk velocity v [m/s] (flux mode) */
+  double force;   /*!< force of the last step, F^(n-1) [m/s^2] */
+  double ub_prev; /*!< bulk velocity one step earlier, v~^(n-2) [m/s] */
+  double dt_prev; /*!< previous time step dt^(n-1) [s] */
+  int started;    /*!< 0 until the first step has been taken */
 };
 
 /** @brief Initialise the driver from the scene (force = drive.force). */

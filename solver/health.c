@@ -37,8 +37,8 @@ int health_check(const struct model *M, const struct particles *P, long step, do
     snprintf(rep->what, sizeof rep->what,
              "%s at step %ld (t = %.9g): particle id %lld at (%.9g, %.9g, %.9g), velocity "
              "(%.6g, %.6g, %.6g), density %.6g",
-             names[rc], step, t, (long long)P->id[a], P->x[a], P->y[a], P->z[a], P->u[a],
-             P->v[a], P->w[a], P->rho[a]);
+             names[rc], step, t, (long long)P->id[a], P->x[a], P->y[a], P->z[a], P->u[a], P->v[a],
+             P->w[a], P->rho[a]);
     break;
   }
   timer_pop();

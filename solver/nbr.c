@@ -41,7 +41,9 @@ void nbr_free(struct nbr *nb) {
   memset(nb, 0, sizeof *nb);
 }
 
-static inline int clampi(int i, int n) { return i < 0 ? 0 : i >= n ? n - 1 : i; }
+static inline int clampi(int i, int n) {
+  return i < 0 ? 0 : i >= n ? n - 1 : i;
+}
 
 void nbr_sort(struct nbr *nb, struct particles *P) {
   timer_push("sort");
@@ -130,8 +132,10 @@ void nbr_build(struct nbr *nb, const struct particles *P, const struct kernel *K
         for (int dz = dz_lo; dz <= dz_hi; dz++) {
           int jz = iz + dz;
           double sz = 0.0;
-          if (jz < 0) jz += nb->nz, sz = -nb->lz;
-          else if (jz >= nb->nz) jz -= nb->nz, sz = nb->lz;
+          if (jz < 0)
+            jz += nb->nz, sz = -nb->lz;
+          else if (jz >= nb->nz)
+            jz -= nb->nz, sz = nb->lz;
           for (int dy = -1; dy <= 1; dy++) {
             const int jy = iy + dy;
             if (jy < 0 || jy >= nb->ny) continue;
@@ -144,8 +148,10 @@ void nbr_build(struct nbr *nb, const struct particles *P, const struct kernel *K
             for (int dx = -1; dx <= 1; dx++) {
               int jx = ix + dx;
               double sx = 0.0;
-              if (jx < 0) jx += nb->nx, sx = -nb->lx;
-              else if (jx >= nb->nx) jx -= nb->nx, sx = nb->lx;
+              if (jx < 0)
+                jx += nb->nx, sx = -nb->lx;
+              else if (jx >= nb->nx)
+                jx -= nb->nx, sx = nb->lx;
               cnt = scan(P, K, a, nb->start[row + jx], nb->start[row + jx + 1], sx, sz,
                          nb->support2, out, cnt, stride, &sum);
             }

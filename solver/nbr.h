@@ -19,19 +19,19 @@
 /** Cell grid and neighbour list. */
 struct nbr {
   int dim;
-  int nx, ny, nz;        /*!< cells per direction */
-  double lx, ly, lz;     /*!< domain lengths [m] (ly = 2 delta) */
-  double cx, cy, cz;     /*!< inverse cell sizes [1/m] */
-  double support2;       /*!< (2h)^2 [m^2] */
+  int nx, ny, nz;    /*!< cells per direction */
+  double lx, ly, lz; /*!< domain lengths [m] (ly = 2 delta) */
+  double cx, cy, cz; /*!< inverse cell sizes [1/m] */
+  double support2;   /*!< (2h)^2 [m^2] */
   size_t ncell;
-  size_t *start;         /*!< particles of cell c are start[c] .. start[c+1]-1 */
-  size_t *perm;          /*!< sort scratch */
-  int *cell;             /*!< cell of each particle (sort scratch) */
-  size_t cap;            /*!< particles the arrays hold */
+  size_t *start; /*!< particles of cell c are start[c] .. start[c+1]-1 */
+  size_t *perm;  /*!< sort scratch */
+  int *cell;     /*!< cell of each particle (sort scratch) */
+  size_t cap;    /*!< particles the arrays hold */
   /* neighbour list */
-  int stride;            /*!< list slots per particle */
-  int *count;            /*!< neighbours of each particle (excluding itself) */
-  int32_t *list;         /*!< neighbours of a: list[a*stride .. a*stride+count[a]-1] */
+  int stride;    /*!< list slots per particle */
+  int *count;    /*!< neighbours of each particle (excluding itself) */
+  int32_t *list; /*!< neighbours of a: list[a*stride .. a*stride+count[a]-1] */
 };
 
 /**
@@ -64,8 +64,10 @@ void nbr_build(struct nbr *nb, const struct particles *P, const struct kernel *K
 
 /** @brief Minimum-image separation in a periodic direction of length l (|d| < l/2 after). */
 static inline double nbr_wrap(double d, const double l) {
-  if (d > 0.5 * l) d -= l;
-  else if (d < -0.5 * l) d += l;
+  if (d > 0.5 * l)
+    d -= l;
+  else if (d < -0.5 * l)
+    d += l;
   return d;
 }
 

@@ -12,11 +12,11 @@
 #include "ncout.h"
 #include "timers.h"
 
-static const char *const series_names[] = {"time",     "u_bulk",    "body_force", "kinetic_energy",
-                                           "mass",     "max_speed", "min_gamma",  "volume",
-                                           "rho_min",  "rho_max",   "dt"};
-static const char *const series_units[] = {"s", "m/s", "m/s^2", "J", "kg", "m/s", "1",
-                                           "m^dim", "kg/m^3", "kg/m^3", "s"};
+static const char *const series_names[] = {"time",    "u_bulk",    "body_force", "kinetic_energy",
+                                           "mass",    "max_speed", "min_gamma",  "volume",
+                                           "rho_min", "rho_max",   "dt"};
+static const char *const series_units[] = {"s", "m/s",   "m/s^2",  "J",      "kg", "m/s",
+                                           "1", "m^dim", "kg/m^3", "kg/m^3", "s"};
 enum { N_SERIES = sizeof series_names / sizeof series_names[0] };
 
 static int mkdir_p(const char *path) {
@@ -45,9 +45,10 @@ int output_open(struct output *o, const char *dir, const struct scene *sc, int o
   static const char *const results[] = {"stats.nc", "log.txt", "particles.nc"};
   for (size_t i = 0; i < sizeof results / sizeof results[0] && !overwrite; i++)
     if (exists(dir, results[i])) {
-      error_input("%s/%s: the output directory already holds results of a run; choose "
-                  "another --out DIR or pass --overwrite",
-                  dir, results[i]);
+      error_input(
+          "%s/%s: the output directory already holds results of a run; choose "
+          "another --out DIR or pass --overwrite",
+          dir, results[i]);
       return CHANSPH_ERR;
     }
   if (mkdir_p(dir)) {
@@ -64,8 +65,9 @@ int output_open(struct output *o, const char *dir, const struct scene *sc, int o
   o->scene_text = scene_text(sc);
   snprintf(path, sizeof path, "%s/scene.used.ini", dir);
   FILE *f = fopen(path, "w");
-  if (!f || fprintf(f, "; resolved scene of %s (defaults included)\n%s", sc->path,
-                    o->scene_text) < 0 || fclose(f)) {
+  if (!f ||
+      fprintf(f, "; resolved scene of %s (defaults included)\n%s", sc->path, o->scene_text) < 0 ||
+      fclose(f)) {
     error_input("%s: cannot write (%s)", path, strerror(errno));
     return CHANSPH_ERR;
   }
@@ -93,17 +95,17 @@ static void logline(struct output *o, const char *fmt, ...) {
 
 static void record(struct output *o, struct sim *S, struct diag *d) {
   sim_diag(S, d);
-  const double row[N_SERIES] = {S->t,         d->u_bulk,    S->fx,       d->kinetic_energy,
-                                d->mass,      d->max_speed, d->min_gamma, d->volume,
-                                d->rho_min,   d->rho_max,   S->dt};
+  const double row[N_SERIES] = {S->t,       d->u_bulk,    S->fx,        d->kinetic_energy,
+                                d->mass,    d->max_speed, d->min_gamma, d->volume,
+                                d->rho_min, d->rho_max,   S->dt};
   series_add(&o->ts, row);
 }
 
 static void log_progress(struct output *o, struct sim *S, const struct diag *d) {
   const double now = timer_now();
-  const double rate = now > o->last_wall ? (double)S->P.n_fluid * (S->step - o->last_step) /
-                                               (now - o->last_wall)
-                                         : 0.0;
+  const double rate = now > o->last_wall
+                          ? (double)S->P.n_fluid * (S->step - o->last_step) / (now - o->last_wall)
+                          : 0.0;
   const double done = S->t - o->t0, left = S->sc->t_end - S->t;
   const double eta = done > 0.0 ? (now - o->wall0) * left / done : 0.0;
   const long es = (long)fmax(0.0, eta);
@@ -123,21 +125,30 @@ static int write_stats(struct output *o, const struct sim *S) {
   snprintf(drive, sizeof drive, "%s", scene_choice("drive.mode", sc->drive_mode));
   snprintf(visc, sizeof visc, "%s", scene_choice("sph.viscous", sc->viscous));
   const struct nc_attr attrs[] = {
-      {"dimension", NULL, sc->dim},        {"delta", NULL, sc->delta},
-      {"lx", NULL, sc->lx},                {"lz", NULL, sc->lz},
-      {"dr", NULL, sc->dr},                {"h", NULL, scene_h(sc)},
-      {"nu", NULL, sc->nu},                {"rho0", NULL, sc->rho0},
-      {"c0", NULL, sc->c0},                {"xi", NULL, scene_xi(sc)},
-      {"drive_mode", drive, 0},            {"viscous", visc, 0},
+      {"dimension", NULL, sc->dim},
+      {"delta", NULL, sc->delta},
+      {"lx", NULL, sc->lx},
+      {"lz", NULL, sc->lz},
+      {"dr", NULL, sc->dr},
+      {"h", NULL, scene_h(sc)},
+      {"nu", NULL, sc->nu},
+      {"rho0", NULL, sc->rho0},
+      {"c0", NULL, sc->c0},
+      {"xi", NULL, scene_xi(sc)},
+      {"drive_mode", drive, 0},
+      {"viscous", visc, 0},
       {"u_bulk_target", NULL, sc->drive_mode == DRIVE_FLUX ? sc->u_bulk : NAN},
-      {"body_force", NULL, S->fx},         {"t_average_start", NULL, sc->t_average_start},
-      {"t_end", NULL, sc->t_end},          {"t_reached", NULL, S->t},
-      {"steps", NULL, (double)S->step},    {"n_fluid", NULL, (double)S->P.n_fluid},
+      {"body_force", NULL, S->fx},
+      {"t_average_start", NULL, sc->t_average_start},
+      {"t_end", NULL, sc->t_end},
+      {"t_reached", NULL, S->t},
+      {"steps", NULL, (double)S->step},
+      {"n_fluid", NULL, (double)S->P.n_fluid},
       {"n_snapshots", NULL, (double)o->prof.n_snapshots},
-      {"code_version", CHANSPH_VERSION, 0}, {"scene", o->scene_text, 0},
+      {"code_version", CHANSPH_VERSION, 0},
+      {"scene", o->scene_text, 0},
   };
-  if (ncout_stats(path, &o->prof, &o->ts, attrs, sizeof attrs / sizeof attrs[0], err,
-                  sizeof err)) {
+  if (ncout_stats(path, &o->prof, &o->ts, attrs, sizeof attrs / sizeof attrs[0], err, sizeof err)) {
     error_input("%s", err);
     return CHANSPH_ERR;
   }
@@ -149,8 +160,9 @@ void output_begin(struct output *o, struct sim *S) {
   record(o, S, &d);
   o->wall0 = o->last_wall = timer_now();
   o->t0 = S->t, o->last_step = S->step;
-  logline(o, "chansph %s: %zu fluid + %zu vertex particles, h = %.6g, dt limits: acoustic "
-             "%.3e s, viscous %.3e s; output in %s\n",
+  logline(o,
+          "chansph %s: %zu fluid + %zu vertex particles, h = %.6g, dt limits: acoustic "
+          "%.3e s, viscous %.3e s; output in %s\n",
           CHANSPH_VERSION, S->P.n_fluid, S->P.n_vertex, S->M.h, S->sc->cfl * S->M.h / S->sc->c0,
           S->sc->c_visc * S->M.h * S->M.h / S->sc->nu, o->dir);
   log_progress(o, S, &d);
@@ -192,16 +204,16 @@ static int write_particles(struct output *o, const struct sim *S) {
     for (int c = 0; c < NC; c++) buf[(size_t)c * n + r] = src[c][a];
   }
   static const char *const names[NC] = {"x", "y", "z", "u", "v", "w", "rho", "p", "gamma", "mass"};
-  static const char *const units[NC] = {"m", "m", "m", "m/s", "m/s", "m/s", "kg/m^3", "Pa", "1",
-                                        "kg"};
+  static const char *const units[NC] = {"m",   "m",      "m",  "m/s", "m/s",
+                                        "m/s", "kg/m^3", "Pa", "1",   "kg"};
   const double *cols[NC];
   for (int c = 0; c < NC; c++) cols[c] = buf + (size_t)c * n;
-  const struct nc_attr attrs[] = {{"time", NULL, S->t}, {"step", NULL, (double)S->step},
-                                  {"scene", o->scene_text, 0}};
+  const struct nc_attr attrs[] = {
+      {"time", NULL, S->t}, {"step", NULL, (double)S->step}, {"scene", o->scene_text, 0}};
   char path[4096], err[4096];
   snprintf(path, sizeof path, "%s/particles.nc", o->dir);
-  const int rc = ncout_columns(path, "particle", n, NC, names, units, cols, ids, attrs, 3, err,
-                               sizeof err);
+  const int rc =
+      ncout_columns(path, "particle", n, NC, names, units, cols, ids, attrs, 3, err, sizeof err);
   free(buf), free(ids);
   if (rc) error_input("%s", err);
   return rc ? CHANSPH_ERR : CHANSPH_OK;
@@ -215,8 +227,8 @@ int output_finish(struct output *o, struct sim *S) {
   const double wall = timer_now() - o->wall0;
   TRY(write_stats(o, S));
   if (S->sc->particles) TRY(write_particles(o, S));
-  logline(o, "finished: %ld steps, t = %.6g s in %.2f s wall (%.3e particle-steps/s)\n",
-          S->step, S->t, wall, wall > 0 ? (double)S->P.n_fluid * S->step / wall : 0.0);
+  logline(o, "finished: %ld steps, t = %.6g s in %.2f s wall (%.3e particle-steps/s)\n", S->step,
+          S->t, wall, wall > 0 ? (double)S->P.n_fluid * S->step / wall : 0.0);
   timer_report(stdout, wall);
   if (o->log) timer_report(o->log, wall);
   logline(o, "results: %s/stats.nc%s\n", o->dir, S->sc->particles ? ", particles.nc" : "");

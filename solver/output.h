@@ -14,16 +14,16 @@
 
 /** Output state of a run. */
 struct output {
-  char dir[2048];       /*!< run directory */
-  FILE *log;            /*!< DIR/log.txt */
-  char *scene_text;     /*!< resolved scene */
-  struct profile prof;  /*!< binned profiles over the averaging window */
-  struct series ts;     /*!< time series */
-  double next_write;    /*!< simulated time of the next stats.nc rewrite [s] */
-  double wall0;         /*!< wall clock at the start of the loop [s] */
-  double t0;            /*!< simulated time at the start of the loop [s] */
-  double last_wall;     /*!< wall clock of the last log line [s] */
-  long last_step;       /*!< step of the last log line */
+  char dir[2048];      /*!< run directory */
+  FILE *log;           /*!< DIR/log.txt */
+  char *scene_text;    /*!< resolved scene */
+  struct profile prof; /*!< binned profiles over the averaging window */
+  struct series ts;    /*!< time series */
+  double next_write;   /*!< simulated time of the next stats.nc rewrite [s] */
+  double wall0;        /*!< wall clock at the start of the loop [s] */
+  double t0;           /*!< simulated time at the start of the loop [s] */
+  double last_wall;    /*!< wall clock of the last log line [s] */
+  long last_step;      /*!< step of the last log line */
 };
 
 /**

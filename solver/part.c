@@ -26,8 +26,8 @@ void *part_alloc(const char *label, size_t bytes) {
       allocs[i].label = label, allocs[i].bytes = bytes, allocs[i].ptr = ptr;
       return ptr;
     }
-  if (n_allocs < MAX_LABELS) allocs[n_allocs].label = label, allocs[n_allocs].bytes = bytes,
-                             allocs[n_allocs++].ptr = ptr;
+  if (n_allocs < MAX_LABELS)
+    allocs[n_allocs].label = label, allocs[n_allocs].bytes = bytes, allocs[n_allocs++].ptr = ptr;
   return ptr;
 }
 
@@ -94,9 +94,9 @@ void part_create(struct particles *P, struct walls *W, const struct scene *s) {
 }
 
 void part_destroy(struct particles *P, struct walls *W) {
-  double **d[] = {&P->x, &P->y, &P->z, &P->u, &P->v, &P->w, &P->rho, &P->m, &P->gam,
-                  &P->ksum, &P->ddiff, &P->p, &P->c, &P->pr2, &P->vol, &P->ax, &P->ay, &P->az, &P->tmp,
-                  &W->rho, &W->p};
+  double **d[] = {&P->x,   &P->y,   &P->z,    &P->u,     &P->v,   &P->w,   &P->rho,
+                  &P->m,   &P->gam, &P->ksum, &P->ddiff, &P->p,   &P->c,   &P->pr2,
+                  &P->vol, &P->ax,  &P->ay,   &P->az,    &P->tmp, &W->rho, &W->p};
   for (size_t i = 0; i < sizeof d / sizeof d[0]; i++) part_free(*d[i]), *d[i] = NULL;
   part_free(P->id), part_free(P->kind), part_free(P->tmp_i);
   P->id = NULL, P->kind = NULL, P->tmp_i = NULL;
@@ -110,8 +110,8 @@ static void permute_d(double **arr, double **tmp, const size_t *perm, size_t n) 
 }
 
 void part_permute(struct particles *P, const size_t *perm) {
-  double **arrs[] = {&P->x, &P->y, &P->z, &P->u, &P->v, &P->w, &P->rho, &P->m, &P->gam,
-                     &P->ksum, &P->ddiff};
+  double **arrs[] = {&P->x,   &P->y, &P->z,   &P->u,    &P->v,    &P->w,
+                     &P->rho, &P->m, &P->gam, &P->ksum, &P->ddiff};
   for (size_t i = 0; i < sizeof arrs / sizeof arrs[0]; i++) permute_d(arrs[i], &P->tmp, perm, P->n);
   int64_t *restrict dst = P->tmp_i;
   uint8_t *restrict kind_tmp = (uint8_t *)P->ax; /* ax is scratch between steps */

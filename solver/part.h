@@ -23,20 +23,20 @@ struct particles {
   size_t n_fluid;  /*!< fluid particles */
   size_t n_vertex; /*!< vertex particles (both walls) */
   /* hot, permuted with the particles */
-  double *x, *y, *z;  /*!< position [m] */
-  double *u, *v, *w;  /*!< velocity [m/s] */
-  double *rho;        /*!< density [kg/m^3] */
-  double *m;          /*!< mass [kg] */
-  double *gam;        /*!< renormalisation gamma [-] (fluid) */
-  double *ksum;       /*!< kernel sum S_a = sum_b m_b w_ab at the current positions [kg/m^dim] */
-  double *ddiff;      /*!< volume-diffusion sum D_a of thesis Eq. 3.64 [kg/m^dim/s] */
-  int64_t *id;        /*!< global particle id */
-  uint8_t *kind;      /*!< enum part_kind */
+  double *x, *y, *z; /*!< position [m] */
+  double *u, *v, *w; /*!< velocity [m/s] */
+  double *rho;       /*!< density [kg/m^3] */
+  double *m;         /*!< mass [kg] */
+  double *gam;       /*!< renormalisation gamma [-] (fluid) */
+  double *ksum;      /*!< kernel sum S_a = sum_b m_b w_ab at the current positions [kg/m^dim] */
+  double *ddiff;     /*!< volume-diffusion sum D_a of thesis Eq. 3.64 [kg/m^dim/s] */
+  int64_t *id;       /*!< global particle id */
+  uint8_t *kind;     /*!< enum part_kind */
   /* recomputed every step, not permuted */
-  double *p;          /*!< pressure [Pa] */
-  double *c;          /*!< local speed of sound [m/s] */
-  double *pr2;        /*!< p / rho^2 [m^5/(kg s^2)] */
-  double *vol;        /*!< volume m / rho [m^dim] */
+  double *p;            /*!< pressure [Pa] */
+  double *c;            /*!< local speed of sound [m/s] */
+  double *pr2;          /*!< p / rho^2 [m^5/(kg s^2)] */
+  double *vol;          /*!< volume m / rho [m^dim] */
   double *ax, *ay, *az; /*!< acceleration without the driving force [m/s^2] */
   /* sort scratch */
   double *tmp;
@@ -45,9 +45,9 @@ struct particles {
 
 /** Wall values on the vertex lattice: index (wall * nx + i) * nz + k, wall 0 at y = 0. */
 struct walls {
-  int nx, nz;     /*!< vertices per wall along x and z */
-  double *rho;    /*!< wall density [kg/m^3] */
-  double *p;      /*!< wall pressure [Pa] */
+  int nx, nz;  /*!< vertices per wall along x and z */
+  double *rho; /*!< wall density [kg/m^3] */
+  double *p;   /*!< wall pressure [Pa] */
 };
 
 /**

@@ -54,8 +54,8 @@ static void check_fixed_dt(struct sim *S, double dt) {
   double best = -1.0;
   for (size_t a = 0; a < P->n; a++) {
     if (P->kind[a] != KIND_FLUID) continue;
-    const double ax = P->ax[a] + S->fx, v2 = P->u[a] * P->u[a] + P->v[a] * P->v[a] +
-                                             P->w[a] * P->w[a];
+    const double ax = P->ax[a] + S->fx,
+                 v2 = P->u[a] * P->u[a] + P->v[a] * P->v[a] + P->w[a] * P->w[a];
     const double key = worst == 0 ? v2 : ax * ax + P->ay[a] * P->ay[a] + P->az[a] * P->az[a];
     if (key > best || (key == best && P->id[a] < P->id[who])) best = key, who = a;
   }

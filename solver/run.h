@@ -31,13 +31,13 @@ struct sim {
 
 /** Global diagnostics of the current state (all fluid particles). */
 struct diag {
-  double u_bulk;          /*!< volume-weighted mean streamwise velocity [m/s] */
-  double kinetic_energy;  /*!< sum of m |v|^2 / 2 [J, or J/m in 2-D] */
-  double mass;            /*!< sum of m [kg] */
-  double volume;          /*!< sum of m / rho [m^dim] */
-  double rho_min, rho_max;/*!< density range [kg/m^3] */
-  double max_speed;       /*!< [m/s] */
-  double min_gamma;       /*!< [-] */
+  double u_bulk;           /*!< volume-weighted mean streamwise velocity [m/s] */
+  double kinetic_energy;   /*!< sum of m |v|^2 / 2 [J, or J/m in 2-D] */
+  double mass;             /*!< sum of m [kg] */
+  double volume;           /*!< sum of m / rho [m^dim] */
+  double rho_min, rho_max; /*!< density range [kg/m^3] */
+  double max_speed;        /*!< [m/s] */
+  double min_gamma;        /*!< [-] */
 };
 
 /**

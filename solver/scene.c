@@ -20,8 +20,8 @@ enum { REQUIRED = 1, LO_OPEN = 2 };
 struct key {
   const char *section, *name;
   enum key_type type;
-  const char *def;     /*!< default as text; NULL for required keys */
-  double lo, hi;       /*!< allowed range (inclusive unless LO_OPEN) */
+  const char *def; /*!< default as text; NULL for required keys */
+  double lo, hi;   /*!< allowed range (inclusive unless LO_OPEN) */
   int flags;
   const char *choices; /*!< "a|b|c" for T_CHOICE; the value stored is the index */
   const char *unit, *help;
@@ -149,10 +149,10 @@ enum { N_KEYS = sizeof keys / sizeof keys[0] };
 struct parse_state {
   struct scene *s;
   const char *file;
-  int line;            /*!< current line, counted by the reader */
-  int where[N_KEYS];   /*!< 0 = default, >0 = file line, -1 = --set */
-  int seen[N_KEYS];    /*!< given with an invalid value */
-  const char *set_text;/*!< the --set argument being applied */
+  int line;             /*!< current line, counted by the reader */
+  int where[N_KEYS];    /*!< 0 = default, >0 = file line, -1 = --set */
+  int seen[N_KEYS];     /*!< given with an invalid value */
+  const char *set_text; /*!< the --set argument being applied */
   int errors;
   FILE *fp;
 };
@@ -202,8 +202,7 @@ static const char *set_value(struct scene *s, int k, const char *text) {
   if (end == text || *end != '\0') return "is not a number";
   if (!isfinite(v)) return "is not finite";
   if (K->type != T_DOUBLE && v != floor(v)) return "is not an integer";
-  if (v < K->lo || v > K->hi || ((K->flags & LO_OPEN) && v == K->lo))
-    return "is out of range";
+  if (v < K->lo || v > K->hi || ((K->flags & LO_OPEN) && v == K->lo)) return "is out of range";
   if (K->type == T_INT)
     *(int *)field = (int)v;
   else if (K->type == T_LONG)
@@ -229,13 +228,13 @@ static void report_value(struct parse_state *ps, int k, int where, const char *v
   char loc[600], range[128];
   location(ps, where, loc, sizeof loc);
   range_text(&keys[k], range, sizeof range);
-  error_input("%s: key '%s.%s': value '%s' %s (allowed: %s %s)", loc, keys[k].section,
-              keys[k].name, value, why, range, keys[k].unit);
+  error_input("%s: key '%s.%s': value '%s' %s (allowed: %s %s)", loc, keys[k].section, keys[k].name,
+              value, why, range, keys[k].unit);
   ps->errors++;
 }
 
-static int apply(struct parse_state *ps, const char *section, const char *name,
-                 const char *value, int where) {
+static int apply(struct parse_state *ps, const char *section, const char *name, const char *value,
+                 int where) {
   char loc[600];
   location(ps, where, loc, sizeof loc);
   const int k = find_key(section, name);
@@ -243,8 +242,7 @@ static int apply(struct parse_state *ps, const char *section, const char *name,
     if (!known_section(section))
       error_input("%s: unknown section [%s] (key '%s')", loc, section, name);
     else
-      error_input("%s: unknown key '%s' in section [%s] (see docs/scenes.md)", loc, name,
-                  section);
+      error_input("%s: unknown key '%s' in section [%s] (see docs/scenes.md)", loc, name, section);
     ps->errors++;
     return 0;
   }
@@ -299,8 +297,7 @@ static void validate(struct parse_state *ps) {
   const struct scene *s = ps->s;
   const double h = scene_h(s), two_delta = 2.0 * s->delta;
   if (!is_multiple(two_delta, s->dr))
-    inconsistent(ps, "domain.delta", "2 delta = %g is not a multiple of dr = %g", two_delta,
-                 s->dr);
+    inconsistent(ps, "domain.delta", "2 delta = %g is not a multiple of dr = %g", two_delta, s->dr);
   else if (two_delta / s->dr < 4.0 - 1e-9)
     inconsistent(ps, "domain.delta", "2 delta = %g must be at least 4 dr = %g", two_delta,
                  4.0 * s->dr);
@@ -315,11 +312,10 @@ static void validate(struct parse_state *ps) {
     else if (!is_multiple(s->lz, s->dr))
       inconsistent(ps, "domain.lz", "lz = %g is not a multiple of dr = %g", s->lz, s->dr);
     else if (s->lz < 6.0 * h * (1.0 - 1e-12))
-      inconsistent(ps, "domain.lz", "lz = %g is shorter than 3 kernel supports (6h = %g)",
-                   s->lz, 6.0 * h);
+      inconsistent(ps, "domain.lz", "lz = %g is shorter than 3 kernel supports (6h = %g)", s->lz,
+                   6.0 * h);
   } else if (s->lz != 0.0) {
-    inconsistent(ps, "domain.lz", "lz = %g is given for a 2-D scene (dimension = %g)", s->lz,
-                 2.0);
+    inconsistent(ps, "domain.lz", "lz = %g is given for a 2-D scene (dimension = %g)", s->lz, 2.0);
   }
   if (s->drive_mode == DRIVE_FLUX && s->u_bulk == 0.0)
     inconsistent(ps, "drive.mode", "flux mode needs drive.u_bulk != 0 (got %g)%.0s", s->u_bulk,
@@ -328,8 +324,7 @@ static void validate(struct parse_state *ps) {
     inconsistent(ps, "output.t_average_start", "averaging start %g is after t_end = %g",
                  s->t_average_start, s->t_end);
   if (s->dt_fixed > 0.0 && s->dt_fixed > s->t_end)
-    inconsistent(ps, "time.dt", "fixed dt = %g is larger than t_end = %g", s->dt_fixed,
-                 s->t_end);
+    inconsistent(ps, "time.dt", "fixed dt = %g is larger than t_end = %g", s->dt_fixed, s->t_end);
 }
 
 int scene_load(struct scene *s, const char *path, int n_set, char *const *set) {
@@ -375,7 +370,9 @@ int scene_load(struct scene *s, const char *path, int n_set, char *const *set) {
   return ps.errors ? CHANSPH_ERR : CHANSPH_OK;
 }
 
-double scene_h(const struct scene *s) { return s->h_over_dr * s->dr; }
+double scene_h(const struct scene *s) {
+  return s->h_over_dr * s->dr;
+}
 
 double scene_xi(const struct scene *s) {
   return s->xi > 0.0 ? s->xi : 1000.0 * s->dr / (2.0 * s->delta);
@@ -406,9 +403,15 @@ const char *scene_choice(const char *key, int value) {
 static void value_text(const struct scene *s, int k, char *buf, size_t n) {
   const void *field = (const char *)s + keys[k].offset;
   switch (keys[k].type) {
-    case T_INT: snprintf(buf, n, "%d", *(const int *)field); break;
-    case T_LONG: snprintf(buf, n, "%ld", *(const long *)field); break;
-    case T_DOUBLE: snprintf(buf, n, "%.17g", *(const double *)field); break;
+    case T_INT:
+      snprintf(buf, n, "%d", *(const int *)field);
+      break;
+    case T_LONG:
+      snprintf(buf, n, "%ld", *(const long *)field);
+      break;
+    case T_DOUBLE:
+      snprintf(buf, n, "%.17g", *(const double *)field);
+      break;
     case T_CHOICE: {
       char key[80];
       snprintf(key, sizeof key, "%s.%s", keys[k].section, keys[k].name);
@@ -459,7 +462,8 @@ void scene_write_doc(FILE *f) {
   for (int k = 0; k < N_KEYS; k++) {
     if (strcmp(section, keys[k].section)) {
       section = keys[k].section;
-      fprintf(f, "\n## [%s]\n\n| key | default | allowed | unit | meaning |\n|---|---|---|---|---|\n",
+      fprintf(f,
+              "\n## [%s]\n\n| key | default | allowed | unit | meaning |\n|---|---|---|---|---|\n",
               section);
     }
     char range[128];

@@ -18,56 +18,56 @@ enum init_profile { INIT_REST = 0, INIT_LAMINAR = 1 };
 /** Every parameter of a run, with units. Derived quantities are marked. */
 struct scene {
   /* [domain] */
-  int dim;            /*!< 2 or 3 */
-  double delta;       /*!< channel half-width [m]; walls at y = 0 and y = 2 delta */
-  double lx;          /*!< periodic length in x [m] */
-  double lz;          /*!< periodic length in z [m] (3-D) */
-  double dr;          /*!< initial particle spacing [m] */
+  int dim;      /*!< 2 or 3 */
+  double delta; /*!< channel half-width [m]; walls at y = 0 and y = 2 delta */
+  double lx;    /*!< periodic length in x [m] */
+  double lz;    /*!< periodic length in z [m] (3-D) */
+  double dr;    /*!< initial particle spacing [m] */
   /* [sph] */
-  double h_over_dr;   /*!< smoothing length over spacing [-] */
-  double xi;          /*!< volume-diffusion constant [-]; 0 selects 1000 dr / (2 delta) */
-  double wall_dmin;   /*!< delta r of Eq. 2.148 over dr [-] */
-  double eta2;        /*!< regularisation of 1/r^2 in the viscous term, over h^2 [-] */
-  int viscous;        /*!< enum viscous_form */
-  int lap_norm;       /*!< enum laplacian_norm */
-  int wall_weight;    /*!< enum wall_weight */
+  double h_over_dr; /*!< smoothing length over spacing [-] */
+  double xi;        /*!< volume-diffusion constant [-]; 0 selects 1000 dr / (2 delta) */
+  double wall_dmin; /*!< delta r of Eq. 2.148 over dr [-] */
+  double eta2;      /*!< regularisation of 1/r^2 in the viscous term, over h^2 [-] */
+  int viscous;      /*!< enum viscous_form */
+  int lap_norm;     /*!< enum laplacian_norm */
+  int wall_weight;  /*!< enum wall_weight */
   /* [fluid] */
-  double nu;          /*!< kinematic viscosity [m^2/s] */
-  double rho0;        /*!< reference density [kg/m^3] */
-  double c0;          /*!< numerical speed of sound [m/s] */
-  double zeta;        /*!< Tait exponent [-] */
-  double p_background;/*!< background pressure over rho0 c0^2 [-] */
-  double gravity_y;   /*!< wall-normal body acceleration [m/s^2] */
+  double nu;           /*!< kinematic viscosity [m^2/s] */
+  double rho0;         /*!< reference density [kg/m^3] */
+  double c0;           /*!< numerical speed of sound [m/s] */
+  double zeta;         /*!< Tait exponent [-] */
+  double p_background; /*!< background pressure over rho0 c0^2 [-] */
+  double gravity_y;    /*!< wall-normal body acceleration [m/s^2] */
   /* [drive] */
-  int drive_mode;     /*!< enum drive_mode */
-  double force;       /*!< body acceleration along x in force mode [m/s^2] */
-  double u_bulk;      /*!< target bulk velocity in flux mode [m/s] */
-  int controller;     /*!< enum flux_controller */
+  int drive_mode; /*!< enum drive_mode */
+  double force;   /*!< body acceleration along x in force mode [m/s^2] */
+  double u_bulk;  /*!< target bulk velocity in flux mode [m/s] */
+  int controller; /*!< enum flux_controller */
   /* [time] */
-  double t_end;       /*!< end time [s] */
-  double dt_fixed;    /*!< fixed time step [s]; 0 = adaptive */
-  double cfl;         /*!< CFL factor of Eq. 2.160 [-] */
-  double c_visc;      /*!< factor of Eq. 2.161 [-] */
-  double c_force;     /*!< factor of Eq. 2.162 [-] */
-  double c_gamma;     /*!< factor of Eq. 2.163 [-]; 0 disables */
-  long max_steps;     /*!< stop after this many steps (0 = no limit) */
+  double t_end;    /*!< end time [s] */
+  double dt_fixed; /*!< fixed time step [s]; 0 = adaptive */
+  double cfl;      /*!< CFL factor of Eq. 2.160 [-] */
+  double c_visc;   /*!< factor of Eq. 2.161 [-] */
+  double c_force;  /*!< factor of Eq. 2.162 [-] */
+  double c_gamma;  /*!< factor of Eq. 2.163 [-]; 0 disables */
+  long max_steps;  /*!< stop after this many steps (0 = no limit) */
   /* [init] */
-  int init_profile;   /*!< enum init_profile */
+  int init_profile; /*!< enum init_profile */
   /* [output] */
-  int log_every;      /*!< steps between log lines */
-  int series_every;   /*!< steps between time-series records */
-  int stats_every;    /*!< steps between statistics samples */
-  double write_every; /*!< simulated seconds between stats.nc rewrites; 0 = only at the end */
+  int log_every;          /*!< steps between log lines */
+  int series_every;       /*!< steps between time-series records */
+  int stats_every;        /*!< steps between statistics samples */
+  double write_every;     /*!< simulated seconds between stats.nc rewrites; 0 = only at the end */
   double t_average_start; /*!< start of the averaging window [s] */
-  int n_bins;         /*!< wall-normal bins; 0 = 2 delta / dr - 1 */
-  int particles;      /*!< write the final particle state to particles.nc (1) or not (0) */
+  int n_bins;             /*!< wall-normal bins; 0 = 2 delta / dr - 1 */
+  int particles;          /*!< write the final particle state to particles.nc (1) or not (0) */
   /* [health] */
-  int health_every;   /*!< steps between full health checks */
+  int health_every; /*!< steps between full health checks */
   /* [run] */
-  int threads;        /*!< OpenMP threads; 0 = OMP_NUM_THREADS / all */
+  int threads; /*!< OpenMP threads; 0 = OMP_NUM_THREADS / all */
 
   /* bookkeeping, not keys */
-  char path[512];     /*!< scene file path */
+  char path[512]; /*!< scene file path */
 };
 
 /**

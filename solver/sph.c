@@ -39,8 +39,7 @@ static inline double channel_gamma(const struct model *M, double y) {
   return wall_gamma(M->dim, y * ih) + wall_gamma(M->dim, (M->ly - y) * ih) - 1.0;
 }
 
-void sph_density(const struct model *M, struct particles *P, const double *ksum_new,
-                 double dt) {
+void sph_density(const struct model *M, struct particles *P, const double *ksum_new, double dt) {
   timer_push("density");
   const double *restrict y = P->y, *restrict m = P->m;
   const uint8_t *restrict kind = P->kind;
@@ -48,8 +47,7 @@ void sph_density(const struct model *M, struct particles *P, const double *ksum_
   for (size_t a = 0; a < P->n; a++) {
     if (kind[a] != KIND_FLUID) continue;
     const double s = ksum_new[a], gam = channel_gamma(M, y[a]);
-    if (dt > 0.0)
-      P->rho[a] = (P->gam[a] * P->rho[a] + s - P->ksum[a] + dt * P->ddiff[a]) / gam;
+    if (dt > 0.0) P->rho[a] = (P->gam[a] * P->rho[a] + s - P->ksum[a] + dt * P->ddiff[a]) / gam;
     P->ksum[a] = s;
     P->gam[a] = gam;
     const double r = P->rho[a], pa = eos_pressure(&M->e, r);
@@ -59,8 +57,7 @@ void sph_density(const struct model *M, struct particles *P, const double *ksum_
   timer_pop();
 }
 
-void sph_walls(const struct model *M, struct particles *P, const struct nbr *nb,
-               struct walls *W) {
+void sph_walls(const struct model *M, struct particles *P, const struct nbr *nb, struct walls *W) {
   timer_push("walls");
   const struct kernel *K = &M->k;
   const double *restrict x = P->x, *restrict y = P->y, *restrict z = P->z, *restrict m = P->m;

@@ -14,25 +14,25 @@
 
 /** Constants of the discretisation, derived once from the scene. */
 struct model {
-  int dim;            /*!< 2 or 3 */
-  int viscous;        /*!< enum viscous_form */
-  struct kernel k;    /*!< Wendland kernel */
-  struct eos e;       /*!< Tait equation of state */
-  double lx, ly, lz;  /*!< domain [m]; ly = 2 delta */
-  double dr, h;       /*!< spacing and smoothing length [m] */
-  double nu;          /*!< kinematic viscosity [m^2/s] */
-  double inv_xi;      /*!< 1 / xi of the volume diffusion [-] */
-  double gy;          /*!< wall-normal body acceleration [m/s^2] */
-  double wall_dmin;   /*!< delta r of Eq. 2.148 [m] */
-  double eta2;        /*!< regularisation of r^2 in the viscous term [m^2] */
-  int lap_norm;       /*!< enum laplacian_norm */
-  int wall_weight;    /*!< enum wall_weight: weight of the wall shear term */
+  int dim;           /*!< 2 or 3 */
+  int viscous;       /*!< enum viscous_form */
+  struct kernel k;   /*!< Wendland kernel */
+  struct eos e;      /*!< Tait equation of state */
+  double lx, ly, lz; /*!< domain [m]; ly = 2 delta */
+  double dr, h;      /*!< spacing and smoothing length [m] */
+  double nu;         /*!< kinematic viscosity [m^2/s] */
+  double inv_xi;     /*!< 1 / xi of the volume diffusion [-] */
+  double gy;         /*!< wall-normal body acceleration [m/s^2] */
+  double wall_dmin;  /*!< delta r of Eq. 2.148 [m] */
+  double eta2;       /*!< regularisation of r^2 in the viscous term [m^2] */
+  int lap_norm;      /*!< enum laplacian_norm */
+  int wall_weight;   /*!< enum wall_weight: weight of the wall shear term */
 };
 
 /** Per-step maxima from the force pass, for the time-step limits. */
 struct force_info {
-  double amax;        /*!< max |a| including the body forces [m/s^2] */
-  double gvmax;       /*!< max over particles and walls of |grad gamma_as . v_a| [1/s] */
+  double amax;  /*!< max |a| including the body forces [m/s^2] */
+  double gvmax; /*!< max over particles and walls of |grad gamma_as . v_a| [1/s] */
 };
 
 /** @brief Derive the model constants from the scene. */
@@ -58,8 +58,7 @@ void sph_density(const struct model *M, struct particles *P, const double *ksum_
  * @param[in] nb neighbour list
  * @param[out] W wall lattice values
  */
-void sph_walls(const struct model *M, struct particles *P, const struct nbr *nb,
-               struct walls *W);
+void sph_walls(const struct model *M, struct particles *P, const struct nbr *nb, struct walls *W);
 
 /**
  * @brief Accelerations of the fluid particles (pressure gradient Grad^{gamma,1} of thesis

@@ -60,7 +60,7 @@ static inline double wall_dgamma(const int dim, const double q) {
   const double q2 = q * q, q4 = q2 * q2;
   const double s = sqrt(4.0 - q2);
   if (q > 1.5) { /* the closed form cancels to (2 - q)^4.5 here: integrate along the line */
-    static const double t[12] = {0.009219682876640378, 0.0479413718147626, 0.11504866290284765,
+    static const double t[12] = {0.009219682876640378, 0.0479413718147626,  0.11504866290284765,
                                  0.20634102285669126,  0.31608425050090994, 0.43738329574426554,
                                  0.5626167042557344,   0.6839157494990901,  0.7936589771433087,
                                  0.8849513370971523,   0.9520586281852375,  0.9907803171233596};

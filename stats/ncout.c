@@ -9,24 +9,23 @@
 #include <unistd.h>
 
 /* On any netCDF failure: record the message, close, remove the temporary file, return 1. */
-#define NC(call)                                                                  \
-  do {                                                                            \
-    const int nc_rc_ = (call);                                                    \
-    if (nc_rc_ != NC_NOERR) {                                                     \
+#define NC(call)                                                                             \
+  do {                                                                                       \
+    const int nc_rc_ = (call);                                                               \
+    if (nc_rc_ != NC_NOERR) {                                                                \
       snprintf(err, errlen, "cannot write %s: %s (in %s)", tmp, nc_strerror(nc_rc_), #call); \
-      if (ncid >= 0) nc_close(ncid);                                              \
-      remove(tmp);                                                                \
-      return 1;                                                                   \
-    }                                                                             \
+      if (ncid >= 0) nc_close(ncid);                                                         \
+      remove(tmp);                                                                           \
+      return 1;                                                                              \
+    }                                                                                        \
   } while (0)
 
 static int put_attrs(int ncid, const struct nc_attr *attrs, int nattrs) {
   for (int i = 0; i < nattrs; i++) {
-    const int rc = attrs[i].text
-                       ? nc_put_att_text(ncid, NC_GLOBAL, attrs[i].name, strlen(attrs[i].text),
-                                         attrs[i].text)
-                       : nc_put_att_double(ncid, NC_GLOBAL, attrs[i].name, NC_DOUBLE, 1,
-                                           &attrs[i].value);
+    const int rc =
+        attrs[i].text
+            ? nc_put_att_text(ncid, NC_GLOBAL, attrs[i].name, strlen(attrs[i].text), attrs[i].text)
+            : nc_put_att_double(ncid, NC_GLOBAL, attrs[i].name, NC_DOUBLE, 1, &attrs[i].value);
     if (rc != NC_NOERR) return rc;
   }
   return NC_NOERR;
@@ -130,10 +129,9 @@ int ncout_stats(const char *path, const struct profile *pr, const struct series 
   return commit(tmp, path, err, errlen);
 }
 
-int ncout_columns(const char *path, const char *dim, size_t n, int ncol,
-                  const char *const *names, const char *const *units, const double *const *cols,
-                  const long long *ids, const struct nc_attr *attrs, int nattrs, char *err,
-                  size_t errlen) {
+int ncout_columns(const char *path, const char *dim, size_t n, int ncol, const char *const *names,
+                  const char *const *units, const double *const *cols, const long long *ids,
+                  const struct nc_attr *attrs, int nattrs, char *err, size_t errlen) {
   char tmp[4096];
   snprintf(tmp, sizeof tmp, "%s.tmp", path);
   int ncid = -1, d, vid = -1;

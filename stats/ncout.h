@@ -44,9 +44,8 @@ int ncout_stats(const char *path, const struct profile *pr, const struct series 
  * @param[out] err,errlen message on failure
  * @return 0 on success
  */
-int ncout_columns(const char *path, const char *dim, size_t n, int ncol,
-                  const char *const *names, const char *const *units, const double *const *cols,
-                  const long long *ids, const struct nc_attr *attrs, int nattrs, char *err,
-                  size_t errlen);
+int ncout_columns(const char *path, const char *dim, size_t n, int ncol, const char *const *names,
+                  const char *const *units, const double *const *cols, const long long *ids,
+                  const struct nc_attr *attrs, int nattrs, char *err, size_t errlen);
 
 #endif

@@ -30,8 +30,8 @@ void profile_free(struct profile *pr) {
   memset(pr, 0, sizeof *pr);
 }
 
-void profile_add(struct profile *pr, size_t n, const double *y, const double *u,
-                 const double *v, const double *w, const uint8_t *skip) {
+void profile_add(struct profile *pr, size_t n, const double *y, const double *u, const double *v,
+                 const double *w, const uint8_t *skip) {
   const double scale = pr->nb / (pr->y1 - pr->y0);
   for (size_t i = 0; i < n; i++) {
     if (skip && skip[i]) continue;

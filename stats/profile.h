@@ -13,12 +13,12 @@
 
 /** Time- and plane-averaged profiles over wall-normal bins. */
 struct profile {
-  int nb;            /*!< number of bins */
-  double y0, y1;     /*!< range of the uniform bins [m] */
+  int nb;                        /*!< number of bins */
+  double y0, y1;                 /*!< range of the uniform bins [m] */
   double *sum_u, *sum_v, *sum_w; /*!< sums of velocity samples per bin [m/s] */
-  double *sum_y;     /*!< sum of sample positions per bin [m] */
-  int64_t *count;    /*!< samples per bin */
-  long n_snapshots;  /*!< snapshots accumulated */
+  double *sum_y;                 /*!< sum of sample positions per bin [m] */
+  int64_t *count;                /*!< samples per bin */
+  long n_snapshots;              /*!< snapshots accumulated */
 };
 
 /**
@@ -40,8 +40,8 @@ void profile_free(struct profile *pr);
  * @param[in] y,u,v,w position and velocity arrays
  * @param[in] skip per-particle flag, nonzero = not sampled (may be NULL)
  */
-void profile_add(struct profile *pr, size_t n, const double *y, const double *u,
-                 const double *v, const double *w, const uint8_t *skip);
+void profile_add(struct profile *pr, size_t n, const double *y, const double *u, const double *v,
+                 const double *w, const uint8_t *skip);
 
 /** @brief Centre of bin i [m]. */
 double profile_centre(const struct profile *pr, int i);

@@ -118,8 +118,8 @@ int main(int argc, char **argv) {
                w_edge, f_edge);
         support_bad++, fail = 1;
       }
-      const double outside[] = {nextafter(2.0 * h, INFINITY), 2.0 * h * (1.0 + 1e-12),
-                                2.5 * h, 4.0 * h, 1e3 * h};
+      const double outside[] = {nextafter(2.0 * h, INFINITY), 2.0 * h * (1.0 + 1e-12), 2.5 * h,
+                                4.0 * h, 1e3 * h};
       for (size_t i = 0; i < sizeof outside / sizeof outside[0]; i++) {
         const double w = kernel_w(&k, outside[i]), f = kernel_f(&k, outside[i]);
         if (w != 0.0 || f != 0.0) {

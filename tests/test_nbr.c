@@ -34,7 +34,9 @@ static double lcg_uniform(void) {
 }
 
 /** Minimum-image separation for |d| <= 2.5 l. */
-static double min_image(double d, double l) { return d - l * nearbyint(d / l); }
+static double min_image(double d, double l) {
+  return d - l * nearbyint(d / l);
+}
 
 static int cmp_i64(const void *a, const void *b) {
   const int64_t x = *(const int64_t *)a, y = *(const int64_t *)b;
@@ -50,13 +52,13 @@ struct snapshot {
 };
 
 static double **field(struct particles *P, int j) {
-  double **f[] = {&P->x, &P->y, &P->z, &P->u, &P->v, &P->w,
+  double **f[] = {&P->x,   &P->y, &P->z,   &P->u,    &P->v,    &P->w,
                   &P->rho, &P->m, &P->gam, &P->ksum, &P->ddiff};
   return f[j];
 }
 
-static int check_round(const char *name0, int round, const struct scene *sc,
-                       struct particles *P, struct nbr *nb);
+static int check_round(const char *name0, int round, const struct scene *sc, struct particles *P,
+                       struct nbr *nb);
 
 /** Run one scene; returns the number of failures. */
 static int run_case(const char *name, int n_set, char **set) {
@@ -100,8 +102,8 @@ static int run_case(const char *name, int n_set, char **set) {
  * in round 1, so that particles change cell and the per-cell id sort has work to do), sort,
  * build and check everything. Returns the number of failures.
  */
-static int check_round(const char *name0, int round, const struct scene *sc,
-                       struct particles *P, struct nbr *nb) {
+static int check_round(const char *name0, int round, const struct scene *sc, struct particles *P,
+                       struct nbr *nb) {
   const struct scene s = *sc;
   char name[128];
   snprintf(name, sizeof name, "%s, round %d", name0, round);
@@ -119,7 +121,7 @@ static int check_round(const char *name0, int round, const struct scene *sc,
     P->y[a] += 0.4 * dr * (2.0 * lcg_uniform() - 1.0);
     if (s.dim == 3) P->z[a] += 0.4 * dr * (2.0 * lcg_uniform() - 1.0);
     if (a % 5 == 0) {
-      const int k = (int)(lcg_uniform() * 4.0) - 2;       /* -2 .. 1 */
+      const int k = (int)(lcg_uniform() * 4.0) - 2;        /* -2 .. 1 */
       const double periods = (double)(k >= 0 ? k + 1 : k); /* -2, -1, 1, 2 */
       P->x[a] += periods * lx;
       if (s.dim == 3 && a % 10 == 0) P->z[a] -= periods * lz;
@@ -165,16 +167,18 @@ static int check_round(const char *name0, int round, const struct scene *sc,
         if (!(now >= 0.0 && now <= l) || err > 1e-12 * l) pos_bad++;
         if (now == l) at_l++;
       } else if (now != was) {
-        if (j <= 2) pos_bad++;
-        else arr_bad++;
+        if (j <= 2)
+          pos_bad++;
+        else
+          arr_bad++;
       }
     }
     if (P->kind[i] != snap.kind[id]) arr_bad++;
   }
   free(seen);
   if (pos_bad || arr_bad) {
-    printf("FAIL: %s: %zu positions and %zu other values did not move with their particle\n",
-           name, pos_bad, arr_bad);
+    printf("FAIL: %s: %zu positions and %zu other values did not move with their particle\n", name,
+           pos_bad, arr_bad);
     fails++;
   }
 
@@ -209,8 +213,7 @@ static int check_round(const char *name0, int round, const struct scene *sc,
     if (e > ksum_err) ksum_err = e;
   }
   free(ksum);
-  printf("%s: kernel sums against brute force: max rel error %.3e (tol 1e-13)\n", name,
-         ksum_err);
+  printf("%s: kernel sums against brute force: max rel error %.3e (tol 1e-13)\n", name, ksum_err);
   if (!(ksum_err <= 1e-13)) fails++;
 
   /* --- neighbour sets against brute force */
@@ -251,9 +254,10 @@ static int check_round(const char *name0, int round, const struct scene *sc,
     int same = ng == nw;
     for (size_t k = 0; same && k < ng; k++) same = got[k] == want[k];
     if (!same) {
-      printf("FAIL: %s: particle id %lld at (%g, %g, %g): %zu neighbours listed, %zu by brute "
-             "force\n",
-             name, (long long)P->id[a], P->x[a], P->y[a], P->z[a], ng, nw);
+      printf(
+          "FAIL: %s: particle id %lld at (%g, %g, %g): %zu neighbours listed, %zu by brute "
+          "force\n",
+          name, (long long)P->id[a], P->x[a], P->y[a], P->z[a], ng, nw);
       set_bad++;
     }
     if (nw > max_nbr) max_nbr = nw;
@@ -271,8 +275,10 @@ static int check_round(const char *name0, int round, const struct scene *sc,
   const int threads = omp_get_max_threads();
   size_t repeat_bad = 0;
   for (int variant = 0; variant < 2; variant++) {
-    if (variant == 0) omp_set_num_threads(1);
-    else nb->stride = 3; /* smaller than the allocation: nbr_build must detect and grow */
+    if (variant == 0)
+      omp_set_num_threads(1);
+    else
+      nb->stride = 3; /* smaller than the allocation: nbr_build must detect and grow */
     double *ks = calloc(n, sizeof *ks);
     nbr_build(nb, P, &K, ks);
     free(ks);
@@ -290,8 +296,7 @@ static int check_round(const char *name0, int round, const struct scene *sc,
   const int grown_stride = nb->stride;
   free(list0), free(count0);
   if (repeat_bad) {
-    printf("FAIL: %s: %zu differences with 1 thread or after growing the list\n", name,
-           repeat_bad);
+    printf("FAIL: %s: %zu differences with 1 thread or after growing the list\n", name, repeat_bad);
     fails++;
   }
 
@@ -307,15 +312,17 @@ static int check_round(const char *name0, int round, const struct scene *sc,
     fails++;
   }
 
-  printf("nbr %s: n = %zu (%zu fluid), cells %dx%dx%d (size/2h %.6f %.6f %.6f), "
-         "neighbours mean %.2f max %zu, stride %d -> %d after forced growth\n",
-         name, n, P->n_fluid, nb->nx, nb->ny, nb->nz, lx / nb->nx / (2.0 * h), ly / nb->ny / (2.0 * h),
-         s.dim == 3 ? lz / nb->nz / (2.0 * h) : 0.0, (double)total / (double)n, max_nbr, stride0,
-         grown_stride);
-  printf("nbr %s: neighbour-set mismatches %zu, order errors %zu, unmoved values %zu, "
-         "max wrap error %.3e, x at l: %zu, pairs within 1e-12 of 2h: %zu, %s\n",
-         name, set_bad, order_bad, pos_bad + arr_bad, max_shift_err, at_l, ambiguous,
-         fails ? "FAILED" : "ok");
+  printf(
+      "nbr %s: n = %zu (%zu fluid), cells %dx%dx%d (size/2h %.6f %.6f %.6f), "
+      "neighbours mean %.2f max %zu, stride %d -> %d after forced growth\n",
+      name, n, P->n_fluid, nb->nx, nb->ny, nb->nz, lx / nb->nx / (2.0 * h), ly / nb->ny / (2.0 * h),
+      s.dim == 3 ? lz / nb->nz / (2.0 * h) : 0.0, (double)total / (double)n, max_nbr, stride0,
+      grown_stride);
+  printf(
+      "nbr %s: neighbour-set mismatches %zu, order errors %zu, unmoved values %zu, "
+      "max wrap error %.3e, x at l: %zu, pairs within 1e-12 of 2h: %zu, %s\n",
+      name, set_bad, order_bad, pos_bad + arr_bad, max_shift_err, at_l, ambiguous,
+      fails ? "FAILED" : "ok");
 
   for (int j = 0; j < N_FIELDS; j++) free(snap.d[j]);
   free(snap.kind);
@@ -325,18 +332,18 @@ static int check_round(const char *name0, int round, const struct scene *sc,
 int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
   int fails = 0;
-  char *base2[] = {"domain.dimension=2", "domain.lx=1.0", "domain.dr=0.05", "fluid.nu=0.1",
-                   "fluid.c0=10", "time.t_end=1"};
+  char *base2[] = {"domain.dimension=2", "domain.lx=1.0", "domain.dr=0.05",
+                   "fluid.nu=0.1",       "fluid.c0=10",   "time.t_end=1"};
   fails += run_case("2-D lx=1", 6, base2);
-  char *narrow2[] = {"domain.dimension=2", "domain.lx=0.4", "domain.dr=0.05",
-                     "domain.delta=0.1", "fluid.nu=0.1", "fluid.c0=10", "time.t_end=1"};
+  char *narrow2[] = {"domain.dimension=2", "domain.lx=0.4", "domain.dr=0.05", "domain.delta=0.1",
+                     "fluid.nu=0.1",       "fluid.c0=10",   "time.t_end=1"};
   fails += run_case("2-D narrow (one cell in y)", 7, narrow2);
   char *base3[] = {"domain.dimension=3", "domain.lx=0.4", "domain.lz=0.4", "domain.dr=0.05",
-                   "fluid.nu=0.1", "fluid.c0=10", "time.t_end=1"};
+                   "fluid.nu=0.1",       "fluid.c0=10",   "time.t_end=1"};
   fails += run_case("3-D 8x19x8", 7, base3);
-  char *wide3[] = {"domain.dimension=3", "domain.lx=0.6", "domain.lz=0.5", "domain.dr=0.05",
-                   "domain.delta=0.4", "sph.h_over_dr=1.6", "fluid.nu=0.1", "fluid.c0=10",
-                   "time.t_end=1"};
+  char *wide3[] = {"domain.dimension=3", "domain.lx=0.6",    "domain.lz=0.5",
+                   "domain.dr=0.05",     "domain.delta=0.4", "sph.h_over_dr=1.6",
+                   "fluid.nu=0.1",       "fluid.c0=10",      "time.t_end=1"};
   fails += run_case("3-D h=1.6dr", 9, wide3);
   printf("%s\n", fails ? "test_nbr: FAILED" : "test_nbr: passed");
   MPI_Finalize();

@@ -51,16 +51,17 @@ static int check(const char *what, const double *x, size_t n, double *max_rel) {
       fails++;
     }
   const long double ref = kahan(x, n);
-  const double rel = ref != 0.0L ? (double)(fabsl((long double)s[0] - ref) / fabsl(ref))
-                                 : fabs(s[0]);
+  const double rel =
+      ref != 0.0L ? (double)(fabsl((long double)s[0] - ref) / fabsl(ref)) : fabs(s[0]);
   if (rel > *max_rel) *max_rel = rel;
   if (!(rel <= 1e-13)) {
     printf("FAIL: %s: sum %.17g, Kahan %.17Lg, rel %.3e\n", what, s[0], ref, rel);
     fails++;
   }
-  printf("reduce %s: n = %zu, sum %.17g, rel error vs long-double Kahan %.3e, bitwise equal for "
-         "1, 2, 3, 4, 7 threads: %s\n",
-         what, n, s[0], rel, fails ? "NO" : "yes");
+  printf(
+      "reduce %s: n = %zu, sum %.17g, rel error vs long-double Kahan %.3e, bitwise equal for "
+      "1, 2, 3, 4, 7 threads: %s\n",
+      what, n, s[0], rel, fails ? "NO" : "yes");
   return fails;
 }
 
@@ -70,7 +71,8 @@ int main(int argc, char **argv) {
   const size_t n = 1000001;
   double *x = malloc(n * sizeof *x);
   /* magnitudes 10^-8 .. 10^8, about 30 % negative: sum |x| / |sum x| ~ 1.5 */
-  for (size_t i = 0; i < n; i++) x[i] = (lcg_uniform() - 0.3) * pow(10.0, 16.0 * lcg_uniform() - 8.0);
+  for (size_t i = 0; i < n; i++)
+    x[i] = (lcg_uniform() - 0.3) * pow(10.0, 16.0 * lcg_uniform() - 8.0);
   int fails = 0;
   double max_rel = 0.0;
   fails += check("1e6 values, 16 decades", x, 1000000, &max_rel);

@@ -62,8 +62,7 @@ static void gauss_legendre(int n, double *x, double *w) {
 typedef double (*integrand)(double t, double q, const struct kernel *k);
 
 /** Composite Gauss-Legendre over [a, b] with np equal panels. */
-static double integrate(integrand f, double a, double b, int np, double q,
-                        const struct kernel *k) {
+static double integrate(integrand f, double a, double b, int np, double q, const struct kernel *k) {
   const double len = (b - a) / np;
   double s = 0.0;
   for (int p = 0; p < np; p++) {
@@ -130,7 +129,9 @@ static void reference(int dim, double q, int np, double *gam, double *dgam, doub
   }
 }
 
-static double rel_err(double a, double ref) { return fabs(a - ref) / fabs(ref); }
+static double rel_err(double a, double ref) {
+  return fabs(a - ref) / fabs(ref);
+}
 
 /** Minimal fixed-seed LCG in [0, 1). */
 static unsigned long long lcg_state = 0x2545F4914F6CDD1DULL;
@@ -160,8 +161,8 @@ int main(int argc, char **argv) {
         const double eq = rel_err(r1[j], r2[j]);
         if (eq > e_quad) e_quad = eq;
         if (!(eq <= 1e-13)) {
-          printf("FAIL: dim %d q %.2f: quadrature not converged (24 vs 48 panels: %.3e)\n", dim,
-                 q, eq);
+          printf("FAIL: dim %d q %.2f: quadrature not converged (24 vs 48 panels: %.3e)\n", dim, q,
+                 eq);
           bad = 1;
         }
         const double ea = fabs(val[j] - r2[j]), er = ea / fabs(r2[j]);
@@ -177,29 +178,32 @@ int main(int argc, char **argv) {
         if (!(ea <= 1e-10 * fabs(r2[j]) + fl)) bad = 1;
       }
       if (bad) {
-        printf("FAIL: dim %d q %.2f: gamma %.17g vs %.17g, dgamma %.17g vs %.17g, "
-               "moment2 %.17g vs %.17g\n",
-               dim, q, val[0], r2[0], val[1], r2[1], val[2], r2[2]);
+        printf(
+            "FAIL: dim %d q %.2f: gamma %.17g vs %.17g, dgamma %.17g vs %.17g, "
+            "moment2 %.17g vs %.17g\n",
+            dim, q, val[0], r2[0], val[1], r2[1], val[2], r2[2]);
         fail = 1;
       }
     }
-    printf("wall %d-D: max rel error (tol 1e-10) gamma %.3e (q=%.2f), h|grad gamma| %.3e "
-           "(q=%.2f), moment2 %.3e (q=%.2f)\n",
-           dim, e_rel[0], q_rel[0], e_rel[1], q_rel[1], e_rel[2], q_rel[2]);
-    printf("wall %d-D: max abs error gamma %.3e, h|grad gamma| %.3e, moment2 %.3e",
-           dim, e_abs[0], e_abs[1], e_abs[2]);
+    printf(
+        "wall %d-D: max rel error (tol 1e-10) gamma %.3e (q=%.2f), h|grad gamma| %.3e "
+        "(q=%.2f), moment2 %.3e (q=%.2f)\n",
+        dim, e_rel[0], q_rel[0], e_rel[1], q_rel[1], e_rel[2], q_rel[2]);
+    printf("wall %d-D: max abs error gamma %.3e, h|grad gamma| %.3e, moment2 %.3e", dim, e_abs[0],
+           e_abs[1], e_abs[2]);
     if (dim == 2)
-      printf(" (atol %.0e); rel error where the value < 1e4 atol (q -> 2, cancellation): "
-             "%.3e, %.3e, %.3e",
-             atol, e_tail[0], e_tail[1], e_tail[2]);
+      printf(
+          " (atol %.0e); rel error where the value < 1e4 atol (q -> 2, cancellation): "
+          "%.3e, %.3e, %.3e",
+          atol, e_tail[0], e_tail[1], e_tail[2]);
     printf("\nwall %d-D: quadrature self-check 24 vs 48 panels %.3e (tol 1e-13)\n", dim, e_quad);
 
     /* endpoints */
-    const double ends[][2] = {{wall_gamma(dim, 0.0), 0.5},    {wall_gamma(dim, 2.0), 1.0},
-                              {wall_gamma(dim, 2.5), 1.0},    {wall_dgamma(dim, 2.0), 0.0},
+    const double ends[][2] = {{wall_gamma(dim, 0.0), 0.5},          {wall_gamma(dim, 2.0), 1.0},
+                              {wall_gamma(dim, 2.5), 1.0},          {wall_dgamma(dim, 2.0), 0.0},
                               {wall_moment2(dim, 0.0), -0.5 * dim}, {wall_moment2(dim, 2.0), 0.0}};
-    const char *names[] = {"gamma(0)", "gamma(2)", "gamma(2.5)", "dgamma(2)", "moment2(0)",
-                           "moment2(2)"};
+    const char *names[] = {"gamma(0)",  "gamma(2)",   "gamma(2.5)",
+                           "dgamma(2)", "moment2(0)", "moment2(2)"};
     for (int i = 0; i < 6; i++)
       if (!(fabs(ends[i][0] - ends[i][1]) <= 1e-15)) {
         printf("FAIL: dim %d: %s = %.17g, expected %g\n", dim, names[i], ends[i][0], ends[i][1]);
@@ -208,16 +212,17 @@ int main(int argc, char **argv) {
     /* small q is continuous with the q = 0 values (2-D special-cases q <= 0) */
     double g, d, m;
     reference(dim, 1e-3, 48, &g, &d, &m);
-    const double e0 = fmax(rel_err(wall_gamma(dim, 1e-3), g),
-                           fmax(rel_err(wall_dgamma(dim, 1e-3), d),
-                                rel_err(wall_moment2(dim, 1e-3), m)));
+    const double e0 =
+        fmax(rel_err(wall_gamma(dim, 1e-3), g),
+             fmax(rel_err(wall_dgamma(dim, 1e-3), d), rel_err(wall_moment2(dim, 1e-3), m)));
     if (!(e0 <= 1e-10)) {
       printf("FAIL: dim %d q = 1e-3: max rel error %.3e\n", dim, e0);
       fail = 1;
     }
-    printf("wall %d-D: endpoints gamma(0) = %.17g, gamma(2) = %.17g, moment2(0) = %.17g; "
-           "q = 1e-3 rel error %.3e\n",
-           dim, wall_gamma(dim, 0.0), wall_gamma(dim, 2.0), wall_moment2(dim, 0.0), e0);
+    printf(
+        "wall %d-D: endpoints gamma(0) = %.17g, gamma(2) = %.17g, moment2(0) = %.17g; "
+        "q = 1e-3 rel error %.3e\n",
+        dim, wall_gamma(dim, 0.0), wall_gamma(dim, 2.0), wall_moment2(dim, 0.0), e0);
   }
 
   /* 2-D: segments covering the whole line sum to the full line integral */
@@ -238,8 +243,8 @@ int main(int argc, char **argv) {
         if (ea > a_seg) a_seg = ea;
         if (1e-12 * ref >= ATOL_2D && ea / ref > e_seg) e_seg = ea / ref, q_seg = q;
         if (!(ea <= 1e-12 * ref + ATOL_2D)) {
-          printf("FAIL: segments of %.2f, q %.2f, offset %.6f: sum %.17g vs dgamma %.17g\n",
-                 len, q, s0, sum, ref);
+          printf("FAIL: segments of %.2f, q %.2f, offset %.6f: sum %.17g vs dgamma %.17g\n", len, q,
+                 s0, sum, ref);
           fail = 1;
         }
       }
@@ -255,9 +260,10 @@ int main(int argc, char **argv) {
       fail = 1;
     }
   }
-  printf("wall 2-D: sum of wall_segment_2d vs wall_dgamma: max rel error %.3e (q=%.2f, "
-         "tol 1e-12), max abs error %.3e (atol %.0e)\n",
-         e_seg, q_seg, a_seg, ATOL_2D);
+  printf(
+      "wall 2-D: sum of wall_segment_2d vs wall_dgamma: max rel error %.3e (q=%.2f, "
+      "tol 1e-12), max abs error %.3e (atol %.0e)\n",
+      e_seg, q_seg, a_seg, ATOL_2D);
 
   printf("%s\n", fail ? "test_wall: FAILED" : "test_wall: passed");
   MPI_Finalize();
