@@ -64,6 +64,11 @@ static const struct key keys[] = {
      "operator exact for a linear velocity profile (docs/theory.md). Violeau always uses "
      "the analytic weight.",
      OFF(wall_weight)},
+    {"sph", "wall_pressure_weight", T_CHOICE, "consistent", 0, 0, 0, "consistent|analytic", "-",
+     "Weight of the pressure wall term: |grad gamma_as| (analytic, thesis Eq. 3.17) or "
+     "max(|grad gamma_as|, sum_b V_b (r_ab . n) F_ab) (consistent), which keeps the first "
+     "particle layer where it is under a uniform pressure (docs/theory.md).",
+     OFF(wall_pressure)},
     {"sph", "wall_dmin", T_DOUBLE, "1", 0, BIG, LO_OPEN, NULL, "dr",
      "Lower bound delta r of the wall distance in the wall shear term (thesis Eq. 2.148), in "
      "units of dr.",

@@ -12,6 +12,7 @@ enum drive_mode { DRIVE_FORCE = 0, DRIVE_FLUX = 1 };
 enum flux_controller { CONTROLLER_EQ343 = 0, CONTROLLER_EQ338 = 1 };
 enum viscous_form { VISCOUS_MORRIS = 0, VISCOUS_VIOLEAU = 1 };
 enum wall_weight { WALL_WEIGHT_DISCRETE = 0, WALL_WEIGHT_ANALYTIC = 1 };
+enum wall_pressure { WALL_PRESSURE_CONSISTENT = 0, WALL_PRESSURE_ANALYTIC = 1 };
 enum laplacian_norm { LAPNORM_WALL_NORMAL = 0, LAPNORM_TRACE = 1, LAPNORM_NONE = 2 };
 enum init_profile { INIT_REST = 0, INIT_LAMINAR = 1 };
 
@@ -24,13 +25,14 @@ struct scene {
   double lz;    /*!< periodic length in z [m] (3-D) */
   double dr;    /*!< initial particle spacing [m] */
   /* [sph] */
-  double h_over_dr; /*!< smoothing length over spacing [-] */
-  double xi;        /*!< volume-diffusion constant [-]; 0 selects 1000 dr / (2 delta) */
-  double wall_dmin; /*!< delta r of Eq. 2.148 over dr [-] */
-  double eta2;      /*!< regularisation of 1/r^2 in the viscous term, over h^2 [-] */
-  int viscous;      /*!< enum viscous_form */
-  int lap_norm;     /*!< enum laplacian_norm */
-  int wall_weight;  /*!< enum wall_weight */
+  double h_over_dr;  /*!< smoothing length over spacing [-] */
+  double xi;         /*!< volume-diffusion constant [-]; 0 selects 1000 dr / (2 delta) */
+  double wall_dmin;  /*!< delta r of Eq. 2.148 over dr [-] */
+  double eta2;       /*!< regularisation of 1/r^2 in the viscous term, over h^2 [-] */
+  int viscous;       /*!< enum viscous_form */
+  int lap_norm;      /*!< enum laplacian_norm */
+  int wall_weight;   /*!< enum wall_weight */
+  int wall_pressure; /*!< enum wall_pressure */
   /* [fluid] */
   double nu;           /*!< kinematic viscosity [m^2/s] */
   double rho0;         /*!< reference density [kg/m^3] */

@@ -31,6 +31,7 @@ void sph_model_init(struct model *M, const struct scene *s) {
   M->eta2 = s->eta2 * M->h * M->h;
   M->lap_norm = s->lap_norm;
   M->wall_weight = s->wall_weight;
+  M->wall_pressure = s->wall_pressure;
 }
 
 /** gamma of the channel: both walls' missing parts subtracted (they never overlap). */
@@ -186,7 +187,10 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
       const double ny = wall ? -1.0 : 1.0;           /* inward normal */
       const double rs = sph_wall_value(M, W, W->rho, wall, x[a], z[a]);
       const double ps = sph_wall_value(M, W, W->p, wall, x[a], z[a]);
-      aya += ig * rs * (pa + ps / (rs * rs)) * dg * ny;
+      /* pressure wall term: |grad gamma_as|, or at least the discrete first moment, so that a
+         uniform pressure exerts no net wall-normal force on the lattice (docs/theory.md) */
+      const double pw = M->wall_pressure == WALL_PRESSURE_CONSISTENT ? fmax(dg, ny * mom1) : dg;
+      aya += ig * rs * (pa + ps / (rs * rs)) * pw * ny;
       /* |grad gamma_as|, or the discrete first moment that makes the Morris operator exact
          for a velocity varying linearly with the wall distance (docs/theory.md) */
       const double weight = discrete ? fmax(0.0, ny * mom1) : dg;

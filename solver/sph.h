@@ -27,6 +27,7 @@ struct model {
   double eta2;       /*!< regularisation of r^2 in the viscous term [m^2] */
   int lap_norm;      /*!< enum laplacian_norm */
   int wall_weight;   /*!< enum wall_weight: weight of the wall shear term */
+  int wall_pressure; /*!< enum wall_pressure: weight of the pressure wall term */
 };
 
 /** Per-step maxima from the force pass, for the time-step limits. */
