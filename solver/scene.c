@@ -64,10 +64,14 @@ static const struct key keys[] = {
      "operator exact for a linear velocity profile (docs/theory.md). Violeau always uses "
      "the analytic weight.",
      OFF(wall_weight)},
-    {"sph", "wall_pressure_weight", T_CHOICE, "consistent", 0, 0, 0, "consistent|analytic", "-",
-     "Weight of the pressure wall term: |grad gamma_as| (analytic, thesis Eq. 3.17) or "
-     "max(|grad gamma_as|, sum_b V_b (r_ab . n) F_ab) (consistent), which keeps the first "
-     "particle layer where it is under a uniform pressure (docs/theory.md).",
+    {"sph", "wall_pressure_weight", T_CHOICE, "lattice", 0, 0, 0, "lattice|consistent|analytic",
+     "-",
+     "Weight of the pressure wall term: |grad gamma_as| (analytic, thesis Eq. 3.17); "
+     "max(|grad gamma_as|, sum_b V_b (r_ab . n) F_ab) of the current particles (consistent), "
+     "which keeps the first particle layer in place under a uniform pressure; or "
+     "|grad gamma_as| plus the excess of that discrete moment over it on the initial particle "
+     "lattice, as a function of the wall distance (lattice): the same equilibrium, but a "
+     "uniform pressure still resists wall-normal disorder (docs/theory.md).",
      OFF(wall_pressure)},
     {"sph", "wall_dmin", T_DOUBLE, "1", 0, BIG, LO_OPEN, NULL, "dr",
      "Lower bound delta r of the wall distance in the wall shear term (thesis Eq. 2.148), in "
@@ -84,8 +88,10 @@ static const struct key keys[] = {
      "Numerical speed of sound (about 10 times the largest velocity).", OFF(c0)},
     {"fluid", "zeta", T_DOUBLE, "7", 1, 10, 0, NULL, "-",
      "Exponent of the Tait equation of state (thesis Eq. 2.11).", OFF(zeta)},
-    {"fluid", "p_background", T_DOUBLE, "0", 0, 10, 0, NULL, "rho0 c0^2",
-     "Background pressure added to the Tait equation of state, in units of rho0 c0^2.",
+    {"fluid", "p_background", T_DOUBLE, "0.01", 0, 10, 0, NULL, "rho0 c0^2",
+     "Background pressure added to the Tait equation of state, in units of rho0 c0^2; it "
+     "gives the particle arrangement a restoring force and, with the lattice pressure wall "
+     "weight, stops the transverse instability of the sheared lattice (docs/theory.md).",
      OFF(p_background)},
     {"fluid", "gravity_y", T_DOUBLE, "0", -BIG, BIG, 0, NULL, "m/s^2",
      "Wall-normal body acceleration; enters the momentum equation, the wall pressure "

@@ -12,7 +12,11 @@ enum drive_mode { DRIVE_FORCE = 0, DRIVE_FLUX = 1 };
 enum flux_controller { CONTROLLER_EQ343 = 0, CONTROLLER_EQ338 = 1 };
 enum viscous_form { VISCOUS_MORRIS = 0, VISCOUS_VIOLEAU = 1 };
 enum wall_weight { WALL_WEIGHT_DISCRETE = 0, WALL_WEIGHT_ANALYTIC = 1 };
-enum wall_pressure { WALL_PRESSURE_CONSISTENT = 0, WALL_PRESSURE_ANALYTIC = 1 };
+enum wall_pressure {
+  WALL_PRESSURE_LATTICE = 0,
+  WALL_PRESSURE_CONSISTENT = 1,
+  WALL_PRESSURE_ANALYTIC = 2
+};
 enum laplacian_norm { LAPNORM_WALL_NORMAL = 0, LAPNORM_TRACE = 1, LAPNORM_NONE = 2 };
 enum init_profile { INIT_REST = 0, INIT_LAMINAR = 1 };
 

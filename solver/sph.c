@@ -32,6 +32,43 @@ void sph_model_init(struct model *M, const struct scene *s) {
   M->lap_norm = s->lap_norm;
   M->wall_weight = s->wall_weight;
   M->wall_pressure = s->wall_pressure;
+  sph_lattice_excess_table(M);
+}
+
+void sph_lattice_excess_table(struct model *M) {
+  const struct kernel *K = &M->k;
+  const double dr = M->dr, ih = K->inv_h, vol = pow(dr, M->dim);
+  const int reach = (int)ceil(2.0 * M->h / dr); /* lattice offsets within the support */
+  int n = 0;
+  for (int j = 1; j * dr < 2.0 * M->h && n < LATTICE_KNOTS - 1; j++) {
+    double mom1 = 0.0; /* sum_b V_b (y_a - y_b) F_ab over the virtual lattice around layer j */
+    for (int k = 0; k <= j + reach; k++) {
+      const double v = k == 0 ? 0.5 * vol : vol, dy = (j - k) * dr; /* k = 0: vertex row */
+      for (int i = -reach; i <= reach; i++)
+        for (int l = M->dim == 3 ? -reach : 0; l <= (M->dim == 3 ? reach : 0); l++) {
+          if (k == j && i == 0 && l == 0) continue;
+          const double r = sqrt((i * i + l * l) * dr * dr + dy * dy);
+          mom1 += v * kernel_f(K, r) * dy;
+        }
+    }
+    const double q = j * dr * ih;
+    M->lat_q[n] = q;
+    M->lat_e[n] = fmax(0.0, mom1 - wall_dgamma(M->dim, q) * ih);
+    n++;
+  }
+  M->lat_q[n] = 2.0, M->lat_e[n] = 0.0;
+  M->n_lat = n + 1;
+}
+
+/** Lattice excess of the pressure wall weight at q = d/h: linear between the layers of the
+    lattice, constant below the first layer, zero at q = 2. */
+static double lattice_excess(const struct model *M, double q) {
+  if (q >= 2.0) return 0.0;
+  if (q <= M->lat_q[0]) return M->lat_e[0];
+  int k = 1;
+  while (k < M->n_lat - 1 && M->lat_q[k] < q) k++;
+  const double t = (q - M->lat_q[k - 1]) / (M->lat_q[k] - M->lat_q[k - 1]);
+  return (1.0 - t) * M->lat_e[k - 1] + t * M->lat_e[k];
 }
 
 /** gamma of the channel: both walls' missing parts subtracted (they never overlap). */
@@ -187,9 +224,13 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
       const double ny = wall ? -1.0 : 1.0;           /* inward normal */
       const double rs = sph_wall_value(M, W, W->rho, wall, x[a], z[a]);
       const double ps = sph_wall_value(M, W, W->p, wall, x[a], z[a]);
-      /* pressure wall term: |grad gamma_as|, or at least the discrete first moment, so that a
-         uniform pressure exerts no net wall-normal force on the lattice (docs/theory.md) */
-      const double pw = M->wall_pressure == WALL_PRESSURE_CONSISTENT ? fmax(dg, ny * mom1) : dg;
+      /* pressure wall term: |grad gamma_as| plus the excess of the discrete first moment on
+         the particle lattice (so that a uniform pressure leaves the lattice in equilibrium yet
+         pushes a displaced particle back), or of the current particles, or nothing
+         (docs/theory.md) */
+      const double pw = M->wall_pressure == WALL_PRESSURE_LATTICE      ? dg + lattice_excess(M, q)
+                        : M->wall_pressure == WALL_PRESSURE_CONSISTENT ? fmax(dg, ny * mom1)
+                                                                       : dg;
       aya += ig * rs * (pa + ps / (rs * rs)) * pw * ny;
       /* |grad gamma_as|, or the discrete first moment that makes the Morris operator exact
          for a velocity varying linearly with the wall distance (docs/theory.md) */

@@ -12,22 +12,27 @@
 #include "part.h"
 #include "scene.h"
 
+enum { LATTICE_KNOTS = 16 };
+
 /** Constants of the discretisation, derived once from the scene. */
 struct model {
-  int dim;           /*!< 2 or 3 */
-  int viscous;       /*!< enum viscous_form */
-  struct kernel k;   /*!< Wendland kernel */
-  struct eos e;      /*!< Tait equation of state */
-  double lx, ly, lz; /*!< domain [m]; ly = 2 delta */
-  double dr, h;      /*!< spacing and smoothing length [m] */
-  double nu;         /*!< kinematic viscosity [m^2/s] */
-  double inv_xi;     /*!< 1 / xi of the volume diffusion [-] */
-  double gy;         /*!< wall-normal body acceleration [m/s^2] */
-  double wall_dmin;  /*!< delta r of Eq. 2.148 [m] */
-  double eta2;       /*!< regularisation of r^2 in the viscous term [m^2] */
-  int lap_norm;      /*!< enum laplacian_norm */
-  int wall_weight;   /*!< enum wall_weight: weight of the wall shear term */
-  int wall_pressure; /*!< enum wall_pressure: weight of the pressure wall term */
+  int dim;                     /*!< 2 or 3 */
+  int viscous;                 /*!< enum viscous_form */
+  struct kernel k;             /*!< Wendland kernel */
+  struct eos e;                /*!< Tait equation of state */
+  double lx, ly, lz;           /*!< domain [m]; ly = 2 delta */
+  double dr, h;                /*!< spacing and smoothing length [m] */
+  double nu;                   /*!< kinematic viscosity [m^2/s] */
+  double inv_xi;               /*!< 1 / xi of the volume diffusion [-] */
+  double gy;                   /*!< wall-normal body acceleration [m/s^2] */
+  double wall_dmin;            /*!< delta r of Eq. 2.148 [m] */
+  double eta2;                 /*!< regularisation of r^2 in the viscous term [m^2] */
+  int lap_norm;                /*!< enum laplacian_norm */
+  int wall_weight;             /*!< enum wall_weight: weight of the wall shear term */
+  int wall_pressure;           /*!< enum wall_pressure: weight of the pressure wall term */
+  int n_lat;                   /*!< knots of the lattice excess of the pressure wall weight */
+  double lat_q[LATTICE_KNOTS]; /*!< their wall distances d/h, increasing, the last one 2 */
+  double lat_e[LATTICE_KNOTS]; /*!< excess of sum_b V_b (r_ab . n) F_ab over |grad gamma| [1/m] */
 };
 
 /** Per-step maxima from the force pass, for the time-step limits. */
@@ -38,6 +43,15 @@ struct force_info {
 
 /** @brief Derive the model constants from the scene. */
 void sph_model_init(struct model *M, const struct scene *s);
+
+/**
+ * @brief Tabulate, on the initial particle lattice (layers y = j dr, the vertex row at y = 0 with
+ *        half volume), how much the discrete first moment sum_b V_b (y_a - y_b) F_ab of each
+ *        layer within 2h of a wall exceeds |grad gamma|; used by the `lattice` pressure wall
+ *        weight. Depends on dim, dr and h only, so a restart rebuilds the same table.
+ * @param[in,out] M model (lat_q, lat_e, n_lat)
+ */
+void sph_lattice_excess_table(struct model *M);
 
 /**
  * @brief Density update of thesis Eq. 3.64 from the kernel sums at the current positions:

@@ -25,3 +25,8 @@ add_executable(test_reduce test_reduce.c)
 target_link_libraries(test_reduce PRIVATE chansph_core)
 add_test(NAME unit_reduce COMMAND test_reduce)
 set_tests_properties(unit_reduce PROPERTIES LABELS unit)
+
+add_executable(test_sph test_sph.c)
+target_link_libraries(test_sph PRIVATE chansph_core)
+add_test(NAME unit_sph COMMAND test_sph)
+set_tests_properties(unit_sph PROPERTIES LABELS unit)
