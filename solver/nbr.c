@@ -11,15 +11,16 @@
 
 void nbr_init(struct nbr *nb, const struct scene *s, size_t n) {
   memset(nb, 0, sizeof *nb);
-  const double two_h = 2.0 * scene_h(s);
+  const double two_h = 2.0 * scene_h(s), cell = two_h / NBR_REACH;
   nb->dim = s->dim;
   nb->lx = s->lx, nb->ly = 2.0 * s->delta, nb->lz = s->dim == 3 ? s->lz : 1.0;
-  nb->nx = (int)floor(nb->lx / two_h * (1.0 + 1e-12));
-  nb->ny = (int)floor(nb->ly / two_h * (1.0 + 1e-12));
-  nb->nz = s->dim == 3 ? (int)floor(nb->lz / two_h * (1.0 + 1e-12)) : 1;
+  nb->nx = (int)floor(nb->lx / cell * (1.0 + 1e-12));
+  nb->ny = (int)floor(nb->ly / cell * (1.0 + 1e-12));
+  nb->nz = s->dim == 3 ? (int)floor(nb->lz / cell * (1.0 + 1e-12)) : 1;
   if (nb->ny < 1) nb->ny = 1;
-  if (nb->nx < 3 || (s->dim == 3 && nb->nz < 3))
-    die("periodic directions need at least 3 cells of size 2h (validated in scene.c)");
+  if (nb->nx < 2 * NBR_REACH + 1 || (s->dim == 3 && nb->nz < 2 * NBR_REACH + 1))
+    die("periodic directions need at least %d cells of size 2h/%d (validated in scene.c)",
+        2 * NBR_REACH + 1, NBR_REACH);
   nb->cx = nb->nx / nb->lx, nb->cy = nb->ny / nb->ly, nb->cz = nb->nz / nb->lz;
   nb->support2 = two_h * two_h;
   nb->ncell = (size_t)nb->nx * nb->ny * nb->nz;
@@ -119,7 +120,7 @@ void nbr_build(struct nbr *nb, const struct particles *P, const struct kernel *K
   for (;;) {
     int overflow = 0;
     const int stride = nb->stride;
-    const int dz_lo = nb->dim == 3 ? -1 : 0, dz_hi = nb->dim == 3 ? 1 : 0;
+    const int R = NBR_REACH, dz_lo = nb->dim == 3 ? -R : 0, dz_hi = nb->dim == 3 ? R : 0;
 #pragma omp parallel for schedule(static) reduction(max : overflow)
     for (size_t c = 0; c < nb->ncell; c++) {
       const int ix = (int)(c % (size_t)nb->nx);
@@ -136,16 +137,16 @@ void nbr_build(struct nbr *nb, const struct particles *P, const struct kernel *K
             jz += nb->nz, sz = -nb->lz;
           else if (jz >= nb->nz)
             jz -= nb->nz, sz = nb->lz;
-          for (int dy = -1; dy <= 1; dy++) {
+          for (int dy = -R; dy <= R; dy++) {
             const int jy = iy + dy;
             if (jy < 0 || jy >= nb->ny) continue;
             const size_t row = ((size_t)jz * nb->ny + jy) * nb->nx;
-            if (ix > 0 && ix < nb->nx - 1) { /* the three x cells are contiguous */
-              cnt = scan(P, K, a, nb->start[row + ix - 1], nb->start[row + ix + 2], 0.0, sz,
+            if (ix >= R && ix < nb->nx - R) { /* the x cells of the stencil are contiguous */
+              cnt = scan(P, K, a, nb->start[row + ix - R], nb->start[row + ix + R + 1], 0.0, sz,
                          nb->support2, out, cnt, stride, &sum);
               continue;
             }
-            for (int dx = -1; dx <= 1; dx++) {
+            for (int dx = -R; dx <= R; dx++) {
               int jx = ix + dx;
               double sx = 0.0;
               if (jx < 0)
