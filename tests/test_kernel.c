@@ -16,35 +16,9 @@
 #include <stdio.h>
 
 #include "kernel.h"
+#include "quadrature.h"
 
 enum { GL_N = 16 };
-
-/** Gauss-Legendre nodes and weights on [-1, 1] by Newton iteration on P_n. */
-static void gauss_legendre(int n, double *x, double *w) {
-  for (int i = 0; i < n; i++) {
-    double z = cos(M_PI * (i + 0.75) / (n + 0.5)), dp = 0.0;
-    for (int it = 0; it < 100; it++) {
-      double p0 = 1.0, p1 = z;
-      for (int k = 2; k <= n; k++) {
-        const double p2 = ((2.0 * k - 1.0) * z * p1 - (k - 1.0) * p0) / k;
-        p0 = p1, p1 = p2;
-      }
-      dp = n * (z * p1 - p0) / (z * z - 1.0);
-      const double dz = p1 / dp;
-      z -= dz;
-      if (fabs(dz) < 1e-16) break;
-    }
-    /* recompute the derivative at the converged root */
-    double p0 = 1.0, p1 = z;
-    for (int k = 2; k <= n; k++) {
-      const double p2 = ((2.0 * k - 1.0) * z * p1 - (k - 1.0) * p0) / k;
-      p0 = p1, p1 = p2;
-    }
-    dp = n * (z * p1 - p0) / (z * z - 1.0);
-    x[i] = z;
-    w[i] = 2.0 / ((1.0 - z * z) * dp * dp);
-  }
-}
 
 /** Integral of w over the whole space, as a radial integral over [0, 2h]. */
 static double kernel_integral(const struct kernel *k, const double *gx, const double *gw) {

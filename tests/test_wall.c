@@ -22,6 +22,7 @@
 #include <stdio.h>
 
 #include "kernel.h"
+#include "quadrature.h"
 #include "wall.h"
 
 enum { GL_N = 20 };
@@ -33,30 +34,6 @@ enum { GL_N = 20 };
    where the value is below 1e4 * ATOL_2D (1e-10) or 1e2 * ATOL_2D (1e-12) respectively. */
 #define ATOL_2D 1e-14
 static double gl_x[GL_N], gl_w[GL_N];
-
-/** Gauss-Legendre nodes and weights on [-1, 1] by Newton iteration on P_n. */
-static void gauss_legendre(int n, double *x, double *w) {
-  for (int i = 0; i < n; i++) {
-    double z = cos(M_PI * (i + 0.75) / (n + 0.5));
-    for (int it = 0; it < 100; it++) {
-      double p0 = 1.0, p1 = z;
-      for (int k = 2; k <= n; k++) {
-        const double p2 = ((2.0 * k - 1.0) * z * p1 - (k - 1.0) * p0) / k;
-        p0 = p1, p1 = p2;
-      }
-      const double dz = p1 / (n * (z * p1 - p0) / (z * z - 1.0));
-      z -= dz;
-      if (fabs(dz) < 1e-16) break;
-    }
-    double p0 = 1.0, p1 = z;
-    for (int k = 2; k <= n; k++) {
-      const double p2 = ((2.0 * k - 1.0) * z * p1 - (k - 1.0) * p0) / k;
-      p0 = p1, p1 = p2;
-    }
-    const double dp = n * (z * p1 - p0) / (z * z - 1.0);
-    x[i] = z, w[i] = 2.0 / ((1.0 - z * z) * dp * dp);
-  }
-}
 
 /** Integrand: f(t; q, kernel). */
 typedef double (*integrand)(double t, double q, const struct kernel *k);
