@@ -114,7 +114,7 @@ void part_permute(struct particles *P, const size_t *perm) {
                      &P->rho, &P->m, &P->gam, &P->ksum, &P->ddiff};
   for (size_t i = 0; i < sizeof arrs / sizeof arrs[0]; i++) permute_d(arrs[i], &P->tmp, perm, P->n);
   int64_t *restrict dst = P->tmp_i;
-  uint8_t *restrict kind_tmp = (uint8_t *)P->ax; /* ax is scratch between steps */
+  uint8_t *restrict kind_tmp = (uint8_t *)P->tmp; /* P->tmp is free after the doubles */
   for (size_t i = 0; i < P->n; i++) dst[i] = P->id[perm[i]], kind_tmp[i] = P->kind[perm[i]];
   P->tmp_i = P->id, P->id = dst;
   memcpy(P->kind, kind_tmp, P->n);

@@ -23,18 +23,20 @@ void sim_init(struct sim *S, const struct scene *sc) {
   if (sc->init_profile == INIT_LAMINAR)
     for (size_t a = 0; a < S->P.n_fluid; a++) S->P.u[a] = laminar_u(sc, S->P.y[a]);
   for (int k = 0; k < 4; k++) S->scratch[k] = part_alloc("diag_scratch", S->P.n * sizeof(double));
+  S->ksum_new = part_alloc("kernel_sum_new", S->P.n * sizeof(double));
   nbr_init(&S->nb, sc, S->P.n);
   drive_init(&S->drive, sc);
   S->fx = S->drive.force;
   nbr_sort(&S->nb, &S->P);
-  nbr_build(&S->nb, &S->P, &S->M.k, S->scratch[0]);
-  sph_density(&S->M, &S->P, S->scratch[0], 0.0);
+  nbr_build(&S->nb, &S->P, &S->M.k, S->ksum_new);
+  sph_density(&S->M, &S->P, S->ksum_new, 0.0);
   sph_walls(&S->M, &S->P, &S->nb, &S->W);
 }
 
 void sim_free(struct sim *S) {
   nbr_free(&S->nb);
   for (int k = 0; k < 4; k++) part_free(S->scratch[k]);
+  part_free(S->ksum_new);
   part_destroy(&S->P, &S->W);
 }
 
@@ -121,8 +123,8 @@ void sim_step(struct sim *S) {
   timer_pop();
   S->t += dt, S->dt = dt, S->fx = fx, S->step++;
   nbr_sort(&S->nb, P);
-  nbr_build(&S->nb, P, &S->M.k, S->scratch[0]);
-  sph_density(&S->M, P, S->scratch[0], dt);
+  nbr_build(&S->nb, P, &S->M.k, S->ksum_new);
+  sph_density(&S->M, P, S->ksum_new, dt);
   sph_walls(&S->M, P, &S->nb, &S->W);
 }
 

@@ -26,6 +26,7 @@ struct sim {
   double fx;              /*!< last streamwise body acceleration [m/s^2] */
   double dt_limits[4];    /*!< last limits: acoustic, viscous, force, wall [s] */
   double *scratch[4];     /*!< per-particle scratch for deterministic sums */
+  double *ksum_new;       /*!< kernel sums at the new positions, from the neighbour pass */
   char violation[320];    /*!< a fixed dt broke a stability limit: what, where (else empty) */
 };
 
