@@ -66,8 +66,6 @@ int cli_parse(int argc, char **argv, struct cli *c) {
       c->overwrite = 1;
     else if (!strcmp(a, "--fpe"))
       c->fpe = 1;
-    else if (!strcmp(a, "--debug"))
-      chansph_debug = 1;
     else if (a[0] != '-' && !c->scene)
       c->scene = a;
     else {

@@ -45,14 +45,4 @@ static inline double eos_sound(const struct eos *e, const double rho) {
   return e->c0 * eos_ipow(rho / e->rho0, 0.5 * (e->zeta - 1.0));
 }
 
-/**
- * @brief Density from pressure, the inverse of eos_pressure().
- * @param[in] e constants
- * @param[in] p pressure [Pa]
- * @return rho [kg/m^3]
- */
-static inline double eos_density(const struct eos *e, const double p) {
-  return e->rho0 * pow(1.0 + e->zeta * (p - e->pb) / (e->rho0 * e->c0 * e->c0), 1.0 / e->zeta);
-}
-
 #endif

@@ -7,8 +7,6 @@
 #include <stdlib.h>
 #include <time.h>
 
-int chansph_debug = 0;
-
 static int my_rank(void) {
   int init = 0, rank = 0;
   MPI_Initialized(&init);

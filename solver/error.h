@@ -13,9 +13,6 @@
 /** Status codes returned by input/output functions. */
 enum { CHANSPH_OK = 0, CHANSPH_ERR = 1 };
 
-/** Compiled into every configuration; switch on with --debug (STYLE item 14). */
-extern int chansph_debug;
-
 /**
  * @brief Print "[rank] file:line func(): message" to stderr, flush and abort all ranks.
  * @param[in] file,line,func location of the failure

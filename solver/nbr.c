@@ -25,6 +25,7 @@ void nbr_init(struct nbr *nb, const struct scene *s, size_t n) {
   nb->support2 = two_h * two_h;
   nb->ncell = (size_t)nb->nx * nb->ny * nb->nz;
   nb->start = part_alloc("cell_start", (nb->ncell + 1) * sizeof(size_t));
+  nb->pos = part_alloc("cell_fill", nb->ncell * sizeof(size_t));
   nb->cap = n;
   nb->perm = part_alloc("sort_perm", n * sizeof(size_t));
   nb->cell = part_alloc("cell_of", n * sizeof(int));
@@ -37,7 +38,7 @@ void nbr_init(struct nbr *nb, const struct scene *s, size_t n) {
 }
 
 void nbr_free(struct nbr *nb) {
-  part_free(nb->start), part_free(nb->perm), part_free(nb->cell);
+  part_free(nb->start), part_free(nb->pos), part_free(nb->perm), part_free(nb->cell);
   part_free(nb->count), part_free(nb->list);
   memset(nb, 0, sizeof *nb);
 }
@@ -75,11 +76,9 @@ void nbr_sort(struct nbr *nb, struct particles *P) {
   /* stable scatter, then order each cell by id (insertion sort: cells are small and their
      content changes little from one step to the next) */
   size_t *restrict perm = nb->perm;
-  size_t *pos = malloc(nb->ncell * sizeof *pos);
-  if (!pos) die("out of memory in nbr_sort");
+  size_t *restrict pos = nb->pos;
   memcpy(pos, start, nb->ncell * sizeof *pos);
   for (size_t a = 0; a < n; a++) perm[pos[cell[a]]++] = a;
-  free(pos);
   const int64_t *id = P->id;
 #pragma omp parallel for schedule(static)
   for (size_t c = 0; c < nb->ncell; c++)

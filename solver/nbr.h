@@ -30,6 +30,7 @@ struct nbr {
   double support2;   /*!< (2h)^2 [m^2] */
   size_t ncell;
   size_t *start; /*!< particles of cell c are start[c] .. start[c+1]-1 */
+  size_t *pos;   /*!< fill position of each cell (sort scratch) */
   size_t *perm;  /*!< sort scratch */
   int *cell;     /*!< cell of each particle (sort scratch) */
   size_t cap;    /*!< particles the arrays hold */

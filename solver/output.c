@@ -221,8 +221,10 @@ static int write_particles(struct output *o, const struct sim *S) {
 
 int output_finish(struct output *o, struct sim *S) {
   struct diag d;
-  if (o->ts.n == 0 || o->ts.data[(o->ts.n - 1) * (size_t)o->ts.ncol] != S->t) record(o, S, &d);
-  sim_diag(S, &d);
+  if (o->ts.n == 0 || o->ts.data[(o->ts.n - 1) * (size_t)o->ts.ncol] != S->t)
+    record(o, S, &d);
+  else
+    sim_diag(S, &d);
   if (S->step != o->last_step) log_progress(o, S, &d);
   const double wall = timer_now() - o->wall0;
   TRY(write_stats(o, S));

@@ -128,23 +128,32 @@ void sph_walls(const struct model *M, struct particles *P, const struct nbr *nb,
   timer_pop();
 }
 
-double sph_wall_value(const struct model *M, const struct walls *W, const double *f, int wall,
-                      double x, double z) {
+void sph_wall_values(const struct model *M, const struct walls *W, int wall, double x, double z,
+                     double *rho, double *p) {
   const double fx = x / M->dr - 0.5;
   const double ix = floor(fx), tx = fx - ix;
   int i0 = (int)ix % W->nx;
   if (i0 < 0) i0 += W->nx;
   const int i1 = (i0 + 1) % W->nx;
-  const double *fw = f + (size_t)wall * W->nx * W->nz;
-  if (M->dim == 2) return (1.0 - tx) * fw[i0] + tx * fw[i1];
+  const size_t off = (size_t)wall * W->nx * W->nz;
+  const double *rw = W->rho + off, *pw = W->p + off;
+  if (M->dim == 2) {
+    *rho = (1.0 - tx) * rw[i0] + tx * rw[i1];
+    *p = (1.0 - tx) * pw[i0] + tx * pw[i1];
+    return;
+  }
   const double fz = z / M->dr - 0.5;
   const double iz = floor(fz), tz = fz - iz;
   int k0 = (int)iz % W->nz;
   if (k0 < 0) k0 += W->nz;
   const int k1 = (k0 + 1) % W->nz;
   const int nz = W->nz;
-  return (1.0 - tx) * ((1.0 - tz) * fw[i0 * nz + k0] + tz * fw[i0 * nz + k1]) +
-         tx * ((1.0 - tz) * fw[i1 * nz + k0] + tz * fw[i1 * nz + k1]);
+  const size_t c00 = (size_t)i0 * nz + k0, c01 = (size_t)i0 * nz + k1;
+  const size_t c10 = (size_t)i1 * nz + k0, c11 = (size_t)i1 * nz + k1;
+  *rho = (1.0 - tx) * ((1.0 - tz) * rw[c00] + tz * rw[c01]) +
+         tx * ((1.0 - tz) * rw[c10] + tz * rw[c11]);
+  *p = (1.0 - tx) * ((1.0 - tz) * pw[c00] + tz * pw[c01]) +
+       tx * ((1.0 - tz) * pw[c10] + tz * pw[c11]);
 }
 
 void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb,
@@ -222,8 +231,8 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
       if (q >= 2.0) continue;
       const double dg = wall_dgamma(M->dim, q) * ih; /* |grad gamma_as| */
       const double ny = wall ? -1.0 : 1.0;           /* inward normal */
-      const double rs = sph_wall_value(M, W, W->rho, wall, x[a], z[a]);
-      const double ps = sph_wall_value(M, W, W->p, wall, x[a], z[a]);
+      double rs, ps;
+      sph_wall_values(M, W, wall, x[a], z[a], &rs, &ps);
       /* pressure wall term: |grad gamma_as| plus the excess of the discrete first moment on
          the particle lattice (so that a uniform pressure leaves the lattice in equilibrium yet
          pushes a displaced particle back), or of the current particles, or nothing

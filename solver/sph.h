@@ -90,11 +90,13 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
                 const struct walls *W, double fx, struct force_info *info);
 
 /**
- * @brief Value of the wall lattice field f at the foot of a particle on a wall: bilinear (3-D)
- *        or linear (2-D) interpolation of the vertex values, the generalisation of thesis
+ * @brief Wall density and pressure at the foot of a particle on a wall: bilinear (3-D) or
+ *        linear (2-D) interpolation of the vertex values, the generalisation of thesis
  *        Eq. 2.138 used for the per-segment boundary sums (see docs/theory.md).
+ * @param[out] rho wall density [kg/m^3]
+ * @param[out] p wall pressure [Pa]
  */
-double sph_wall_value(const struct model *M, const struct walls *W, const double *f, int wall,
-                      double x, double z);
+void sph_wall_values(const struct model *M, const struct walls *W, int wall, double x, double z,
+                     double *rho, double *p);
 
 #endif

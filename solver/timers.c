@@ -54,12 +54,6 @@ void timer_reset(void) {
   for (int i = 0; i < n_phases; i++) phases[i].seconds = 0.0, phases[i].calls = 0;
 }
 
-double timer_get(const char *name) {
-  for (int i = 0; i < n_phases; i++)
-    if (!strcmp(phases[i].name, name)) return phases[i].seconds;
-  return 0.0;
-}
-
 void timer_report(FILE *f, double total) {
   double sum = 0.0;
   fprintf(f, "%-14s %10s %7s %8s\n", "phase", "seconds", "share", "calls");

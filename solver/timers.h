@@ -19,9 +19,6 @@ double timer_now(void);
 /** @brief Reset all phase totals. */
 void timer_reset(void);
 
-/** @brief Seconds accumulated in a phase (0 if unknown). */
-double timer_get(const char *name);
-
 /**
  * @brief Print the per-phase table: seconds, share of the total and calls.
  * @param[in] f stream
