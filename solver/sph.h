@@ -11,6 +11,7 @@
 #include "nbr.h"
 #include "part.h"
 #include "scene.h"
+#include "walllaw.h"
 
 enum { LATTICE_KNOTS = 16 };
 
@@ -30,6 +31,14 @@ struct model {
   int lap_norm;                /*!< enum laplacian_norm */
   int wall_weight;             /*!< enum wall_weight: weight of the wall shear term */
   int wall_pressure;           /*!< enum wall_pressure: weight of the pressure wall term */
+  int pgrad;                   /*!< enum pressure_gradient */
+  int les;                     /*!< eddy viscosity on (enum les_model) */
+  int strain;                  /*!< enum les_strain */
+  int van_driest;              /*!< damping on */
+  double cs, delta_g, a_plus;  /*!< C_S [-], Delta_G [m], A+ [-] */
+  double cy;                   /*!< Yoshizawa C_Y [-]; 0 = off */
+  struct wall_law_def law;     /*!< wall law of the wall shear term */
+  int wall_tau;                /*!< wall stresses carried to the vertices (turb.h) */
   int n_lat;                   /*!< knots of the lattice excess of the pressure wall weight */
   double lat_q[LATTICE_KNOTS]; /*!< their wall distances d/h, increasing, the last one 2 */
   double lat_e[LATTICE_KNOTS]; /*!< excess of sum_b V_b (r_ab . n) F_ab over |grad gamma| [1/m] */
@@ -98,5 +107,17 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
  */
 void sph_wall_values(const struct model *M, const struct walls *W, int wall, double x, double z,
                      double *rho, double *p);
+
+/**
+ * @brief Solve A x = g for a symmetric positive definite A (2x2 or 3x3, stored as
+ *        {xx, xy, xz, yy, yz, zz}): applies L = A^-1 of thesis Eq. 2.88. A degenerate A (an
+ *        isolated particle) falls back to the isotropic dim / trace(A).
+ */
+void sph_solve_sym(int dim, const double A[6], const double g[3], double x[3]);
+
+/** @brief One wall lattice field f (nx nz values per wall) at the foot of a particle, with the
+           same interpolation as sph_wall_values. */
+double sph_wall_field(const struct model *M, const struct walls *W, const double *f, int wall,
+                      double x, double z);
 
 #endif

@@ -5,6 +5,8 @@
 #                analogues) against quadrature; Ferrand Eq. 51-52 segments
 #   test_nbr:    cell-list neighbour search against brute force, sort order and permutation
 #   test_reduce: deterministic blocked sums, bitwise across thread counts
+#   test_walllaw: wall-law friction velocity (thesis Eq. 2.146, 5.51, 5.53): residual over
+#                y+ 1e-6..1e6, any speed and viscosity
 
 add_executable(test_kernel test_kernel.c)
 target_link_libraries(test_kernel PRIVATE chansph_core)
@@ -30,3 +32,8 @@ add_executable(test_sph test_sph.c)
 target_link_libraries(test_sph PRIVATE chansph_core)
 add_test(NAME unit_sph COMMAND test_sph)
 set_tests_properties(unit_sph PROPERTIES LABELS unit)
+
+add_executable(test_walllaw test_walllaw.c)
+target_link_libraries(test_walllaw PRIVATE chansph_core m)
+add_test(NAME unit_walllaw COMMAND test_walllaw)
+set_tests_properties(unit_walllaw PROPERTIES LABELS unit)
