@@ -17,10 +17,13 @@
 
 /** Run a scene into a directory; returns the process exit code. */
 static int run(const struct scene *sc, const struct cli *c) {
-  struct output out;
-  if (output_open(&out, c->out, sc, c->overwrite)) return 1;
   struct sim S;
-  sim_init(&S, sc);
+  if (sim_init(&S, sc)) return 1; /* before the run directory exists: nothing to clean up */
+  struct output out;
+  if (output_open(&out, c->out, sc, c->overwrite)) {
+    sim_free(&S);
+    return 1;
+  }
   output_begin(&out, &S);
   int rc = 0;
   while (!sim_done(&S)) {

@@ -5,16 +5,10 @@
 #include <string.h>
 
 #include "error.h"
+#include "init.h"
 #include "reduce.h"
 #include "timers.h"
 #include "turb.h"
-
-/** Laminar Poiseuille velocity of a body acceleration f: u = f y (2 delta - y) / (2 nu). */
-static double laminar_u(const struct scene *sc, double y) {
-  double f = sc->force;
-  if (sc->drive_mode == DRIVE_FLUX) f = 3.0 * sc->nu * sc->u_bulk / (sc->delta * sc->delta);
-  return f * y * (2.0 * sc->delta - y) / (2.0 * sc->nu);
-}
 
 double sim_viscosity(const struct scene *sc, double t) {
   if (!(sc->nu_start > 0.0) || t >= sc->nu_ramp_end) return sc->nu;
@@ -29,14 +23,16 @@ static void model_update(struct sim *S) {
   S->nu_max = turb_update(&S->M, &S->P, &S->nb, &S->W);
 }
 
-void sim_init(struct sim *S, const struct scene *sc) {
+int sim_init(struct sim *S, const struct scene *sc) {
   memset(S, 0, sizeof *S);
   S->sc = sc;
   sph_model_init(&S->M, sc);
   part_create(&S->P, &S->W, sc);
   turb_init(&S->M, &S->P, &S->W);
-  if (sc->init_profile == INIT_LAMINAR)
-    for (size_t a = 0; a < S->P.n_fluid; a++) S->P.u[a] = laminar_u(sc, S->P.y[a]);
+  if (init_fields(sc, &S->P)) {
+    part_destroy(&S->P, &S->W);
+    return CHANSPH_ERR;
+  }
   for (int k = 0; k < 4; k++) S->scratch[k] = part_alloc("diag_scratch", S->P.n * sizeof(double));
   S->ksum_new = part_alloc("kernel_sum_new", S->P.n * sizeof(double));
   nbr_init(&S->nb, sc, S->P.n);
@@ -47,6 +43,7 @@ void sim_init(struct sim *S, const struct scene *sc) {
   sph_density(&S->M, &S->P, S->ksum_new, 0.0);
   sph_walls(&S->M, &S->P, &S->nb, &S->W);
   model_update(S);
+  return CHANSPH_OK;
 }
 
 void sim_free(struct sim *S) {

@@ -51,8 +51,9 @@ double sim_viscosity(const struct scene *sc, double t);
  *        and the model terms.
  * @param[out] S simulation
  * @param[in] sc validated scene (kept by pointer)
+ * @return CHANSPH_OK, or CHANSPH_ERR after a message (init.from unreadable or mismatched)
  */
-void sim_init(struct sim *S, const struct scene *sc);
+int sim_init(struct sim *S, const struct scene *sc);
 
 /** @brief Free the simulation. */
 void sim_free(struct sim *S);
