@@ -41,6 +41,47 @@ void sph_model_init(struct model *M, const struct scene *s) {
   M->law = wall_law_make(s->wall_law, s->kappa, s->log_b);
   M->wall_tau = M->les || s->wall_law != WALL_LAW_LAMINAR;
   sph_lattice_excess_table(M);
+  sph_violeau_table(M);
+}
+
+/** Integral over the half-space y > q (units of h) of y^2 F(r) ((n+2) x_t^2 / r^2 + 1), with
+    x_t^2 the mean square of one wall-parallel component (r^2 - y^2)/(n - 1). */
+static double violeau_wall_moment(int dim, double q) {
+  if (q >= 2.0) return 0.0;
+  const struct kernel K = kernel_make(dim, 1.0);
+  const double n = dim, gp = (n + 2.0) / (n - 1.0);
+  enum { PANELS = 8 };
+  double sum = 0.0;
+  for (int py = 0; py < PANELS; py++)
+    for (int iy = 0; iy < 12; iy++) {
+      const double ya = q + (2.0 - q) * py / PANELS, yl = (2.0 - q) / PANELS;
+      const double y = ya + yl * wall_gl12_t[iy], wy = yl * wall_gl12_w[iy];
+      const double rmax = sqrt(fmax(0.0, 4.0 - y * y)); /* radial extent in the plane */
+      double inner = 0.0;
+      for (int pr = 0; pr < PANELS; pr++)
+        for (int ir = 0; ir < 12; ir++) {
+          const double rl = rmax / PANELS, rho = rl * (pr + wall_gl12_t[ir]);
+          const double wr = rl * wall_gl12_w[ir], r2 = rho * rho + y * y, r = sqrt(r2);
+          const double g = y * y * kernel_f(&K, r) * (gp * rho * rho / r2 + 1.0);
+          inner += wr * g * (dim == 3 ? 2.0 * M_PI * rho : 2.0); /* both sides of x in 2-D */
+        }
+      sum += wy * inner;
+    }
+  return sum;
+}
+
+void sph_violeau_table(struct model *M) {
+  for (int k = 0; k <= VIOLEAU_KNOTS; k++)
+    M->vio_m2[k] = violeau_wall_moment(M->dim, 2.0 * k / VIOLEAU_KNOTS);
+}
+
+double sph_violeau_moment(const struct model *M, double q) {
+  if (q >= 2.0) return 0.0;
+  if (q <= 0.0) return M->vio_m2[0];
+  const double f = q * VIOLEAU_KNOTS / 2.0;
+  const int k = (int)f;
+  const double t = f - k;
+  return (1.0 - t) * M->vio_m2[k] + t * M->vio_m2[k + 1];
 }
 
 void sph_lattice_excess_table(struct model *M) {
@@ -225,7 +266,8 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
   const double dgrav = M->e.rho0 / (M->e.c0 * M->e.c0) * M->gy; /* Eq. 3.61 */
   const double dplus2 = M->dim + 2.0;
   const int violeau = M->viscous == VISCOUS_VIOLEAU;
-  const int discrete = !violeau && M->wall_weight == WALL_WEIGHT_DISCRETE;
+  const int discrete = M->wall_weight == WALL_WEIGHT_DISCRETE;
+  const double np2 = M->dim + 2.0; /* Violeau weight (n + 2) x_i^2 / r^2 + 1, see m1x */
   const int les = M->les, corrected = M->pgrad == PGRAD_CORRECTED;
   const int wall_law = M->law.law != WALL_LAW_LAMINAR;
   const double *restrict nur = P->nur;
@@ -242,6 +284,8 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
     double mom2 = 0;                  /* sum V_b r_ab . grad w_ab, Laplacian normalisation */
     double momyy = 0;                 /* sum V_b y_ab^2 F_ab, wall-normal normalisation */
     double mom1 = 0;                  /* sum V_b y_ab f_ab, discrete wall weight */
+    /* Violeau: sum V_b y_ab^k F_ab ((n+2) x_i^2/r^2 + 1), k = 1, 2, for i = x and z */
+    double m1x = 0, m2x = 0, m1z = 0, m2z = 0;
     double A[6] = {0, 0, 0, 0, 0, 0}; /* corrected gradient: -sum V_b f r_ab (x) r_ab */
     double gc[3] = {0, 0, 0};         /* corrected gradient: sum V_b (p_b - p_a) f r_ab */
     const double pm_a = corrected ? pa * ra * ra : 0.0;
@@ -265,6 +309,11 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
       const double ux = u[a] - u[b], uy = v[a] - v[b], uz = w[a] - w[b];
       const double vf = vb * f;
       mom2 += vf * r2, momyy += vf * dy * dy, mom1 += vf * dy;
+      if (violeau) {
+        const double gx = vf * (np2 * dx * dx / (r2 + eta2) + 1.0) * dy;
+        const double gz = vf * (np2 * dz * dz / (r2 + eta2) + 1.0) * dy;
+        m1x += gx, m2x += gx * dy, m1z += gz, m2z += gz * dy;
+      }
       if (les) { /* Eq. 2.100 with f = mu = rho (nu + nu_r) */
         const double coef = vb * 0.5 * (mu_a + rb * (nu + nur[b])) * f / (r2 + eta2);
         const double vr = dplus2 * (ux * dx + uy * dy + uz * dz);
@@ -292,17 +341,25 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
       sph_solve_sym(M->dim, A, gc, gr);
       axa = -gr[0] * ira, aya = -gr[1] * ira, aza = -gr[2] * ira;
     }
-    double kappa = 1.0;
-    if (M->lap_norm != LAPNORM_NONE) { /* discrete + analytic part behind the walls */
+    double kappa = 1.0, kx = 1.0, kz = 1.0; /* normalisation; Violeau: of the x and z parts */
+    if (M->lap_norm != LAPNORM_NONE) {      /* discrete + analytic part behind the walls */
       const double qb = y[a] * ih, qt = (M->ly - y[a]) * ih;
-      if (M->lap_norm == LAPNORM_TRACE)
+      if (M->lap_norm == LAPNORM_TRACE) {
         kappa = -M->dim / (mom2 + wall_moment2(M->dim, qb) + wall_moment2(M->dim, qt));
-      else
+        kx = kz = kappa;
+      } else if (violeau) { /* its own y-y moments: -2 in the full space */
+        const double wm = sph_violeau_moment(M, qb) + sph_violeau_moment(M, qt);
+        kx = -2.0 / (m2x + wm);
+        kz = M->dim == 3 ? -2.0 / (m2z + wm) : kx;
+        kappa = 0.5 * (kx + kz);
+      } else {
         kappa = -1.0 / (momyy + wall_moment_yy(M->dim, qb) + wall_moment_yy(M->dim, qt));
+        kx = kz = kappa;
+      }
     }
     const double lap = nu * ig * kappa; /* nu / gamma_a, normalised */
-    const double vis = les ? ig * kappa / ra : violeau ? lap / ra : lap;
-    axa += vis * vx, aya += vis * vy, aza += vis * vz;
+    const double vis = les ? ig / ra : violeau ? nu * ig / ra : nu * ig;
+    axa += vis * kx * vx, aya += vis * kappa * vy, aza += vis * kz * vz;
     /* wall terms: pressure (Eq. 3.17, k = 1) and wall shear (Eq. 2.147-2.148) */
     double gv = 0.0;
     for (int wall = 0; wall < 2; wall++) {
@@ -329,9 +386,16 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
       } else {
         /* |grad gamma_as|, or the discrete first moment that makes the Morris operator exact
            for a velocity varying linearly with the wall distance (docs/theory.md) */
-        const double weight = discrete ? fmax(0.0, ny * mom1) : dg;
-        const double shear = 2.0 * lap * weight / (d > M->wall_dmin ? d : M->wall_dmin);
-        axa -= shear * u[a], aza -= shear * w[a];
+        const double dw = 2.0 * nu * ig / (d > M->wall_dmin ? d : M->wall_dmin);
+        if (violeau) { /* half the first moment of its x and z parts */
+          const double wx = discrete ? 0.5 * fmax(0.0, ny * m1x) : dg;
+          const double wz = discrete ? 0.5 * fmax(0.0, ny * m1z) : dg;
+          axa -= dw * kx * wx * u[a], aza -= dw * kz * wz * w[a];
+        } else {
+          const double weight = discrete ? fmax(0.0, ny * mom1) : dg;
+          const double shear = 2.0 * lap * weight / (d > M->wall_dmin ? d : M->wall_dmin);
+          axa -= shear * u[a], aza -= shear * w[a];
+        }
       }
       const double g = fabs(dg * v[a]);
       if (g > gv) gv = g;

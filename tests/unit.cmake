@@ -5,6 +5,8 @@
 #                analogues) against quadrature; Ferrand Eq. 51-52 segments
 #   test_nbr:    cell-list neighbour search against brute force, sort order and permutation
 #   test_reduce: deterministic blocked sums, bitwise across thread counts
+#   test_turb:   model terms (strain, van Driest, Smagorinsky, Yoshizawa, Violeau-Issa,
+#                wall-law stresses, Violeau wall moment) against closed forms
 #   test_walllaw: wall-law friction velocity (thesis Eq. 2.146, 5.51, 5.53): residual over
 #                y+ 1e-6..1e6, any speed and viscosity
 
@@ -37,3 +39,8 @@ add_executable(test_walllaw test_walllaw.c)
 target_link_libraries(test_walllaw PRIVATE chansph_core m)
 add_test(NAME unit_walllaw COMMAND test_walllaw)
 set_tests_properties(unit_walllaw PROPERTIES LABELS unit)
+
+add_executable(test_turb test_turb.c)
+target_link_libraries(test_turb PRIVATE chansph_core)
+add_test(NAME unit_turb COMMAND test_turb)
+set_tests_properties(unit_turb PROPERTIES LABELS unit)
