@@ -44,3 +44,11 @@ add_executable(test_turb test_turb.c)
 target_link_libraries(test_turb PRIVATE chansph_core)
 add_test(NAME unit_turb COMMAND test_turb)
 set_tests_properties(unit_turb PROPERTIES LABELS unit)
+
+# Taylor-Green check of the pressure gradient (thesis Sec. 6.2.2); the table and plot of
+# docs/validation/taylor_green.md come from tests/taylor_green_doc.py
+add_executable(taylor_green taylor_green.c)
+target_link_libraries(taylor_green PRIVATE chansph_core)
+add_test(NAME taylor_green_lattice COMMAND taylor_green --check)
+add_test(NAME taylor_green_jittered COMMAND taylor_green --jitter 0.2 --check)
+set_tests_properties(taylor_green_lattice taylor_green_jittered PROPERTIES LABELS "validation;models")
