@@ -92,7 +92,7 @@ double turb_update(const struct model *M, struct particles *P, const struct nbr 
   const double *restrict m = P->m, *restrict rho = P->rho;
   const uint8_t *restrict kind = P->kind;
   double *restrict twx = P->twx, *restrict twz = P->twz;
-  /* 1. wall-law stress of the near-wall particles: u_tau^2 along their tangential velocity */
+  /* 1. wall-law stress of the near-wall particles: rho u_tau^2 along their tangential velocity */
 #pragma omp parallel for schedule(static)
   for (size_t a = 0; a < P->n; a++) {
     twx[a] = twz[a] = 0.0;
