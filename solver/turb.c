@@ -74,7 +74,7 @@ static double vertex_sums(const struct model *M, const struct particles *P, cons
     if (P->kind[b] != KIND_FLUID) continue;
     const double dx = nbr_wrap(x[s] - x[b], M->lx), dy = y[s] - y[b];
     const double dz = M->dim == 3 ? nbr_wrap(z[s] - z[b], M->lz) : 0.0;
-    const double vw = P->m[b] / P->rho[b] * kernel_w(&M->k, sqrt(dx * dx + dy * dy + dz * dz));
+    const double vw = P->vol[b] * kernel_w(&M->k, sqrt(dx * dx + dy * dy + dz * dz));
     alpha += vw;
     for (int k = 0; k < nf; k++) out[k] += vw * f[k][b];
   }
@@ -89,7 +89,7 @@ double turb_update(const struct model *M, struct particles *P, const struct nbr 
   const double two_h = 2.0 * M->h, nu = M->nu;
   const double *restrict x = P->x, *restrict y = P->y, *restrict z = P->z;
   const double *restrict u = P->u, *restrict v = P->v, *restrict w = P->w;
-  const double *restrict m = P->m, *restrict rho = P->rho;
+  const double *restrict vol = P->vol, *restrict rho = P->rho;
   const uint8_t *restrict kind = P->kind;
   double *restrict twx = P->twx, *restrict twz = P->twz;
   /* 1. wall-law stress of the near-wall particles: rho u_tau^2 along their tangential velocity */
@@ -149,7 +149,7 @@ double turb_update(const struct model *M, struct particles *P, const struct nbr 
         const double dx = nbr_wrap(x[a] - x[b], M->lx), dy = y[a] - y[b];
         const double dz = M->dim == 3 ? nbr_wrap(z[a] - z[b], M->lz) : 0.0;
         const double r = sqrt(dx * dx + dy * dy + dz * dz);
-        const double vf = m[b] / rho[b] * kernel_f(K, r);
+        const double vf = vol[b] * kernel_f(K, r);
         const double du[3] = {u[b] - u[a], v[b] - v[a], w[b] - w[a]}, rr[3] = {dx, dy, dz};
         A[0] -= vf * dx * dx, A[1] -= vf * dx * dy, A[2] -= vf * dx * dz;
         A[3] -= vf * dy * dy, A[4] -= vf * dy * dz, A[5] -= vf * dz * dz;
@@ -165,8 +165,7 @@ double turb_update(const struct model *M, struct particles *P, const struct nbr 
         const double dz = M->dim == 3 ? nbr_wrap(z[a] - z[b], M->lz) : 0.0;
         const double r = sqrt(dx * dx + dy * dy + dz * dz);
         const double ux = u[a] - u[b], uy = v[a] - v[b], uz = w[a] - w[b];
-        sum -= m[b] / rho[b] * 0.5 * (rho[a] + rho[b]) * (ux * ux + uy * uy + uz * uz) *
-               kernel_f(K, r);
+        sum -= vol[b] * 0.5 * (rho[a] + rho[b]) * (ux * ux + uy * uy + uz * uz) * kernel_f(K, r);
       }
       const double ig = 1.0 / P->gam[a];
       sum *= ig / rho[a];
