@@ -148,6 +148,22 @@ static const struct key keys[] = {
      OFF(n_bins)},
     {"output", "particles", T_INT, "1", 0, 1, 0, NULL, "-",
      "Write the final particle state to DIR/particles.nc (1) or not (0).", OFF(particles)},
+    {"stats", "eulerian", T_INT, "1", 0, 1, 0, NULL, "-",
+     "Eulerian statistics: wall-normal profiles of means, Reynolds stresses, skewness, "
+     "flatness with standard errors, friction velocity and shear-stress balance "
+     "(docs/stats-format.md); sampled every output.stats_every steps from "
+     "output.t_average_start in output.n_bins bins.",
+     OFF(stats_eulerian)},
+    {"stats", "window", T_DOUBLE, "0", 0, BIG, 0, NULL, "s",
+     "Length of an averaging window: stats.nc keeps the sums of every window (re-average a "
+     "range with `chansph extract --window`), and the window means are the batch means of "
+     "the standard errors, so a window should span several correlation times (the log "
+     "reports the estimate). 0 = a tenth of t_end - t_average_start.",
+     OFF(stats_window)},
+    {"stats", "fold", T_INT, "0", 0, 1, 0, NULL, "-",
+     "Fold the upper half onto the lower one (y -> 2 delta - y, v -> -v) before binning; the "
+     "bins then cover 0 .. delta.",
+     OFF(stats_fold)},
     {"health", "every", T_INT, "1", 1, 1e9, 0, NULL, "steps",
      "Steps between full health checks (NaN, wall crossing, CFL); 1 checks every step.",
      OFF(health_every)},

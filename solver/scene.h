@@ -67,6 +67,10 @@ struct scene {
   double t_average_start; /*!< start of the averaging window [s] */
   int n_bins;             /*!< wall-normal bins; 0 = 2 delta / dr - 1 */
   int particles;          /*!< write the final particle state to particles.nc (1) or not (0) */
+  /* [stats] */
+  int stats_eulerian;  /*!< Eulerian profiles on (1) or off (0) */
+  double stats_window; /*!< averaging window (batch) length [s]; 0 = a tenth of the average */
+  int stats_fold;      /*!< fold the upper half of the channel onto the lower one (1) */
   /* [health] */
   int health_every; /*!< steps between full health checks */
   /* [run] */

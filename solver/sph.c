@@ -183,6 +183,7 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
     double mom2 = 0;                  /* sum V_b r_ab . grad w_ab, Laplacian normalisation */
     double momyy = 0;                 /* sum V_b y_ab^2 F_ab, wall-normal normalisation */
     double mom1 = 0;                  /* sum V_b y_ab f_ab, discrete wall weight */
+    double wvx = 0;                   /* part of vx from wall vertices */
     for (int j = 0; j < cnt; j++) {
       const int32_t b = nl[j];
       const double dx = nbr_wrap(x[a] - x[b], M->lx), dy = y[a] - y[b];
@@ -193,7 +194,7 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
       const double pp = mb * (pa + pr2[b]) * f;
       gpx += pp * dx, gpy += pp * dy, gpz += pp * dz;
       const double ux = u[a] - u[b], uy = v[a] - v[b], uz = w[a] - w[b];
-      const double vf = vb * f;
+      const double vf = vb * f, vx_before = vx;
       mom2 += vf * r2, momyy += vf * dy * dy, mom1 += vf * dy;
       if (violeau) {
         const double coef = vb * 0.5 * (ra + rb) * f / (r2 + eta2);
@@ -208,6 +209,8 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
         const double cab = ca > c[b] ? ca : c[b];
         const double vrho = ra - rb - dgrav * dy; /* varrho_ab of Eq. 3.61 */
         diff += vb * cab * vrho * f * r;
+      } else { /* viscous pull of the wall vertices, for the wall shear stress */
+        wvx += vx - vx_before;
       }
     }
     const double ig = 1.0 / P->gam[a];
@@ -223,6 +226,7 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
     const double lap = nu * ig * kappa; /* nu / gamma_a, normalised */
     const double vis = violeau ? lap / ra : lap;
     axa += vis * vx, aya += vis * vy, aza += vis * vz;
+    double awall = vis * wvx; /* x-acceleration from the walls, for the statistics */
     /* wall terms: pressure (Eq. 3.17, k = 1) and wall shear (Eq. 2.147-2.148) */
     double gv = 0.0;
     for (int wall = 0; wall < 2; wall++) {
@@ -246,11 +250,13 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
       const double weight = discrete ? fmax(0.0, ny * mom1) : dg;
       const double shear = 2.0 * lap * weight / (d > M->wall_dmin ? d : M->wall_dmin);
       axa -= shear * u[a], aza -= shear * w[a];
+      awall -= shear * u[a];
       const double g = fabs(dg * v[a]);
       if (g > gv) gv = g;
     }
     aya += M->gy;
     P->ax[a] = axa, P->ay[a] = aya, P->az[a] = aza;
+    if (info->wall_ax) info->wall_ax[a] = awall;
     P->ddiff[a] = diff * inv_xi; /* enters gamma rho directly (Eq. 3.64): no 1/gamma */
     const double ax2 = (axa + fx) * (axa + fx) + aya * aya + aza * aza;
     if (ax2 > amax2) amax2 = ax2;
