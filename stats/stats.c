@@ -109,6 +109,9 @@ static int write_eulerian(const struct euler *e, int ncid, char *err, size_t err
               {"average_end", r.t1},
               {"n_windows", (double)r.n_batches},
               {"window_length", e->cfg.window},
+              {"bin_lower", e->cfg.y0},
+              {"bin_upper", e->cfg.y1},
+              {"wall_area", e->cfg.area},
               {"fold", (double)e->cfg.fold}};
   for (size_t i = 0; i < sizeof scal / sizeof scal[0]; i++)
     CK(put_att_d(ncid, NC_GLOBAL, scal[i].name, scal[i].v));
