@@ -17,13 +17,13 @@
 
 static int failures = 0;
 
-#define EXPECT(cond, ...)              \
-  do {                                 \
-    if (!(cond)) {                     \
-      printf("FAIL: " __VA_ARGS__);    \
-      printf("\n");                    \
-      failures++;                      \
-    }                                  \
+#define EXPECT(cond, ...)           \
+  do {                              \
+    if (!(cond)) {                  \
+      printf("FAIL: " __VA_ARGS__); \
+      printf("\n");                 \
+      failures++;                   \
+    }                               \
   } while (0)
 
 /* Counter-based generator (splitmix64 of a key): reproducible, no hidden state. */
@@ -63,8 +63,15 @@ static void make_snapshot(long s, double *y, double *u, double *v, double *w, do
 }
 
 static struct euler_config config(void) {
-  struct euler_config c = {.nb = NB, .y0 = 0.0, .y1 = 2.0, .delta = 1.0, .nu = 1e-3,
-                           .rho0 = 1000.0, .area = 1.0, .t_start = 0.0, .window = 1.0};
+  struct euler_config c = {.nb = NB,
+                           .y0 = 0.0,
+                           .y1 = 2.0,
+                           .delta = 1.0,
+                           .nu = 1e-3,
+                           .rho0 = 1000.0,
+                           .area = 1.0,
+                           .t_start = 0.0,
+                           .window = 1.0};
   return c;
 }
 
@@ -72,8 +79,15 @@ static void feed(struct euler *e, long s0, long s1, double *buf) {
   double *y = buf, *u = y + NP, *v = u + NP, *w = v + NP, *p = w + NP, *rho = p + NP;
   for (long s = s0; s < s1; s++) {
     make_snapshot(s, y, u, v, w, p, rho);
-    const struct stats_snapshot snap = {.n = NP, .y = y, .u = u, .v = v, .w = w, .p = p,
-                                        .rho = rho, .t = 0.1 * s + 0.05, .fx = 2e-3,
+    const struct stats_snapshot snap = {.n = NP,
+                                        .y = y,
+                                        .u = u,
+                                        .v = v,
+                                        .w = w,
+                                        .p = p,
+                                        .rho = rho,
+                                        .t = 0.1 * s + 0.05,
+                                        .fx = 2e-3,
                                         .wall_fx = {-1.0, -1.0}};
     euler_sample(e, &snap);
   }
@@ -106,8 +120,8 @@ static void test_known_field(double *buf) {
     for (int c = 0; c < 6; c++) {
       const double z = (r.prof[EP_UU + c][b] - exact[c]) / r.prof[EP_SE_U + 5 + c][b];
       worst = fmax(worst, fabs(z));
-      EXPECT(fabs(z) < 3, "bin %d stress %d: %.6f exact %.6f se %.2e", b, c,
-             r.prof[EP_UU + c][b], exact[c], r.prof[EP_SE_U + 5 + c][b]);
+      EXPECT(fabs(z) < 3, "bin %d stress %d: %.6f exact %.6f se %.2e", b, c, r.prof[EP_UU + c][b],
+             exact[c], r.prof[EP_SE_U + 5 + c][b]);
     }
     for (int i = 0; i < 3; i++) {
       EXPECT(fabs(r.prof[EP_SKEW_U + i][b]) < 0.05, "bin %d skewness %d = %.4f", b, i,
@@ -119,10 +133,11 @@ static void test_known_field(double *buf) {
   EXPECT(r.n_batches == NSNAP / 10 - 1, "batches %d", r.n_batches);
   EXPECT(fabs(r.u_tau_force - sqrt(2e-3)) < 1e-15, "u_tau_force %.17g", r.u_tau_force);
   EXPECT(fabs(r.u_tau_wall - sqrt(1e-3)) < 1e-15, "u_tau_wall %.17g", r.u_tau_wall);
-  printf("known field: %d bins x %d snapshots of %d particles, %d batches: largest deviation "
-         "of means and stresses %.2f standard errors; correlation time %.3g s (snapshots 0.1 s "
-         "apart, independent: expected about 0.05)\n",
-         NB, NSNAP, NP, r.n_batches, worst, r.corr_time);
+  printf(
+      "known field: %d bins x %d snapshots of %d particles, %d batches: largest deviation "
+      "of means and stresses %.2f standard errors; correlation time %.3g s (snapshots 0.1 s "
+      "apart, independent: expected about 0.05)\n",
+      NB, NSNAP, NP, r.n_batches, worst, r.corr_time);
   EXPECT(r.corr_time < 0.1, "correlation time %.3g of independent snapshots", r.corr_time);
   euler_result_free(&r);
   euler_free(&e);
@@ -138,16 +153,22 @@ static void test_merge(void) {
   enum { N = 30000 };
   double ref[MOM_LEN] = {0}, parts[3][MOM_LEN], worst = 0.0;
   for (int i = 0; i < N; i++) {
-    const double s[MOM_NQ] = {5.0 + gauss(10 * i), -2.0 + 0.5 * gauss(10 * i + 1),
-                              0.1 * uniform(10 * i + 2), 1e5 + gauss(10 * i + 3), 1000.0,
+    const double s[MOM_NQ] = {5.0 + gauss(10 * i),
+                              -2.0 + 0.5 * gauss(10 * i + 1),
+                              0.1 * uniform(10 * i + 2),
+                              1e5 + gauss(10 * i + 3),
+                              1000.0,
                               uniform(10 * i + 4)};
     mom_add(ref, s);
   }
   for (int split = 2; split <= 3; split++) {
     memset(parts, 0, sizeof parts);
     for (int i = 0; i < N; i++) {
-      const double s[MOM_NQ] = {5.0 + gauss(10 * i), -2.0 + 0.5 * gauss(10 * i + 1),
-                                0.1 * uniform(10 * i + 2), 1e5 + gauss(10 * i + 3), 1000.0,
+      const double s[MOM_NQ] = {5.0 + gauss(10 * i),
+                                -2.0 + 0.5 * gauss(10 * i + 1),
+                                0.1 * uniform(10 * i + 2),
+                                1e5 + gauss(10 * i + 3),
+                                1000.0,
                                 uniform(10 * i + 4)};
       mom_add(parts[(long)i * split / N], s);
     }
@@ -166,13 +187,13 @@ static void test_merge(void) {
       if (k >= MOM_M3 && k < MOM_M3 + 3) scale = pow(ref[MOM_C2 + k - MOM_M3], 1.5) / sqrt(N);
       const double e = scale > 0 ? fabs(ref[k] - m[k]) / scale : 0.0;
       worst = fmax(worst, e);
-      EXPECT(e < 1e-14, "split %d slot %d: %.17g vs %.17g",
-             split, k, ref[k], m[k]);
+      EXPECT(e < 1e-14, "split %d slot %d: %.17g vs %.17g", split, k, ref[k], m[k]);
     }
   }
-  printf("merge invariance: %d samples in 1, 2, 3 accumulators, largest relative difference "
-         "%.2e\n",
-         N, worst);
+  printf(
+      "merge invariance: %d samples in 1, 2, 3 accumulators, largest relative difference "
+      "%.2e\n",
+      N, worst);
   (void)rel;
 }
 
