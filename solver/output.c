@@ -92,6 +92,15 @@ void output_stats_config(const struct scene *sc, struct stats_config *cfg) {
   e->t_start = sc->t_average_start;
   e->window = sc->stats_window > 0.0 ? sc->stats_window : (sc->t_end - sc->t_average_start) / 10;
   if (!(e->window > 0.0)) e->window = sc->t_end > 0 ? sc->t_end / 10 : 1.0;
+  const double u_tau = sc->u_tau_ref > 0.0 ? sc->u_tau_ref : sqrt(sc->delta * fabs(sc->force));
+  struct corr_config *c = &cfg->corr;
+  c->n_levels = sc->corr_y_plus.n;
+  for (int l = 0; l < c->n_levels; l++)
+    c->y_plus[l] = sc->corr_y_plus.v[l], c->y[l] = c->y_plus[l] * sc->nu / u_tau;
+  c->nx = sc->corr_nx > 0 ? sc->corr_nx : (int)floor(sc->lx / sc->dr + 0.5);
+  c->nz = sc->dim == 2 ? 1 : sc->corr_nz > 0 ? sc->corr_nz : (int)floor(sc->lz / sc->dr + 0.5);
+  c->lx = sc->lx, c->lz = sc->lz, c->delta = sc->delta, c->t_start = sc->t_average_start;
+  c->half = 0.5 * sc->corr_thickness * sc->dr;
   if (sc->n_bins > 0) {
     e->nb = sc->n_bins, e->y0 = 0.0, e->y1 = (sc->stats_fold ? 1.0 : 2.0) * sc->delta;
   } else if (sc->stats_fold) {

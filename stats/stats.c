@@ -14,20 +14,24 @@ void stats_init(struct stats *st, const struct stats_config *cfg) {
   memset(st, 0, sizeof *st);
   st->cfg = *cfg;
   if (cfg->eulerian) euler_init(&st->eu, &cfg->eul);
+  if (cfg->corr.n_levels) corr_init(&st->co, &cfg->corr);
 }
 
 void stats_free(struct stats *st) {
   if (st->cfg.eulerian) euler_free(&st->eu);
+  if (st->cfg.corr.n_levels) corr_free(&st->co);
   memset(st, 0, sizeof *st);
 }
 
 void stats_sample(struct stats *st, const struct stats_snapshot *s) {
   if (st->cfg.eulerian) euler_sample(&st->eu, s);
+  if (st->cfg.corr.n_levels) corr_sample(&st->co, s);
   st->samples++;
 }
 
 void stats_state(struct stats *st, struct state_list *L) {
   if (st->cfg.eulerian) euler_state(&st->eu, L);
+  if (st->cfg.corr.n_levels) corr_state(&st->co, L);
 }
 
 /* The running result: every row with data; closed windows are the batches. */
@@ -162,6 +166,10 @@ fail:
 int stats_nc_write(const struct stats *st, int ncid, char *err, size_t errlen) {
   if (st->cfg.eulerian) {
     const int rc = write_eulerian(&st->eu, ncid, err, errlen);
+    if (rc) return rc;
+  }
+  if (st->cfg.corr.n_levels) {
+    const int rc = corr_nc_write(&st->co, ncid, err, errlen);
     if (rc) return rc;
   }
   return NC_NOERR;

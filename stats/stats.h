@@ -12,6 +12,7 @@
 
 #include <stddef.h>
 
+#include "corr.h"
 #include "euler.h"
 
 struct state_list;
@@ -20,12 +21,14 @@ struct state_list;
 struct stats_config {
   int eulerian;            /*!< 1: Eulerian profiles */
   struct euler_config eul; /*!< their bins and windows */
+  struct corr_config corr; /*!< two-point correlations (off if corr.n_levels == 0) */
 };
 
 /** The engine. */
 struct stats {
   struct stats_config cfg;
   struct euler eu; /*!< Eulerian profiles (if cfg.eulerian) */
+  struct corr co;  /*!< correlations and spectra (if cfg.corr.n_levels) */
   long samples;    /*!< snapshots handed to the engine */
 };
 
