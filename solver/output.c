@@ -101,6 +101,17 @@ void output_stats_config(const struct scene *sc, struct stats_config *cfg) {
   c->nz = sc->dim == 2 ? 1 : sc->corr_nz > 0 ? sc->corr_nz : (int)floor(sc->lz / sc->dr + 0.5);
   c->lx = sc->lx, c->lz = sc->lz, c->delta = sc->delta, c->t_start = sc->t_average_start;
   c->half = 0.5 * sc->corr_thickness * sc->dr;
+  struct lagr_config *g = &cfg->lagr;
+  g->n_levels = sc->lagr_y_plus.n;
+  for (int l = 0; l < g->n_levels; l++)
+    g->y_plus[l] = sc->lagr_y_plus.v[l], g->y[l] = g->y_plus[l] * sc->nu / u_tau;
+  g->x0 = sc->lagr_x0, g->half = 0.5 * sc->dr, g->lx = sc->lx;
+  g->lz = sc->dim == 3 ? sc->lz : 0.0, g->delta = sc->delta;
+  g->horizon = sc->lagr_horizon, g->n_lags = sc->lagr_n_lags, g->pdf_bins = sc->lagr_pdf_bins;
+  g->release_every = sc->lagr_release_every > 0.0 ? sc->lagr_release_every : sc->lagr_horizon;
+  g->n_stations = sc->lagr_pdf_x.n;
+  for (int k = 0; k < g->n_stations; k++) g->station[k] = sc->lagr_pdf_x.v[k];
+  g->t_start = sc->t_average_start;
   if (sc->n_bins > 0) {
     e->nb = sc->n_bins, e->y0 = 0.0, e->y1 = (sc->stats_fold ? 1.0 : 2.0) * sc->delta;
   } else if (sc->stats_fold) {

@@ -9,29 +9,35 @@
 
 #include "moments.h"
 #include "ncout.h"
+#include "state.h"
 
 void stats_init(struct stats *st, const struct stats_config *cfg) {
   memset(st, 0, sizeof *st);
   st->cfg = *cfg;
   if (cfg->eulerian) euler_init(&st->eu, &cfg->eul);
   if (cfg->corr.n_levels) corr_init(&st->co, &cfg->corr);
+  if (cfg->lagr.n_levels) lagr_init(&st->la, &cfg->lagr);
 }
 
 void stats_free(struct stats *st) {
   if (st->cfg.eulerian) euler_free(&st->eu);
   if (st->cfg.corr.n_levels) corr_free(&st->co);
+  if (st->cfg.lagr.n_levels) lagr_free(&st->la);
   memset(st, 0, sizeof *st);
 }
 
 void stats_sample(struct stats *st, const struct stats_snapshot *s) {
   if (st->cfg.eulerian) euler_sample(&st->eu, s);
   if (st->cfg.corr.n_levels) corr_sample(&st->co, s);
+  if (st->cfg.lagr.n_levels) lagr_sample(&st->la, s);
   st->samples++;
 }
 
 void stats_state(struct stats *st, struct state_list *L) {
+  state_add(L, "stats/samples", STATE_I64, 0, NULL, &st->samples, NULL);
   if (st->cfg.eulerian) euler_state(&st->eu, L);
   if (st->cfg.corr.n_levels) corr_state(&st->co, L);
+  if (st->cfg.lagr.n_levels) lagr_state(&st->la, L);
 }
 
 /* The running result: every row with data; closed windows are the batches. */
@@ -170,6 +176,10 @@ int stats_nc_write(const struct stats *st, int ncid, char *err, size_t errlen) {
   }
   if (st->cfg.corr.n_levels) {
     const int rc = corr_nc_write(&st->co, ncid, err, errlen);
+    if (rc) return rc;
+  }
+  if (st->cfg.lagr.n_levels) {
+    const int rc = lagr_nc_write(&st->la, ncid, err, errlen);
     if (rc) return rc;
   }
   return NC_NOERR;

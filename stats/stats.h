@@ -11,9 +11,11 @@
 #define CHANSPH_STATS_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include "corr.h"
 #include "euler.h"
+#include "lagr.h"
 
 struct state_list;
 
@@ -22,6 +24,7 @@ struct stats_config {
   int eulerian;            /*!< 1: Eulerian profiles */
   struct euler_config eul; /*!< their bins and windows */
   struct corr_config corr; /*!< two-point correlations (off if corr.n_levels == 0) */
+  struct lagr_config lagr; /*!< Lagrangian statistics (off if lagr.n_levels == 0) */
 };
 
 /** The engine. */
@@ -29,7 +32,8 @@ struct stats {
   struct stats_config cfg;
   struct euler eu; /*!< Eulerian profiles (if cfg.eulerian) */
   struct corr co;  /*!< correlations and spectra (if cfg.corr.n_levels) */
-  long samples;    /*!< snapshots handed to the engine */
+  struct lagr la;  /*!< Lagrangian statistics (if cfg.lagr.n_levels) */
+  int64_t samples; /*!< snapshots handed to the engine */
 };
 
 /** @brief Set up the requested engines. */

@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "euler.h"
+#include "lagr.h"
 #include "moments.h"
 #include "state.h"
 #include "stats.h"
@@ -208,6 +209,10 @@ struct saved {
 
 static void save(struct state_list *L, struct saved *sv) {
   sv->n = L->n;
+  if (L->n > 32) {
+    printf("FAIL: more than 32 state fields\n");
+    exit(1);
+  }
   for (int i = 0; i < L->n; i++) {
     const struct state_field *f = &L->f[i];
     snprintf(sv->name[i], sizeof sv->name[i], "%s", f->name);
@@ -233,41 +238,103 @@ static void restore(struct state_list *L, const struct saved *sv) {
   }
 }
 
+/* Feed snapshots s0..s1-1 of the synthetic field to a whole engine (positions in x, z and ids
+   too, so that all three engines see data). */
+static void feed_all(struct stats *st, long s0, long s1, double *buf) {
+  double *y = buf, *u = y + NP, *v = u + NP, *w = v + NP, *p = w + NP, *rho = p + NP;
+  static double x[NP], z[NP];
+  static int64_t id[NP];
+  for (long s = s0; s < s1; s++) {
+    make_snapshot(s, y, u, v, w, p, rho);
+    for (size_t a = 0; a < NP; a++)
+      id[a] = (int64_t)a, x[a] = uniform(((uint64_t)s * NP + a) * 8 + 5),
+      z[a] = uniform(((uint64_t)s * NP + a) * 8 + 6);
+    const struct stats_snapshot snap = {.n = NP,
+                                        .x = x,
+                                        .y = y,
+                                        .z = z,
+                                        .u = u,
+                                        .v = v,
+                                        .w = w,
+                                        .p = p,
+                                        .rho = rho,
+                                        .ax = u,
+                                        .ay = v,
+                                        .az = w,
+                                        .id = id,
+                                        .t = 0.1 * s + 0.05,
+                                        .fx = 2e-3,
+                                        .wall_fx = {-1.0, -1.0}};
+    stats_sample(st, &snap);
+  }
+}
+
+static struct stats_config all_engines(void) {
+  struct stats_config c = {.eulerian = 1, .eul = config()};
+  c.corr = (struct corr_config){.n_levels = 2,
+                                .y = {0.5, 0.25},
+                                .nx = 8,
+                                .nz = 4,
+                                .lx = 1.0,
+                                .lz = 1.0,
+                                .half = 0.05,
+                                .delta = 1.0};
+  c.lagr = (struct lagr_config){.n_levels = 2,
+                                .y = {0.5, 0.3},
+                                .x0 = 0.5,
+                                .half = 0.05,
+                                .lx = 1.0,
+                                .lz = 1.0,
+                                .delta = 1.0,
+                                .horizon = 1.0,
+                                .release_every = 0.5,
+                                .n_lags = 10,
+                                .n_stations = 1,
+                                .station = {0.1},
+                                .pdf_bins = 10};
+  return c;
+}
+
 /* Acceptance 3 (engine side): serialise -> restore in a fresh engine -> continue gives the
-   same raw state and results bit for bit as never stopping. */
+   same state, field by field and bit for bit, as never stopping (all three engines). */
 static void test_round_trip(double *buf) {
-  const struct euler_config cfg = config();
-  struct euler a, b, c;
-  euler_init(&a, &cfg);
-  feed(&a, 0, 137, buf);
-  euler_init(&b, &cfg);
-  feed(&b, 0, 61, buf);
+  const struct stats_config cfg = all_engines();
+  struct stats a, b, c;
+  stats_init(&a, &cfg);
+  feed_all(&a, 0, 137, buf);
+  stats_init(&b, &cfg);
+  feed_all(&b, 0, 61, buf);
   struct state_list L = {0};
-  struct stats sb = {.cfg = {.eulerian = 1}, .eu = b};
-  stats_state(&sb, &L);
+  stats_state(&b, &L);
   struct saved sv;
   save(&L, &sv);
   state_free(&L);
-  euler_free(&sb.eu);
-  euler_init(&c, &cfg);
-  struct stats sc = {.cfg = {.eulerian = 1}, .eu = c};
-  stats_state(&sc, &L);
+  stats_free(&b);
+  stats_init(&c, &cfg);
+  stats_state(&c, &L);
   restore(&L, &sv);
   state_free(&L);
-  feed(&sc.eu, 61, 137, buf);
-  const size_t nb = NB;
-  EXPECT(sc.eu.nwin == a.nwin, "windows %zu vs %zu", sc.eu.nwin, a.nwin);
-  const size_t rows = a.nwin + 1;
-  const int same = sc.eu.nwin == a.nwin &&
-                   !memcmp(sc.eu.win, a.win, rows * WIN_LEN * sizeof(double)) &&
-                   !memcmp(sc.eu.mom, a.mom, rows * nb * MOM_LEN * sizeof(double)) &&
-                   !memcmp(sc.eu.snp, a.snp, rows * nb * SCAL_LEN * sizeof(double));
+  feed_all(&c, 61, 137, buf);
+  struct state_list La = {0}, Lc = {0};
+  stats_state(&a, &La);
+  stats_state(&c, &Lc);
+  int same = La.n == Lc.n;
+  for (int i = 0; i < La.n && same; i++) {
+    const struct state_field *fa = &La.f[i], *fc = state_find(&Lc, fa->name);
+    same = fc && state_count(fa) == state_count(fc) &&
+           !memcmp(fa->data, fc->data, state_count(fa) * sizeof(double));
+    if (!same) printf("field %s differs\n", fa->name);
+  }
   EXPECT(same, "state after a round trip differs from the uninterrupted run");
-  printf("state round trip after 61 of 137 snapshots (%d fields): %s\n", sv.n,
-         same ? "bitwise identical" : "DIFFERENT");
+  EXPECT(a.la.releases > 2 && a.la.ntracks > 0, "Lagrangian engine idle in the round trip");
+  printf(
+      "state round trip after 61 of 137 snapshots (%d fields, Eulerian, correlations, "
+      "Lagrangian with %g releases done and %zu tracks active): %s\n",
+      La.n, a.la.releases, a.la.ntracks, same ? "bitwise identical" : "DIFFERENT");
   for (int i = 0; i < sv.n; i++) free(sv.data[i]);
-  euler_free(&sc.eu);
-  euler_free(&a);
+  state_free(&La), state_free(&Lc);
+  stats_free(&c);
+  stats_free(&a);
 }
 
 /* Acceptance 1: a field with a known sinusoidal correlation gives R(l) to 1e-6. */
@@ -332,12 +399,142 @@ static void test_corr(void) {
   corr_free(&c);
 }
 
+/* Acceptance 1: tracks from Ornstein-Uhlenbeck processes of known time scale give
+   rho^L(tau) = exp(-tau/T), D(tau) = 2 var (1 - exp(-tau/T)) and T_L within 3 standard
+   errors of Eq. 5.61 applied to exp(-tau/T) (T (1 - e^-4), times the trapezoid factor). */
+static void test_lagr_ou(void) {
+  enum { NPART = 2000, RELEASES = 40, NLAG = 40 };
+  const double T = 1.0, Ta = 0.25, dt = 0.125, horizon = 5.0;
+  const struct lagr_config cfg = {.n_levels = 1,
+                                  .y = {0.5},
+                                  .y_plus = {50},
+                                  .x0 = 0.0,
+                                  .half = 0.05,
+                                  .lx = 10.0,
+                                  .lz = 0.0,
+                                  .delta = 1.0,
+                                  .horizon = horizon,
+                                  .release_every = horizon,
+                                  .n_lags = NLAG,
+                                  .pdf_bins = 10};
+  struct lagr g;
+  lagr_init(&g, &cfg);
+  static double x[NPART], y[NPART], z[NPART], u[NPART], v[NPART], w[NPART], ax[NPART];
+  static double zero[NPART];
+  static int64_t id[NPART];
+  const double f = exp(-dt / T), fa = exp(-dt / Ta);
+  for (int p = 0; p < NPART; p++) {
+    id[p] = p, x[p] = 0.0, y[p] = 0.5, z[p] = 0.0;
+    u[p] = 3.0 + gauss(7000000 + 3 * p), v[p] = gauss(7000001 + 3 * p), w[p] = 0.0;
+    ax[p] = gauss(7000002 + 3 * p);
+  }
+  const long steps = (long)(RELEASES * horizon / dt) + 1;
+  for (long n = 0; n < steps; n++) {
+    const struct stats_snapshot snap = {.n = NPART,
+                                        .x = x,
+                                        .y = y,
+                                        .z = z,
+                                        .u = u,
+                                        .v = v,
+                                        .w = w,
+                                        .ax = ax,
+                                        .ay = zero,
+                                        .az = zero,
+                                        .id = id,
+                                        .t = n * dt};
+    lagr_sample(&g, &snap);
+    for (int p = 0; p < NPART; p++) {
+      const uint64_t k = 100000000ULL + ((uint64_t)n * NPART + (uint64_t)p) * 4;
+      u[p] = 3.0 + f * (u[p] - 3.0) + sqrt(1 - f * f) * gauss(k);
+      v[p] = f * v[p] + sqrt(1 - f * f) * gauss(k + 1);
+      w[p] = 0.1 * gauss(k + 2); /* uncorrelated */
+      ax[p] = fa * ax[p] + sqrt(1 - fa * fa) * gauss(k + 3);
+    }
+  }
+  const size_t nlag = NLAG + 1;
+  double fn[LF_LEN * (NLAG + 1)], tl[3];
+  lagr_functions(&g, 0, fn, tl);
+  double dr = 0, da = 0, dd = 0;
+  for (size_t k = 0; k < nlag; k++) {
+    const double tau = k * horizon / NLAG;
+    dr = fmax(dr, fabs(fn[LF_RHO_L * nlag + k] - exp(-tau / T)));
+    dr = fmax(dr, fabs(fn[(LF_RHO_L + 1) * nlag + k] - exp(-tau / T)));
+    da = fmax(da, fabs(fn[LF_RHO_A * nlag + k] - exp(-tau / Ta)));
+    dd = fmax(dd, fabs(fn[LF_D * nlag + k] - 2.0 * (1.0 - exp(-tau / T))));
+  }
+  const double q = dt / (2 * T), expect = T * (1 - exp(-4.0)) * q / tanh(q);
+  const double *W = g.tl; /* u: [n, mean, M2] over the releases */
+  const double se = sqrt(W[SCAL_M2] / (W[SCAL_N] - 1) / W[SCAL_N]);
+  printf(
+      "Lagrangian OU tracks (%d particles x %.0f releases, T = %g): max |rho_L - exp(-tau/T)| "
+      "%.4f, max |rho_a - exp(-tau/T_a)| %.4f, max |D_u - 2(1 - exp)| %.4f; T_L merged %.4f, "
+      "release mean %.4f +- %.4f, expected %.4f (%.2f standard errors)\n",
+      NPART, g.releases, T, dr, da, dd, tl[0], W[SCAL_MEAN], se, expect,
+      (W[SCAL_MEAN] - expect) / se);
+  EXPECT(g.releases >= RELEASES - 1, "releases %g", g.releases);
+  EXPECT(dr < 0.02 && da < 0.02 && dd < 0.04, "Lagrangian correlations off");
+  EXPECT(fabs(W[SCAL_MEAN] - expect) < 3 * se, "T_L of the releases not within 3 se");
+  EXPECT(fabs(tl[0] - expect) < 3 * se, "merged T_L not within 3 se");
+  lagr_free(&g);
+}
+
+/* Acceptance 1: tracks with a known y-distribution at a station give its PDF and moments. */
+static void test_lagr_pdf(void) {
+  enum { NPART = 20000, BINS = 50 };
+  const double sy = 0.1, dt = 0.0625, X = 0.5;
+  const struct lagr_config cfg = {.n_levels = 1,
+                                  .y = {0.5},
+                                  .x0 = 0.0,
+                                  .half = 0.05,
+                                  .lx = 10.0,
+                                  .delta = 1.0,
+                                  .horizon = 1.0,
+                                  .release_every = 100.0,
+                                  .n_lags = 16,
+                                  .n_stations = 1,
+                                  .station = {X},
+                                  .pdf_bins = BINS};
+  struct lagr g;
+  lagr_init(&g, &cfg);
+  static double x[NPART], y[NPART], z[NPART], u[NPART], g0[NPART];
+  static int64_t id[NPART];
+  for (int p = 0; p < NPART; p++) id[p] = p, g0[p] = gauss(9000000 + p), u[p] = 1.0;
+  for (int n = 0; n <= 16; n++) {
+    const double t = n * dt;
+    for (int p = 0; p < NPART; p++) /* x = U t, y drifts linearly: N(0.5, sy^2) at x = X */
+      x[p] = t, y[p] = 0.5 + sy * g0[p] * t / X, z[p] = 0.0;
+    const struct stats_snapshot snap = {
+        .n = NPART, .x = x, .y = y, .z = z, .u = u, .v = u, .w = u, .id = id, .t = t};
+    lagr_sample(&g, &snap);
+  }
+  const double *P = g.pdf, n = P[BINS], mu = P[BINS + 1] / n, var = P[BINS + 2] / n - mu * mu;
+  const double se_mu = sy / sqrt(n), se_var = sy * sy * sqrt(2.0 / n), width = 2.0 / BINS;
+  double worst = 0.0; /* per-bin deviation from the Gaussian in units of its Poisson error */
+  for (int b = 0; b < BINS; b++) {
+    const double lo = b * width, hi = lo + width;
+    const double pexp =
+        0.5 * (erf((hi - 0.5) / (sy * sqrt(2.0))) - erf((lo - 0.5) / (sy * sqrt(2.0))));
+    if (pexp * n < 5) continue;
+    worst = fmax(worst, fabs(P[b] - pexp * n) / sqrt(pexp * n));
+  }
+  printf(
+      "Lagrangian PDF at x - x0 = %g: %.0f tracks, mu_y = %.5f (exact 0.5, %.2f se), "
+      "variance %.6f (exact %.6f, %.2f se), largest bin deviation %.2f Poisson errors\n",
+      X, n, mu, (mu - 0.5) / se_mu, var, sy * sy, (var - sy * sy) / se_var, worst);
+  EXPECT(n == NPART, "tracks crossing the station: %g", n);
+  EXPECT(fabs(mu - 0.5) < 3 * se_mu && fabs(var - sy * sy) < 3 * se_var, "PDF moments off");
+  EXPECT(worst < 4.5, "PDF histogram off");
+  lagr_free(&g);
+}
+
 int main(void) {
   double *buf = malloc(6 * NP * sizeof(double));
   test_known_field(buf);
   test_merge();
   test_round_trip(buf);
   test_corr();
+  test_lagr_ou();
+  test_lagr_pdf();
   free(buf);
   printf(failures ? "FAILED (%d)\n" : "all passed\n", failures);
   return failures ? 1 : 0;
