@@ -211,7 +211,7 @@ void output_begin(struct output *o, struct sim *S) {
 
 void output_step(struct output *o, struct sim *S) {
   const struct scene *sc = S->sc;
-  if (S->t >= sc->t_average_start && S->step % sc->stats_every == 0) {
+  if (stats_wanted(&o->st) && S->t >= sc->t_average_start && S->step % sc->stats_every == 0) {
     timer_push("stats");
     const struct particles *P = &S->P;
     const struct stats_snapshot snap = {.n = P->n,
@@ -295,6 +295,8 @@ int output_finish(struct output *o, struct sim *S) {
   char line[1024];
   stats_convergence_line(&o->st, line, sizeof line);
   logline(o, "%s", line);
+  logline(o, "statistics engine: %.3f MB (%lld snapshots)\n", stats_memory(&o->st) / 1048576.0,
+          (long long)o->st.samples);
   TRY(write_stats(o, S));
   if (S->sc->particles) TRY(write_particles(o, S));
   logline(o, "finished: %ld steps, t = %.6g s in %.2f s wall (%.3e particle-steps/s)\n", S->step,

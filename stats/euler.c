@@ -45,6 +45,8 @@ const struct euler_meta euler_prof_meta[EP_NPROF] = {
     [EP_TOTAL] = {"total_stress", "m^2/s^2", "total shear stress nu dU/dy - <u'v'> (Eq. 5.12)"},
     [EP_TOTAL_EXPECTED] = {"total_stress_expected", "m^2/s^2",
                            "tau_w / rho (1 - y / delta) with the force-balance tau_w (Eq. 5.13)"},
+    [EP_NUT] = {"nu_t_mean", "m^2/s", "mean eddy viscosity (LES, thesis Eq. 5.45)"},
+    [EP_KR] = {"k_r_mean", "m^2/s^2", "mean residual kinetic energy (LES, Yoshizawa)"},
 };
 
 static void *xrealloc(void *p, size_t bytes) {
@@ -126,7 +128,14 @@ void euler_sample(struct euler *e, const struct stats_snapshot *s) {
     if (c->fold && upper) y = ly - y, v = -v;
     int b = (int)floor((y - c->y0) * scale);
     b = b < 0 ? 0 : b >= c->nb ? c->nb - 1 : b; /* samples outside [y0, y1]: end bins */
-    const double smp[MOM_NQ] = {s->u[a], v, s->w[a], s->p[a], s->rho[a], y};
+    const double smp[MOM_NQ] = {s->u[a],
+                                v,
+                                s->w[a],
+                                s->p[a],
+                                s->rho[a],
+                                y,
+                                s->nu_t ? s->nu_t[a] : 0.0,
+                                s->k_r ? s->k_r[a] : 0.0};
     mom_add(row + (size_t)b * MOM_LEN, smp);
     e->tmp[2 * b] += s->u[a], e->tmp[2 * b + 1] += 1.0;
   }
@@ -207,6 +216,8 @@ void euler_finalise(const struct euler_config *cfg, const double *win, const dou
     res->prof[EP_N][b] = n;
     res->prof[EP_Y_MEAN][b] = n > 0.0 ? m[MOM_MEAN + MOM_Y] : res->prof[EP_Y][b];
     for (int q = 0; q < 5; q++) res->prof[EP_U + q][b] = n > 0.0 ? m[MOM_MEAN + q] : nan;
+    res->prof[EP_NUT][b] = n > 0.0 ? m[MOM_MEAN + MOM_NUT] : nan;
+    res->prof[EP_KR][b] = n > 0.0 ? m[MOM_MEAN + MOM_KR] : nan;
     for (int c = 0; c < MOM_NC; c++) res->prof[EP_UU + c][b] = n > 0.0 ? m[MOM_C2 + c] / n : nan;
     for (int i = 0; i < 3; i++) {
       const double m2 = m[MOM_C2 + i] / n;

@@ -33,6 +33,7 @@ struct euler_config {
   double area;    /*!< area of one wall (lx lz in 3-D, lx in 2-D) [m^2 or m] */
   double t_start; /*!< start of the averaging [s] */
   double window;  /*!< length of an averaging window [s] */
+  int les;        /*!< 1: eddy viscosity and residual kinetic energy profiles too */
 };
 
 /** The raw state: windows of per-bin moment records. */
@@ -53,6 +54,8 @@ struct stats_snapshot {
   const double *u, *v, *w;    /*!< velocities [m/s] */
   const double *p, *rho, *m;  /*!< pressure [Pa], density [kg/m^3], mass [kg] */
   const double *ax, *ay, *az; /*!< accelerations without the body force [m/s^2], or NULL */
+  const double *nu_t;         /*!< eddy viscosity [m^2/s], or NULL (no LES) */
+  const double *k_r;          /*!< residual kinetic energy [m^2/s^2], or NULL (no LES) */
   const int64_t *id;          /*!< global ids */
   const uint8_t *skip;        /*!< nonzero: not a fluid particle, not sampled */
   double t;                   /*!< simulated time [s] */
@@ -89,6 +92,8 @@ enum {
   EP_VISC,
   EP_TOTAL,
   EP_TOTAL_EXPECTED,
+  EP_NUT,
+  EP_KR,
   EP_NPROF
 };
 

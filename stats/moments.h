@@ -12,11 +12,12 @@
 #ifndef CHANSPH_MOMENTS_H
 #define CHANSPH_MOMENTS_H
 
-/** Quantities averaged per bin (the order of the mean slots). */
-enum { MOM_U, MOM_V, MOM_W, MOM_P, MOM_RHO, MOM_Y, MOM_NQ };
+/** Quantities averaged per bin (the order of the mean slots); eddy viscosity and residual
+    kinetic energy are zero without LES. */
+enum { MOM_U, MOM_V, MOM_W, MOM_P, MOM_RHO, MOM_Y, MOM_NUT, MOM_KR, MOM_NQ };
 /** Co-moment slots: uu vv ww uv uw vw. */
 enum { MOM_UU, MOM_VV, MOM_WW, MOM_UV, MOM_UW, MOM_VW, MOM_NC };
-/** Layout of a record: [count | mean[6] | co-moments[6] | M3 of u,v,w | M4 of u,v,w]. */
+/** Layout of a record: [count | means[8] | co-moments[6] | M3 of u,v,w | M4 of u,v,w]. */
 enum {
   MOM_N = 0,
   MOM_MEAN = 1,
@@ -62,7 +63,7 @@ static inline void mom_merge(double *restrict a, const double *restrict b) {
 }
 
 /**
- * @brief Add one sample (u, v, w, p, rho, y) to a record: the merge with a one-sample
+ * @brief Add one sample (u, v, w, p, rho, y, nu_t, k_r) to a record: the merge with a one-sample
  *        record, written out (Welford's update with the higher moments of Pebay 2008).
  * @param[in,out] a record
  * @param[in] s the sample, MOM_NQ values in slot order

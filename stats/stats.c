@@ -26,6 +26,10 @@ void stats_free(struct stats *st) {
   memset(st, 0, sizeof *st);
 }
 
+int stats_wanted(const struct stats *st) {
+  return st->cfg.eulerian || st->cfg.corr.n_levels > 0 || st->cfg.lagr.n_levels > 0;
+}
+
 void stats_sample(struct stats *st, const struct stats_snapshot *s) {
   if (st->cfg.eulerian) euler_sample(&st->eu, s);
   if (st->cfg.corr.n_levels) corr_sample(&st->co, s);
@@ -38,6 +42,29 @@ void stats_state(struct stats *st, struct state_list *L) {
   if (st->cfg.eulerian) euler_state(&st->eu, L);
   if (st->cfg.corr.n_levels) corr_state(&st->co, L);
   if (st->cfg.lagr.n_levels) lagr_state(&st->la, L);
+}
+
+size_t stats_memory(const struct stats *st) {
+  const size_t d = sizeof(double);
+  size_t b = 0;
+  if (st->cfg.eulerian) {
+    const size_t nb = (size_t)st->eu.cfg.nb;
+    b += st->eu.cap * (WIN_LEN + nb * (MOM_LEN + SCAL_LEN)) * d + 2 * nb * d;
+  }
+  if (st->cfg.corr.n_levels) {
+    const struct corr *c = &st->co;
+    const size_t nk = (size_t)c->cfg.nx * (size_t)c->nzh, np = (size_t)c->cfg.nx * c->cfg.nz;
+    b += (size_t)c->cfg.n_levels * (nk * CS_LEN + 2) * d + 4 * np * d + 3 * nk * 2 * d;
+  }
+  if (st->cfg.lagr.n_levels) {
+    const struct lagr *g = &st->la;
+    const size_t nl = (size_t)g->cfg.n_levels, ns = (size_t)g->n_slots;
+    const size_t nst = (size_t)(g->cfg.n_stations ? g->cfg.n_stations : 1);
+    b += nl * g->nlag * LG_LEN * d * (1 + ns) + ns * SL_LEN * d + nl * 3 * SCAL_LEN * d +
+         nl * nst * ((size_t)g->cfg.pdf_bins + 3) * d + g->cap * TR_LEN * d +
+         g->index_len * sizeof(long);
+  }
+  return b;
 }
 
 /* The running result: every row with data; closed windows are the batches. */
@@ -93,6 +120,7 @@ static int write_eulerian(const struct euler *e, int ncid, char *err, size_t err
   const size_t nb = (size_t)e->cfg.nb, rows = euler_rows(e);
   CK(nc_def_dim(ncid, "y", nb, &dy));
   for (int k = 0; k < EP_NPROF; k++) {
+    if ((k == EP_NUT || k == EP_KR) && !e->cfg.les) continue;
     const struct euler_meta *m = &euler_prof_meta[k];
     CK(ncout_def(ncid, m->name, NC_DOUBLE, 1, &dy, m->units, m->long_name, &vid));
     if (k == EP_Y) {
@@ -145,8 +173,8 @@ static int write_eulerian(const struct euler *e, int ncid, char *err, size_t err
                "of tau_w/rho at y=0 and y=2delta [m^2/s^2]",
                &vw));
   CK(ncout_def(g, "moments", NC_DOUBLE, 3, d3m, "1",
-               "per window and bin: count, means of u v w p rho y, co-moments uu vv ww uv uw "
-               "vw, third and fourth central moments of u v w (sums, not divided by count)",
+               "per window and bin: count, means of u v w p rho y nu_t k_r, co-moments uu vv ww "
+               "uv uw vw, third and fourth central moments of u v w (sums, not divided by count)",
                &vm));
   CK(ncout_def(g, "snapshot_u", NC_DOUBLE, 3, d3s, "1",
                "per window and bin: count, mean and M2 of the per-snapshot bin means of u", &vs));

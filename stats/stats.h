@@ -42,6 +42,9 @@ void stats_init(struct stats *st, const struct stats_config *cfg);
 /** @brief Free them. */
 void stats_free(struct stats *st);
 
+/** @brief True if the scene requested any engine (else the solver need not build snapshots). */
+int stats_wanted(const struct stats *st);
+
 /** @brief Hand one snapshot to every requested engine. */
 void stats_sample(struct stats *st, const struct stats_snapshot *s);
 
@@ -60,6 +63,9 @@ void stats_state(struct stats *st, struct state_list *L);
  * @return 0 or a netCDF status
  */
 int stats_nc_write(const struct stats *st, int ncid, char *err, size_t errlen);
+
+/** @brief Bytes held by the requested engines (accumulators, work arrays, tracks). */
+size_t stats_memory(const struct stats *st);
 
 /**
  * @brief One line for the log: windows, correlation time, largest standard error of u_mean,
