@@ -4,6 +4,7 @@
  */
 #define _GNU_SOURCE /* feenableexcept */
 #include <fenv.h>
+#include <math.h>
 #include <mpi.h>
 #include <omp.h>
 #include <stdio.h>
@@ -19,14 +20,20 @@
 
 /** Run a scene into a directory; returns the process exit code. */
 static int run(const struct scene *sc, const struct cli *c) {
-  struct output out;
-  if (output_open(&out, c->out, sc, c->overwrite)) return 1;
   struct sim S;
-  sim_init(&S, sc);
+  if (sim_init(&S, sc)) return 1; /* before the run directory exists: nothing to clean up */
+  struct output out;
+  if (output_open(&out, c->out, sc, c->overwrite)) {
+    sim_free(&S);
+    return 1;
+  }
   output_begin(&out, &S);
   int rc = 0;
   while (!sim_done(&S)) {
     sim_step(&S);
+    if (c->inject_id >= 0 && S.step == c->inject_step)
+      for (size_t a = 0; a < S.P.n; a++)
+        if (S.P.id[a] == c->inject_id) S.P.u[a] = NAN; /* fault injection (tests only) */
     struct health_report rep;
     if (S.violation[0]) snprintf(rep.what, sizeof rep.what, "%s", S.violation);
     if (S.violation[0] ||

@@ -12,13 +12,15 @@ enum command { CMD_HELP, CMD_VERSION, CMD_RUN, CMD_BENCH, CMD_SCENE_DOC };
 /** Parsed command line. */
 struct cli {
   enum command cmd;
-  const char *scene; /*!< scene file (bench: optional) */
-  char out[2048];    /*!< run directory */
-  int n_set;         /*!< number of --set overrides */
-  char **set;        /*!< the overrides (pointers into argv) */
-  int overwrite;     /*!< --overwrite */
-  int fpe;           /*!< --fpe: trap floating-point exceptions */
-  long steps;        /*!< bench: --steps */
+  const char *scene;   /*!< scene file (bench: optional) */
+  char out[2048];      /*!< run directory */
+  int n_set;           /*!< number of --set overrides */
+  char **set;          /*!< the overrides (pointers into argv) */
+  int overwrite;       /*!< --overwrite */
+  int fpe;             /*!< --fpe: trap floating-point exceptions */
+  long steps;          /*!< bench: --steps */
+  long inject_step;    /*!< --inject-nan STEP:ID (fault injection for the stability tests) */
+  long long inject_id; /*!< particle whose u becomes NaN after that step; -1 = none */
 };
 
 /**

@@ -90,6 +90,7 @@ void output_stats_config(const struct scene *sc, struct stats_config *cfg) {
   e->fold = sc->stats_fold, e->delta = sc->delta, e->nu = sc->nu, e->rho0 = sc->rho0;
   e->area = sc->dim == 3 ? sc->lx * sc->lz : sc->lx;
   e->t_start = sc->t_average_start;
+  e->les = sc->les != LES_NONE;
   e->window = sc->stats_window > 0.0 ? sc->stats_window : (sc->t_end - sc->t_average_start) / 10;
   if (!(e->window > 0.0)) e->window = sc->t_end > 0 ? sc->t_end / 10 : 1.0;
   const double u_tau = sc->u_tau_ref > 0.0 ? sc->u_tau_ref : sqrt(sc->delta * fabs(sc->force));
@@ -223,6 +224,8 @@ void output_step(struct output *o, struct sim *S) {
                                         .w = P->w,
                                         .p = P->p,
                                         .rho = P->rho,
+                                        .nu_t = P->nur,
+                                        .k_r = P->kr,
                                         .m = P->m,
                                         .ax = P->ax,
                                         .ay = P->ay,

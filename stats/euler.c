@@ -41,7 +41,8 @@ const struct euler_meta euler_prof_meta[EP_NPROF] = {
     [EP_FLAT_U] = {"u_flatness", "1", "flatness (kurtosis) of u"},
     [EP_FLAT_V] = {"v_flatness", "1", "flatness (kurtosis) of v"},
     [EP_FLAT_W] = {"w_flatness", "1", "flatness (kurtosis) of w"},
-    [EP_VISC] = {"viscous_stress", "m^2/s^2", "viscous shear stress nu dU/dy (Eq. 5.11)"},
+    [EP_VISC] = {"viscous_stress", "m^2/s^2",
+                 "viscous shear stress (nu + <nu_t>) dU/dy (Eq. 5.11; nu_t with LES only)"},
     [EP_TOTAL] = {"total_stress", "m^2/s^2", "total shear stress nu dU/dy - <u'v'> (Eq. 5.12)"},
     [EP_TOTAL_EXPECTED] = {"total_stress_expected", "m^2/s^2",
                            "tau_w / rho (1 - y / delta) with the force-balance tau_w (Eq. 5.13)"},
@@ -259,8 +260,10 @@ void euler_finalise(const struct euler_config *cfg, const double *win, const dou
   for (int b = 0; b < nb; b++) {
     const double dudy = ok[b] ? deriv(res->prof[EP_Y_MEAN], res->prof[EP_U], ok, nb, b) : nan;
     const double yb = res->prof[EP_Y_MEAN][b];
-    res->prof[EP_VISC][b] = cfg->nu * dudy;
-    res->prof[EP_TOTAL][b] = cfg->nu * dudy - res->prof[EP_UV][b];
+    /* with LES the modelled stress <nu_t> dU/dy joins the viscous one (Eq. 5.45) */
+    const double nu_eff = cfg->nu + (cfg->les && ok[b] ? res->prof[EP_NUT][b] : 0.0);
+    res->prof[EP_VISC][b] = nu_eff * dudy;
+    res->prof[EP_TOTAL][b] = nu_eff * dudy - res->prof[EP_UV][b];
     res->prof[EP_TOTAL_EXPECTED][b] = tw_force * (1.0 - yb / cfg->delta);
     if (b > 0 && b < nb - 1 && ok[b] && tw_force > 0.0) {
       const double err = fabs(res->prof[EP_TOTAL][b] - res->prof[EP_TOTAL_EXPECTED][b]) / tw_force;

@@ -12,7 +12,7 @@
 #include "moments.h"
 
 /** How a profile scales: velocity, stress, pressure, length, or not at all. */
-enum unit_class { UC_NONE, UC_VEL, UC_STRESS, UC_PRESSURE, UC_LENGTH };
+enum unit_class { UC_NONE, UC_VEL, UC_STRESS, UC_PRESSURE, UC_LENGTH, UC_VISC };
 
 static enum unit_class class_of(int k) {
   switch (k) {
@@ -29,6 +29,8 @@ static enum unit_class class_of(int k) {
     case EP_P:
     case EP_SE_U + 3:
       return UC_PRESSURE;
+    case EP_NUT:
+      return UC_VISC;
     case EP_RHO:
     case EP_SE_U + 4:
     case EP_N:
@@ -74,6 +76,9 @@ static int read_stored(const char *path, struct stored *s) {
       get_att(ncid, "bin_upper", &s->cfg.y1, path) || get_att(ncid, "wall_area", &area, path) ||
       get_att(ncid, "fold", &fold, path) || get_att(ncid, "window_length", &s->cfg.window, path);
   s->cfg.fold = (int)fold, s->cfg.area = area;
+  double les = 0.0; /* optional: eddy-viscosity profiles present */
+  if (!bad && nc_get_att_double(ncid, NC_GLOBAL, "les", &les) != NC_NOERR) les = 0.0;
+  s->cfg.les = les != 0.0;
   int dy, dw, vw, vm, vs, vc;
   size_t nb = 0;
   if (!bad && (nc_inq_ncid(ncid, "eulerian", &g) || nc_inq_dimid(ncid, "y", &dy) ||
@@ -112,7 +117,7 @@ static void usage(void) {
           "  variables: u_mean v_mean w_mean p_mean rho_mean uu vv ww uv uw vw u_rms v_rms "
           "w_rms\n"
           "  u_skewness ... w_flatness viscous_stress total_stress total_stress_expected "
-          "n_samples y_mean\n"
+          "n_samples y_mean nu_t_mean k_r_mean (LES)\n"
           "  (standard errors are printed next to the variables that have them)\n");
 }
 
@@ -198,7 +203,7 @@ int extract_main(int argc, char **argv) {
       ut, res.u_tau_wall, res.u_tau_force, res.u_tau_stderr, res.re_tau, res.corr_time,
       res.balance_error);
   printf("# units: %s\n", wall ? "wall (y+ = y u_tau/nu, velocities/u_tau, stresses/u_tau^2, "
-                                 "p/(rho0 u_tau^2))"
+                                 "p/(rho0 u_tau^2), nu_t/nu)"
                                : "outer (y/delta; values in SI units)");
   printf("%s%c%s", "y", sep, wall ? "y_plus" : "y_over_delta");
   for (int c = 0; c < nc; c++) {
@@ -229,6 +234,9 @@ int extract_main(int argc, char **argv) {
             break;
           case UC_LENGTH:
             scale = ut / s.cfg.nu;
+            break;
+          case UC_VISC:
+            scale = 1.0 / s.cfg.nu;
             break;
           case UC_NONE:
             break;

@@ -150,7 +150,8 @@ static int write_eulerian(const struct euler *e, int ncid, char *err, size_t err
               {"bin_lower", e->cfg.y0},
               {"bin_upper", e->cfg.y1},
               {"wall_area", e->cfg.area},
-              {"fold", (double)e->cfg.fold}};
+              {"fold", (double)e->cfg.fold},
+              {"les", (double)e->cfg.les}};
   for (size_t i = 0; i < sizeof scal / sizeof scal[0]; i++)
     CK(put_att_d(ncid, NC_GLOBAL, scal[i].name, scal[i].v));
   /* the raw windows: the complete accumulator state, re-averaged by chansph extract */
