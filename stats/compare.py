@@ -198,7 +198,9 @@ def plots(ours, dns, out_dir):
         fig, ax = plt.subplots(figsize=(6, 4.2))
         ax.semilogx(dns["yplus"][1:], dns[q][1:], "k-", lw=1.2, label="DNS: " + dns["name"])
         se = ours.get(q + "_se")
-        yerr = 2 * se if se is not None else None
+        yerr = None
+        if se is not None and np.isfinite(se).any():
+            yerr = np.where(np.isfinite(se), 2 * se, 0.0)
         ax.errorbar(ours["yplus"], ours[q], yerr=yerr, fmt="o", ms=3, capsize=2,
                     label="%s (bars: 2 standard errors)" % ours["label"])
         if q == "U+":
