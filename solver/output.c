@@ -91,6 +91,7 @@ void output_stats_config(const struct scene *sc, struct stats_config *cfg) {
   e->area = sc->dim == 3 ? sc->lx * sc->lz : sc->lx;
   e->t_start = sc->t_average_start;
   e->les = sc->les != LES_NONE;
+  e->method = sc->stats_method, e->h = scene_h(sc), e->dim = sc->dim;
   e->window = sc->stats_window > 0.0 ? sc->stats_window : (sc->t_end - sc->t_average_start) / 10;
   if (!(e->window > 0.0)) e->window = sc->t_end > 0 ? sc->t_end / 10 : 1.0;
   const double u_tau = sc->u_tau_ref > 0.0 ? sc->u_tau_ref : sqrt(sc->delta * fabs(sc->force));

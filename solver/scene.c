@@ -250,6 +250,12 @@ static const struct key keys[] = {
      "Fold the upper half onto the lower one (y -> 2 delta - y, v -> -v) before binning; the "
      "bins then cover 0 .. delta.",
      OFF(stats_fold)},
+    {"stats", "method", T_CHOICE, "bins", 0, 0, 0, "bins|sph", "-",
+     "How particles make the profiles: bin sampling (thesis Eq. 5.54-5.55), or SPH "
+     "interpolation (Eq. 5.56) at the bin centres averaged over the plane, each particle "
+     "weighted by V_a times the plane integral of the kernel; the means are Eq. 5.56, the "
+     "stresses then also hold the mean-shear variation across the kernel (use bins for them).",
+     OFF(stats_method)},
     {"stats", "u_tau_ref", T_DOUBLE, "0", 0, BIG, 0, NULL, "m/s",
      "Friction velocity that places the y+ levels of the correlations and Lagrangian releases "
      "(y = y+ nu / u_tau_ref); 0 = sqrt(delta drive.force), the force-balance value.",

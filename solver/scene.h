@@ -106,6 +106,7 @@ struct scene {
   int stats_eulerian;  /*!< Eulerian profiles on (1) or off (0) */
   double stats_window; /*!< averaging window (batch) length [s]; 0 = a tenth of the average */
   int stats_fold;      /*!< fold the upper half of the channel onto the lower one (1) */
+  int stats_method;    /*!< 0: bin sampling (Eq. 5.54-5.55), 1: SPH interpolation (Eq. 5.56) */
   double u_tau_ref;    /*!< friction velocity placing y+ levels [m/s]; 0 = sqrt(delta force) */
   /* [correlations] */
   struct scene_list corr_y_plus; /*!< y+ levels of the two-point correlations (empty = off) */

@@ -12,7 +12,8 @@
 const struct euler_meta euler_prof_meta[EP_NPROF] = {
     [EP_Y] = {"y", "m", "wall-normal bin centre (walls at 0 and 2 delta)"},
     [EP_Y_MEAN] = {"y_mean", "m", "mean position of the samples in the bin"},
-    [EP_N] = {"n_samples", "1", "particle samples in the bin"},
+    [EP_N] = {"n_samples", "1",
+              "particle samples in the bin (SPH interpolation: sum of the weights V_a W1)"},
     [EP_U] = {"u_mean", "m/s", "mean streamwise velocity"},
     [EP_V] = {"v_mean", "m/s", "mean wall-normal velocity"},
     [EP_W] = {"w_mean", "m/s", "mean spanwise velocity"},
@@ -85,9 +86,41 @@ static void open_row(struct euler *e, double t0) {
   w[WIN_T1] = e->cfg.window > 0.0 ? t0 + e->cfg.window : INFINITY;
 }
 
+/* Shape of the Wendland kernel (thesis Eq. 2.63-2.66) without its constant: the constant
+   cancels in the ratio of Eq. 5.56. */
+static double wendland_shape(double q) {
+  if (q >= 2.0) return 0.0;
+  const double t = 1.0 - 0.5 * q;
+  return t * t * t * t * (2.0 * q + 1.0);
+}
+
+/* W1(s) = int over the plane of w(sqrt(s^2 + rho^2)): in 3-D proportional to
+   int_0^L w(sqrt(s^2 + t^2)) t dt, in 2-D to int_0^L w(sqrt(s^2 + t^2)) dt, L = sqrt(4 - s^2)
+   (composite Simpson, 256 intervals). */
+static void build_w1(struct euler *e) {
+  for (int i = 0; i <= EULER_W1_N; i++) {
+    const double s = 2.0 * i / EULER_W1_N, L = sqrt(fmax(0.0, 4.0 - s * s));
+    const int m = 256;
+    double sum = 0.0;
+    for (int k = 0; k <= m; k++) {
+      const double t = L * k / m, c = k == 0 || k == m ? 1.0 : k % 2 ? 4.0 : 2.0;
+      sum += c * wendland_shape(sqrt(s * s + t * t)) * (e->cfg.dim == 3 ? t : 1.0);
+    }
+    e->w1[i] = sum * L / (3.0 * m);
+  }
+}
+
+static double w1_at(const struct euler *e, double q) {
+  const double x = q * (0.5 * EULER_W1_N);
+  if (x >= EULER_W1_N) return 0.0;
+  const int i = (int)x;
+  return e->w1[i] + (x - i) * (e->w1[i + 1] - e->w1[i]);
+}
+
 void euler_init(struct euler *e, const struct euler_config *cfg) {
   memset(e, 0, sizeof *e);
   e->cfg = *cfg;
+  if (cfg->method == EULER_SPH) build_w1(e);
   e->tmp = xrealloc(NULL, (size_t)cfg->nb * 2 * sizeof(double));
   open_row(e, cfg->t_start);
 }
@@ -127,8 +160,6 @@ void euler_sample(struct euler *e, const struct stats_snapshot *s) {
     double y = s->y[a], v = s->v[a];
     const int upper = y > c->delta;
     if (c->fold && upper) y = ly - y, v = -v;
-    int b = (int)floor((y - c->y0) * scale);
-    b = b < 0 ? 0 : b >= c->nb ? c->nb - 1 : b; /* samples outside [y0, y1]: end bins */
     const double smp[MOM_NQ] = {s->u[a],
                                 v,
                                 s->w[a],
@@ -137,6 +168,26 @@ void euler_sample(struct euler *e, const struct stats_snapshot *s) {
                                 y,
                                 s->nu_t ? s->nu_t[a] : 0.0,
                                 s->k_r ? s->k_r[a] : 0.0};
+    if (c->method == EULER_SPH) {
+      /* Eq. 5.56 averaged over the plane y = y_i: every profile point within 2h takes the
+         sample with weight V_a W1(|y_a - y_i| / h) (a weighted one-sample merge) */
+      const double vol = s->m ? s->m[a] / s->rho[a] : 1.0, h2 = 2.0 * c->h;
+      int lo = (int)ceil((y - h2 - c->y0) * scale - 0.5),
+          hi = (int)floor((y + h2 - c->y0) * scale - 0.5);
+      lo = lo < 0 ? 0 : lo, hi = hi >= c->nb ? c->nb - 1 : hi;
+      for (int b = lo; b <= hi; b++) {
+        const double wt = vol * w1_at(e, fabs(y - euler_centre(c, b)) / c->h);
+        if (wt <= 0.0) continue;
+        double one[MOM_LEN] = {0};
+        one[MOM_N] = wt;
+        for (int q = 0; q < MOM_NQ; q++) one[MOM_MEAN + q] = smp[q];
+        mom_merge(row + (size_t)b * MOM_LEN, one);
+        e->tmp[2 * b] += wt * s->u[a], e->tmp[2 * b + 1] += wt;
+      }
+      continue;
+    }
+    int b = (int)floor((y - c->y0) * scale);
+    b = b < 0 ? 0 : b >= c->nb ? c->nb - 1 : b; /* samples outside [y0, y1]: end bins */
     mom_add(row + (size_t)b * MOM_LEN, smp);
     e->tmp[2 * b] += s->u[a], e->tmp[2 * b + 1] += 1.0;
   }
@@ -192,7 +243,7 @@ void euler_finalise(const struct euler_config *cfg, const double *win, const dou
       if (s[SCAL_N] > 0.0) {
         within[2 * b] += s[SCAL_M2], within[2 * b + 1] += s[SCAL_N] - 1.0;
       }
-      if (!complete[r] || m[MOM_N] < 2.0) continue;
+      if (!complete[r] || m[MOM_N] <= 0.0) continue;
       double *B = bm + (size_t)b * 11 * SCAL_LEN;
       for (int q = 0; q < 5; q++) scal_add(B + q * SCAL_LEN, m[MOM_MEAN + q]);
       for (int c = 0; c < MOM_NC; c++) scal_add(B + (5 + c) * SCAL_LEN, m[MOM_C2 + c] / m[MOM_N]);

@@ -34,17 +34,26 @@ struct euler_config {
   double t_start; /*!< start of the averaging [s] */
   double window;  /*!< length of an averaging window [s] */
   int les;        /*!< 1: eddy viscosity and residual kinetic energy profiles too */
+  int method;     /*!< EULER_BINS (Eq. 5.54-5.55) or EULER_SPH (Eq. 5.56) */
+  double h;       /*!< smoothing length of the SPH interpolation [m] */
+  int dim;        /*!< 2 or 3 (shape of the plane-averaged kernel) */
 };
+
+/** How particles are assigned to the wall-normal profile points. */
+enum { EULER_BINS = 0, EULER_SPH = 1 };
+
+enum { EULER_W1_N = 512 }; /*!< table points of the plane-averaged kernel over q in [0, 2] */
 
 /** The raw state: windows of per-bin moment records. */
 struct euler {
   struct euler_config cfg;
-  size_t nwin; /*!< closed windows */
-  size_t cap;  /*!< rows allocated (>= nwin + 1) */
-  double *win; /*!< [row][WIN_LEN] */
-  double *mom; /*!< [row][nb][MOM_LEN] moment records of the samples */
-  double *snp; /*!< [row][nb][SCAL_LEN] moments of the per-snapshot bin means of u */
-  double *tmp; /*!< scratch [nb][2]: per-snapshot sums of u and counts */
+  size_t nwin;               /*!< closed windows */
+  size_t cap;                /*!< rows allocated (>= nwin + 1) */
+  double *win;               /*!< [row][WIN_LEN] */
+  double *mom;               /*!< [row][nb][MOM_LEN] moment records of the samples */
+  double *snp;               /*!< [row][nb][SCAL_LEN] moments of the per-snapshot bin means of u */
+  double *tmp;               /*!< scratch [nb][2]: per-snapshot sums of u and counts */
+  double w1[EULER_W1_N + 1]; /*!< plane-averaged kernel W1(q), q = |y_a - y_i| / h (SPH) */
 };
 
 /** One snapshot of the particles, as plain arrays (the engine never sees solver structs). */
