@@ -55,14 +55,16 @@ void corr_init(struct corr *c, const struct corr_config *cfg);
 /** @brief Free. */
 void corr_free(struct corr *c);
 
-/** @brief Add one snapshot (serial, deterministic). */
+/** @brief Add one snapshot (serial, deterministic). Implements: Eq. 5.54-5.55 on the plane
+ *         grid and the spectra behind Eq. 5.57-5.59. */
 void corr_sample(struct corr *c, const struct stats_snapshot *s);
 
 /** @brief Expose the sums to a state list. */
 void corr_state(struct corr *c, struct state_list *L);
 
 /**
- * @brief Results of the sums: correlations along x and z, their normalised forms and the
+ * @brief Implements: thesis Eq. 5.57-5.59.
+ *        Results of the sums: correlations along x and z, their normalised forms and the
  *        one-sided 1-D spectra of each level.
  * @param[in] c engine
  * @param[out] rx [level][4][nx] R_uu, R_vv, R_ww, R_uv along x (l = i lx/nx)

@@ -135,7 +135,9 @@ void euler_init(struct euler *e, const struct euler_config *cfg);
 void euler_free(struct euler *e);
 
 /**
- * @brief Add one snapshot: each fluid particle to its bin (Eq. 5.54-5.55), one wall-stress
+ * @brief Add one snapshot. Implements: thesis Eq. 5.54-5.55 (bins) or 5.56 (stats.method =
+ *        sph), and the wall-stress sample of Eq. 5.13-5.14.
+ *        Each fluid particle to its bin (Eq. 5.54-5.55), one wall-stress
  *        and body-force sample to the window; closes windows that ended before s->t.
  *        Serial over the particles in the given order: independent of the thread count.
  */
@@ -143,6 +145,8 @@ void euler_sample(struct euler *e, const struct stats_snapshot *s);
 
 /**
  * @brief Statistics of rows [r0, r1) merged in row order (bitwise reproducible).
+ *        Implements: means and Reynolds stresses of Sec. 5.2.3.1, u_tau (Eq. 5.14 and the wall
+ *        force), the total shear stress of Eq. 5.11-5.13.
  *        Standard errors from the batch means of the complete windows in the range.
  * @param[in] cfg configuration (bins, delta, nu, rho0, area)
  * @param[in] win,mom,snp raw rows, as in struct euler

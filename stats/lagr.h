@@ -100,7 +100,8 @@ void lagr_init(struct lagr *g, const struct lagr_config *cfg);
 /** @brief Free. */
 void lagr_free(struct lagr *g);
 
-/** @brief Add one snapshot: releases, lag samples, PDF crossings (serial, deterministic). */
+/** @brief Add one snapshot: releases, lag samples, PDF crossings (serial, deterministic).
+ *         Implements: the set-up of thesis Sec. 6.1.3 and the sums of Eq. 5.60-5.68. */
 void lagr_sample(struct lagr *g, const struct stats_snapshot *s);
 
 /** @brief Expose the complete state to a state list (rebuild before each checkpoint). */
@@ -108,6 +109,7 @@ void lagr_state(struct lagr *g, struct state_list *L);
 
 /**
  * @brief The lag functions of one level from the sums (completed releases only).
+ *        Implements: thesis Eq. 5.60, 5.62-5.66 (and 5.61 through lagr_tl).
  * @param[in] g engine
  * @param[in] level release level
  * @param[out] out [quantity][nlag], quantities: rho_L u v w, rho_a u v w, D u v w, S u v w,

@@ -31,7 +31,8 @@ enum {
 static const int mom_pair[MOM_NC][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
 
 /**
- * @brief Merge record b into record a (a := a + b).
+ * @brief Merge record b into record a (a := a + b). Implements: the moments of the Eulerian
+ *        statistics (thesis Sec. 5.2.3.1) with the pairwise update of Pebay (2008).
  *        Pairwise update of the mean, co-moments, M3 and M4 (Pebay 2008, Eq. 1.1-1.4 with
  *        delta = mean_b - mean_a); b empty leaves a bitwise unchanged.
  * @param[in,out] a record
