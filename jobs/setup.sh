@@ -7,7 +7,7 @@ here=$(cd "$(dirname "$0")/.." && pwd)
 cd "$here"
 
 packages=(build-essential cmake pkg-config openmpi-bin libopenmpi-dev libhdf5-openmpi-dev
-          hdf5-tools libnetcdf-mpi-dev netcdf-bin libfftw3-dev libinih-dev librandom123-dev
+          hdf5-tools libnetcdf-mpi-dev netcdf-bin nco libfftw3-dev libinih-dev librandom123-dev
           python3 python3-numpy python3-netcdf4 python3-matplotlib clang-format)
 missing=()
 for p in "${packages[@]}"; do

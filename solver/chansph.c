@@ -9,9 +9,11 @@
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "cli.h"
 #include "error.h"
+#include "extract.h"
 #include "health.h"
 #include "output.h"
 #include "run.h"
@@ -49,6 +51,10 @@ static int run(const struct scene *sc, const struct cli *c) {
 }
 
 int main(int argc, char **argv) {
+  /* post-processing commands: serial, no MPI */
+  if (argc > 1 && !strcmp(argv[1], "extract")) return extract_main(argc - 2, argv + 2);
+  if (argc > 1 && !strcmp(argv[1], "compare"))
+    return compare_main(argc - 2, argv + 2, CHANSPH_STATS_DIR);
   MPI_Init(&argc, &argv);
   int size = 1, rc = 0;
   MPI_Comm_size(MPI_COMM_WORLD, &size);

@@ -71,14 +71,57 @@ int output_open(struct output *o, const char *dir, const struct scene *sc, int o
     error_input("%s: cannot write (%s)", path, strerror(errno));
     return CHANSPH_ERR;
   }
-  /* default: one bin of width dr around each particle layer y = j dr (j = 1 .. 2delta/dr-1),
-     the thin strips next to the walls joining the first and last bins; with n_bins set:
-     uniform bins between the walls */
-  const double edge = sc->n_bins > 0 ? 0.0 : 0.5 * sc->dr;
-  profile_init(&o->prof, scene_bins(sc), edge, 2.0 * sc->delta - edge);
+  struct stats_config cfg;
+  output_stats_config(sc, &cfg);
+  stats_init(&o->st, &cfg);
   series_init(&o->ts, N_SERIES, series_names, series_units);
   o->next_write = sc->write_every > 0.0 ? sc->write_every : INFINITY;
   return CHANSPH_OK;
+}
+
+/* The engine's configuration from the scene: default bins are of width dr around each particle
+   layer y = j dr (j = 1 .. 2delta/dr-1), the thin strips next to the walls joining the first and
+   last bins; folded, the layers 1 .. delta/dr; with n_bins set: uniform bins between the walls
+   (folded: between the wall and the centre). */
+void output_stats_config(const struct scene *sc, struct stats_config *cfg) {
+  memset(cfg, 0, sizeof *cfg);
+  struct euler_config *e = &cfg->eul;
+  cfg->eulerian = sc->stats_eulerian;
+  e->fold = sc->stats_fold, e->delta = sc->delta, e->nu = sc->nu, e->rho0 = sc->rho0;
+  e->area = sc->dim == 3 ? sc->lx * sc->lz : sc->lx;
+  e->t_start = sc->t_average_start;
+  e->les = sc->les != LES_NONE;
+  e->method = sc->stats_method, e->h = scene_h(sc), e->dim = sc->dim;
+  e->window = sc->stats_window > 0.0 ? sc->stats_window : (sc->t_end - sc->t_average_start) / 10;
+  if (!(e->window > 0.0)) e->window = sc->t_end > 0 ? sc->t_end / 10 : 1.0;
+  const double u_tau = sc->u_tau_ref > 0.0 ? sc->u_tau_ref : sqrt(sc->delta * fabs(sc->force));
+  struct corr_config *c = &cfg->corr;
+  c->n_levels = sc->corr_y_plus.n;
+  for (int l = 0; l < c->n_levels; l++)
+    c->y_plus[l] = sc->corr_y_plus.v[l], c->y[l] = c->y_plus[l] * sc->nu / u_tau;
+  c->nx = sc->corr_nx > 0 ? sc->corr_nx : (int)floor(sc->lx / sc->dr + 0.5);
+  c->nz = sc->dim == 2 ? 1 : sc->corr_nz > 0 ? sc->corr_nz : (int)floor(sc->lz / sc->dr + 0.5);
+  c->lx = sc->lx, c->lz = sc->lz, c->delta = sc->delta, c->t_start = sc->t_average_start;
+  c->half = 0.5 * sc->corr_thickness * sc->dr;
+  struct lagr_config *g = &cfg->lagr;
+  g->n_levels = sc->lagr_y_plus.n;
+  for (int l = 0; l < g->n_levels; l++)
+    g->y_plus[l] = sc->lagr_y_plus.v[l], g->y[l] = g->y_plus[l] * sc->nu / u_tau;
+  g->x0 = sc->lagr_x0, g->half = 0.5 * sc->dr, g->lx = sc->lx;
+  g->lz = sc->dim == 3 ? sc->lz : 0.0, g->delta = sc->delta;
+  g->horizon = sc->lagr_horizon, g->n_lags = sc->lagr_n_lags, g->pdf_bins = sc->lagr_pdf_bins;
+  g->release_every = sc->lagr_release_every > 0.0 ? sc->lagr_release_every : sc->lagr_horizon;
+  g->n_stations = sc->lagr_pdf_x.n;
+  for (int k = 0; k < g->n_stations; k++) g->station[k] = sc->lagr_pdf_x.v[k];
+  g->t_start = sc->t_average_start;
+  if (sc->n_bins > 0) {
+    e->nb = sc->n_bins, e->y0 = 0.0, e->y1 = (sc->stats_fold ? 1.0 : 2.0) * sc->delta;
+  } else if (sc->stats_fold) {
+    e->nb = (int)floor(sc->delta / sc->dr + 0.5), e->y0 = 0.5 * sc->dr;
+    e->y1 = e->y0 + e->nb * sc->dr;
+  } else {
+    e->nb = scene_bins(sc), e->y0 = 0.5 * sc->dr, e->y1 = 2.0 * sc->delta - 0.5 * sc->dr;
+  }
 }
 
 /* A line to stdout and log.txt. */
@@ -144,11 +187,11 @@ static int write_stats(struct output *o, const struct sim *S) {
       {"t_reached", NULL, S->t},
       {"steps", NULL, (double)S->step},
       {"n_fluid", NULL, (double)S->P.n_fluid},
-      {"n_snapshots", NULL, (double)o->prof.n_snapshots},
+      {"n_snapshots", NULL, (double)o->st.samples},
       {"code_version", CHANSPH_VERSION, 0},
       {"scene", o->scene_text, 0},
   };
-  if (ncout_stats(path, &o->prof, &o->ts, attrs, sizeof attrs / sizeof attrs[0], err, sizeof err)) {
+  if (ncout_stats(path, &o->st, &o->ts, attrs, sizeof attrs / sizeof attrs[0], err, sizeof err)) {
     error_input("%s", err);
     return CHANSPH_ERR;
   }
@@ -170,11 +213,34 @@ void output_begin(struct output *o, struct sim *S) {
 
 void output_step(struct output *o, struct sim *S) {
   const struct scene *sc = S->sc;
-  timer_push("output");
-  if (S->t >= sc->t_average_start && S->step % sc->stats_every == 0) {
+  if (stats_wanted(&o->st) && S->t >= sc->t_average_start && S->step % sc->stats_every == 0) {
+    timer_push("stats");
     const struct particles *P = &S->P;
-    profile_add(&o->prof, P->n, P->y, P->u, P->v, P->w, P->kind);
+    const struct stats_snapshot snap = {.n = P->n,
+                                        .x = P->x,
+                                        .y = P->y,
+                                        .z = P->z,
+                                        .u = P->u,
+                                        .v = P->v,
+                                        .w = P->w,
+                                        .p = P->p,
+                                        .rho = P->rho,
+                                        .nu_t = P->nur,
+                                        .k_r = P->kr,
+                                        .m = P->m,
+                                        .ax = P->ax,
+                                        .ay = P->ay,
+                                        .az = P->az,
+                                        .id = P->id,
+                                        .skip = P->kind,
+                                        .t = S->t,
+                                        .fx = S->fx,
+                                        .step = S->step,
+                                        .wall_fx = {S->wall_fx[0], S->wall_fx[1]}};
+    stats_sample(&o->st, &snap);
+    timer_pop();
   }
+  timer_push("output");
   struct diag d;
   int have = 0;
   if (S->step % sc->series_every == 0) record(o, S, &d), have = 1;
@@ -183,6 +249,9 @@ void output_step(struct output *o, struct sim *S) {
     log_progress(o, S, &d);
   }
   if (S->t >= o->next_write) {
+    char line[1024];
+    stats_convergence_line(&o->st, line, sizeof line);
+    logline(o, "%s", line);
     if (write_stats(o, S)) die("stopping: cannot write statistics");
     while (o->next_write <= S->t) o->next_write += sc->write_every;
   }
@@ -227,6 +296,11 @@ int output_finish(struct output *o, struct sim *S) {
     sim_diag(S, &d);
   if (S->step != o->last_step) log_progress(o, S, &d);
   const double wall = timer_now() - o->wall0;
+  char line[1024];
+  stats_convergence_line(&o->st, line, sizeof line);
+  logline(o, "%s", line);
+  logline(o, "statistics engine: %.3f MB (%lld snapshots)\n", stats_memory(&o->st) / 1048576.0,
+          (long long)o->st.samples);
   TRY(write_stats(o, S));
   if (S->sc->particles) TRY(write_particles(o, S));
   logline(o, "finished: %ld steps, t = %.6g s in %.2f s wall (%.3e particle-steps/s)\n", S->step,
@@ -247,7 +321,7 @@ void output_fail(struct output *o, struct sim *S, const struct health_report *re
 void output_close(struct output *o) {
   if (o->log) fclose(o->log);
   free(o->scene_text);
-  profile_free(&o->prof);
+  stats_free(&o->st);
   series_free(&o->ts);
   memset(o, 0, sizeof *o);
 }

@@ -9,21 +9,22 @@
 #include <stdio.h>
 
 #include "health.h"
-#include "profile.h"
 #include "run.h"
+#include "series.h"
+#include "stats.h"
 
 /** Output state of a run. */
 struct output {
-  char dir[2048];      /*!< run directory */
-  FILE *log;           /*!< DIR/log.txt */
-  char *scene_text;    /*!< resolved scene */
-  struct profile prof; /*!< binned profiles over the averaging window */
-  struct series ts;    /*!< time series */
-  double next_write;   /*!< simulated time of the next stats.nc rewrite [s] */
-  double wall0;        /*!< wall clock at the start of the loop [s] */
-  double t0;           /*!< simulated time at the start of the loop [s] */
-  double last_wall;    /*!< wall clock of the last log line [s] */
-  long last_step;      /*!< step of the last log line */
+  char dir[2048];    /*!< run directory */
+  FILE *log;         /*!< DIR/log.txt */
+  char *scene_text;  /*!< resolved scene */
+  struct stats st;   /*!< the statistics engine */
+  struct series ts;  /*!< time series */
+  double next_write; /*!< simulated time of the next stats.nc rewrite [s] */
+  double wall0;      /*!< wall clock at the start of the loop [s] */
+  double t0;         /*!< simulated time at the start of the loop [s] */
+  double last_wall;  /*!< wall clock of the last log line [s] */
+  long last_step;    /*!< step of the last log line */
 };
 
 /**
@@ -32,6 +33,9 @@ struct output {
  * @return CHANSPH_OK or CHANSPH_ERR with a message
  */
 int output_open(struct output *o, const char *dir, const struct scene *sc, int overwrite);
+
+/** @brief The statistics engine's configuration from the scene (bins, windows, engines). */
+void output_stats_config(const struct scene *sc, struct stats_config *cfg);
 
 /** @brief Record the initial state and start the clocks. */
 void output_begin(struct output *o, struct sim *S);

@@ -35,6 +35,8 @@ int sim_init(struct sim *S, const struct scene *sc) {
   }
   for (int k = 0; k < 4; k++) S->scratch[k] = part_alloc("diag_scratch", S->P.n * sizeof(double));
   S->ksum_new = part_alloc("kernel_sum_new", S->P.n * sizeof(double));
+  if (sc->stats_eulerian) S->wall_ax = part_alloc("wall_ax", S->P.n * sizeof(double));
+  S->wall_fx[0] = S->wall_fx[1] = NAN;
   nbr_init(&S->nb, sc, S->P.n);
   drive_init(&S->drive, sc);
   S->fx = S->drive.force;
@@ -51,6 +53,7 @@ void sim_free(struct sim *S) {
   nbr_free(&S->nb);
   for (int k = 0; k < 4; k++) part_free(S->scratch[k]);
   part_free(S->ksum_new);
+  if (S->wall_ax) part_free(S->wall_ax);
   part_destroy(&S->P, &S->W);
 }
 
@@ -113,11 +116,28 @@ static double bulk_velocity(struct sim *S) {
   return s[0] / s[1];
 }
 
+/* x-force of each wall on the fluid from the per-particle wall accelerations (deterministic). */
+static void wall_force(struct sim *S) {
+  const struct particles *P = &S->P;
+  double *lo = S->scratch[2], *hi = S->scratch[3];
+  const double delta = S->sc->delta;
+#pragma omp parallel for schedule(static)
+  for (size_t a = 0; a < P->n; a++) {
+    const double f = P->kind[a] == KIND_FLUID ? P->m[a] * S->wall_ax[a] : 0.0;
+    lo[a] = P->y[a] < delta ? f : 0.0, hi[a] = P->y[a] < delta ? 0.0 : f;
+  }
+  const double *arrs[2] = {lo, hi};
+  reduce_sums(2, arrs, P->n, S->wall_fx);
+}
+
 void sim_step(struct sim *S) {
   struct particles *P = &S->P;
-  struct force_info fi;
+  /* the wall shear stress is gathered only on steps whose end state the statistics sample */
+  const int wall_sample = S->wall_ax && (S->step + 1) % S->sc->stats_every == 0;
+  struct force_info fi = {.wall_ax = wall_sample ? S->wall_ax : NULL};
   const double ub = S->drive.mode == DRIVE_FLUX ? bulk_velocity(S) : 0.0;
   sph_forces(&S->M, P, &S->nb, &S->W, S->fx, &fi);
+  if (wall_sample) wall_force(S);
   double maxima[2] = {fi.amax, fi.gvmax};
   reduce_global_max(maxima, 2);
   fi.amax = maxima[0], fi.gvmax = maxima[1];

@@ -28,6 +28,9 @@ struct sim {
   double nu_max;          /*!< largest nu + nu_r of the current state [m^2/s] */
   double *scratch[4];     /*!< per-particle scratch for deterministic sums */
   double *ksum_new;       /*!< kernel sums at the new positions, from the neighbour pass */
+  double *wall_ax;        /*!< per particle x-acceleration from the walls (statistics only) */
+  double wall_fx[2];      /*!< x-force of the walls y = 0, 2 delta on the fluid, last sampled
+                               force pass (NaN if not sampled) [N, N/m in 2-D] */
   char violation[320];    /*!< a fixed dt broke a stability limit: what, where (else empty) */
 };
 

@@ -13,7 +13,7 @@
 
 #include "error.h"
 
-enum key_type { T_INT, T_LONG, T_DOUBLE, T_CHOICE, T_STRING };
+enum key_type { T_INT, T_LONG, T_DOUBLE, T_CHOICE, T_STRING, T_LIST };
 enum { REQUIRED = 1, LO_OPEN = 2 };
 
 /** One scene key: where it lives, its type, default, range and documentation. */
@@ -235,6 +235,66 @@ static const struct key keys[] = {
      OFF(n_bins)},
     {"output", "particles", T_INT, "1", 0, 1, 0, NULL, "-",
      "Write the final particle state to DIR/particles.nc (1) or not (0).", OFF(particles)},
+    {"stats", "eulerian", T_INT, "1", 0, 1, 0, NULL, "-",
+     "Eulerian statistics: wall-normal profiles of means, Reynolds stresses, skewness, "
+     "flatness with standard errors, friction velocity and shear-stress balance "
+     "(docs/stats-format.md); sampled every output.stats_every steps from "
+     "output.t_average_start in output.n_bins bins.",
+     OFF(stats_eulerian)},
+    {"stats", "window", T_DOUBLE, "0", 0, BIG, 0, NULL, "s",
+     "Length of an averaging window: stats.nc keeps the sums of every window (re-average a "
+     "range with `chansph extract --window`), and the window means are the batch means of "
+     "the standard errors, so a window should span several correlation times (the log "
+     "reports the estimate). 0 = a tenth of t_end - t_average_start.",
+     OFF(stats_window)},
+    {"stats", "fold", T_INT, "0", 0, 1, 0, NULL, "-",
+     "Fold the upper half onto the lower one (y -> 2 delta - y, v -> -v) before binning; the "
+     "bins then cover 0 .. delta.",
+     OFF(stats_fold)},
+    {"stats", "method", T_CHOICE, "bins", 0, 0, 0, "bins|sph", "-",
+     "How particles make the profiles: bin sampling (thesis Eq. 5.54-5.55), or SPH "
+     "interpolation (Eq. 5.56) at the bin centres averaged over the plane, each particle "
+     "weighted by V_a times the plane integral of the kernel; the means are Eq. 5.56, the "
+     "stresses then also hold the mean-shear variation across the kernel (use bins for them).",
+     OFF(stats_method)},
+    {"stats", "u_tau_ref", T_DOUBLE, "0", 0, BIG, 0, NULL, "m/s",
+     "Friction velocity that places the y+ levels of the correlations and Lagrangian releases "
+     "(y = y+ nu / u_tau_ref); 0 = sqrt(delta drive.force), the force-balance value.",
+     OFF(u_tau_ref)},
+    {"correlations", "y_plus", T_LIST, "", 0, BIG, 0, NULL, "-",
+     "Comma-separated y+ levels (up to 8) of the two-point correlations and 1-D spectra "
+     "(thesis Eq. 5.57-5.59); each level and its mirror 2 delta - y are sampled. Empty = off.",
+     OFF(corr_y_plus)},
+    {"correlations", "nx", T_INT, "0", 0, 1e6, 0, NULL, "-",
+     "Points of the plane grid along x (bin averages, Eq. 5.54-5.55); 0 = lx / dr.", OFF(corr_nx)},
+    {"correlations", "nz", T_INT, "0", 0, 1e6, 0, NULL, "-",
+     "Points of the plane grid along z; 0 = lz / dr (1 in 2-D).", OFF(corr_nz)},
+    {"correlations", "thickness", T_DOUBLE, "1", 0, 100, LO_OPEN, NULL, "dr",
+     "Thickness of the slab of particles binned onto each plane, in units of dr.",
+     OFF(corr_thickness)},
+    {"lagrangian", "y_plus", T_LIST, "", 0, BIG, 0, NULL, "-",
+     "Comma-separated y+ release levels (up to 8) of the Lagrangian statistics (thesis Sec. "
+     "5.2.3.2, 6.1.3): fluid particles within dr/2 of each level (and of its mirror) and "
+     "within dr/2 of x0 are tracked. Empty = off.",
+     OFF(lagr_y_plus)},
+    {"lagrangian", "x0", T_DOUBLE, "0", 0, BIG, 0, NULL, "m",
+     "Release plane: particles with |x - x0| < dr/2 are released.", OFF(lagr_x0)},
+    {"lagrangian", "horizon", T_DOUBLE, "1", 0, BIG, LO_OPEN, NULL, "s",
+     "How long each release is followed (the largest lag tau).", OFF(lagr_horizon)},
+    {"lagrangian", "release_every", T_DOUBLE, "0", 0, BIG, 0, NULL, "s",
+     "Time between release iterations; releases overlap when shorter than the horizon. 0 = "
+     "the horizon (consecutive, independent releases, thesis Sec. 6.1.3).",
+     OFF(lagr_release_every)},
+    {"lagrangian", "n_lags", T_INT, "50", 2, 1e5, 0, NULL, "-",
+     "Lag samples over the horizon (a particle is sampled at the first statistics sample "
+     "in each lag interval).",
+     OFF(lagr_n_lags)},
+    {"lagrangian", "pdf_x", T_LIST, "", 0, BIG, 0, NULL, "m",
+     "Comma-separated downstream distances x - x0 (up to 8) of the stations of the PDFs P(y; "
+     "x) (Eq. 5.67-5.68); empty = no PDFs.",
+     OFF(lagr_pdf_x)},
+    {"lagrangian", "pdf_bins", T_INT, "50", 2, 1e5, 0, NULL, "-",
+     "Bins of the PDFs P(y; x) across the channel.", OFF(lagr_pdf_bins)},
     {"health", "every", T_INT, "1", 1, 1e9, 0, NULL, "steps",
      "Steps between full health checks (NaN, wall crossing, CFL); 1 checks every step.",
      OFF(health_every)},
@@ -301,6 +361,26 @@ static const char *set_value(struct scene *s, int k, const char *text) {
     }
     return "is not one of the allowed choices";
   }
+  if (K->type == T_LIST) {
+    struct scene_list *L = field;
+    L->n = 0;
+    for (const char *c = text; *c;) {
+      while (*c == ' ' || *c == '\t') c++;
+      if (!*c) break;
+      if (L->n == SCENE_LIST_MAX) return "has more than 8 entries";
+      const double v = strtod(c, &end);
+      if (end == c) return "is not a comma-separated list of numbers";
+      if (!isfinite(v) || v < K->lo || v > K->hi) return "has an entry out of range";
+      L->v[L->n++] = v;
+      c = end;
+      while (*c == ' ' || *c == '\t') c++;
+      if (*c == ',')
+        c++;
+      else if (*c)
+        return "is not a comma-separated list of numbers";
+    }
+    return NULL;
+  }
   const double v = strtod(text, &end);
   if (end == text || *end != '\0') return "is not a number";
   if (!isfinite(v)) return "is not finite";
@@ -325,6 +405,10 @@ static void range_text(const struct key *K, char *buf, size_t n) {
     return;
   }
   char lo[32] = "-inf", hi[32] = "inf";
+  if (K->type == T_LIST) {
+    snprintf(buf, n, "up to %d comma-separated numbers >= %g", SCENE_LIST_MAX, K->lo);
+    return;
+  }
   if (K->lo > -BIG) snprintf(lo, sizeof lo, "%g", K->lo);
   if (K->hi < BIG) snprintf(hi, sizeof hi, "%g", K->hi);
   snprintf(buf, n, "%s%s, %s]", (K->flags & LO_OPEN) ? "(" : "[", lo, hi);
@@ -444,6 +528,12 @@ static void validate(struct parse_state *ps) {
   if (s->t_average_start > s->t_end)
     inconsistent(ps, "output.t_average_start", "averaging start %g is after t_end = %g",
                  s->t_average_start, s->t_end);
+  if ((s->corr_y_plus.n || s->lagr_y_plus.n) && s->u_tau_ref == 0.0 &&
+      (s->drive_mode == DRIVE_FLUX || s->force <= 0.0))
+    inconsistent(ps, "stats.u_tau_ref",
+                 "y+ levels need stats.u_tau_ref > 0 unless a positive drive.force gives it "
+                 "(u_tau_ref = %g, force = %g)",
+                 s->u_tau_ref, s->force);
   if (s->dt_fixed > 0.0 && s->dt_fixed > s->t_end)
     inconsistent(ps, "time.dt", "fixed dt = %g is larger than t_end = %g", s->dt_fixed, s->t_end);
 }
@@ -533,6 +623,14 @@ static void value_text(const struct scene *s, int k, char *buf, size_t n) {
     case T_DOUBLE:
       snprintf(buf, n, "%.17g", *(const double *)field);
       break;
+    case T_LIST: {
+      const struct scene_list *L = field;
+      size_t m = 0;
+      buf[0] = '\0';
+      for (int i = 0; i < L->n && m < n; i++)
+        m += (size_t)snprintf(buf + m, n - m, "%s%.17g", i ? "," : "", L->v[i]);
+      break;
+    }
     case T_STRING:
       snprintf(buf, n, "%s", (const char *)field);
       break;
@@ -595,6 +693,7 @@ void scene_write_doc(FILE *f) {
     for (char *c = range; *c; c++)
       if (*c == '|') *c = '/';
     fprintf(f, "| `%s` | %s | %s | %s | %s |\n", keys[k].name,
-            keys[k].def ? keys[k].def : "**required**", range, keys[k].unit, keys[k].help);
+            keys[k].def ? (keys[k].def[0] ? keys[k].def : "(empty)") : "**required**", range,
+            keys[k].unit, keys[k].help);
   }
 }

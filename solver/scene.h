@@ -23,6 +23,14 @@ enum les_model { LES_NONE = 0, LES_SMAGORINSKY = 1 };
 enum les_strain { STRAIN_GRADIENT = 0, STRAIN_VIOLEAU_ISSA = 1 };
 enum pressure_gradient { PGRAD_STANDARD = 0, PGRAD_CORRECTED = 1 };
 
+enum { SCENE_LIST_MAX = 8 };
+
+/** A short list of numbers (a comma-separated scene value). */
+struct scene_list {
+  int n;                    /*!< entries */
+  double v[SCENE_LIST_MAX]; /*!< values */
+};
+
 /** Every parameter of a run, with units. Derived quantities are marked. */
 struct scene {
   /* [domain] */
@@ -94,6 +102,24 @@ struct scene {
   double t_average_start; /*!< start of the averaging window [s] */
   int n_bins;             /*!< wall-normal bins; 0 = 2 delta / dr - 1 */
   int particles;          /*!< write the final particle state to particles.nc (1) or not (0) */
+  /* [stats] */
+  int stats_eulerian;  /*!< Eulerian profiles on (1) or off (0) */
+  double stats_window; /*!< averaging window (batch) length [s]; 0 = a tenth of the average */
+  int stats_fold;      /*!< fold the upper half of the channel onto the lower one (1) */
+  int stats_method;    /*!< 0: bin sampling (Eq. 5.54-5.55), 1: SPH interpolation (Eq. 5.56) */
+  double u_tau_ref;    /*!< friction velocity placing y+ levels [m/s]; 0 = sqrt(delta force) */
+  /* [correlations] */
+  struct scene_list corr_y_plus; /*!< y+ levels of the two-point correlations (empty = off) */
+  int corr_nx, corr_nz;          /*!< plane grid; 0 = lx/dr, lz/dr */
+  double corr_thickness;         /*!< slab thickness around each level [dr] */
+  /* [lagrangian] */
+  struct scene_list lagr_y_plus; /*!< release levels (empty = off) */
+  double lagr_x0;                /*!< release plane x0 [m] */
+  double lagr_horizon;           /*!< how long each release is followed [s] */
+  double lagr_release_every;     /*!< time between releases [s]; 0 = the horizon */
+  int lagr_n_lags;               /*!< lag samples over the horizon */
+  struct scene_list lagr_pdf_x;  /*!< downstream distances of the PDF stations [m] */
+  int lagr_pdf_bins;             /*!< bins of the PDFs P(y; x) */
   /* [health] */
   int health_every; /*!< steps between full health checks */
   /* [run] */

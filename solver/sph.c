@@ -284,6 +284,7 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
     double mom2 = 0;                  /* sum V_b r_ab . grad w_ab, Laplacian normalisation */
     double momyy = 0;                 /* sum V_b y_ab^2 F_ab, wall-normal normalisation */
     double mom1 = 0;                  /* sum V_b y_ab f_ab, discrete wall weight */
+    double wvx = 0;                   /* part of vx from wall vertices */
     /* Violeau: sum V_b y_ab^k F_ab ((n+2) x_i^2/r^2 + 1), k = 1, 2, for i = x and z */
     double m1x = 0, m2x = 0, m1z = 0, m2z = 0;
     double A[6] = {0, 0, 0, 0, 0, 0}; /* corrected gradient: -sum V_b f r_ab (x) r_ab */
@@ -307,7 +308,7 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
         gpx += pp * dx, gpy += pp * dy, gpz += pp * dz;
       }
       const double ux = u[a] - u[b], uy = v[a] - v[b], uz = w[a] - w[b];
-      const double vf = vb * f;
+      const double vf = vb * f, vx_before = vx;
       mom2 += vf * r2, momyy += vf * dy * dy, mom1 += vf * dy;
       if (violeau) {
         const double gx = vf * (np2 * dx * dx / (r2 + eta2) + 1.0) * dy;
@@ -332,6 +333,8 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
         const double cab = ca > c[b] ? ca : c[b];
         const double vrho = ra - rb - dgrav * dy; /* varrho_ab of Eq. 3.61 */
         diff += vb * cab * vrho * f * r;
+      } else { /* viscous pull of the wall vertices, for the wall shear stress */
+        wvx += vx - vx_before;
       }
     }
     const double ig = 1.0 / P->gam[a];
@@ -360,6 +363,7 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
     const double lap = nu * ig * kappa; /* nu / gamma_a, normalised */
     const double vis = les ? ig / ra : violeau ? nu * ig / ra : nu * ig;
     axa += vis * kx * vx, aya += vis * kappa * vy, aza += vis * kz * vz;
+    double awall = vis * kx * wvx; /* x-acceleration from the walls, for the statistics */
     /* wall terms: pressure (Eq. 3.17, k = 1) and wall shear (Eq. 2.147-2.148) */
     double gv = 0.0;
     for (int wall = 0; wall < 2; wall++) {
@@ -382,7 +386,9 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
                          2.145) with the vertex values of Ferrand Eq. 38 at the foot */
         const struct foot ft = wall_foot(M, W, wall, x[a], z[a]);
         const double sw = 2.0 * ig * dg * ira;
-        axa -= sw * foot_value(M, &ft, W->tx), aza -= sw * foot_value(M, &ft, W->tz);
+        const double tx = sw * foot_value(M, &ft, W->tx);
+        axa -= tx, aza -= sw * foot_value(M, &ft, W->tz);
+        awall -= tx;
       } else {
         /* |grad gamma_as|, or the discrete first moment that makes the Morris operator exact
            for a velocity varying linearly with the wall distance (docs/theory.md) */
@@ -391,10 +397,12 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
           const double wx = discrete ? 0.5 * fmax(0.0, ny * m1x) : dg;
           const double wz = discrete ? 0.5 * fmax(0.0, ny * m1z) : dg;
           axa -= dw * kx * wx * u[a], aza -= dw * kz * wz * w[a];
+          awall -= dw * kx * wx * u[a];
         } else {
           const double weight = discrete ? fmax(0.0, ny * mom1) : dg;
           const double shear = 2.0 * lap * weight / (d > M->wall_dmin ? d : M->wall_dmin);
           axa -= shear * u[a], aza -= shear * w[a];
+          awall -= shear * u[a];
         }
       }
       const double g = fabs(dg * v[a]);
@@ -402,6 +410,7 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
     }
     aya += M->gy;
     P->ax[a] = axa, P->ay[a] = aya, P->az[a] = aza;
+    if (info->wall_ax) info->wall_ax[a] = awall;
     P->ddiff[a] = diff * inv_xi; /* enters gamma rho directly (Eq. 3.64): no 1/gamma */
     const double ax2 = (axa + fx) * (axa + fx) + aya * aya + aza * aza;
     if (ax2 > amax2) amax2 = ax2;

@@ -51,6 +51,10 @@ struct model {
 struct force_info {
   double amax;  /*!< max |a| including the body forces [m/s^2] */
   double gvmax; /*!< max over particles and walls of |grad gamma_as . v_a| [1/s] */
+  /** Input: if not NULL, receives per particle the x-acceleration the walls apply (wall shear
+      term plus the viscous interaction with vertex particles) [m/s^2]; it gives the wall
+      shear stress of the statistics (u_tau). Zero for particles away from the walls. */
+  double *wall_ax;
 };
 
 /** @brief Derive the model constants from the scene. */

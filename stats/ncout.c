@@ -1,6 +1,8 @@
 /** @file ncout.c @brief Implementation of ncout.h. */
 #include "ncout.h"
 
+#include "stats.h"
+
 #include <fcntl.h>
 #include <netcdf.h>
 #include <stdio.h>
@@ -58,71 +60,44 @@ static int commit(const char *tmp, const char *path, char *err, size_t errlen) {
   return 0;
 }
 
-int ncout_stats(const char *path, const struct profile *pr, const struct series *ts,
+int ncout_def(int ncid, const char *name, int type, int ndim, const int *dims, const char *units,
+              const char *long_name, int *varid) {
+  return def_var(ncid, name, (nc_type)type, ndim, dims, units, long_name, varid);
+}
+
+int ncout_stats(const char *path, const struct stats *st, const struct series *ts,
                 const struct nc_attr *attrs, int nattrs, char *err, size_t errlen) {
   char tmp[4096];
   snprintf(tmp, sizeof tmp, "%s.tmp", path);
-  int ncid = -1;
+  int ncid = -1, dt;
   NC(nc_create(tmp, NC_NETCDF4 | NC_CLOBBER, &ncid));
-  int dy, dt, vy, vym, vu, vv, vw, vn;
-  NC(nc_def_dim(ncid, "y", (size_t)pr->nb, &dy));
-  NC(nc_def_dim(ncid, "time", NC_UNLIMITED, &dt));
-  NC(def_var(ncid, "y", NC_DOUBLE, 1, &dy, "m", "wall-normal bin centre (walls at 0 and 2 delta)",
-             &vy));
-  NC(def_var(ncid, "y_mean", NC_DOUBLE, 1, &dy, "m", "mean position of the samples in the bin",
-             &vym));
-  NC(def_var(ncid, "u_mean", NC_DOUBLE, 1, &dy, "m/s", "mean streamwise velocity", &vu));
-  NC(def_var(ncid, "v_mean", NC_DOUBLE, 1, &dy, "m/s", "mean wall-normal velocity", &vv));
-  NC(def_var(ncid, "w_mean", NC_DOUBLE, 1, &dy, "m/s", "mean spanwise velocity", &vw));
-  NC(def_var(ncid, "n_samples", NC_INT64, 1, &dy, "1", "particle samples in the bin", &vn));
-  int *vts = malloc((size_t)ts->ncol * sizeof *vts);
-  if (!vts) {
-    snprintf(err, errlen, "out of memory writing %s", path);
-    nc_close(ncid), remove(tmp);
-    return 1;
-  }
-  for (int c = 0; c < ts->ncol; c++) {
-    const int rc = def_var(ncid, ts->names[c], NC_DOUBLE, 1, &dt, ts->units[c], NULL, &vts[c]);
-    if (rc != NC_NOERR) free(vts);
-    NC(rc);
-  }
   NC(nc_put_att_text(ncid, NC_GLOBAL, "Conventions", 6, "CF-1.8"));
+  NC(nc_put_att_text(ncid, NC_GLOBAL, "title", 36, "chansph channel-flow statistics file"));
   NC(nc_put_att_text(ncid, NC_GLOBAL, "source", 7, "chansph"));
   NC(put_attrs(ncid, attrs, nattrs));
-  NC(nc_enddef(ncid));
-
-  const size_t nb = (size_t)pr->nb;
-  double *buf = malloc(3 * (nb ? nb : 1) * sizeof *buf);
-  if (!buf) {
-    free(vts);
-    snprintf(err, errlen, "out of memory writing %s", path);
+  /* the engines: profiles (dimension y), groups of raw accumulators */
+  char eerr[1024] = "";
+  const int erc = stats_nc_write(st, ncid, eerr, sizeof eerr);
+  if (erc != NC_NOERR) {
+    snprintf(err, errlen, "cannot write %s: %s", tmp, eerr);
     nc_close(ncid), remove(tmp);
     return 1;
   }
-  double *yc = buf, *ym = buf + nb, *um = buf + 2 * nb;
-  int rc = NC_NOERR;
-  for (size_t i = 0; i < nb; i++) yc[i] = profile_centre(pr, (int)i);
-  rc = nc_put_var_double(ncid, vy, yc);
-  for (size_t i = 0; i < nb; i++)
-    ym[i] = pr->count[i] ? pr->sum_y[i] / (double)pr->count[i] : yc[i];
-  if (rc == NC_NOERR) rc = nc_put_var_double(ncid, vym, ym);
-  const double *sums[3] = {pr->sum_u, pr->sum_v, pr->sum_w};
-  const int vids[3] = {vu, vv, vw};
-  for (int k = 0; k < 3 && rc == NC_NOERR; k++) {
-    for (size_t i = 0; i < nb; i++)
-      um[i] = pr->count[i] ? sums[k][i] / (double)pr->count[i] : NC_FILL_DOUBLE;
-    rc = nc_put_var_double(ncid, vids[k], um);
+  /* time series, column by column, on the unlimited dimension time */
+  NC(nc_def_dim(ncid, "time", NC_UNLIMITED, &dt));
+  int *vts = malloc((size_t)ts->ncol * sizeof *vts);
+  double *col = malloc((ts->n ? ts->n : 1) * sizeof *col);
+  int rc = vts && col ? NC_NOERR : NC_ENOMEM;
+  for (int c = 0; c < ts->ncol && rc == NC_NOERR; c++) {
+    rc = def_var(ncid, ts->names[c], NC_DOUBLE, 1, &dt, ts->units[c], NULL, &vts[c]);
+    if (rc == NC_NOERR && c == 0) rc = nc_put_att_text(ncid, vts[c], "standard_name", 4, "time");
   }
-  if (rc == NC_NOERR) rc = nc_put_var_longlong(ncid, vn, (const long long *)pr->count);
-  /* time series, column by column */
-  double *col = ts->n ? malloc(ts->n * sizeof *col) : NULL;
   for (int c = 0; c < ts->ncol && rc == NC_NOERR && ts->n; c++) {
-    if (!col) break;
     for (size_t r = 0; r < ts->n; r++) col[r] = ts->data[r * (size_t)ts->ncol + c];
     const size_t start = 0, count = ts->n;
     rc = nc_put_vara_double(ncid, vts[c], &start, &count, col);
   }
-  free(col), free(buf), free(vts);
+  free(col), free(vts);
   NC(rc);
   NC(nc_close(ncid));
   ncid = -1;

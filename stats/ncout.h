@@ -9,7 +9,9 @@
 
 #include <stddef.h>
 
-#include "profile.h"
+#include "series.h"
+
+struct stats;
 
 /** A global attribute: text if text != NULL, else a double. */
 struct nc_attr {
@@ -21,14 +23,14 @@ struct nc_attr {
 /**
  * @brief Write stats.nc atomically.
  * @param[in] path final file name
- * @param[in] pr profiles (dimension y)
+ * @param[in] st statistics engine (its variables and groups, stats_nc_write)
  * @param[in] ts time series (unlimited dimension time; column 0 must be the time)
  * @param[in] attrs,nattrs global attributes
  * @param[out] err message buffer (filled on failure)
  * @param[in] errlen its size
  * @return 0 on success, nonzero on failure (the previous file is left untouched)
  */
-int ncout_stats(const char *path, const struct profile *pr, const struct series *ts,
+int ncout_stats(const char *path, const struct stats *st, const struct series *ts,
                 const struct nc_attr *attrs, int nattrs, char *err, size_t errlen);
 
 /**
@@ -47,5 +49,12 @@ int ncout_stats(const char *path, const struct profile *pr, const struct series 
 int ncout_columns(const char *path, const char *dim, size_t n, int ncol, const char *const *names,
                   const char *const *units, const double *const *cols, const long long *ids,
                   const struct nc_attr *attrs, int nattrs, char *err, size_t errlen);
+
+/**
+ * @brief Define a variable with units and long_name attributes (CF).
+ * @return a netCDF status
+ */
+int ncout_def(int ncid, const char *name, int type, int ndim, const int *dims, const char *units,
+              const char *long_name, int *varid);
 
 #endif

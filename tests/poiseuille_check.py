@@ -8,6 +8,8 @@ Subcommands (each runs chansph, reads its netCDF output, prints the numbers, exi
   longrun SCENE --steps N      N steps: no particle lost or through a wall, density drift, gamma
   convergence SCENE            error at 2 delta/dr = 20, 40, 80 and the observed order
   study SCENE2D SCENE3D --doc DIR   error against wall-clock time for four resolutions (PNG + table)
+  stats SCENE --max-stress E   statistics engine on laminar flow: Reynolds stresses below
+                               E u_bulk^2, shear-stress balance and u_tau within 1%
   restart-finer SCENE --max-l2 E  start a run at dr/2 from the steady particles.nc of a run at
                                dr (init.from, Shepard interpolation): initial profile error
   smagorinsky SCENE --max-l2 E   steady laminar flow with the Smagorinsky model on, against the
@@ -215,6 +217,28 @@ def cmd_study(args):
     return True
 
 
+def cmd_stats(args):
+    out, wall = run(args, args.scene, "stats_" + os.path.basename(args.scene)[:-4], args.set)
+    with netCDF4.Dataset(os.path.join(out, "stats.nc")) as d:
+        a = {k: d.getncattr(k) for k in d.ncattrs()}
+        ub = float(d["u_bulk"][-1])
+        stress = {n: np.ma.filled(d[n][:].astype(float), np.nan) for n in
+                  ("uu", "vv", "ww", "uv", "uw", "vw")}
+    worst = max(np.nanmax(np.abs(v)) for v in stress.values()) / ub ** 2
+    which = max(stress, key=lambda n: np.nanmax(np.abs(stress[n])))
+    bal = float(a["stress_balance_error"])
+    dut = abs(a["u_tau_wall"] - a["u_tau_force"]) / a["u_tau_force"]
+    print("laminar statistics %dD, %d windows of %.3g s: max |Reynolds stress| = %.3e u_bulk^2 "
+          "(%s; limit %.3g): the method's velocity noise" %
+          (a["dimension"], a["n_windows"], a["window_length"], worst, which, args.max_stress))
+    print("shear-stress balance: max |nu dU/dy - <u'v'> - tau_w/rho (1 - y/delta)| = %.3e "
+          "tau_w/rho (limit 0.01)" % bal)
+    print("u_tau from the wall shear %.6g, from the force balance %.6g: %.3e relative "
+          "(limit 0.01); correlation time %.3g s" % (a["u_tau_wall"], a["u_tau_force"], dut,
+                                                     a["correlation_time"]))
+    return worst < args.max_stress and bal < 0.01 and dut < 0.01
+
+
 def scene_attr(out, section, key):
     """A value of the resolved scene stored in stats.nc."""
     text = attrs(os.path.join(out, "stats.nc"))["scene"]
@@ -281,11 +305,12 @@ def main():
     p.add_argument("--chansph", default="build/chansph")
     p.add_argument("--runs", default="build/test-runs")
     p.add_argument("what", choices=["steady", "startup", "flux", "longrun", "convergence", "study",
-                                      "smagorinsky", "restart-finer"])
+                                    "stats", "smagorinsky", "restart-finer"])
     p.add_argument("scene")
     p.add_argument("scene3d", nargs="?")
     p.add_argument("--max-l2", type=float, default=0.01)
     p.add_argument("--max-rel", type=float, default=1e-5)
+    p.add_argument("--max-stress", type=float, default=1e-4)
     p.add_argument("--steps", type=int, default=20000)
     p.add_argument("--doc", default="docs/validation")
     p.add_argument("--set", action="append", default=[])

@@ -1,14 +1,18 @@
 #!/usr/bin/env bash
 # Bitwise reproducibility: the same scene with OMP_NUM_THREADS=1 and 2 gives identical
-# stats.nc and particles.nc data (compared through ncdump with 17 significant digits); the
-# LES smoke scene covers the model terms (wall law, strain, eddy viscosity, k_r).
+# stats.nc and particles.nc data (compared through ncdump with 17 significant digits), with
+# every statistics engine on (Eulerian, correlations and spectra, Lagrangian); the LES smoke
+# scene covers the model terms (wall law, strain, eddy viscosity, k_r).
 set -eu
 chansph=$1 scenes=$2 runs=$3
 status=0
 for scene in poiseuille2d poiseuille3d poiseuille2d_flux les395_smoke; do
   for t in 1 2; do
     OMP_NUM_THREADS=$t "$chansph" run "$scenes/$scene.ini" --out "$runs/threads_${scene}_$t" \
-      --overwrite --set time.t_end=1.0 --set output.t_average_start=0.5 > /dev/null
+      --overwrite --set time.t_end=1.0 --set output.t_average_start=0.5 --set stats.window=0.1 \
+      --set stats.u_tau_ref=0.6 --set correlations.y_plus=1,2 --set lagrangian.y_plus=1,2 \
+      --set lagrangian.horizon=0.2 --set lagrangian.release_every=0.1 \
+      --set lagrangian.n_lags=10 --set lagrangian.pdf_x=0.01 > /dev/null
   done
   for f in stats.nc particles.nc; do
     if diff <(ncdump -p 9,17 "$runs/threads_${scene}_1/$f" | tail -n +2) \

@@ -35,6 +35,13 @@ target_link_libraries(test_sph PRIVATE chansph_core)
 add_test(NAME unit_sph COMMAND test_sph)
 set_tests_properties(unit_sph PROPERTIES LABELS unit)
 
+#   test_stats:  statistics engine: known synthetic fields, merge invariance, state round trip
+add_executable(test_stats test_stats.c)
+target_link_libraries(test_stats PRIVATE chansph_core)
+target_include_directories(test_stats PRIVATE ${PROJECT_SOURCE_DIR}/stats)
+add_test(NAME unit_stats COMMAND test_stats)
+set_tests_properties(unit_stats PROPERTIES LABELS unit)
+
 add_executable(test_walllaw test_walllaw.c)
 target_link_libraries(test_walllaw PRIVATE chansph_core m)
 add_test(NAME unit_walllaw COMMAND test_walllaw)

@@ -1,0 +1,222 @@
+#!/usr/bin/python3
+"""chansph compare: profiles of a run (stats.nc) against a DNS data set, in wall units.
+
+usage: chansph compare STATS.nc --dns FILE [--out DIR] [--no-plots]
+       (or: python3 stats/compare.py STATS.nc --dns FILE ...)
+
+FILE is one file of a DNS set we ship in stats/dns/ (or one in the same formats):
+  Moser, Kim & Mansour 1999: chanNNN.means (+ companion chanNNN.reystress, found by name)
+  Lee & Moser 2015:          LM_Channel_NNNN_mean_prof.dat (+ derived/LM_Channel_RetauNNN.txt)
+                             or the derived table itself.
+STATS.nc may itself be a DNS file: comparing a DNS set with itself gives zero error.
+
+Wall units come from the run's own u_tau (stats.nc attribute u_tau). The DNS profiles are
+interpolated (linearly in y+) to the run's bin positions; the upper half of an unfolded run
+is mirrored onto the lower one. Prints the L2 (root mean square) and Linf (maximum)
+differences of U+, u_rms+, v_rms+, w_rms+ and -u'v'+ per y+ range, writes compare.csv and
+one PNG per quantity (ours with error bars of 2 standard errors, DNS, law of the wall).
+"""
+import argparse
+import math
+import os
+import re
+import sys
+
+import numpy as np
+
+QUANTITIES = ("U+", "u_rms+", "v_rms+", "w_rms+", "-u'v'+")
+RANGES = (("viscous sublayer", "y+ < 5"), ("buffer layer", "5 <= y+ < 30"),
+          ("log layer", "y+ >= 30, y/delta < 0.3"), ("outer layer", "y+ >= 30, y/delta >= 0.3"))
+KAPPA, B_LOG = 0.41, 5.2
+
+
+def numeric_rows(path):
+    """Rows of numbers of a text file; comment (#, %) and header lines are skipped."""
+    rows = []
+    with open(path) as f:
+        for line in f:
+            s = line.strip()
+            if not s or s[0] in "#%":
+                continue
+            try:
+                rows.append([float(x) for x in re.split(r"[,\s]+", s) if x])
+            except ValueError:
+                continue  # a bare column-name line
+    return np.array(rows)
+
+
+def read_dns(path):
+    """A DNS set as a dict: yplus, y_delta, re_tau and the QUANTITIES (None if absent)."""
+    base = os.path.basename(path)
+    d = os.path.dirname(path)
+    out = {"name": base, "label": base}
+    m = re.match(r"chan(\d+)\.(means|reystress)$", base)
+    if m:  # Moser, Kim & Mansour 1999
+        means = os.path.join(d, "chan%s.means" % m.group(1))
+        rey = os.path.join(d, "chan%s.reystress" % m.group(1))
+        a = numeric_rows(means)
+        out.update(yplus=a[:, 1], y_delta=a[:, 0], re_tau=a[-1, 1] / a[-1, 0])
+        out["U+"] = a[:, 2]
+        out["source"] = "Moser, Kim & Mansour (1999), %s" % os.path.basename(means)
+        if os.path.exists(rey):
+            r = numeric_rows(rey)
+            if not np.allclose(r[:, 1], out["yplus"]):
+                sys.exit("error: %s and %s have different y+ points" % (means, rey))
+            out["u_rms+"], out["v_rms+"], out["w_rms+"] = (np.sqrt(np.abs(r[:, k])) for k in (2, 3, 4))
+            out["-u'v'+"] = -r[:, 5]
+            out["source"] += " + " + os.path.basename(rey)
+        return out
+    m = re.match(r"LM_Channel_(\d+)_mean_prof\.dat$", base)
+    derived = None
+    if m:  # Lee & Moser 2015, mean profile
+        a = numeric_rows(path)
+        out.update(yplus=a[:, 1], y_delta=a[:, 0], re_tau=a[-1, 1] / a[-1, 0], source=
+                   "Lee & Moser (2015), %s" % base)
+        out["U+"] = a[:, 2]
+        cand = os.path.join(d, "derived", "LM_Channel_Retau%d.txt" % int(m.group(1)))
+        derived = cand if os.path.exists(cand) else None
+    elif re.match(r"LM_Channel_Retau(\d+)\.txt$", base):
+        derived = path
+    if derived:
+        with open(derived) as f:
+            header = [h.strip() for h in f.readline().split(",")]
+        a = numeric_rows(derived)
+        col = {h: i for i, h in enumerate(header)}
+        yp = a[:, col["y+"]]
+        if "yplus" not in out:
+            out.update(yplus=yp, re_tau=yp[-1], y_delta=yp / yp[-1], source="Lee & Moser (2015)")
+            out["U+"] = a[:, col["u_1"]]
+
+        def on_grid(v):
+            return np.interp(out["yplus"], yp, v)
+        out["u_rms+"] = on_grid(np.sqrt(np.abs(a[:, col["uu_11"]])))
+        out["v_rms+"] = on_grid(np.sqrt(np.abs(a[:, col["uu_22"]])))
+        out["w_rms+"] = on_grid(np.sqrt(np.abs(a[:, col["uu_33"]])))
+        out["-u'v'+"] = on_grid(-a[:, col["uu_12"]])
+        out["source"] += " + derived/" + os.path.basename(derived)
+        return out
+    if m:
+        return out
+    sys.exit("error: %s: not a DNS file of a known set (chanNNN.means/.reystress, "
+             "LM_Channel_NNNN_mean_prof.dat, LM_Channel_RetauNNN.txt)" % path)
+
+
+def read_run(path):
+    """Our profiles in wall units (lower half, upper half mirrored), with standard errors."""
+    import netCDF4
+    with netCDF4.Dataset(path) as d:
+        a = {k: d.getncattr(k) for k in d.ncattrs()}
+
+        def v(name):
+            x = d[name][:]
+            return np.ma.filled(x.astype(float), np.nan)
+        y, u, uu, vv, ww, uv = (v(n) for n in ("y_mean", "u_mean", "uu", "vv", "ww", "uv"))
+        se = {n: v(n + "_stderr") for n in ("u_mean", "uu", "vv", "ww", "uv")}
+    ut, nu, delta = float(a["u_tau"]), float(a["nu"]), float(a["delta"])
+    if not ut > 0:
+        sys.exit("error: %s: no positive u_tau (attribute u_tau = %r)" % (path, ut))
+    upper = y > delta
+    y = np.where(upper, 2 * delta - y, y)
+    sign = np.where(upper, -1.0, 1.0)
+    out = {"yplus": y * ut / nu, "y_delta": y / delta, "re_tau": ut * delta / nu, "label": "chansph",
+           "source": "chansph %s (u_tau = %.6g m/s, windows %d)" % (path, ut, a.get("n_windows", 0))}
+    out["U+"], out["U+_se"] = u / ut, se["u_mean"] / ut
+    for c, s2, name in (("u", uu, "uu"), ("v", vv, "vv"), ("w", ww, "ww")):
+        r = np.sqrt(np.abs(s2)) / ut
+        out[c + "_rms+"] = r
+        out[c + "_rms+_se"] = np.where(r > 0, 0.5 * se[name] / ut ** 2 / np.where(r > 0, r, 1), np.nan)
+    out["-u'v'+"] = -sign * uv / ut ** 2
+    out["-u'v'+_se"] = se["uv"] / ut ** 2
+    order = np.argsort(out["yplus"], kind="stable")
+    return {k: (val[order] if isinstance(val, np.ndarray) else val) for k, val in out.items()}
+
+
+def region_masks(yp, yd):
+    return (yp < 5, (yp >= 5) & (yp < 30), (yp >= 30) & (yd < 0.3), (yp >= 30) & (yd >= 0.3))
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
+    p.add_argument("stats", help="stats.nc of a run (or a DNS file)")
+    p.add_argument("--dns", required=True, help="one file of a DNS set")
+    p.add_argument("--out", help="directory for compare.csv and the PNGs (default: beside STATS)")
+    p.add_argument("--no-plots", action="store_true")
+    p.add_argument("--max-error", type=float,
+                   help="exit with status 1 if any L2 or Linf error exceeds this (tests)")
+    args = p.parse_args()
+    dns = read_dns(args.dns)
+    ours = read_run(args.stats) if args.stats.endswith(".nc") else read_dns(args.stats)
+    out_dir = args.out or os.path.join(os.path.dirname(os.path.abspath(args.stats)), "compare")
+    os.makedirs(out_dir, exist_ok=True)
+    print("ours: %s, Re_tau = %.2f" % (ours["source"], ours["re_tau"]))
+    print("DNS:  %s, Re_tau = %.2f" % (dns["source"], dns["re_tau"]))
+    yp, yd = ours["yplus"], ours["y_delta"]
+    inside = (yp >= dns["yplus"][0]) & (yp <= dns["yplus"][-1])
+    masks = region_masks(yp, yd)
+    rows = []
+    print("%-8s %-17s %6s %12s %12s %12s" % ("quantity", "range", "points", "L2", "Linf",
+                                              "L2 relative"))
+    for q in QUANTITIES:
+        if dns.get(q) is None or ours.get(q) is None:
+            print("%-8s (not in both data sets)" % q)
+            continue
+        ref = np.interp(yp, dns["yplus"], dns[q])
+        diff = ours[q] - ref
+        for (name, _), m in zip(RANGES, masks):
+            sel = m & inside & np.isfinite(diff)
+            if not sel.any():
+                rows.append((q, name, 0, math.nan, math.nan, math.nan))
+                print("%-8s %-17s %6d %12s %12s %12s" % (q, name, 0, "-", "-", "-"))
+                continue
+            l2 = math.sqrt(np.mean(diff[sel] ** 2))
+            linf = float(np.max(np.abs(diff[sel])))
+            scale = math.sqrt(np.mean(ref[sel] ** 2))
+            rows.append((q, name, int(sel.sum()), l2, linf, l2 / scale if scale > 0 else math.nan))
+            print("%-8s %-17s %6d %12.4e %12.4e %12.4e" % rows[-1])
+    with open(os.path.join(out_dir, "compare.csv"), "w") as f:
+        f.write("# ours: %s\n# DNS: %s\nquantity,range,points,L2,Linf,L2_relative\n" %
+                (ours["source"], dns["source"]))
+        for r in rows:
+            f.write("%s,%s,%d,%.6e,%.6e,%.6e\n" % r)
+    if not args.no_plots:
+        plots(ours, dns, out_dir)
+    print("wrote %s/compare.csv%s" % (out_dir, "" if args.no_plots else " and one PNG per quantity"))
+    if args.max_error is not None:
+        worst = max((max(r[3], r[4]) for r in rows if r[2] > 0), default=math.nan)
+        ok = worst <= args.max_error
+        print("largest error %.3e (limit %.3g): %s" % (worst, args.max_error, "PASS" if ok else "FAIL"))
+        sys.exit(0 if ok else 1)
+
+
+def plots(ours, dns, out_dir):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    for q in QUANTITIES:
+        if dns.get(q) is None or ours.get(q) is None:
+            continue
+        fig, ax = plt.subplots(figsize=(6, 4.2))
+        ax.semilogx(dns["yplus"][1:], dns[q][1:], "k-", lw=1.2, label="DNS: " + dns["name"])
+        se = ours.get(q + "_se")
+        yerr = None
+        if se is not None and np.isfinite(se).any():
+            yerr = np.where(np.isfinite(se), 2 * se, 0.0)
+        ax.errorbar(ours["yplus"], ours[q], yerr=yerr, fmt="o", ms=3, capsize=2,
+                    label="%s (bars: 2 standard errors)" % ours["label"])
+        if q == "U+":
+            y = np.logspace(-1, math.log10(max(dns["yplus"][-1], ours["yplus"][-1])), 200)
+            ax.semilogx(y[y < 12], y[y < 12], "g--", lw=0.8, label="U+ = y+")
+            ax.semilogx(y[y > 5], np.log(y[y > 5]) / KAPPA + B_LOG, "r--", lw=0.8,
+                        label="log law (kappa 0.41, B 5.2)")
+        ax.set_xlabel("y+")
+        ax.set_ylabel(q)
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        name = q.replace("'", "").replace("-", "minus_").replace("+", "plus")
+        fig.savefig(os.path.join(out_dir, "%s.png" % name), dpi=110)
+        plt.close(fig)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,277 @@
+/** @file corr.c @brief Implementation of corr.h. */
+#include "corr.h"
+
+#include <fftw3.h>
+#include <math.h>
+#include <netcdf.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "ncout.h"
+#include "state.h"
+
+static const double two_pi = 6.283185307179586;
+
+static void *xalloc(size_t bytes) {
+  void *p = calloc(1, bytes ? bytes : 1);
+  if (!p) {
+    fprintf(stderr, "error: out of memory in the correlation engine\n");
+    abort();
+  }
+  return p;
+}
+
+void corr_init(struct corr *c, const struct corr_config *cfg) {
+  memset(c, 0, sizeof *c);
+  c->cfg = *cfg;
+  if (cfg->n_levels <= 0) return;
+  const int nx = cfg->nx, nz = cfg->nz;
+  c->nzh = nz / 2 + 1;
+  const size_t nk = (size_t)nx * (size_t)c->nzh;
+  c->spec = xalloc((size_t)cfg->n_levels * nk * CS_LEN * sizeof(double));
+  c->samples = xalloc((size_t)cfg->n_levels * sizeof(double));
+  c->empty = xalloc((size_t)cfg->n_levels * sizeof(double));
+  c->grid = fftw_malloc(4 * (size_t)nx * (size_t)nz * sizeof(double));
+  c->out = fftw_malloc(3 * nk * sizeof(fftw_complex));
+  if (!c->grid || !c->out) {
+    fprintf(stderr, "error: out of memory in the correlation engine\n");
+    abort();
+  }
+  /* three transforms of nx x nz at once; FFTW_ESTIMATE chooses the plan without timing, so
+     the same sizes give the same plan, and the same sums, on every run and restart */
+  const int n[2] = {nx, nz};
+  c->plan = fftw_plan_many_dft_r2c(2, n, 3, c->grid, NULL, 1, nx * nz, c->out, NULL, 1, (int)nk,
+                                   FFTW_ESTIMATE);
+}
+
+void corr_free(struct corr *c) {
+  if (c->plan) fftw_destroy_plan(c->plan);
+  if (c->grid) fftw_free(c->grid);
+  if (c->out) fftw_free(c->out);
+  free(c->spec), free(c->samples), free(c->empty);
+  memset(c, 0, sizeof *c);
+}
+
+/* Bin the slab around height yl onto the grid (mirror: v -> -v), remove the plane means,
+   transform, and add the spectra to level l. Returns 0 if the slab holds no particle. */
+static int add_plane(struct corr *c, int l, double yl, int mirror, const struct stats_snapshot *s) {
+  const int nx = c->cfg.nx, nz = c->cfg.nz;
+  const size_t np = (size_t)nx * (size_t)nz;
+  double *g = c->grid, *cnt = g + 3 * np;
+  memset(g, 0, 4 * np * sizeof(double));
+  const double sx = nx / c->cfg.lx, sz = nz > 1 ? nz / c->cfg.lz : 0.0;
+  size_t found = 0;
+  for (size_t a = 0; a < s->n; a++) {
+    if (s->skip && s->skip[a]) continue;
+    if (fabs(s->y[a] - yl) >= c->cfg.half) continue;
+    long ix = (long)floor(s->x[a] * sx) % nx, iz = nz > 1 ? (long)floor(s->z[a] * sz) % nz : 0;
+    ix += ix < 0 ? nx : 0, iz += iz < 0 ? nz : 0;
+    const size_t q = (size_t)ix * (size_t)nz + (size_t)iz;
+    g[q] += s->u[a], g[np + q] += mirror ? -s->v[a] : s->v[a], g[2 * np + q] += s->w[a];
+    cnt[q] += 1.0, found++;
+  }
+  if (!found) return 0;
+  double mean[3] = {0, 0, 0}, filled = 0;
+  for (size_t q = 0; q < np; q++)
+    if (cnt[q] > 0)
+      for (int k = 0; k < 3; k++) g[k * np + q] /= cnt[q];
+  for (size_t q = 0; q < np; q++)
+    if (cnt[q] > 0) {
+      for (int k = 0; k < 3; k++) mean[k] += g[k * np + q];
+      filled += 1;
+    }
+  for (int k = 0; k < 3; k++) mean[k] /= filled;
+  for (size_t q = 0; q < np; q++) /* empty cells carry no fluctuation */
+    for (int k = 0; k < 3; k++) g[k * np + q] = cnt[q] > 0 ? g[k * np + q] - mean[k] : 0.0;
+  c->empty[l] += (double)np - filled;
+  fftw_execute(c->plan);
+  const size_t nk = (size_t)nx * (size_t)c->nzh;
+  const fftw_complex *U = c->out, *V = U + nk, *W = V + nk;
+  double *S = c->spec + (size_t)l * nk * CS_LEN;
+  for (size_t k = 0; k < nk; k++) {
+    double *sk = S + k * CS_LEN;
+    sk[CS_UU] += U[k][0] * U[k][0] + U[k][1] * U[k][1];
+    sk[CS_VV] += V[k][0] * V[k][0] + V[k][1] * V[k][1];
+    sk[CS_WW] += W[k][0] * W[k][0] + W[k][1] * W[k][1];
+    sk[CS_UV_RE] += U[k][0] * V[k][0] + U[k][1] * V[k][1]; /* conj(U) V */
+    sk[CS_UV_IM] += U[k][0] * V[k][1] - U[k][1] * V[k][0];
+  }
+  c->samples[l] += 1.0;
+  return 1;
+}
+
+void corr_sample(struct corr *c, const struct stats_snapshot *s) {
+  if (c->cfg.n_levels <= 0 || s->t < c->cfg.t_start) return;
+  for (int l = 0; l < c->cfg.n_levels; l++) {
+    const double yl = c->cfg.y[l], ym = 2.0 * c->cfg.delta - yl;
+    add_plane(c, l, yl, 0, s);
+    if (fabs(ym - yl) >= 2.0 * c->cfg.half) add_plane(c, l, ym, 1, s);
+  }
+}
+
+void corr_state(struct corr *c, struct state_list *L) {
+  if (c->cfg.n_levels <= 0) return;
+  const size_t d4[4] = {(size_t)c->cfg.n_levels, (size_t)c->cfg.nx, (size_t)c->nzh, CS_LEN};
+  const size_t dims3[3] = {d4[0], d4[1] * d4[2], CS_LEN}, d1[1] = {d4[0]};
+  state_add(L, "stats/correlations/spectra", STATE_F64, 3, dims3, c->spec, NULL);
+  state_add(L, "stats/correlations/samples", STATE_F64, 1, d1, c->samples, NULL);
+  state_add(L, "stats/correlations/empty_cells", STATE_F64, 1, d1, c->empty, NULL);
+}
+
+/* Weight of a stored r2c coefficient (kz column iz) in sums over the full spectrum: its
+   conjugate partner (-kx, -kz) is not stored unless kz = 0 or kz = nz/2 (nz even). */
+static double weight(int iz, int nz) {
+  return iz == 0 || (nz % 2 == 0 && iz == nz / 2) ? 1.0 : 2.0;
+}
+
+void corr_results(const struct corr *c, double *rx, double *rz, double *ex, double *ez) {
+  const int nx = c->cfg.nx, nz = c->cfg.nz, nzh = c->nzh, nxh = nx / 2 + 1;
+  const size_t nk = (size_t)nx * (size_t)nzh, np = (size_t)nx * (size_t)nz;
+  const double N = (double)np;
+  fftw_complex *in = fftw_malloc(nk * sizeof(fftw_complex));
+  double *r = fftw_malloc(np * sizeof(double));
+  const int n[2] = {nx, nz};
+  fftw_plan back = fftw_plan_dft_c2r(2, n, in, r, FFTW_ESTIMATE);
+  for (int l = 0; l < c->cfg.n_levels; l++) {
+    const double *S = c->spec + (size_t)l * nk * CS_LEN;
+    const double ns = c->samples[l] > 0 ? c->samples[l] : NAN;
+    const double norm = 1.0 / (N * N * ns);
+    static const int slot_re[4] = {CS_UU, CS_VV, CS_WW, CS_UV_RE};
+    for (int q = 0; q < 4; q++) {
+      for (size_t k = 0; k < nk; k++) {
+        in[k][0] = S[k * CS_LEN + slot_re[q]];
+        in[k][1] = q == 3 ? S[k * CS_LEN + CS_UV_IM] : 0.0;
+      }
+      fftw_execute(back); /* r(l) = sum_k S_k e^{i k l} = N sum_r u(r) u(r + l) */
+      for (int i = 0; i < nx; i++) rx[((size_t)l * 4 + q) * nx + i] = r[(size_t)i * nz] * norm;
+      for (int k = 0; k < nz; k++) rz[((size_t)l * 4 + q) * nz + k] = r[k] * norm;
+    }
+    for (int q = 0; q < 3; q++) {
+      double *Ex = ex + ((size_t)l * 3 + q) * nxh, *Ez = ez + ((size_t)l * 3 + q) * nzh;
+      memset(Ex, 0, (size_t)nxh * sizeof(double));
+      memset(Ez, 0, (size_t)nzh * sizeof(double));
+      for (int i = 0; i < nx; i++)
+        for (int k = 0; k < nzh; k++) {
+          const double phi = weight(k, nz) * S[((size_t)i * nzh + k) * CS_LEN + q] * norm;
+          Ex[i <= nx - i ? i : nx - i] += phi;
+          Ez[k] += phi;
+        }
+      /* densities over k = 2 pi m / L: sum_m E(k_m) dk = <u_i'^2> */
+      for (int m = 0; m < nxh; m++) Ex[m] *= c->cfg.lx / two_pi;
+      for (int m = 0; m < nzh; m++) Ez[m] *= nz > 1 ? c->cfg.lz / two_pi : 1.0;
+    }
+  }
+  fftw_destroy_plan(back);
+  fftw_free(in), fftw_free(r);
+}
+
+#define CK(call)                                                   \
+  do {                                                             \
+    rc = (call);                                                   \
+    if (rc != NC_NOERR) {                                          \
+      snprintf(err, errlen, "%s (in %s)", nc_strerror(rc), #call); \
+      goto done;                                                   \
+    }                                                              \
+  } while (0)
+
+int corr_nc_write(const struct corr *c, int ncid, char *err, size_t errlen) {
+  const int nl = c->cfg.n_levels, nx = c->cfg.nx, nz = c->cfg.nz, nzh = c->nzh;
+  const int nxh = nx / 2 + 1;
+  double *rx = malloc((size_t)nl * 4 * nx * sizeof(double));
+  double *rz = malloc((size_t)nl * 4 * nz * sizeof(double));
+  double *ex = malloc((size_t)nl * 3 * nxh * sizeof(double));
+  double *ez = malloc((size_t)nl * 3 * nzh * sizeof(double));
+  double *tmp = malloc((size_t)(nx > nz ? nx : nz) * 4 * sizeof(double));
+  int rc = NC_NOERR, g, dl, dx, dz, dkx, dkz, dkk, dsl, v;
+  corr_results(c, rx, rz, ex, ez);
+  CK(nc_def_grp(ncid, "correlations", &g));
+  static const char desc[] =
+      "two-point correlations and 1-D spectra in wall-parallel planes (thesis Eq. "
+      "5.57-5.59); a level and its mirror 2 delta - y (v -> -v) are both sampled";
+  CK(nc_put_att_text(g, NC_GLOBAL, "description", strlen(desc), desc));
+  CK(nc_def_dim(g, "level", (size_t)nl, &dl));
+  CK(nc_def_dim(g, "separation_x", (size_t)nx, &dx));
+  CK(nc_def_dim(g, "separation_z", (size_t)nz, &dz));
+  CK(nc_def_dim(g, "kx", (size_t)nxh, &dkx));
+  CK(nc_def_dim(g, "kz", (size_t)nzh, &dkz));
+  CK(nc_def_dim(g, "k_index", (size_t)nx * (size_t)nzh, &dkk));
+  CK(nc_def_dim(g, "spectrum_slot", CS_LEN, &dsl));
+  CK(ncout_def(g, "level", NC_DOUBLE, 1, &dl, "m", "height of the plane above the lower wall", &v));
+  CK(nc_put_var_double(g, v, c->cfg.y));
+  CK(ncout_def(g, "y_plus", NC_DOUBLE, 1, &dl, "1", "level in wall units of stats.u_tau_ref", &v));
+  CK(nc_put_var_double(g, v, c->cfg.y_plus));
+  CK(ncout_def(g, "samples", NC_DOUBLE, 1, &dl, "1", "planes accumulated", &v));
+  CK(nc_put_var_double(g, v, c->samples));
+  CK(ncout_def(g, "empty_cells", NC_DOUBLE, 1, &dl, "1",
+               "grid cells without a particle, summed over the planes (set to zero fluctuation)",
+               &v));
+  CK(nc_put_var_double(g, v, c->empty));
+  for (int i = 0; i < nx; i++) tmp[i] = i * c->cfg.lx / nx;
+  CK(ncout_def(g, "separation_x", NC_DOUBLE, 1, &dx, "m", "streamwise separation l_x", &v));
+  CK(nc_put_var_double(g, v, tmp));
+  for (int i = 0; i < nz; i++) tmp[i] = nz > 1 ? i * c->cfg.lz / nz : 0.0;
+  CK(ncout_def(g, "separation_z", NC_DOUBLE, 1, &dz, "m", "spanwise separation l_z", &v));
+  CK(nc_put_var_double(g, v, tmp));
+  for (int i = 0; i < nxh; i++) tmp[i] = two_pi * i / c->cfg.lx;
+  CK(ncout_def(g, "kx", NC_DOUBLE, 1, &dkx, "1/m", "streamwise wavenumber", &v));
+  CK(nc_put_var_double(g, v, tmp));
+  for (int i = 0; i < nzh; i++) tmp[i] = nz > 1 ? two_pi * i / c->cfg.lz : 0.0;
+  CK(ncout_def(g, "kz", NC_DOUBLE, 1, &dkz, "1/m", "spanwise wavenumber", &v));
+  CK(nc_put_var_double(g, v, tmp));
+  static const char *const comp[4] = {"uu", "vv", "ww", "uv"};
+  for (int q = 0; q < 4; q++) {
+    char name[32], ln[160];
+    const int d2x[2] = {dl, dx}, d2z[2] = {dl, dz};
+    for (int dir = 0; dir < 2; dir++) {
+      const int n = dir ? nz : nx;
+      const double *R = dir ? rz : rx;
+      snprintf(name, sizeof name, "R_%s_%c", comp[q], dir ? 'z' : 'x');
+      snprintf(ln, sizeof ln, "two-point correlation <%c'(r) %c'(r + l e_%c)> (Eq. 5.57)",
+               comp[q][0], comp[q][1], dir ? 'z' : 'x');
+      CK(ncout_def(g, name, NC_DOUBLE, 2, dir ? d2z : d2x, "m^2/s^2", ln, &v));
+      for (int l = 0; l < nl; l++) {
+        const size_t st[2] = {(size_t)l, 0}, ct[2] = {1, (size_t)n};
+        CK(nc_put_vara_double(g, v, st, ct, R + ((size_t)l * 4 + q) * n));
+      }
+      snprintf(name, sizeof name, "rho_%s_%c", comp[q], dir ? 'z' : 'x');
+      snprintf(ln, sizeof ln, "normalised two-point correlation R_%s / <%c'%c'> (Eq. 5.58)",
+               comp[q], comp[q][0], comp[q][0]);
+      CK(ncout_def(g, name, NC_DOUBLE, 2, dir ? d2z : d2x, "1", ln, &v));
+      for (int l = 0; l < nl; l++) {
+        const double *src = R + ((size_t)l * 4 + q) * n;
+        const double r0 = R[((size_t)l * 4 + (q == 3 ? 0 : q)) * n];
+        for (int i = 0; i < n; i++) tmp[i] = src[i] / r0;
+        const size_t st[2] = {(size_t)l, 0}, ct[2] = {1, (size_t)n};
+        CK(nc_put_vara_double(g, v, st, ct, tmp));
+      }
+    }
+  }
+  for (int q = 0; q < 3; q++) {
+    char name[32], ln[160];
+    for (int dir = 0; dir < 2; dir++) {
+      const int n = dir ? nzh : nxh;
+      const int d2[2] = {dl, dir ? dkz : dkx};
+      snprintf(name, sizeof name, "E_%s_k%c", comp[q], dir ? 'z' : 'x');
+      snprintf(ln, sizeof ln,
+               "one-sided 1-D energy spectrum of %c' over k_%c (Eq. 5.59; sum E dk = <%c'%c'>)",
+               comp[q][0], dir ? 'z' : 'x', comp[q][0], comp[q][0]);
+      CK(ncout_def(g, name, NC_DOUBLE, 2, d2, "m^3/s^2", ln, &v));
+      for (int l = 0; l < nl; l++) {
+        const size_t st[2] = {(size_t)l, 0}, ct[2] = {1, (size_t)n};
+        CK(nc_put_vara_double(g, v, st, ct, (dir ? ez : ex) + ((size_t)l * 3 + q) * n));
+      }
+    }
+  }
+  {
+    const int d3[3] = {dl, dkk, dsl};
+    CK(ncout_def(g, "spectra", NC_DOUBLE, 3, d3, "m^2/s^2",
+                 "raw sums over the planes of conj(F u_i) F u_j on the r2c grid [kx][kz]: uu, "
+                 "vv, ww, Re uv, Im uv (unnormalised FFTW transforms of nx x nz)",
+                 &v));
+    CK(nc_put_var_double(g, v, c->spec));
+  }
+done:
+  free(rx), free(rz), free(ex), free(ez), free(tmp);
+  return rc;
+}

@@ -1,0 +1,80 @@
+/**
+ * @file corr.h
+ * @brief Two-point correlations and spectra in wall-parallel planes (thesis Eq. 5.57-5.59),
+ *        with FFTW.
+ *
+ * At each level the particles of a thin slab are bin-averaged onto an nx x nz grid (Eq.
+ * 5.54-5.55), the plane mean is removed, and the 2-D FFTs of u', v', w' give the spectra
+ * S_ij(k) = conj(u_i(k)) u_j(k), summed over samples (a level and its mirror 2 delta - y,
+ * with v -> -v, are two samples of one snapshot). The sums are the whole state: mergeable by
+ * addition, serialisable, and every result derives from them:
+ *   R_ij(l) = <u_i'(r) u_j'(r + l)> = IFFT(S_ij)(l) / (N^2 samples)            (Eq. 5.57)
+ *   rho_ij(l) = R_ij(l) / R_ii(0)                                               (Eq. 5.58)
+ *   E_ii(k_x) one-sided, normalised so that sum_k E_ii(k) dk = <u_i'^2>       (Eq. 5.59)
+ */
+#ifndef CHANSPH_CORR_H
+#define CHANSPH_CORR_H
+
+#include <stddef.h>
+
+#include "euler.h"
+
+struct state_list;
+
+enum { CORR_MAX_LEVELS = 8 };
+/** Spectrum slots per wavenumber: S_uu, S_vv, S_ww, Re S_uv, Im S_uv. */
+enum { CS_UU, CS_VV, CS_WW, CS_UV_RE, CS_UV_IM, CS_LEN };
+
+/** Configuration of the correlation engine. */
+struct corr_config {
+  int n_levels;                   /*!< levels (0: engine off) */
+  double y[CORR_MAX_LEVELS];      /*!< level heights from the lower wall [m] */
+  double y_plus[CORR_MAX_LEVELS]; /*!< the y+ they were given as */
+  int nx, nz;                     /*!< grid (nz = 1 in 2-D) */
+  double lx, lz;                  /*!< periodic lengths [m] (lz unused in 2-D) */
+  double half;                    /*!< half thickness of the slabs [m] */
+  double delta;                   /*!< channel half-width [m] (mirror levels) */
+  double t_start;                 /*!< start of the averaging [s] */
+};
+
+/** The engine. */
+struct corr {
+  struct corr_config cfg;
+  int nzh;         /*!< nz / 2 + 1 (r2c output along z) */
+  double *spec;    /*!< [level][nx][nzh][CS_LEN] summed spectra */
+  double *samples; /*!< [level] planes accumulated */
+  double *empty;   /*!< [level] empty grid cells met (diagnostic) */
+  double *grid;    /*!< fftw_malloc'd work: 3 planes nx*nz (+ counts) */
+  void *out;       /*!< fftw_malloc'd complex output, 3 x nx*nzh */
+  void *plan;      /*!< r2c plan (FFTW_ESTIMATE, fixed: deterministic) */
+};
+
+/** @brief Set up (allocates only if n_levels > 0). */
+void corr_init(struct corr *c, const struct corr_config *cfg);
+
+/** @brief Free. */
+void corr_free(struct corr *c);
+
+/** @brief Add one snapshot (serial, deterministic). Implements: Eq. 5.54-5.55 on the plane
+ *         grid and the spectra behind Eq. 5.57-5.59. */
+void corr_sample(struct corr *c, const struct stats_snapshot *s);
+
+/** @brief Expose the sums to a state list. */
+void corr_state(struct corr *c, struct state_list *L);
+
+/**
+ * @brief Implements: thesis Eq. 5.57-5.59.
+ *        Results of the sums: correlations along x and z, their normalised forms and the
+ *        one-sided 1-D spectra of each level.
+ * @param[in] c engine
+ * @param[out] rx [level][4][nx] R_uu, R_vv, R_ww, R_uv along x (l = i lx/nx)
+ * @param[out] rz [level][4][nz] the same along z
+ * @param[out] ex [level][3][nx/2+1] E_uu, E_vv, E_ww over k_x = 2 pi m / lx
+ * @param[out] ez [level][3][nz/2+1] the same over k_z
+ */
+void corr_results(const struct corr *c, double *rx, double *rz, double *ex, double *ez);
+
+/** @brief Write group "correlations" into an open netCDF-4 file; returns a netCDF status. */
+int corr_nc_write(const struct corr *c, int ncid, char *err, size_t errlen);
+
+#endif

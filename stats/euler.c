@@ -1,0 +1,363 @@
+/** @file euler.c @brief Implementation of euler.h. */
+#include "euler.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "moments.h"
+#include "state.h"
+
+const struct euler_meta euler_prof_meta[EP_NPROF] = {
+    [EP_Y] = {"y", "m", "wall-normal bin centre (walls at 0 and 2 delta)"},
+    [EP_Y_MEAN] = {"y_mean", "m", "mean position of the samples in the bin"},
+    [EP_N] = {"n_samples", "1",
+              "particle samples in the bin (SPH interpolation: sum of the weights V_a W1)"},
+    [EP_U] = {"u_mean", "m/s", "mean streamwise velocity"},
+    [EP_V] = {"v_mean", "m/s", "mean wall-normal velocity"},
+    [EP_W] = {"w_mean", "m/s", "mean spanwise velocity"},
+    [EP_P] = {"p_mean", "Pa", "mean pressure"},
+    [EP_RHO] = {"rho_mean", "kg/m^3", "mean density"},
+    [EP_UU] = {"uu", "m^2/s^2", "Reynolds stress <u'u'>"},
+    [EP_VV] = {"vv", "m^2/s^2", "Reynolds stress <v'v'>"},
+    [EP_WW] = {"ww", "m^2/s^2", "Reynolds stress <w'w'>"},
+    [EP_UV] = {"uv", "m^2/s^2", "Reynolds stress <u'v'>"},
+    [EP_UW] = {"uw", "m^2/s^2", "Reynolds stress <u'w'>"},
+    [EP_VW] = {"vw", "m^2/s^2", "Reynolds stress <v'w'>"},
+    [EP_SE_U + 0] = {"u_mean_stderr", "m/s", "standard error of u_mean (batch means)"},
+    [EP_SE_U + 1] = {"v_mean_stderr", "m/s", "standard error of v_mean (batch means)"},
+    [EP_SE_U + 2] = {"w_mean_stderr", "m/s", "standard error of w_mean (batch means)"},
+    [EP_SE_U + 3] = {"p_mean_stderr", "Pa", "standard error of p_mean (batch means)"},
+    [EP_SE_U + 4] = {"rho_mean_stderr", "kg/m^3", "standard error of rho_mean (batch means)"},
+    [EP_SE_U + 5] = {"uu_stderr", "m^2/s^2", "standard error of uu (batch means)"},
+    [EP_SE_U + 6] = {"vv_stderr", "m^2/s^2", "standard error of vv (batch means)"},
+    [EP_SE_U + 7] = {"ww_stderr", "m^2/s^2", "standard error of ww (batch means)"},
+    [EP_SE_U + 8] = {"uv_stderr", "m^2/s^2", "standard error of uv (batch means)"},
+    [EP_SE_U + 9] = {"uw_stderr", "m^2/s^2", "standard error of uw (batch means)"},
+    [EP_SE_U + 10] = {"vw_stderr", "m^2/s^2", "standard error of vw (batch means)"},
+    [EP_SKEW_U] = {"u_skewness", "1", "skewness of u"},
+    [EP_SKEW_V] = {"v_skewness", "1", "skewness of v"},
+    [EP_SKEW_W] = {"w_skewness", "1", "skewness of w"},
+    [EP_FLAT_U] = {"u_flatness", "1", "flatness (kurtosis) of u"},
+    [EP_FLAT_V] = {"v_flatness", "1", "flatness (kurtosis) of v"},
+    [EP_FLAT_W] = {"w_flatness", "1", "flatness (kurtosis) of w"},
+    [EP_VISC] = {"viscous_stress", "m^2/s^2",
+                 "viscous shear stress (nu + <nu_t>) dU/dy (Eq. 5.11; nu_t with LES only)"},
+    [EP_TOTAL] = {"total_stress", "m^2/s^2", "total shear stress nu dU/dy - <u'v'> (Eq. 5.12)"},
+    [EP_TOTAL_EXPECTED] = {"total_stress_expected", "m^2/s^2",
+                           "tau_w / rho (1 - y / delta) with the force-balance tau_w (Eq. 5.13)"},
+    [EP_NUT] = {"nu_t_mean", "m^2/s", "mean eddy viscosity (LES, thesis Eq. 5.45)"},
+    [EP_KR] = {"k_r_mean", "m^2/s^2", "mean residual kinetic energy (LES, Yoshizawa)"},
+};
+
+static void *xrealloc(void *p, size_t bytes) {
+  void *q = realloc(p, bytes ? bytes : 1);
+  if (!q) {
+    fprintf(stderr, "error: out of memory in the statistics engine\n");
+    abort();
+  }
+  return q;
+}
+
+double euler_centre(const struct euler_config *cfg, int i) {
+  return cfg->y0 + (i + 0.5) * (cfg->y1 - cfg->y0) / cfg->nb;
+}
+
+/* Make room for rows 0..rows-1; new rows are zero. */
+static void reserve_rows(struct euler *e, size_t rows) {
+  if (rows <= e->cap) return;
+  const size_t nb = (size_t)e->cfg.nb, old = e->cap;
+  size_t cap = old ? old : 8;
+  while (cap < rows) cap *= 2;
+  e->win = xrealloc(e->win, cap * WIN_LEN * sizeof(double));
+  e->mom = xrealloc(e->mom, cap * nb * MOM_LEN * sizeof(double));
+  e->snp = xrealloc(e->snp, cap * nb * SCAL_LEN * sizeof(double));
+  memset(e->win + old * WIN_LEN, 0, (cap - old) * WIN_LEN * sizeof(double));
+  memset(e->mom + old * nb * MOM_LEN, 0, (cap - old) * nb * MOM_LEN * sizeof(double));
+  memset(e->snp + old * nb * SCAL_LEN, 0, (cap - old) * nb * SCAL_LEN * sizeof(double));
+  e->cap = cap;
+}
+
+static void open_row(struct euler *e, double t0) {
+  reserve_rows(e, e->nwin + 1);
+  double *w = e->win + e->nwin * WIN_LEN;
+  w[WIN_T0] = t0;
+  w[WIN_T1] = e->cfg.window > 0.0 ? t0 + e->cfg.window : INFINITY;
+}
+
+/* Shape of the Wendland kernel (thesis Eq. 2.63-2.66) without its constant: the constant
+   cancels in the ratio of Eq. 5.56. */
+static double wendland_shape(double q) {
+  if (q >= 2.0) return 0.0;
+  const double t = 1.0 - 0.5 * q;
+  return t * t * t * t * (2.0 * q + 1.0);
+}
+
+/* W1(s) = int over the plane of w(sqrt(s^2 + rho^2)): in 3-D proportional to
+   int_0^L w(sqrt(s^2 + t^2)) t dt, in 2-D to int_0^L w(sqrt(s^2 + t^2)) dt, L = sqrt(4 - s^2)
+   (composite Simpson, 256 intervals). */
+static void build_w1(struct euler *e) {
+  for (int i = 0; i <= EULER_W1_N; i++) {
+    const double s = 2.0 * i / EULER_W1_N, L = sqrt(fmax(0.0, 4.0 - s * s));
+    const int m = 256;
+    double sum = 0.0;
+    for (int k = 0; k <= m; k++) {
+      const double t = L * k / m, c = k == 0 || k == m ? 1.0 : k % 2 ? 4.0 : 2.0;
+      sum += c * wendland_shape(sqrt(s * s + t * t)) * (e->cfg.dim == 3 ? t : 1.0);
+    }
+    e->w1[i] = sum * L / (3.0 * m);
+  }
+}
+
+static double w1_at(const struct euler *e, double q) {
+  const double x = q * (0.5 * EULER_W1_N);
+  if (x >= EULER_W1_N) return 0.0;
+  const int i = (int)x;
+  return e->w1[i] + (x - i) * (e->w1[i + 1] - e->w1[i]);
+}
+
+void euler_init(struct euler *e, const struct euler_config *cfg) {
+  memset(e, 0, sizeof *e);
+  e->cfg = *cfg;
+  if (cfg->method == EULER_SPH) build_w1(e);
+  e->tmp = xrealloc(NULL, (size_t)cfg->nb * 2 * sizeof(double));
+  open_row(e, cfg->t_start);
+}
+
+void euler_free(struct euler *e) {
+  free(e->win), free(e->mom), free(e->snp), free(e->tmp);
+  memset(e, 0, sizeof *e);
+}
+
+size_t euler_rows(const struct euler *e) {
+  return e->nwin + (e->win[e->nwin * WIN_LEN + WIN_NSNAP] > 0.0);
+}
+
+void euler_sample(struct euler *e, const struct stats_snapshot *s) {
+  const struct euler_config *c = &e->cfg;
+  if (s->t < c->t_start) return;
+  /* close the open window when the snapshot lies past its end; an empty open window moves
+     forward to the interval holding the snapshot */
+  for (double *w = e->win + e->nwin * WIN_LEN; s->t >= w[WIN_T1]; w = e->win + e->nwin * WIN_LEN) {
+    if (w[WIN_NSNAP] > 0.0) {
+      e->nwin++;
+      open_row(e, w[WIN_T1]);
+    } else {
+      w[WIN_T0] += floor((s->t - w[WIN_T0]) / c->window) * c->window;
+      w[WIN_T1] = w[WIN_T0] + c->window;
+      if (s->t >= w[WIN_T1]) w[WIN_T0] = w[WIN_T1], w[WIN_T1] += c->window; /* rounding */
+    }
+  }
+  const size_t nb = (size_t)c->nb;
+  double *row = e->mom + e->nwin * nb * MOM_LEN;
+  double *srow = e->snp + e->nwin * nb * SCAL_LEN;
+  double *win = e->win + e->nwin * WIN_LEN;
+  memset(e->tmp, 0, nb * 2 * sizeof(double));
+  const double scale = c->nb / (c->y1 - c->y0), ly = 2.0 * c->delta;
+  for (size_t a = 0; a < s->n; a++) {
+    if (s->skip && s->skip[a]) continue;
+    double y = s->y[a], v = s->v[a];
+    const int upper = y > c->delta;
+    if (c->fold && upper) y = ly - y, v = -v;
+    const double smp[MOM_NQ] = {s->u[a],
+                                v,
+                                s->w[a],
+                                s->p[a],
+                                s->rho[a],
+                                y,
+                                s->nu_t ? s->nu_t[a] : 0.0,
+                                s->k_r ? s->k_r[a] : 0.0};
+    if (c->method == EULER_SPH) {
+      /* Eq. 5.56 averaged over the plane y = y_i: every profile point within 2h takes the
+         sample with weight V_a W1(|y_a - y_i| / h) (a weighted one-sample merge) */
+      const double vol = s->m ? s->m[a] / s->rho[a] : 1.0, h2 = 2.0 * c->h;
+      int lo = (int)ceil((y - h2 - c->y0) * scale - 0.5),
+          hi = (int)floor((y + h2 - c->y0) * scale - 0.5);
+      lo = lo < 0 ? 0 : lo, hi = hi >= c->nb ? c->nb - 1 : hi;
+      for (int b = lo; b <= hi; b++) {
+        const double wt = vol * w1_at(e, fabs(y - euler_centre(c, b)) / c->h);
+        if (wt <= 0.0) continue;
+        double one[MOM_LEN] = {0};
+        one[MOM_N] = wt;
+        for (int q = 0; q < MOM_NQ; q++) one[MOM_MEAN + q] = smp[q];
+        mom_merge(row + (size_t)b * MOM_LEN, one);
+        e->tmp[2 * b] += wt * s->u[a], e->tmp[2 * b + 1] += wt;
+      }
+      continue;
+    }
+    int b = (int)floor((y - c->y0) * scale);
+    b = b < 0 ? 0 : b >= c->nb ? c->nb - 1 : b; /* samples outside [y0, y1]: end bins */
+    mom_add(row + (size_t)b * MOM_LEN, smp);
+    e->tmp[2 * b] += s->u[a], e->tmp[2 * b + 1] += 1.0;
+  }
+  for (size_t b = 0; b < nb; b++)
+    if (e->tmp[2 * b + 1] > 0.0) scal_add(srow + b * SCAL_LEN, e->tmp[2 * b] / e->tmp[2 * b + 1]);
+  win[WIN_NSNAP] += 1.0;
+  win[WIN_SUM_FX] += s->fx;
+  /* wall shear stress over density: minus the wall force on the fluid per unit area */
+  win[WIN_SUM_TW0] += -s->wall_fx[0] / (c->rho0 * c->area);
+  win[WIN_SUM_TW1] += -s->wall_fx[1] / (c->rho0 * c->area);
+}
+
+/* Derivative of f at point i from its neighbours (3-point Lagrange on uneven points). */
+static double deriv(const double *x, const double *f, const int *ok, int n, int i) {
+  int l = i - 1, r = i + 1;
+  while (l >= 0 && !ok[l]) l--;
+  while (r < n && !ok[r]) r++;
+  if (l < 0 && r >= n) return NAN;
+  if (l < 0) return (f[r] - f[i]) / (x[r] - x[i]);
+  if (r >= n) return (f[i] - f[l]) / (x[i] - x[l]);
+  const double h1 = x[i] - x[l], h2 = x[r] - x[i];
+  return (-h2 / (h1 * (h1 + h2))) * f[l] + ((h2 - h1) / (h1 * h2)) * f[i] +
+         (h1 / (h2 * (h1 + h2))) * f[r];
+}
+
+void euler_finalise(const struct euler_config *cfg, const double *win, const double *mom,
+                    const double *snp, const int *complete, size_t r0, size_t r1,
+                    struct euler_result *res) {
+  const int nb = cfg->nb;
+  memset(res, 0, sizeof *res);
+  res->nb = nb;
+  for (int k = 0; k < EP_NPROF; k++) res->prof[k] = xrealloc(NULL, (size_t)nb * sizeof(double));
+  double *tot = xrealloc(NULL, (size_t)nb * MOM_LEN * sizeof(double));
+  double *bm = xrealloc(NULL, (size_t)nb * 11 * SCAL_LEN * sizeof(double)); /* batch moments */
+  double *sn = xrealloc(NULL, (size_t)nb * SCAL_LEN * sizeof(double));
+  double *within = xrealloc(NULL, (size_t)nb * 2 * sizeof(double));
+  memset(tot, 0, (size_t)nb * MOM_LEN * sizeof(double));
+  memset(bm, 0, (size_t)nb * 11 * SCAL_LEN * sizeof(double));
+  memset(sn, 0, (size_t)nb * SCAL_LEN * sizeof(double));
+  memset(within, 0, (size_t)nb * 2 * sizeof(double));
+  double snaps = 0.0, sum_fx = 0.0, sum_tw = 0.0, tw_batch[SCAL_LEN] = {0, 0, 0};
+  double batch_len = 0.0;
+  res->t0 = r1 > r0 ? win[r0 * WIN_LEN + WIN_T0] : NAN;
+  res->t1 = r1 > r0 ? win[(r1 - 1) * WIN_LEN + WIN_T1] : NAN;
+  for (size_t r = r0; r < r1; r++) {
+    const double *w = win + r * WIN_LEN;
+    snaps += w[WIN_NSNAP], sum_fx += w[WIN_SUM_FX];
+    sum_tw += 0.5 * (w[WIN_SUM_TW0] + w[WIN_SUM_TW1]);
+    for (int b = 0; b < nb; b++) {
+      const double *m = mom + (r * (size_t)nb + (size_t)b) * MOM_LEN;
+      mom_merge(tot + (size_t)b * MOM_LEN, m);
+      const double *s = snp + (r * (size_t)nb + (size_t)b) * SCAL_LEN;
+      if (s[SCAL_N] > 0.0) {
+        within[2 * b] += s[SCAL_M2], within[2 * b + 1] += s[SCAL_N] - 1.0;
+      }
+      if (!complete[r] || m[MOM_N] <= 0.0) continue;
+      double *B = bm + (size_t)b * 11 * SCAL_LEN;
+      for (int q = 0; q < 5; q++) scal_add(B + q * SCAL_LEN, m[MOM_MEAN + q]);
+      for (int c = 0; c < MOM_NC; c++) scal_add(B + (5 + c) * SCAL_LEN, m[MOM_C2 + c] / m[MOM_N]);
+      if (s[SCAL_N] > 0.0) scal_add(sn + (size_t)b * SCAL_LEN, s[SCAL_MEAN]);
+    }
+    if (complete[r] && w[WIN_NSNAP] > 0.0) {
+      scal_add(tw_batch, 0.5 * (w[WIN_SUM_TW0] + w[WIN_SUM_TW1]) / w[WIN_NSNAP]);
+      batch_len += w[WIN_T1] - w[WIN_T0];
+      res->n_batches++;
+    }
+  }
+  res->snapshots = snaps;
+  const double nan = NAN;
+  int *ok = xrealloc(NULL, (size_t)nb * sizeof(int));
+  double tau_sum = 0.0;
+  int tau_n = 0;
+  for (int b = 0; b < nb; b++) {
+    const double *m = tot + (size_t)b * MOM_LEN;
+    const double n = m[MOM_N];
+    ok[b] = n > 0.0;
+    res->prof[EP_Y][b] = euler_centre(cfg, b);
+    res->prof[EP_N][b] = n;
+    res->prof[EP_Y_MEAN][b] = n > 0.0 ? m[MOM_MEAN + MOM_Y] : res->prof[EP_Y][b];
+    for (int q = 0; q < 5; q++) res->prof[EP_U + q][b] = n > 0.0 ? m[MOM_MEAN + q] : nan;
+    res->prof[EP_NUT][b] = n > 0.0 ? m[MOM_MEAN + MOM_NUT] : nan;
+    res->prof[EP_KR][b] = n > 0.0 ? m[MOM_MEAN + MOM_KR] : nan;
+    for (int c = 0; c < MOM_NC; c++) res->prof[EP_UU + c][b] = n > 0.0 ? m[MOM_C2 + c] / n : nan;
+    for (int i = 0; i < 3; i++) {
+      const double m2 = m[MOM_C2 + i] / n;
+      res->prof[EP_SKEW_U + i][b] = n > 0.0 && m2 > 0.0 ? m[MOM_M3 + i] / n / pow(m2, 1.5) : nan;
+      res->prof[EP_FLAT_U + i][b] = n > 0.0 && m2 > 0.0 ? m[MOM_M4 + i] / n / (m2 * m2) : nan;
+    }
+    const double *B = bm + (size_t)b * 11 * SCAL_LEN;
+    for (int k = 0; k < 11; k++) {
+      const double *s = B + k * SCAL_LEN;
+      res->prof[EP_SE_U + k][b] =
+          s[SCAL_N] >= 2.0 ? sqrt(s[SCAL_M2] / (s[SCAL_N] - 1.0) / s[SCAL_N]) : nan;
+    }
+    /* statistical inefficiency of the per-snapshot bin means: batch variance times batch
+       size over the variance within the batches; correlation time = s dt_sample / 2 */
+    const double *s = sn + (size_t)b * SCAL_LEN;
+    if (s[SCAL_N] >= 2.0 && within[2 * b + 1] > 0.0 && within[2 * b] > 0.0 && snaps > 0.0) {
+      const double var_b = s[SCAL_M2] / (s[SCAL_N] - 1.0);
+      const double var_w = within[2 * b] / within[2 * b + 1];
+      const double per_batch = snaps / (double)(r1 - r0);
+      const double dt_s = batch_len / (double)res->n_batches / per_batch;
+      const double ineff = fmax(1.0, per_batch * var_b / var_w);
+      tau_sum += 0.5 * ineff * dt_s, tau_n++;
+    }
+  }
+  res->corr_time = tau_n ? tau_sum / tau_n : nan;
+  const double tw_force = snaps > 0.0 ? cfg->delta * sum_fx / snaps : nan;
+  const double tw_wall = snaps > 0.0 ? sum_tw / snaps : nan;
+  res->u_tau_force = tw_force >= 0.0 ? sqrt(tw_force) : nan;
+  res->u_tau_wall = tw_wall >= 0.0 ? sqrt(tw_wall) : nan;
+  res->u_tau =
+      isfinite(res->u_tau_wall) && res->u_tau_wall > 0.0 ? res->u_tau_wall : res->u_tau_force;
+  res->u_tau_stderr = tw_batch[SCAL_N] >= 2.0 && res->u_tau_wall > 0.0
+                          ? sqrt(tw_batch[SCAL_M2] / (tw_batch[SCAL_N] - 1.0) / tw_batch[SCAL_N]) /
+                                (2.0 * res->u_tau_wall)
+                          : nan;
+  res->re_tau = res->u_tau * cfg->delta / cfg->nu;
+  /* shear-stress balance (Eq. 5.11-5.13): nu dU/dy - <u'v'> = tau_w/rho (1 - y/delta) */
+  res->balance_error = 0.0;
+  for (int b = 0; b < nb; b++) {
+    const double dudy = ok[b] ? deriv(res->prof[EP_Y_MEAN], res->prof[EP_U], ok, nb, b) : nan;
+    const double yb = res->prof[EP_Y_MEAN][b];
+    /* with LES the modelled stress <nu_t> dU/dy joins the viscous one (Eq. 5.45) */
+    const double nu_eff = cfg->nu + (cfg->les && ok[b] ? res->prof[EP_NUT][b] : 0.0);
+    res->prof[EP_VISC][b] = nu_eff * dudy;
+    res->prof[EP_TOTAL][b] = nu_eff * dudy - res->prof[EP_UV][b];
+    res->prof[EP_TOTAL_EXPECTED][b] = tw_force * (1.0 - yb / cfg->delta);
+    if (b > 0 && b < nb - 1 && ok[b] && tw_force > 0.0) {
+      const double err = fabs(res->prof[EP_TOTAL][b] - res->prof[EP_TOTAL_EXPECTED][b]) / tw_force;
+      if (err > res->balance_error) res->balance_error = err;
+    }
+  }
+  if (!(tw_force > 0.0)) res->balance_error = nan;
+  free(ok), free(tot), free(bm), free(sn), free(within);
+}
+
+void euler_result_free(struct euler_result *res) {
+  for (int k = 0; k < EP_NPROF; k++) free(res->prof[k]);
+  memset(res, 0, sizeof *res);
+}
+
+/* Reserve callbacks: the stored shape says how many rows the run had. */
+static void *reserve_win(void *owner, int rank, const size_t *dims) {
+  struct euler *e = owner;
+  if (rank != 2 || dims[0] < 1 || dims[1] != WIN_LEN) return NULL;
+  reserve_rows(e, dims[0]);
+  e->nwin = dims[0] - 1;
+  return e->win;
+}
+static void *reserve_mom(void *owner, int rank, const size_t *dims) {
+  struct euler *e = owner;
+  if (rank != 3 || dims[1] != (size_t)e->cfg.nb || dims[2] != MOM_LEN) return NULL;
+  reserve_rows(e, dims[0]);
+  return e->mom;
+}
+static void *reserve_snp(void *owner, int rank, const size_t *dims) {
+  struct euler *e = owner;
+  if (rank != 3 || dims[1] != (size_t)e->cfg.nb || dims[2] != SCAL_LEN) return NULL;
+  reserve_rows(e, dims[0]);
+  return e->snp;
+}
+
+void euler_state(struct euler *e, struct state_list *L) {
+  const size_t rows = e->nwin + 1, nb = (size_t)e->cfg.nb;
+  const size_t dw[2] = {rows, WIN_LEN}, dm[3] = {rows, nb, MOM_LEN}, ds[3] = {rows, nb, SCAL_LEN};
+  struct state_field *f = state_add(L, "stats/eulerian/windows", STATE_F64, 2, dw, e->win, NULL);
+  f->reserve = reserve_win, f->owner = e;
+  f = state_add(L, "stats/eulerian/moments", STATE_F64, 3, dm, e->mom, NULL);
+  f->reserve = reserve_mom, f->owner = e;
+  f = state_add(L, "stats/eulerian/snapshot_u", STATE_F64, 3, ds, e->snp, NULL);
+  f->reserve = reserve_snp, f->owner = e;
+}

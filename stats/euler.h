@@ -1,0 +1,172 @@
+/**
+ * @file euler.h
+ * @brief Eulerian statistics of the channel: wall-normal bins (bin sampling, thesis Eq.
+ *        5.54-5.55), averaged over x, z and time (optionally folded over the two halves).
+ *
+ * The engine keeps one moment record (moments.h) per bin and averaging window. A window is a
+ * scene-chosen interval of simulated time; closed windows are kept, so any range of them can
+ * be re-averaged afterwards (chansph extract --window) and their means are the batch means
+ * of the standard errors. The windows are the whole state: the results are a pure function
+ * of them (euler_finalise), for the running engine and for the extract command alike.
+ *
+ * Rows of the window arrays: 0 .. nwin-1 are closed windows, row nwin is the open one.
+ */
+#ifndef CHANSPH_EULER_H
+#define CHANSPH_EULER_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+struct state_list;
+
+/** Per-window scalars: nominal interval, snapshots, sums over snapshots. */
+enum { WIN_T0, WIN_T1, WIN_NSNAP, WIN_SUM_FX, WIN_SUM_TW0, WIN_SUM_TW1, WIN_LEN };
+
+/** Geometry and physics the Eulerian engine needs (filled from the scene by the caller). */
+struct euler_config {
+  int nb;         /*!< bins */
+  double y0, y1;  /*!< range of the uniform bins [m]; samples outside go to the end bins */
+  int fold;       /*!< 1: map the upper half onto the lower one (y -> 2 delta - y, v -> -v) */
+  double delta;   /*!< channel half-width [m] */
+  double nu;      /*!< kinematic viscosity [m^2/s] */
+  double rho0;    /*!< reference density [kg/m^3] */
+  double area;    /*!< area of one wall (lx lz in 3-D, lx in 2-D) [m^2 or m] */
+  double t_start; /*!< start of the averaging [s] */
+  double window;  /*!< length of an averaging window [s] */
+  int les;        /*!< 1: eddy viscosity and residual kinetic energy profiles too */
+  int method;     /*!< EULER_BINS (Eq. 5.54-5.55) or EULER_SPH (Eq. 5.56) */
+  double h;       /*!< smoothing length of the SPH interpolation [m] */
+  int dim;        /*!< 2 or 3 (shape of the plane-averaged kernel) */
+};
+
+/** How particles are assigned to the wall-normal profile points. */
+enum { EULER_BINS = 0, EULER_SPH = 1 };
+
+enum { EULER_W1_N = 512 }; /*!< table points of the plane-averaged kernel over q in [0, 2] */
+
+/** The raw state: windows of per-bin moment records. */
+struct euler {
+  struct euler_config cfg;
+  size_t nwin;               /*!< closed windows */
+  size_t cap;                /*!< rows allocated (>= nwin + 1) */
+  double *win;               /*!< [row][WIN_LEN] */
+  double *mom;               /*!< [row][nb][MOM_LEN] moment records of the samples */
+  double *snp;               /*!< [row][nb][SCAL_LEN] moments of the per-snapshot bin means of u */
+  double *tmp;               /*!< scratch [nb][2]: per-snapshot sums of u and counts */
+  double w1[EULER_W1_N + 1]; /*!< plane-averaged kernel W1(q), q = |y_a - y_i| / h (SPH) */
+};
+
+/** One snapshot of the particles, as plain arrays (the engine never sees solver structs). */
+struct stats_snapshot {
+  size_t n;                   /*!< particles */
+  const double *x, *y, *z;    /*!< positions [m] */
+  const double *u, *v, *w;    /*!< velocities [m/s] */
+  const double *p, *rho, *m;  /*!< pressure [Pa], density [kg/m^3], mass [kg] */
+  const double *ax, *ay, *az; /*!< accelerations without the body force [m/s^2], or NULL */
+  const double *nu_t;         /*!< eddy viscosity [m^2/s], or NULL (no LES) */
+  const double *k_r;          /*!< residual kinetic energy [m^2/s^2], or NULL (no LES) */
+  const int64_t *id;          /*!< global ids */
+  const uint8_t *skip;        /*!< nonzero: not a fluid particle, not sampled */
+  double t;                   /*!< simulated time [s] */
+  double fx;                  /*!< streamwise body acceleration applied [m/s^2] */
+  long step;                  /*!< step number */
+  double wall_fx[2];          /*!< x-force of the walls y = 0, 2 delta on the fluid [N];
+                                   NaN if unknown */
+};
+
+/** Finished profiles: names, units and long names are in euler_prof_meta. */
+enum {
+  EP_Y,
+  EP_Y_MEAN,
+  EP_N,
+  EP_U,
+  EP_V,
+  EP_W,
+  EP_P,
+  EP_RHO,
+  EP_UU,
+  EP_VV,
+  EP_WW,
+  EP_UV,
+  EP_UW,
+  EP_VW,
+  EP_SE_U, /* stderr of u, v, w, p, rho, uu, vv, ww, uv, uw, vw in that order */
+  EP_SE_END = EP_SE_U + 11,
+  EP_SKEW_U = EP_SE_END,
+  EP_SKEW_V,
+  EP_SKEW_W,
+  EP_FLAT_U,
+  EP_FLAT_V,
+  EP_FLAT_W,
+  EP_VISC,
+  EP_TOTAL,
+  EP_TOTAL_EXPECTED,
+  EP_NUT,
+  EP_KR,
+  EP_NPROF
+};
+
+/** Name, units and long name of each finished profile. */
+struct euler_meta {
+  const char *name, *units, *long_name;
+};
+extern const struct euler_meta euler_prof_meta[EP_NPROF];
+
+/** Finished statistics of a range of windows. */
+struct euler_result {
+  int nb;
+  double *prof[EP_NPROF]; /*!< each nb values; NaN where a bin has no samples */
+  double u_tau_wall;      /*!< from the mean wall shear stress the solver applied [m/s] */
+  double u_tau_force;     /*!< from the force balance tau_w = rho delta <f_x> (Eq. 5.14) [m/s] */
+  double u_tau;           /*!< the one used for wall units (wall, else force) [m/s] */
+  double u_tau_stderr;    /*!< batch-means standard error of u_tau [m/s] */
+  double re_tau;          /*!< u_tau delta / nu */
+  double corr_time;       /*!< integrated correlation time of the bin means of u [s] */
+  double balance_error;   /*!< max |total - expected| / u_tau_force^2 over interior bins */
+  double t0, t1;          /*!< averaged interval [s] */
+  double snapshots;       /*!< snapshots averaged */
+  int n_batches;          /*!< complete windows used as batches for the standard errors */
+};
+
+/** @brief Set up an empty engine. */
+void euler_init(struct euler *e, const struct euler_config *cfg);
+
+/** @brief Free the engine. */
+void euler_free(struct euler *e);
+
+/**
+ * @brief Add one snapshot. Implements: thesis Eq. 5.54-5.55 (bins) or 5.56 (stats.method =
+ *        sph), and the wall-stress sample of Eq. 5.13-5.14.
+ *        Each fluid particle to its bin (Eq. 5.54-5.55), one wall-stress
+ *        and body-force sample to the window; closes windows that ended before s->t.
+ *        Serial over the particles in the given order: independent of the thread count.
+ */
+void euler_sample(struct euler *e, const struct stats_snapshot *s);
+
+/**
+ * @brief Statistics of rows [r0, r1) merged in row order (bitwise reproducible).
+ *        Implements: means and Reynolds stresses of Sec. 5.2.3.1, u_tau (Eq. 5.14 and the wall
+ *        force), the total shear stress of Eq. 5.11-5.13.
+ *        Standard errors from the batch means of the complete windows in the range.
+ * @param[in] cfg configuration (bins, delta, nu, rho0, area)
+ * @param[in] win,mom,snp raw rows, as in struct euler
+ * @param[in] complete per-row flag: 1 for a closed window (batch), 0 for a partial one
+ * @param[out] res result (allocated; free with euler_result_free)
+ */
+void euler_finalise(const struct euler_config *cfg, const double *win, const double *mom,
+                    const double *snp, const int *complete, size_t r0, size_t r1,
+                    struct euler_result *res);
+
+/** @brief Free a result. */
+void euler_result_free(struct euler_result *res);
+
+/** @brief Rows holding data (closed windows plus the open one if it has samples). */
+size_t euler_rows(const struct euler *e);
+
+/** @brief Expose the complete state (rows 0..nwin, open window included) to a state list. */
+void euler_state(struct euler *e, struct state_list *L);
+
+/** @brief Bin centre i of a configuration [m]. */
+double euler_centre(const struct euler_config *cfg, int i);
+
+#endif

@@ -1,0 +1,271 @@
+/** @file extract.c @brief Implementation of extract.h. */
+#include "extract.h"
+
+#include <math.h>
+#include <netcdf.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "euler.h"
+#include "moments.h"
+
+/** How a profile scales: velocity, stress, pressure, length, or not at all. */
+enum unit_class { UC_NONE, UC_VEL, UC_STRESS, UC_PRESSURE, UC_LENGTH, UC_VISC };
+
+static enum unit_class class_of(int k) {
+  switch (k) {
+    case EP_Y:
+    case EP_Y_MEAN:
+      return UC_LENGTH;
+    case EP_U:
+    case EP_V:
+    case EP_W:
+    case EP_SE_U + 0:
+    case EP_SE_U + 1:
+    case EP_SE_U + 2:
+      return UC_VEL;
+    case EP_P:
+    case EP_SE_U + 3:
+      return UC_PRESSURE;
+    case EP_NUT:
+      return UC_VISC;
+    case EP_RHO:
+    case EP_SE_U + 4:
+    case EP_N:
+      return UC_NONE;
+    default:
+      return k >= EP_SKEW_U && k <= EP_FLAT_W ? UC_NONE : UC_STRESS;
+  }
+}
+
+static int find_prof(const char *name) {
+  for (int k = 0; k < EP_NPROF; k++)
+    if (!strcmp(euler_prof_meta[k].name, name)) return k;
+  return -1;
+}
+
+/* The stored windows of stats.nc and the configuration they were gathered with. */
+struct stored {
+  struct euler_config cfg;
+  size_t rows;
+  double *win, *mom, *snp;
+  int *complete;
+};
+
+static int get_att(int ncid, const char *name, double *v, const char *path) {
+  if (nc_get_att_double(ncid, NC_GLOBAL, name, v) != NC_NOERR) {
+    fprintf(stderr, "error: %s: no global attribute '%s' (not a chansph stats.nc?)\n", path, name);
+    return 1;
+  }
+  return 0;
+}
+
+static int read_stored(const char *path, struct stored *s) {
+  memset(s, 0, sizeof *s);
+  int ncid, g, rc = nc_open(path, NC_NOWRITE, &ncid);
+  if (rc != NC_NOERR) {
+    fprintf(stderr, "error: %s: %s\n", path, nc_strerror(rc));
+    return 1;
+  }
+  double fold = 0, area = 0;
+  int bad =
+      get_att(ncid, "delta", &s->cfg.delta, path) || get_att(ncid, "nu", &s->cfg.nu, path) ||
+      get_att(ncid, "rho0", &s->cfg.rho0, path) || get_att(ncid, "bin_lower", &s->cfg.y0, path) ||
+      get_att(ncid, "bin_upper", &s->cfg.y1, path) || get_att(ncid, "wall_area", &area, path) ||
+      get_att(ncid, "fold", &fold, path) || get_att(ncid, "window_length", &s->cfg.window, path);
+  s->cfg.fold = (int)fold, s->cfg.area = area;
+  double les = 0.0; /* optional: eddy-viscosity profiles present */
+  if (!bad && nc_get_att_double(ncid, NC_GLOBAL, "les", &les) != NC_NOERR) les = 0.0;
+  s->cfg.les = les != 0.0;
+  int dy, dw, vw, vm, vs, vc;
+  size_t nb = 0;
+  if (!bad && (nc_inq_ncid(ncid, "eulerian", &g) || nc_inq_dimid(ncid, "y", &dy) ||
+               nc_inq_dimlen(ncid, dy, &nb) || nc_inq_dimid(g, "window", &dw) ||
+               nc_inq_dimlen(g, dw, &s->rows) || nc_inq_varid(g, "windows", &vw) ||
+               nc_inq_varid(g, "moments", &vm) || nc_inq_varid(g, "snapshot_u", &vs) ||
+               nc_inq_varid(g, "window_complete", &vc))) {
+    fprintf(stderr, "error: %s: no group 'eulerian' with the raw windows\n", path);
+    bad = 1;
+  }
+  if (!bad) {
+    s->cfg.nb = (int)nb;
+    const size_t r = s->rows ? s->rows : 1;
+    s->win = malloc(r * WIN_LEN * sizeof(double));
+    s->mom = malloc(r * nb * MOM_LEN * sizeof(double));
+    s->snp = malloc(r * nb * SCAL_LEN * sizeof(double));
+    s->complete = malloc(r * sizeof(int));
+    if (s->rows && (nc_get_var_double(g, vw, s->win) || nc_get_var_double(g, vm, s->mom) ||
+                    nc_get_var_double(g, vs, s->snp) || nc_get_var_int(g, vc, s->complete))) {
+      fprintf(stderr, "error: %s: cannot read the raw windows\n", path);
+      bad = 1;
+    }
+  }
+  nc_close(ncid);
+  return bad;
+}
+
+static void free_stored(struct stored *s) {
+  free(s->win), free(s->mom), free(s->snp), free(s->complete);
+}
+
+static void usage(void) {
+  fprintf(stderr,
+          "usage: chansph extract STATS.nc [--var a,b,...] [--units wall|outer] "
+          "[--format csv|tsv] [--window T0:T1]\n"
+          "  variables: u_mean v_mean w_mean p_mean rho_mean uu vv ww uv uw vw u_rms v_rms "
+          "w_rms\n"
+          "  u_skewness ... w_flatness viscous_stress total_stress total_stress_expected "
+          "n_samples y_mean nu_t_mean k_r_mean (LES)\n"
+          "  (standard errors are printed next to the variables that have them)\n");
+}
+
+int extract_main(int argc, char **argv) {
+  const char *path = NULL, *vars = "u_mean,u_rms,v_rms,w_rms,uv", *units = "wall", *fmt = "csv";
+  double t0 = -INFINITY, t1 = INFINITY;
+  for (int i = 0; i < argc; i++) {
+    const int more = i + 1 < argc;
+    if (!strcmp(argv[i], "--var") && more)
+      vars = argv[++i];
+    else if (!strcmp(argv[i], "--units") && more)
+      units = argv[++i];
+    else if (!strcmp(argv[i], "--format") && more)
+      fmt = argv[++i];
+    else if (!strcmp(argv[i], "--window") && more) {
+      char *end;
+      const char *w = argv[++i];
+      t0 = *w == ':' ? -INFINITY : strtod(w, &end);
+      const char *colon = strchr(w, ':');
+      if (!colon) {
+        fprintf(stderr, "error: --window %s: expected T0:T1 (either may be empty)\n", w);
+        return 1;
+      }
+      t1 = colon[1] ? strtod(colon + 1, &end) : INFINITY;
+    } else if (argv[i][0] != '-' && !path)
+      path = argv[i];
+    else {
+      fprintf(stderr, "error: unexpected argument '%s'\n", argv[i]);
+      usage();
+      return 1;
+    }
+  }
+  if (!path || (strcmp(units, "wall") && strcmp(units, "outer")) ||
+      (strcmp(fmt, "csv") && strcmp(fmt, "tsv"))) {
+    usage();
+    return 1;
+  }
+  const int wall = !strcmp(units, "wall");
+  const char sep = !strcmp(fmt, "csv") ? ',' : '\t';
+  struct stored s;
+  if (read_stored(path, &s)) {
+    free_stored(&s);
+    return 1;
+  }
+  /* windows wholly inside [t0, t1] (with a relative tolerance for the nominal bounds) */
+  size_t r0 = s.rows, r1 = 0;
+  const double tol = 1e-9 * s.cfg.window;
+  for (size_t r = 0; r < s.rows; r++) {
+    const double a = s.win[r * WIN_LEN + WIN_T0], b = s.win[r * WIN_LEN + WIN_T1];
+    if (a >= t0 - tol && b <= t1 + tol) r0 = r < r0 ? r : r0, r1 = r + 1;
+  }
+  if (r1 <= r0) {
+    fprintf(stderr, "error: %s: no averaging window lies inside %g:%g\n", path, t0, t1);
+    free_stored(&s);
+    return 1;
+  }
+  struct euler_result res;
+  euler_finalise(&s.cfg, s.win, s.mom, s.snp, s.complete, r0, r1, &res);
+  /* columns */
+  int cols[64], rms[64], nc = 0;
+  char *list = strdup(vars);
+  for (char *tok = strtok(list, ","); tok && nc < 64; tok = strtok(NULL, ",")) {
+    int k = find_prof(tok), is_rms = 0;
+    if (k < 0 && strlen(tok) == 5 && !strcmp(tok + 1, "_rms") && strchr("uvw", tok[0]))
+      k = EP_UU + (tok[0] - 'u'), is_rms = 1;
+    if (k < 0) {
+      fprintf(stderr, "error: unknown variable '%s'\n", tok);
+      usage();
+      free(list), free_stored(&s), euler_result_free(&res);
+      return 1;
+    }
+    cols[nc] = k, rms[nc++] = is_rms;
+  }
+  free(list);
+  const double ut = res.u_tau, delta = s.cfg.delta;
+  printf(
+      "# chansph extract %s: windows %zu..%zu, t = %.9g .. %.9g s, %.0f snapshots, %d "
+      "batches\n",
+      path, r0, r1 - 1, res.t0, res.t1, res.snapshots, res.n_batches);
+  printf(
+      "# u_tau = %.9g m/s (wall shear %.9g, force balance %.9g, stderr %.3g), Re_tau = %.6g, "
+      "correlation time %.4g s, stress balance error %.4g\n",
+      ut, res.u_tau_wall, res.u_tau_force, res.u_tau_stderr, res.re_tau, res.corr_time,
+      res.balance_error);
+  printf("# units: %s\n", wall ? "wall (y+ = y u_tau/nu, velocities/u_tau, stresses/u_tau^2, "
+                                 "p/(rho0 u_tau^2), nu_t/nu)"
+                               : "outer (y/delta; values in SI units)");
+  printf("%s%c%s", "y", sep, wall ? "y_plus" : "y_over_delta");
+  for (int c = 0; c < nc; c++) {
+    const char *name = euler_prof_meta[cols[c]].name;
+    char rname[16];
+    if (rms[c]) snprintf(rname, sizeof rname, "%c_rms", name[0]), name = rname;
+    printf("%c%s", sep, name);
+    const int se = cols[c] >= EP_U && cols[c] <= EP_VW ? EP_SE_U + (cols[c] - EP_U) : -1;
+    if (se >= 0) printf("%c%s_stderr", sep, name);
+  }
+  printf("\n");
+  for (int b = 0; b < res.nb; b++) {
+    const double y = res.prof[EP_Y_MEAN][b];
+    printf("%.9g%c%.9g", y, sep, wall ? y * ut / s.cfg.nu : y / delta);
+    for (int c = 0; c < nc; c++) {
+      const int k = cols[c];
+      const int se = k >= EP_U && k <= EP_VW ? EP_SE_U + (k - EP_U) : -1;
+      double scale = 1.0;
+      if (wall) switch (class_of(k)) {
+          case UC_VEL:
+            scale = 1.0 / ut;
+            break;
+          case UC_STRESS:
+            scale = 1.0 / (ut * ut);
+            break;
+          case UC_PRESSURE:
+            scale = 1.0 / (s.cfg.rho0 * ut * ut);
+            break;
+          case UC_LENGTH:
+            scale = ut / s.cfg.nu;
+            break;
+          case UC_VISC:
+            scale = 1.0 / s.cfg.nu;
+            break;
+          case UC_NONE:
+            break;
+        }
+      else if (class_of(k) == UC_LENGTH)
+        scale = 1.0 / delta;
+      double v = res.prof[k][b] * scale, e = se >= 0 ? res.prof[se][b] * scale : NAN;
+      if (rms[c]) { /* rms and its standard error by the delta method */
+        const double r = sqrt(res.prof[k][b]) * (wall ? 1.0 / ut : 1.0);
+        e = r > 0 ? 0.5 * e / r : NAN, v = r;
+      }
+      printf("%c%.9g", sep, v);
+      if (se >= 0) printf("%c%.9g", sep, e);
+    }
+    printf("\n");
+  }
+  euler_result_free(&res);
+  free_stored(&s);
+  return 0;
+}
+
+int compare_main(int argc, char **argv, const char *stats_dir) {
+  char script[4096];
+  snprintf(script, sizeof script, "%s/compare.py", stats_dir);
+  char **args = calloc((size_t)argc + 3, sizeof *args);
+  args[0] = "python3", args[1] = script;
+  for (int i = 0; i < argc; i++) args[2 + i] = argv[i];
+  execv("/usr/bin/python3", args);
+  perror("error: cannot start /usr/bin/python3 for chansph compare");
+  free(args);
+  return 1;
+}

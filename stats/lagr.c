@@ -1,0 +1,440 @@
+/** @file lagr.c @brief Implementation of lagr.h. */
+#include "lagr.h"
+
+#include <math.h>
+#include <netcdf.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "moments.h"
+#include "ncout.h"
+#include "state.h"
+
+static void *xcalloc(size_t n, size_t size) {
+  void *p = calloc(n ? n : 1, size);
+  if (!p) {
+    fprintf(stderr, "error: out of memory in the Lagrangian engine\n");
+    abort();
+  }
+  return p;
+}
+
+static size_t rec(const struct lagr *g, int level, size_t k) { /* offset of a sums record */
+  return ((size_t)level * g->nlag + k) * LG_LEN;
+}
+
+static double *slot_rec(const struct lagr *g, int slot, int level, size_t k) {
+  return g->slot_sums + (size_t)slot * (size_t)g->cfg.n_levels * g->nlag * LG_LEN +
+         rec(g, level, k);
+}
+
+void lagr_init(struct lagr *g, const struct lagr_config *cfg) {
+  memset(g, 0, sizeof *g);
+  g->cfg = *cfg;
+  if (cfg->n_levels <= 0) return;
+  g->nlag = (size_t)cfg->n_lags + 1;
+  g->n_slots = (int)ceil(cfg->horizon / cfg->release_every - 1e-9) + 1;
+  const size_t nl = (size_t)cfg->n_levels;
+  g->sums = xcalloc(nl * g->nlag * LG_LEN, sizeof(double));
+  g->slot_sums = xcalloc((size_t)g->n_slots * nl * g->nlag * LG_LEN, sizeof(double));
+  g->slots = xcalloc((size_t)g->n_slots * SL_LEN, sizeof(double));
+  g->tl = xcalloc(nl * 3 * SCAL_LEN, sizeof(double));
+  g->pdf =
+      xcalloc(nl * (size_t)(cfg->n_stations ? cfg->n_stations : 1) * (size_t)(cfg->pdf_bins + 3),
+              sizeof(double));
+  g->next_release = cfg->t_start;
+}
+
+void lagr_free(struct lagr *g) {
+  free(g->sums), free(g->slot_sums), free(g->slots), free(g->tl), free(g->pdf);
+  free(g->tracks), free(g->index);
+  memset(g, 0, sizeof *g);
+}
+
+static double wrap(double d, double l) { /* minimum image */
+  if (l <= 0.0) return d;
+  return d - l * floor(d / l + 0.5);
+}
+
+static void reserve_tracks(struct lagr *g, size_t n) {
+  if (n <= g->cap) return;
+  size_t cap = g->cap ? g->cap : 256;
+  while (cap < n) cap *= 2;
+  g->tracks = realloc(g->tracks, cap * TR_LEN * sizeof(double));
+  if (!g->tracks) {
+    fprintf(stderr, "error: out of memory in the Lagrangian engine\n");
+    abort();
+  }
+  g->cap = cap;
+}
+
+/* Add a track's values at the current sample to record R (lag k of its release). */
+static void contribute(const double *tr, const struct stats_snapshot *s, size_t a, double *R) {
+  const double sg = tr[TR_MIRROR] != 0.0 ? -1.0 : 1.0;
+  const double vt[3] = {s->u[a], sg * s->v[a], s->w[a]};
+  const double at[3] = {s->ax ? s->ax[a] : 0.0, s->ay ? sg * s->ay[a] : 0.0,
+                        s->az ? s->az[a] : 0.0};
+  R[LG_N] += 1.0;
+  for (int i = 0; i < 3; i++) {
+    const double v0 = tr[TR_V0 + i], a0 = tr[TR_A0 + i];
+    double *V = R + LG_VEL + 5 * i, *A = R + LG_ACC + 5 * i;
+    V[0] += v0, V[1] += vt[i], V[2] += v0 * v0, V[3] += vt[i] * vt[i], V[4] += v0 * vt[i];
+    A[0] += a0, A[1] += at[i], A[2] += a0 * a0, A[3] += at[i] * at[i], A[4] += a0 * at[i];
+    const double dv = vt[i] - v0, dv2 = dv * dv;
+    R[LG_STRUCT + 3 * i] += dv2, R[LG_STRUCT + 3 * i + 1] += dv2 * dv;
+    R[LG_STRUCT + 3 * i + 2] += dv2 * dv2;
+    R[LG_DISP + i] += tr[TR_DISP + i] * tr[TR_DISP + i];
+  }
+}
+
+/* Correlation coefficient of the pair (block of 5 sums) over n samples. */
+static double corr5(const double *S, double n) {
+  if (n < 2.0) return NAN;
+  const double m0 = S[0] / n, mt = S[1] / n;
+  const double c = S[4] / n - m0 * mt, v0 = S[2] / n - m0 * m0, vt = S[3] / n - mt * mt;
+  return v0 > 0.0 && vt > 0.0 ? c / sqrt(v0 * vt) : NAN;
+}
+
+double lagr_tl(const double *rho, size_t nlag, double dtau) {
+  const double target = exp(-0.5);
+  double half = NAN; /* T_E / 2 */
+  for (size_t k = 1; k < nlag; k++)
+    if (isfinite(rho[k]) && isfinite(rho[k - 1]) && rho[k] <= target) {
+      half = dtau * ((double)(k - 1) + (rho[k - 1] - target) / (rho[k - 1] - rho[k]));
+      break;
+    }
+  if (!isfinite(half)) return NAN;
+  const double end = fmin(8.0 * half, dtau * (double)(nlag - 1)); /* 4 T_E */
+  double sum = 0.0;
+  for (size_t k = 1; k < nlag; k++) {
+    const double t0 = dtau * (double)(k - 1), t1 = dtau * (double)k;
+    if (t0 >= end) break;
+    if (t1 <= end) {
+      sum += 0.5 * dtau * (rho[k - 1] + rho[k]);
+    } else { /* partial interval up to end */
+      const double f = (end - t0) / dtau, re = rho[k - 1] + f * (rho[k] - rho[k - 1]);
+      sum += 0.5 * (end - t0) * (rho[k - 1] + re);
+    }
+  }
+  return sum;
+}
+
+static void retire(struct lagr *g, int slot) {
+  const int nl = g->cfg.n_levels;
+  const double dtau = g->cfg.horizon / g->cfg.n_lags;
+  double *rho = xcalloc(g->nlag, sizeof(double));
+  for (int l = 0; l < nl; l++) {
+    for (size_t k = 0; k < g->nlag; k++) {
+      const double *R = slot_rec(g, slot, l, k);
+      double *G = g->sums + rec(g, l, k);
+      for (int q = 0; q < LG_LEN; q++) G[q] += R[q];
+    }
+    for (int i = 0; i < 3; i++) { /* this release's T_L: one batch */
+      for (size_t k = 0; k < g->nlag; k++) {
+        const double *R = slot_rec(g, slot, l, k);
+        rho[k] = corr5(R + LG_VEL + 5 * i, R[LG_N]);
+      }
+      const double t = lagr_tl(rho, g->nlag, dtau);
+      if (isfinite(t)) scal_add(g->tl + ((size_t)l * 3 + (size_t)i) * SCAL_LEN, t);
+    }
+  }
+  free(rho);
+  memset(slot_rec(g, slot, 0, 0), 0, (size_t)nl * g->nlag * LG_LEN * sizeof(double));
+  /* drop the release's tracks, keeping the order of the others */
+  size_t w = 0;
+  for (size_t r = 0; r < g->ntracks; r++)
+    if (g->tracks[r * TR_LEN + TR_SLOT] != (double)slot) {
+      if (w != r) memcpy(g->tracks + w * TR_LEN, g->tracks + r * TR_LEN, TR_LEN * sizeof(double));
+      w++;
+    }
+  g->ntracks = w;
+  memset(g->slots + (size_t)slot * SL_LEN, 0, SL_LEN * sizeof(double));
+  g->releases += 1.0;
+}
+
+static void build_index(struct lagr *g, const struct stats_snapshot *s) {
+  size_t len = 0;
+  for (size_t a = 0; a < s->n; a++)
+    if (s->id[a] >= 0 && (size_t)s->id[a] + 1 > len) len = (size_t)s->id[a] + 1;
+  if (len > g->index_len) {
+    free(g->index);
+    g->index = xcalloc(len, sizeof(long));
+    g->index_len = len;
+  }
+  for (size_t i = 0; i < g->index_len; i++) g->index[i] = -1;
+  for (size_t a = 0; a < s->n; a++)
+    if (s->id[a] >= 0) g->index[s->id[a]] = (long)a;
+}
+
+static void release(struct lagr *g, int slot, const struct stats_snapshot *s) {
+  const struct lagr_config *c = &g->cfg;
+  double *sl = g->slots + (size_t)slot * SL_LEN;
+  sl[SL_T0] = s->t, sl[SL_LAST_K] = 0.0, sl[SL_ACTIVE] = 1.0, sl[SL_N] = 0.0;
+  for (size_t a = 0; a < s->n; a++) {
+    if (s->skip && s->skip[a]) continue;
+    if (fabs(wrap(s->x[a] - c->x0, c->lx)) >= c->half) continue;
+    for (int l = 0; l < c->n_levels; l++) {
+      const double ym = 2.0 * c->delta - c->y[l];
+      int mirror = -1;
+      if (fabs(s->y[a] - c->y[l]) < c->half)
+        mirror = 0;
+      else if (fabs(ym - c->y[l]) >= 2.0 * c->half && fabs(s->y[a] - ym) < c->half)
+        mirror = 1;
+      if (mirror < 0) continue;
+      reserve_tracks(g, g->ntracks + 1);
+      double *tr = g->tracks + g->ntracks * TR_LEN;
+      memset(tr, 0, TR_LEN * sizeof(double));
+      const double sg = mirror ? -1.0 : 1.0;
+      tr[TR_SLOT] = slot, tr[TR_LEVEL] = l, tr[TR_MIRROR] = mirror, tr[TR_ID] = (double)s->id[a];
+      tr[TR_V0] = s->u[a], tr[TR_V0 + 1] = sg * s->v[a], tr[TR_V0 + 2] = s->w[a];
+      tr[TR_A0] = s->ax ? s->ax[a] : 0.0, tr[TR_A0 + 1] = s->ay ? sg * s->ay[a] : 0.0;
+      tr[TR_A0 + 2] = s->az ? s->az[a] : 0.0;
+      tr[TR_LAST] = s->x[a], tr[TR_LAST + 1] = s->y[a], tr[TR_LAST + 2] = s->z ? s->z[a] : 0.0;
+      contribute(tr, s, a, slot_rec(g, slot, l, 0));
+      g->ntracks++, sl[SL_N] += 1.0;
+      break;
+    }
+  }
+}
+
+void lagr_sample(struct lagr *g, const struct stats_snapshot *s) {
+  const struct lagr_config *c = &g->cfg;
+  if (c->n_levels <= 0 || s->t < c->t_start) return;
+  const int due = s->t >= g->next_release;
+  if (!g->ntracks && !due) return;
+  build_index(g, s);
+  const double dtau = c->horizon / c->n_lags, ly = 2.0 * c->delta;
+  const size_t nbin = (size_t)c->pdf_bins + 3;
+  /* displacements, station crossings and lag samples of the tracked particles */
+  for (size_t r = 0; r < g->ntracks; r++) {
+    double *tr = g->tracks + r * TR_LEN;
+    const int64_t id = (int64_t)tr[TR_ID];
+    const long a = id >= 0 && (size_t)id < g->index_len ? g->index[id] : -1;
+    if (a < 0) continue; /* left this rank (not with one rank) */
+    const double z = s->z ? s->z[a] : 0.0;
+    const double dx = wrap(s->x[a] - tr[TR_LAST], c->lx), dz = wrap(z - tr[TR_LAST + 2], c->lz);
+    const double dprev = tr[TR_DISP], yprev = tr[TR_LAST + 1];
+    tr[TR_DISP] += dx, tr[TR_DISP + 2] += dz;
+    tr[TR_DISP + 1] += (tr[TR_MIRROR] != 0.0 ? -1.0 : 1.0) * (s->y[a] - yprev);
+    tr[TR_LAST] = s->x[a], tr[TR_LAST + 1] = s->y[a], tr[TR_LAST + 2] = z;
+    const int l = (int)tr[TR_LEVEL];
+    for (int st = 0; st < c->n_stations; st++) {
+      const unsigned bit = 1u << st;
+      if (((unsigned)tr[TR_DONE] & bit) || tr[TR_DISP] < c->station[st]) continue;
+      const double f = dx != 0.0 ? (c->station[st] - dprev) / dx : 1.0;
+      double y = yprev + f * (s->y[a] - yprev); /* y where the track crossed the station */
+      if (tr[TR_MIRROR] != 0.0) y = ly - y;
+      double *P = g->pdf + ((size_t)l * (size_t)c->n_stations + (size_t)st) * nbin;
+      int b = (int)floor(y / ly * c->pdf_bins);
+      b = b < 0 ? 0 : b >= c->pdf_bins ? c->pdf_bins - 1 : b;
+      P[b] += 1.0, P[c->pdf_bins] += 1.0, P[c->pdf_bins + 1] += y, P[c->pdf_bins + 2] += y * y;
+      tr[TR_DONE] = (double)((unsigned)tr[TR_DONE] | bit);
+    }
+  }
+  for (int sl = 0; sl < g->n_slots; sl++) {
+    double *S = g->slots + (size_t)sl * SL_LEN;
+    if (S[SL_ACTIVE] == 0.0) continue;
+    const double k = floor((s->t - S[SL_T0]) / dtau + 1e-9);
+    if (k > S[SL_LAST_K] && k <= c->n_lags) {
+      for (size_t r = 0; r < g->ntracks; r++) {
+        const double *tr = g->tracks + r * TR_LEN;
+        if (tr[TR_SLOT] != (double)sl) continue;
+        const long a = g->index[(int64_t)tr[TR_ID]];
+        if (a >= 0) contribute(tr, s, (size_t)a, slot_rec(g, sl, (int)tr[TR_LEVEL], (size_t)k));
+      }
+      S[SL_LAST_K] = k;
+    }
+    if (k >= c->n_lags) retire(g, sl);
+  }
+  if (due) {
+    int slot = -1;
+    for (int sl = 0; sl < g->n_slots && slot < 0; sl++)
+      if (g->slots[(size_t)sl * SL_LEN + SL_ACTIVE] == 0.0) slot = sl;
+    if (slot >= 0) release(g, slot, s);
+    while (g->next_release <= s->t) g->next_release += c->release_every;
+  }
+}
+
+static void *reserve_tr(void *owner, int rank, const size_t *dims) {
+  struct lagr *g = owner;
+  if (rank != 2 || dims[1] != TR_LEN) return NULL;
+  reserve_tracks(g, dims[0] ? dims[0] : 1);
+  g->ntracks = dims[0];
+  return g->tracks;
+}
+
+void lagr_state(struct lagr *g, struct state_list *L) {
+  if (g->cfg.n_levels <= 0) return;
+  reserve_tracks(g, 1);
+  const size_t nl = (size_t)g->cfg.n_levels, ns = (size_t)g->n_slots;
+  const size_t st = (size_t)(g->cfg.n_stations ? g->cfg.n_stations : 1);
+  const size_t d3[3] = {nl, g->nlag, LG_LEN}, d4[3] = {ns, nl * g->nlag, LG_LEN};
+  const size_t ds[2] = {ns, SL_LEN}, dt[3] = {nl, 3, SCAL_LEN};
+  const size_t dp[3] = {nl, st, (size_t)g->cfg.pdf_bins + 3}, dtr[2] = {g->ntracks, TR_LEN};
+  state_add(L, "stats/lagrangian/sums", STATE_F64, 3, d3, g->sums, NULL);
+  state_add(L, "stats/lagrangian/slot_sums", STATE_F64, 3, d4, g->slot_sums, NULL);
+  state_add(L, "stats/lagrangian/slots", STATE_F64, 2, ds, g->slots, NULL);
+  state_add(L, "stats/lagrangian/tl_batches", STATE_F64, 3, dt, g->tl, "s");
+  state_add(L, "stats/lagrangian/pdf", STATE_F64, 3, dp, g->pdf, NULL);
+  struct state_field *f =
+      state_add(L, "stats/lagrangian/tracks", STATE_F64, 2, dtr, g->tracks, NULL);
+  f->reserve = reserve_tr, f->owner = g;
+  state_add(L, "stats/lagrangian/next_release", STATE_F64, 0, NULL, &g->next_release, "s");
+  state_add(L, "stats/lagrangian/releases", STATE_F64, 0, NULL, &g->releases, NULL);
+}
+
+void lagr_functions(const struct lagr *g, int level, double *out, double *tl) {
+  const size_t nlag = g->nlag;
+  for (size_t k = 0; k < nlag; k++) {
+    const double *R = g->sums + rec(g, level, k);
+    const double n = R[LG_N];
+    for (int i = 0; i < 3; i++) {
+      out[(LF_RHO_L + i) * nlag + k] = corr5(R + LG_VEL + 5 * i, n);
+      out[(LF_RHO_A + i) * nlag + k] = corr5(R + LG_ACC + 5 * i, n);
+      out[(LF_D + i) * nlag + k] = n > 0 ? R[LG_STRUCT + 3 * i] / n : NAN;
+      out[(LF_S + i) * nlag + k] = n > 0 ? R[LG_STRUCT + 3 * i + 1] / n : NAN;
+      out[(LF_K + i) * nlag + k] = n > 0 ? R[LG_STRUCT + 3 * i + 2] / n : NAN;
+      out[(LF_SIG2 + i) * nlag + k] = n > 0 ? R[LG_DISP + i] / n : NAN;
+    }
+    out[LF_N * nlag + k] = n;
+  }
+  for (int i = 0; i < 3; i++)
+    tl[i] = lagr_tl(out + (LF_RHO_L + i) * nlag, nlag, g->cfg.horizon / g->cfg.n_lags);
+}
+
+#define CK(call)                                                   \
+  do {                                                             \
+    rc = (call);                                                   \
+    if (rc != NC_NOERR) {                                          \
+      snprintf(err, errlen, "%s (in %s)", nc_strerror(rc), #call); \
+      goto done;                                                   \
+    }                                                              \
+  } while (0)
+
+static int put_rows(int g, int v, int level, size_t n, const double *src) {
+  double *tmp = malloc(n * sizeof *tmp);
+  for (size_t i = 0; i < n; i++) tmp[i] = isfinite(src[i]) ? src[i] : NC_FILL_DOUBLE;
+  const size_t st[2] = {(size_t)level, 0}, ct[2] = {1, n};
+  const int rc = nc_put_vara_double(g, v, st, ct, tmp);
+  free(tmp);
+  return rc;
+}
+
+int lagr_nc_write(const struct lagr *g, int ncid, char *err, size_t errlen) {
+  const struct lagr_config *c = &g->cfg;
+  const int nl = c->n_levels, ns = c->n_stations, nb = c->pdf_bins;
+  const size_t nlag = g->nlag;
+  double *fn = malloc((size_t)nl * LF_LEN * nlag * sizeof(double));
+  double *tl = malloc((size_t)nl * 3 * sizeof(double));
+  double *tmp = malloc((nlag + (size_t)nb + 16) * sizeof(double));
+  int rc = NC_NOERR, gr, dl, dk, dc, v;
+  for (int l = 0; l < nl; l++) lagr_functions(g, l, fn + (size_t)l * LF_LEN * nlag, tl + 3 * l);
+  CK(nc_def_grp(ncid, "lagrangian", &gr));
+  static const char desc[] =
+      "Lagrangian statistics of particles released at x0 and y+ levels (thesis Eq. 5.60-5.68), "
+      "ensemble averages over the completed releases";
+  CK(nc_put_att_text(gr, NC_GLOBAL, "description", strlen(desc), desc));
+  CK(nc_put_att_double(gr, NC_GLOBAL, "releases", NC_DOUBLE, 1, &g->releases));
+  CK(nc_put_att_double(gr, NC_GLOBAL, "x0", NC_DOUBLE, 1, &c->x0));
+  CK(nc_put_att_double(gr, NC_GLOBAL, "horizon", NC_DOUBLE, 1, &c->horizon));
+  CK(nc_put_att_double(gr, NC_GLOBAL, "release_every", NC_DOUBLE, 1, &c->release_every));
+  CK(nc_def_dim(gr, "level", (size_t)nl, &dl));
+  CK(nc_def_dim(gr, "lag", nlag, &dk));
+  CK(nc_def_dim(gr, "component", 3, &dc));
+  CK(ncout_def(gr, "level", NC_DOUBLE, 1, &dl, "m", "release height above the lower wall", &v));
+  CK(nc_put_var_double(gr, v, c->y));
+  CK(ncout_def(gr, "y_plus", NC_DOUBLE, 1, &dl, "1", "release level in wall units", &v));
+  CK(nc_put_var_double(gr, v, c->y_plus));
+  for (size_t k = 0; k < nlag; k++) tmp[k] = (double)k * c->horizon / c->n_lags;
+  CK(ncout_def(gr, "lag", NC_DOUBLE, 1, &dk, "s", "time lag tau", &v));
+  CK(nc_put_var_double(gr, v, tmp));
+  static const char *const comp = "uvw", *const pos = "xyz";
+  const struct {
+    int row;
+    const char *fmt, *units, *lfmt;
+    const char *letters;
+  } q[] = {
+      {LF_RHO_L, "rho_L_%c", "1", "Lagrangian velocity autocorrelation of %c (Eq. 5.60)", comp},
+      {LF_RHO_A, "rho_a_%c", "1", "Lagrangian acceleration autocorrelation of a_%c (Eq. 5.62)",
+       comp},
+      {LF_D, "D_%c", "m^2/s^2", "second-order structure function of %c (Eq. 5.63)", comp},
+      {LF_S, "S_%c", "m^3/s^3", "third-order structure function of %c (Eq. 5.64)", comp},
+      {LF_K, "K_%c", "m^4/s^4", "fourth-order structure function of %c (Eq. 5.65)", comp},
+      {LF_SIG2, "sigma2_%c", "m^2", "dispersion <(%c(t0 + tau) - %c(t0))^2> (Eq. 5.66)", pos},
+  };
+  const int d2[2] = {dl, dk};
+  for (size_t j = 0; j < sizeof q / sizeof q[0]; j++)
+    for (int i = 0; i < 3; i++) {
+      char name[32], ln[160];
+      snprintf(name, sizeof name, q[j].fmt, q[j].letters[i]);
+      snprintf(ln, sizeof ln, q[j].lfmt, q[j].letters[i], q[j].letters[i]);
+      CK(ncout_def(gr, name, NC_DOUBLE, 2, d2, q[j].units, ln, &v));
+      const double fill = NC_FILL_DOUBLE;
+      CK(nc_put_att_double(gr, v, "_FillValue", NC_DOUBLE, 1, &fill));
+      for (int l = 0; l < nl; l++)
+        CK(put_rows(gr, v, l, nlag, fn + ((size_t)l * LF_LEN + (size_t)(q[j].row + i)) * nlag));
+    }
+  CK(ncout_def(gr, "n_tracks", NC_DOUBLE, 2, d2, "1", "particle samples at each lag", &v));
+  for (int l = 0; l < nl; l++)
+    CK(put_rows(gr, v, l, nlag, fn + ((size_t)l * LF_LEN + LF_N) * nlag));
+  {
+    const int dlc[2] = {dl, dc};
+    double *a = malloc((size_t)nl * 9 * sizeof(double));
+    for (int l = 0; l < nl; l++)
+      for (int i = 0; i < 3; i++) {
+        const double *W = g->tl + ((size_t)l * 3 + (size_t)i) * SCAL_LEN;
+        a[l * 3 + i] = isfinite(tl[3 * l + i]) ? tl[3 * l + i] : NC_FILL_DOUBLE;
+        a[3 * nl + l * 3 + i] = W[SCAL_N] > 0 ? W[SCAL_MEAN] : NC_FILL_DOUBLE;
+        a[6 * nl + l * 3 + i] =
+            W[SCAL_N] >= 2 ? sqrt(W[SCAL_M2] / (W[SCAL_N] - 1) / W[SCAL_N]) : NC_FILL_DOUBLE;
+      }
+    static const char *const nm[3] = {"T_L", "T_L_release_mean", "T_L_stderr"};
+    static const char *const lnm[3] = {
+        "Lagrangian integral time of u, v, w (Eq. 5.61) from the merged releases",
+        "mean over the releases of their own T_L", "standard error of T_L over the releases"};
+    for (int j = 0; j < 3 && rc == NC_NOERR; j++) {
+      rc = ncout_def(gr, nm[j], NC_DOUBLE, 2, dlc, "s", lnm[j], &v);
+      const double fill = NC_FILL_DOUBLE;
+      if (rc == NC_NOERR) rc = nc_put_att_double(gr, v, "_FillValue", NC_DOUBLE, 1, &fill);
+      if (rc == NC_NOERR) rc = nc_put_var_double(gr, v, a + (size_t)j * 3 * nl);
+    }
+    free(a);
+    CK(rc);
+  }
+  if (ns > 0) {
+    int dst, db;
+    CK(nc_def_dim(gr, "station", (size_t)ns, &dst));
+    CK(nc_def_dim(gr, "pdf_bin", (size_t)nb, &db));
+    CK(ncout_def(gr, "station", NC_DOUBLE, 1, &dst, "m", "downstream distance x - x0", &v));
+    CK(nc_put_var_double(gr, v, c->station));
+    for (int b = 0; b < nb; b++) tmp[b] = (b + 0.5) * 2.0 * c->delta / nb;
+    CK(ncout_def(gr, "pdf_bin", NC_DOUBLE, 1, &db, "m", "y at the centre of the PDF bin", &v));
+    CK(nc_put_var_double(gr, v, tmp));
+    const int d3[3] = {dl, dst, db}, dls[2] = {dl, dst};
+    int vp, vmu, vvar, vn;
+    CK(ncout_def(gr, "pdf_y", NC_DOUBLE, 3, d3, "1/m",
+                 "PDF P(y; x) of the heights where the tracks cross the station", &vp));
+    CK(ncout_def(gr, "pdf_mu_y", NC_DOUBLE, 2, dls, "m", "mean height mu_y (Eq. 5.67)", &vmu));
+    CK(ncout_def(gr, "pdf_var_y", NC_DOUBLE, 2, dls, "m^2",
+                 "variance of the height about mu_y (Eq. 5.68, printed there as sigma_y)", &vvar));
+    CK(ncout_def(gr, "pdf_count", NC_DOUBLE, 2, dls, "1", "tracks that crossed the station", &vn));
+    const double width = 2.0 * c->delta / nb;
+    for (int l = 0; l < nl; l++)
+      for (int s = 0; s < ns; s++) {
+        const double *P = g->pdf + ((size_t)l * ns + (size_t)s) * (size_t)(nb + 3);
+        const double n = P[nb], mu = n > 0 ? P[nb + 1] / n : NC_FILL_DOUBLE;
+        const double var = n > 0 ? P[nb + 2] / n - mu * mu : NC_FILL_DOUBLE;
+        for (int b = 0; b < nb; b++) tmp[b] = n > 0 ? P[b] / (n * width) : 0.0;
+        const size_t st3[3] = {(size_t)l, (size_t)s, 0}, ct3[3] = {1, 1, (size_t)nb};
+        const size_t st2[2] = {(size_t)l, (size_t)s};
+        CK(nc_put_vara_double(gr, vp, st3, ct3, tmp));
+        CK(nc_put_var1_double(gr, vmu, st2, &mu));
+        CK(nc_put_var1_double(gr, vvar, st2, &var));
+        CK(nc_put_var1_double(gr, vn, st2, &n));
+      }
+  }
+done:
+  free(fn), free(tl), free(tmp);
+  return rc;
+}

@@ -1,0 +1,134 @@
+/**
+ * @file lagr.h
+ * @brief Lagrangian statistics of tracked fluid particles (thesis Sec. 5.2.3.2, Eq.
+ *        5.60-5.68; set-up Sec. 6.1.3).
+ *
+ * A release selects the fluid particles within dr/2 of the plane x = x0 and of a y+ level
+ * (or of its mirror 2 delta - y, counted with y -> 2 delta - y, v -> -v). They are followed
+ * for a horizon and sampled at lags tau_k = k horizon / n_lags (the first statistics sample
+ * in each lag interval). Releases start every release_every; with release_every >= horizon
+ * they are independent, and each one is a batch of the standard error of T_L.
+ *
+ * Per level and lag the engine sums (n, then for u, v, w: sums of v0, vt, v0^2, vt^2, v0 vt;
+ * the same for the accelerations; sums of dv^2, dv^3, dv^4 with dv = v(t0 + tau) - v(t0);
+ * sums of the squared displacements). From the sums:
+ *   rho^L_ii(tau) = cov(v_i(t0), v_i(t0 + tau)) / (sd(v_i(t0)) sd(v_i(t0 + tau)))   (Eq. 5.60)
+ *   T_L,i = int_0^{4 T_E,i} rho^L_ii dt, rho^L_ii(T_E,i / 2) = e^{-1/2}             (Eq. 5.61)
+ *   rho^a_ii (Eq. 5.62), D_ii, S_ii, K_ii (Eq. 5.63-5.65), sigma_i^2 (Eq. 5.66),
+ * and at downstream stations x - x0 = X the histogram of y of the particles crossing it,
+ * P(y; X), with mu_y and the variance of Eq. 5.67-5.68.
+ * The covariance form of Eq. 5.60 measures fluctuations about the ensemble mean of the
+ * release at each lag (the mean velocity of a release level is not known in advance).
+ */
+#ifndef CHANSPH_LAGR_H
+#define CHANSPH_LAGR_H
+
+#include <stddef.h>
+
+#include "euler.h"
+
+struct state_list;
+
+enum { LAGR_MAX_LEVELS = 8, LAGR_MAX_STATIONS = 8 };
+
+/** Sums per level and lag. */
+enum {
+  LG_N = 0,
+  LG_VEL = 1,              /* 3 x [S0, St, S00, Stt, S0t] for u, v, w */
+  LG_ACC = LG_VEL + 15,    /* the same for ax, ay, az */
+  LG_STRUCT = LG_ACC + 15, /* 3 x [sum dv^2, dv^3, dv^4] */
+  LG_DISP = LG_STRUCT + 9, /* 3 x sum dr^2 */
+  LG_LEN = LG_DISP + 3
+};
+
+/** Per tracked particle. */
+enum {
+  TR_SLOT,
+  TR_LEVEL,
+  TR_MIRROR,
+  TR_ID,
+  TR_V0,                 /* u, v, w at release (v mirrored) */
+  TR_A0 = TR_V0 + 3,     /* ax, ay, az at release */
+  TR_LAST = TR_A0 + 3,   /* position at the last sample */
+  TR_DISP = TR_LAST + 3, /* displacement since release (unwrapped) */
+  TR_DONE = TR_DISP + 3, /* stations passed (bit mask) */
+  TR_LEN
+};
+
+/** Per release slot: start time, last lag sampled, tracked particles, active flag. */
+enum { SL_T0, SL_LAST_K, SL_N, SL_ACTIVE, SL_LEN };
+
+/** Configuration of the Lagrangian engine. */
+struct lagr_config {
+  int n_levels;                      /*!< release levels (0: engine off) */
+  double y[LAGR_MAX_LEVELS];         /*!< their heights [m] */
+  double y_plus[LAGR_MAX_LEVELS];    /*!< the y+ they were given as */
+  double x0;                         /*!< release plane [m] */
+  double half;                       /*!< half thickness of the release slabs (dr/2) [m] */
+  double lx, lz;                     /*!< periodic lengths [m] (lz = 0 in 2-D) */
+  double delta;                      /*!< half-width [m] */
+  double horizon;                    /*!< lag range [s] */
+  double release_every;              /*!< time between releases [s] */
+  int n_lags;                        /*!< lag intervals over the horizon */
+  int n_stations;                    /*!< PDF stations */
+  double station[LAGR_MAX_STATIONS]; /*!< downstream distances x - x0 [m] */
+  int pdf_bins;                      /*!< bins over 0 .. 2 delta (or 0 .. delta folded) */
+  double t_start;                    /*!< first release not before [s] */
+};
+
+/** The engine. */
+struct lagr {
+  struct lagr_config cfg;
+  int n_slots;         /*!< release slots */
+  size_t nlag;         /*!< n_lags + 1 */
+  double *sums;        /*!< [level][lag][LG_LEN] completed releases */
+  double *slot_sums;   /*!< [slot][level][lag][LG_LEN] active releases */
+  double *slots;       /*!< [slot][SL_LEN] */
+  double *tl;          /*!< [level][3][3] Welford of the per-release T_L over releases */
+  double *pdf;         /*!< [level][station][pdf_bins + 3]: counts, then n, sum y, sum y^2 */
+  double *tracks;      /*!< [ntracks][TR_LEN] */
+  size_t ntracks, cap; /*!< tracked particles, capacity */
+  double next_release; /*!< time of the next release [s] */
+  double releases;     /*!< completed releases */
+  long *index;         /*!< scratch: array index of each id */
+  size_t index_len;    /*!< its length */
+};
+
+/** @brief Set up (allocates only if n_levels > 0). */
+void lagr_init(struct lagr *g, const struct lagr_config *cfg);
+
+/** @brief Free. */
+void lagr_free(struct lagr *g);
+
+/** @brief Add one snapshot: releases, lag samples, PDF crossings (serial, deterministic).
+ *         Implements: the set-up of thesis Sec. 6.1.3 and the sums of Eq. 5.60-5.68. */
+void lagr_sample(struct lagr *g, const struct stats_snapshot *s);
+
+/** @brief Expose the complete state to a state list (rebuild before each checkpoint). */
+void lagr_state(struct lagr *g, struct state_list *L);
+
+/**
+ * @brief The lag functions of one level from the sums (completed releases only).
+ *        Implements: thesis Eq. 5.60, 5.62-5.66 (and 5.61 through lagr_tl).
+ * @param[in] g engine
+ * @param[in] level release level
+ * @param[out] out [quantity][nlag], quantities: rho_L u v w, rho_a u v w, D u v w, S u v w,
+ *             K u v w, sigma2 x y z, n (19 rows)
+ * @param[out] tl T_L of u, v, w from the merged releases (Eq. 5.61) [s]
+ */
+void lagr_functions(const struct lagr *g, int level, double *out, double *tl);
+
+/** Rows of lagr_functions. */
+enum { LF_RHO_L = 0, LF_RHO_A = 3, LF_D = 6, LF_S = 9, LF_K = 12, LF_SIG2 = 15, LF_N = 18, LF_LEN };
+
+/**
+ * @brief T_L of Eq. 5.61 from a sampled rho(tau_k), tau_k = k dtau: T_E from the first
+ *        crossing of e^{-1/2} (linear interpolation), trapezoidal integral to 4 T_E (or to
+ *        the last lag if shorter). NaN if rho never falls to e^{-1/2}.
+ */
+double lagr_tl(const double *rho, size_t nlag, double dtau);
+
+/** @brief Write group "lagrangian" into an open netCDF-4 file; returns a netCDF status. */
+int lagr_nc_write(const struct lagr *g, int ncid, char *err, size_t errlen);
+
+#endif

@@ -1,0 +1,31 @@
+/** @file series.c @brief Implementation of series.h. */
+#include "series.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+void series_init(struct series *s, int ncol, const char *const *names, const char *const *units) {
+  memset(s, 0, sizeof *s);
+  s->ncol = ncol, s->names = names, s->units = units;
+}
+
+void series_add(struct series *s, const double *row) {
+  if (s->n == s->cap) {
+    s->cap = s->cap ? 2 * s->cap : 256;
+    double *d = realloc(s->data, s->cap * (size_t)s->ncol * sizeof *d);
+    if (!d) {
+      fprintf(stderr, "error: out of memory in the time series\n");
+      abort();
+    }
+    s->data = d;
+  }
+  memcpy(s->data + s->n * (size_t)s->ncol, row, (size_t)s->ncol * sizeof *row);
+  s->n++;
+}
+
+void series_free(struct series *s) {
+  free(s->data);
+  memset(s, 0, sizeof *s);
+}

@@ -1,0 +1,215 @@
+/** @file stats.c @brief Implementation of stats.h. */
+#include "stats.h"
+
+#include <math.h>
+#include <netcdf.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "moments.h"
+#include "ncout.h"
+#include "state.h"
+
+void stats_init(struct stats *st, const struct stats_config *cfg) {
+  memset(st, 0, sizeof *st);
+  st->cfg = *cfg;
+  if (cfg->eulerian) euler_init(&st->eu, &cfg->eul);
+  if (cfg->corr.n_levels) corr_init(&st->co, &cfg->corr);
+  if (cfg->lagr.n_levels) lagr_init(&st->la, &cfg->lagr);
+}
+
+void stats_free(struct stats *st) {
+  if (st->cfg.eulerian) euler_free(&st->eu);
+  if (st->cfg.corr.n_levels) corr_free(&st->co);
+  if (st->cfg.lagr.n_levels) lagr_free(&st->la);
+  memset(st, 0, sizeof *st);
+}
+
+int stats_wanted(const struct stats *st) {
+  return st->cfg.eulerian || st->cfg.corr.n_levels > 0 || st->cfg.lagr.n_levels > 0;
+}
+
+void stats_sample(struct stats *st, const struct stats_snapshot *s) {
+  if (st->cfg.eulerian) euler_sample(&st->eu, s);
+  if (st->cfg.corr.n_levels) corr_sample(&st->co, s);
+  if (st->cfg.lagr.n_levels) lagr_sample(&st->la, s);
+  st->samples++;
+}
+
+void stats_state(struct stats *st, struct state_list *L) {
+  state_add(L, "stats/samples", STATE_I64, 0, NULL, &st->samples, NULL);
+  if (st->cfg.eulerian) euler_state(&st->eu, L);
+  if (st->cfg.corr.n_levels) corr_state(&st->co, L);
+  if (st->cfg.lagr.n_levels) lagr_state(&st->la, L);
+}
+
+size_t stats_memory(const struct stats *st) {
+  const size_t d = sizeof(double);
+  size_t b = 0;
+  if (st->cfg.eulerian) {
+    const size_t nb = (size_t)st->eu.cfg.nb;
+    b += st->eu.cap * (WIN_LEN + nb * (MOM_LEN + SCAL_LEN)) * d + 2 * nb * d;
+  }
+  if (st->cfg.corr.n_levels) {
+    const struct corr *c = &st->co;
+    const size_t nk = (size_t)c->cfg.nx * (size_t)c->nzh, np = (size_t)c->cfg.nx * c->cfg.nz;
+    b += (size_t)c->cfg.n_levels * (nk * CS_LEN + 2) * d + 4 * np * d + 3 * nk * 2 * d;
+  }
+  if (st->cfg.lagr.n_levels) {
+    const struct lagr *g = &st->la;
+    const size_t nl = (size_t)g->cfg.n_levels, ns = (size_t)g->n_slots;
+    const size_t nst = (size_t)(g->cfg.n_stations ? g->cfg.n_stations : 1);
+    b += nl * g->nlag * LG_LEN * d * (1 + ns) + ns * SL_LEN * d + nl * 3 * SCAL_LEN * d +
+         nl * nst * ((size_t)g->cfg.pdf_bins + 3) * d + g->cap * TR_LEN * d +
+         g->index_len * sizeof(long);
+  }
+  return b;
+}
+
+/* The running result: every row with data; closed windows are the batches. */
+static void eulerian_result(const struct euler *e, struct euler_result *res) {
+  const size_t rows = euler_rows(e);
+  int *complete = calloc(rows ? rows : 1, sizeof *complete);
+  for (size_t r = 0; r < rows; r++) complete[r] = r < e->nwin;
+  euler_finalise(&e->cfg, e->win, e->mom, e->snp, complete, 0, rows, res);
+  free(complete);
+}
+
+void stats_convergence_line(const struct stats *st, char *buf, size_t len) {
+  buf[0] = '\0';
+  if (!st->cfg.eulerian || euler_rows(&st->eu) == 0) return;
+  struct euler_result r;
+  eulerian_result(&st->eu, &r);
+  double se = 0.0, umax = 0.0;
+  for (int b = 0; b < r.nb; b++) {
+    if (isfinite(r.prof[EP_SE_U][b])) se = fmax(se, r.prof[EP_SE_U][b]);
+    if (isfinite(r.prof[EP_U][b])) umax = fmax(umax, fabs(r.prof[EP_U][b]));
+  }
+  const double win = st->cfg.eul.window;
+  snprintf(buf, len,
+           "stats: %d complete windows of %.4g s, %.0f snapshots; correlation time %.3g s "
+           "(window/corr %.3g); max stderr(u_mean) %.3g m/s (%.3g%% of max u_mean); "
+           "u_tau wall %.6g force %.6g; stress balance error %.3g%s\n",
+           r.n_batches, win, r.snapshots, r.corr_time, win / r.corr_time, se,
+           umax > 0 ? 100 * se / umax : NAN, r.u_tau_wall, r.u_tau_force, r.balance_error,
+           r.n_batches < 2           ? " (fewer than 2 windows: no error bars yet)"
+           : win < 5.0 * r.corr_time ? " (windows shorter than 5 correlation times: error bars "
+                                       "too small; increase stats.window)"
+                                     : "");
+  euler_result_free(&r);
+}
+
+#define CK(call)                                                   \
+  do {                                                             \
+    rc = (call);                                                   \
+    if (rc != NC_NOERR) {                                          \
+      snprintf(err, errlen, "%s (in %s)", nc_strerror(rc), #call); \
+      goto fail;                                                   \
+    }                                                              \
+  } while (0)
+
+static int put_att_d(int ncid, int var, const char *name, double v) {
+  return nc_put_att_double(ncid, var, name, NC_DOUBLE, 1, &v);
+}
+
+static int write_eulerian(const struct euler *e, int ncid, char *err, size_t errlen) {
+  int rc = NC_NOERR, dy, vid;
+  struct euler_result r;
+  eulerian_result(e, &r);
+  const size_t nb = (size_t)e->cfg.nb, rows = euler_rows(e);
+  CK(nc_def_dim(ncid, "y", nb, &dy));
+  for (int k = 0; k < EP_NPROF; k++) {
+    if ((k == EP_NUT || k == EP_KR) && !e->cfg.les) continue;
+    const struct euler_meta *m = &euler_prof_meta[k];
+    CK(ncout_def(ncid, m->name, NC_DOUBLE, 1, &dy, m->units, m->long_name, &vid));
+    if (k == EP_Y) {
+      CK(nc_put_att_text(ncid, vid, "axis", 1, "Y"));
+    } else {
+      const double fill = NC_FILL_DOUBLE;
+      CK(nc_put_att_double(ncid, vid, "_FillValue", NC_DOUBLE, 1, &fill));
+    }
+    for (int b = 0; b < r.nb; b++)
+      if (isnan(r.prof[k][b])) r.prof[k][b] = NC_FILL_DOUBLE;
+    CK(nc_put_var_double(ncid, vid, r.prof[k]));
+  }
+  const struct {
+    const char *name;
+    double v;
+  } scal[] = {{"u_tau", r.u_tau},
+              {"u_tau_stderr", r.u_tau_stderr},
+              {"u_tau_wall", r.u_tau_wall},
+              {"u_tau_force", r.u_tau_force},
+              {"re_tau", r.re_tau},
+              {"correlation_time", r.corr_time},
+              {"stress_balance_error", r.balance_error},
+              {"average_start", r.t0},
+              {"average_end", r.t1},
+              {"n_windows", (double)r.n_batches},
+              {"window_length", e->cfg.window},
+              {"bin_lower", e->cfg.y0},
+              {"bin_upper", e->cfg.y1},
+              {"wall_area", e->cfg.area},
+              {"fold", (double)e->cfg.fold},
+              {"les", (double)e->cfg.les}};
+  for (size_t i = 0; i < sizeof scal / sizeof scal[0]; i++)
+    CK(put_att_d(ncid, NC_GLOBAL, scal[i].name, scal[i].v));
+  /* the raw windows: the complete accumulator state, re-averaged by chansph extract */
+  int g, dw, dwf, dm, ds, vw, vm, vs, vc, v0, v1;
+  CK(nc_def_grp(ncid, "eulerian", &g));
+  static const char desc[] =
+      "raw per-window moment records of the wall-normal bins; re-average any range of windows "
+      "with chansph extract --window T0:T1 (docs/stats-format.md)";
+  CK(nc_put_att_text(g, NC_GLOBAL, "description", strlen(desc), desc));
+  CK(nc_def_dim(g, "window", rows, &dw));
+  CK(nc_def_dim(g, "window_field", WIN_LEN, &dwf));
+  CK(nc_def_dim(g, "moment", MOM_LEN, &dm));
+  CK(nc_def_dim(g, "snapshot_moment", SCAL_LEN, &ds));
+  CK(ncout_def(g, "window_start", NC_DOUBLE, 1, &dw, "s", "start of the averaging window", &v0));
+  CK(ncout_def(g, "window_end", NC_DOUBLE, 1, &dw, "s", "end of the averaging window", &v1));
+  CK(ncout_def(g, "window_complete", NC_INT, 1, &dw, "1", "1: closed window, 0: still open", &vc));
+  const int d2[2] = {dw, dwf}, d3m[3] = {dw, dy, dm}, d3s[3] = {dw, dy, ds};
+  CK(ncout_def(g, "windows", NC_DOUBLE, 2, d2, "1",
+               "per window: t_start [s], t_end [s], snapshots, sum of body force [m/s^2], sums "
+               "of tau_w/rho at y=0 and y=2delta [m^2/s^2]",
+               &vw));
+  CK(ncout_def(g, "moments", NC_DOUBLE, 3, d3m, "1",
+               "per window and bin: count, means of u v w p rho y nu_t k_r, co-moments uu vv ww "
+               "uv uw vw, third and fourth central moments of u v w (sums, not divided by count)",
+               &vm));
+  CK(ncout_def(g, "snapshot_u", NC_DOUBLE, 3, d3s, "1",
+               "per window and bin: count, mean and M2 of the per-snapshot bin means of u", &vs));
+  for (size_t w = 0; w < rows; w++) {
+    const size_t st[1] = {w}, ct[1] = {1};
+    const int cpl = w < e->nwin;
+    CK(nc_put_vara_double(g, v0, st, ct, &e->win[w * WIN_LEN + WIN_T0]));
+    CK(nc_put_vara_double(g, v1, st, ct, &e->win[w * WIN_LEN + WIN_T1]));
+    CK(nc_put_vara_int(g, vc, st, ct, &cpl));
+  }
+  if (rows) {
+    CK(nc_put_var_double(g, vw, e->win));
+    CK(nc_put_var_double(g, vm, e->mom));
+    CK(nc_put_var_double(g, vs, e->snp));
+  }
+  euler_result_free(&r);
+  return NC_NOERR;
+fail:
+  euler_result_free(&r);
+  return rc ? rc : NC_EINVAL;
+}
+
+int stats_nc_write(const struct stats *st, int ncid, char *err, size_t errlen) {
+  if (st->cfg.eulerian) {
+    const int rc = write_eulerian(&st->eu, ncid, err, errlen);
+    if (rc) return rc;
+  }
+  if (st->cfg.corr.n_levels) {
+    const int rc = corr_nc_write(&st->co, ncid, err, errlen);
+    if (rc) return rc;
+  }
+  if (st->cfg.lagr.n_levels) {
+    const int rc = lagr_nc_write(&st->la, ncid, err, errlen);
+    if (rc) return rc;
+  }
+  return NC_NOERR;
+}

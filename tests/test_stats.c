@@ -1,0 +1,589 @@
+/**
+ * @file test_stats.c
+ * @brief Unit tests of the Eulerian statistics engine (issue 5, acceptance 1-3):
+ *        synthetic fields with known means, stresses and higher moments; merge invariance of
+ *        the moment records; state round trip (serialise, restore, continue) bitwise.
+ */
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "euler.h"
+#include "lagr.h"
+#include "moments.h"
+#include "state.h"
+#include "stats.h"
+
+static int failures = 0;
+
+#define EXPECT(cond, ...)           \
+  do {                              \
+    if (!(cond)) {                  \
+      printf("FAIL: " __VA_ARGS__); \
+      printf("\n");                 \
+      failures++;                   \
+    }                               \
+  } while (0)
+
+/* Counter-based generator (splitmix64 of a key): reproducible, no hidden state. */
+static uint64_t mix(uint64_t z) {
+  z += 0x9e3779b97f4a7c15ULL;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+static double uniform(uint64_t key) {
+  return ((double)(mix(key) >> 11) + 0.5) / 9007199254740992.0;
+}
+static double gauss(uint64_t key) { /* Box-Muller */
+  return sqrt(-2.0 * log(uniform(2 * key))) * cos(6.283185307179586 * uniform(2 * key + 1));
+}
+
+enum { NB = 8, NP = 4000, NSNAP = 400 };
+static const double A = 0.3, B = -0.2, C = 0.25, SW = 0.15; /* u' = A g1, v' = B g1 + C g2 */
+
+static double U_of_bin(int b) {
+  return 1.0 + 0.1 * b;
+}
+
+/* Snapshot s of the synthetic field: y uniform in (0, 2), bins of width 0.25. */
+static void make_snapshot(long s, double *y, double *u, double *v, double *w, double *p,
+                          double *rho) {
+  for (size_t a = 0; a < NP; a++) {
+    const uint64_t k = ((uint64_t)s * NP + a) * 8;
+    y[a] = 2.0 * uniform(k);
+    const int b = (int)floor(y[a] / 0.25);
+    const double g1 = gauss(k + 1), g2 = gauss(k + 2), g3 = gauss(k + 3);
+    u[a] = U_of_bin(b) + A * g1;
+    v[a] = B * g1 + C * g2;
+    w[a] = SW * g3;
+    p[a] = 100.0 + gauss(k + 4), rho[a] = 1000.0;
+  }
+}
+
+static struct euler_config config(void) {
+  struct euler_config c = {.nb = NB,
+                           .y0 = 0.0,
+                           .y1 = 2.0,
+                           .delta = 1.0,
+                           .nu = 1e-3,
+                           .rho0 = 1000.0,
+                           .area = 1.0,
+                           .t_start = 0.0,
+                           .window = 1.0};
+  return c;
+}
+
+static void feed(struct euler *e, long s0, long s1, double *buf) {
+  double *y = buf, *u = y + NP, *v = u + NP, *w = v + NP, *p = w + NP, *rho = p + NP;
+  for (long s = s0; s < s1; s++) {
+    make_snapshot(s, y, u, v, w, p, rho);
+    const struct stats_snapshot snap = {.n = NP,
+                                        .y = y,
+                                        .u = u,
+                                        .v = v,
+                                        .w = w,
+                                        .p = p,
+                                        .rho = rho,
+                                        .t = 0.1 * s + 0.05,
+                                        .fx = 2e-3,
+                                        .wall_fx = {-1.0, -1.0}};
+    euler_sample(e, &snap);
+  }
+}
+
+static void finalise(const struct euler *e, struct euler_result *r) {
+  const size_t rows = euler_rows(e);
+  int *complete = calloc(rows, sizeof *complete);
+  for (size_t i = 0; i < rows; i++) complete[i] = i < e->nwin;
+  euler_finalise(&e->cfg, e->win, e->mom, e->snp, complete, 0, rows, r);
+  free(complete);
+}
+
+/* Acceptance 1: means and stresses of a field with known answers within 3 standard errors. */
+static void test_known_field(double *buf) {
+  const struct euler_config cfg = config();
+  struct euler e;
+  euler_init(&e, &cfg);
+  feed(&e, 0, NSNAP, buf);
+  struct euler_result r;
+  finalise(&e, &r);
+  const double exact[6] = {A * A, B * B + C * C, SW * SW, A * B, 0.0, 0.0};
+  double worst = 0.0;
+  for (int b = 0; b < NB; b++) {
+    const double z_u = (r.prof[EP_U][b] - U_of_bin(b)) / r.prof[EP_SE_U][b];
+    const double z_v = r.prof[EP_V][b] / r.prof[EP_SE_U + 1][b];
+    EXPECT(fabs(z_u) < 3 && fabs(z_v) < 3, "bin %d: u_mean %.6f (exact %.6f, se %.2e)", b,
+           r.prof[EP_U][b], U_of_bin(b), r.prof[EP_SE_U][b]);
+    worst = fmax(worst, fmax(fabs(z_u), fabs(z_v)));
+    for (int c = 0; c < 6; c++) {
+      const double z = (r.prof[EP_UU + c][b] - exact[c]) / r.prof[EP_SE_U + 5 + c][b];
+      worst = fmax(worst, fabs(z));
+      EXPECT(fabs(z) < 3, "bin %d stress %d: %.6f exact %.6f se %.2e", b, c, r.prof[EP_UU + c][b],
+             exact[c], r.prof[EP_SE_U + 5 + c][b]);
+    }
+    for (int i = 0; i < 3; i++) {
+      EXPECT(fabs(r.prof[EP_SKEW_U + i][b]) < 0.05, "bin %d skewness %d = %.4f", b, i,
+             r.prof[EP_SKEW_U + i][b]);
+      EXPECT(fabs(r.prof[EP_FLAT_U + i][b] - 3.0) < 0.1, "bin %d flatness %d = %.4f", b, i,
+             r.prof[EP_FLAT_U + i][b]);
+    }
+  }
+  EXPECT(r.n_batches == NSNAP / 10 - 1, "batches %d", r.n_batches);
+  EXPECT(fabs(r.u_tau_force - sqrt(2e-3)) < 1e-15, "u_tau_force %.17g", r.u_tau_force);
+  EXPECT(fabs(r.u_tau_wall - sqrt(1e-3)) < 1e-15, "u_tau_wall %.17g", r.u_tau_wall);
+  printf(
+      "known field: %d bins x %d snapshots of %d particles, %d batches: largest deviation "
+      "of means and stresses %.2f standard errors; correlation time %.3g s (snapshots 0.1 s "
+      "apart, independent: expected about 0.05)\n",
+      NB, NSNAP, NP, r.n_batches, worst, r.corr_time);
+  EXPECT(r.corr_time < 0.1, "correlation time %.3g of independent snapshots", r.corr_time);
+  euler_result_free(&r);
+  euler_free(&e);
+}
+
+static double rel(double a, double b) {
+  const double s = fmax(fabs(a), fabs(b));
+  return s > 0 ? fabs(a - b) / s : 0.0;
+}
+
+/* Acceptance 2: the same samples in 1, 2 or 3 accumulators, merged, agree to 1e-14. */
+static void test_merge(void) {
+  enum { N = 30000 };
+  double ref[MOM_LEN] = {0}, parts[3][MOM_LEN], worst = 0.0;
+  for (int i = 0; i < N; i++) {
+    const double s[MOM_NQ] = {5.0 + gauss(10 * i),
+                              -2.0 + 0.5 * gauss(10 * i + 1),
+                              0.1 * uniform(10 * i + 2),
+                              1e5 + gauss(10 * i + 3),
+                              1000.0,
+                              uniform(10 * i + 4)};
+    mom_add(ref, s);
+  }
+  for (int split = 2; split <= 3; split++) {
+    memset(parts, 0, sizeof parts);
+    for (int i = 0; i < N; i++) {
+      const double s[MOM_NQ] = {5.0 + gauss(10 * i),
+                                -2.0 + 0.5 * gauss(10 * i + 1),
+                                0.1 * uniform(10 * i + 2),
+                                1e5 + gauss(10 * i + 3),
+                                1000.0,
+                                uniform(10 * i + 4)};
+      mom_add(parts[(long)i * split / N], s);
+    }
+    double m[MOM_LEN] = {0}, m2[MOM_LEN] = {0};
+    for (int k = 0; k < split; k++) mom_merge(m, parts[k]);
+    for (int k = 0; k < split; k++) mom_merge(m2, parts[k]);
+    EXPECT(!memcmp(m, m2, sizeof m), "merge in a fixed order is not bitwise reproducible");
+    for (int k = 0; k < MOM_LEN; k++) {
+      /* co-moments of nearly uncorrelated variables are sums of cancelling terms: compare
+         them on the scale of the variances they are bounded by */
+      double scale = fmax(fabs(ref[k]), fabs(m[k]));
+      if (k >= MOM_C2 && k < MOM_C2 + MOM_NC) {
+        const int i = mom_pair[k - MOM_C2][0], j = mom_pair[k - MOM_C2][1];
+        scale = sqrt(ref[MOM_C2 + i] * ref[MOM_C2 + j]);
+      }
+      if (k >= MOM_M3 && k < MOM_M3 + 3) scale = pow(ref[MOM_C2 + k - MOM_M3], 1.5) / sqrt(N);
+      const double e = scale > 0 ? fabs(ref[k] - m[k]) / scale : 0.0;
+      worst = fmax(worst, e);
+      EXPECT(e < 1e-14, "split %d slot %d: %.17g vs %.17g", split, k, ref[k], m[k]);
+    }
+  }
+  printf(
+      "merge invariance: %d samples in 1, 2, 3 accumulators, largest relative difference "
+      "%.2e\n",
+      N, worst);
+  (void)rel;
+}
+
+/* A copy of a state list's arrays (what a checkpoint would write). */
+struct saved {
+  int n;
+  char name[32][96];
+  int rank[32];
+  size_t dims[32][STATE_MAX_RANK];
+  double *data[32];
+};
+
+static void save(struct state_list *L, struct saved *sv) {
+  sv->n = L->n;
+  if (L->n > 32) {
+    printf("FAIL: more than 32 state fields\n");
+    exit(1);
+  }
+  for (int i = 0; i < L->n; i++) {
+    const struct state_field *f = &L->f[i];
+    snprintf(sv->name[i], sizeof sv->name[i], "%s", f->name);
+    sv->rank[i] = f->rank;
+    memcpy(sv->dims[i], f->dims, sizeof f->dims);
+    const size_t n = state_count(f);
+    sv->data[i] = malloc(n * sizeof(double));
+    memcpy(sv->data[i], f->data, n * sizeof(double));
+  }
+}
+
+static void restore(struct state_list *L, const struct saved *sv) {
+  EXPECT(L->n == sv->n, "state lists differ in length");
+  for (int i = 0; i < L->n && i < sv->n; i++) {
+    struct state_field *f = state_find(L, sv->name[i]);
+    EXPECT(f != NULL, "field %s missing", sv->name[i]);
+    if (!f) continue;
+    void *dst = f->reserve ? f->reserve(f->owner, sv->rank[i], sv->dims[i]) : f->data;
+    EXPECT(dst != NULL, "reserve refused %s", sv->name[i]);
+    size_t n = 1;
+    for (int k = 0; k < sv->rank[i]; k++) n *= sv->dims[i][k];
+    if (dst) memcpy(dst, sv->data[i], n * sizeof(double));
+  }
+}
+
+/* Feed snapshots s0..s1-1 of the synthetic field to a whole engine (positions in x, z and ids
+   too, so that all three engines see data). */
+static void feed_all(struct stats *st, long s0, long s1, double *buf) {
+  double *y = buf, *u = y + NP, *v = u + NP, *w = v + NP, *p = w + NP, *rho = p + NP;
+  static double x[NP], z[NP];
+  static int64_t id[NP];
+  for (long s = s0; s < s1; s++) {
+    make_snapshot(s, y, u, v, w, p, rho);
+    for (size_t a = 0; a < NP; a++)
+      id[a] = (int64_t)a, x[a] = uniform(((uint64_t)s * NP + a) * 8 + 5),
+      z[a] = uniform(((uint64_t)s * NP + a) * 8 + 6);
+    const struct stats_snapshot snap = {.n = NP,
+                                        .x = x,
+                                        .y = y,
+                                        .z = z,
+                                        .u = u,
+                                        .v = v,
+                                        .w = w,
+                                        .p = p,
+                                        .rho = rho,
+                                        .ax = u,
+                                        .ay = v,
+                                        .az = w,
+                                        .id = id,
+                                        .t = 0.1 * s + 0.05,
+                                        .fx = 2e-3,
+                                        .wall_fx = {-1.0, -1.0}};
+    stats_sample(st, &snap);
+  }
+}
+
+static struct stats_config all_engines(void) {
+  struct stats_config c = {.eulerian = 1, .eul = config()};
+  c.corr = (struct corr_config){.n_levels = 2,
+                                .y = {0.5, 0.25},
+                                .nx = 8,
+                                .nz = 4,
+                                .lx = 1.0,
+                                .lz = 1.0,
+                                .half = 0.05,
+                                .delta = 1.0};
+  c.lagr = (struct lagr_config){.n_levels = 2,
+                                .y = {0.5, 0.3},
+                                .x0 = 0.5,
+                                .half = 0.05,
+                                .lx = 1.0,
+                                .lz = 1.0,
+                                .delta = 1.0,
+                                .horizon = 1.0,
+                                .release_every = 0.5,
+                                .n_lags = 10,
+                                .n_stations = 1,
+                                .station = {0.1},
+                                .pdf_bins = 10};
+  return c;
+}
+
+/* Acceptance 3 (engine side): serialise -> restore in a fresh engine -> continue gives the
+   same state, field by field and bit for bit, as never stopping (all three engines). */
+static void test_round_trip(double *buf) {
+  const struct stats_config cfg = all_engines();
+  struct stats a, b, c;
+  stats_init(&a, &cfg);
+  feed_all(&a, 0, 137, buf);
+  stats_init(&b, &cfg);
+  feed_all(&b, 0, 61, buf);
+  struct state_list L = {0};
+  stats_state(&b, &L);
+  struct saved sv;
+  save(&L, &sv);
+  state_free(&L);
+  stats_free(&b);
+  stats_init(&c, &cfg);
+  stats_state(&c, &L);
+  restore(&L, &sv);
+  state_free(&L);
+  feed_all(&c, 61, 137, buf);
+  struct state_list La = {0}, Lc = {0};
+  stats_state(&a, &La);
+  stats_state(&c, &Lc);
+  int same = La.n == Lc.n;
+  for (int i = 0; i < La.n && same; i++) {
+    const struct state_field *fa = &La.f[i], *fc = state_find(&Lc, fa->name);
+    same = fc && state_count(fa) == state_count(fc) &&
+           !memcmp(fa->data, fc->data, state_count(fa) * sizeof(double));
+    if (!same) printf("field %s differs\n", fa->name);
+  }
+  EXPECT(same, "state after a round trip differs from the uninterrupted run");
+  EXPECT(a.la.releases > 2 && a.la.ntracks > 0, "Lagrangian engine idle in the round trip");
+  printf(
+      "state round trip after 61 of 137 snapshots (%d fields, Eulerian, correlations, "
+      "Lagrangian with %g releases done and %zu tracks active): %s\n",
+      La.n, a.la.releases, a.la.ntracks, same ? "bitwise identical" : "DIFFERENT");
+  for (int i = 0; i < sv.n; i++) free(sv.data[i]);
+  state_free(&La), state_free(&Lc);
+  stats_free(&c);
+  stats_free(&a);
+}
+
+/* Acceptance 1: a field with a known sinusoidal correlation gives R(l) to 1e-6. */
+static void test_corr(void) {
+  enum { NX = 16, NZ = 8, M = 3, NM = 1 };
+  const double lx = 1.6, lz = 0.8, amp_a = 0.7, amp_b = 0.4, amp_c = 0.3, amp_d = 0.2;
+  const double phi = 0.4, tp = 6.283185307179586;
+  const struct corr_config cfg = {.n_levels = 1,
+                                  .y = {0.3},
+                                  .y_plus = {10},
+                                  .nx = NX,
+                                  .nz = NZ,
+                                  .lx = lx,
+                                  .lz = lz,
+                                  .half = 0.05,
+                                  .delta = 1.0};
+  struct corr c;
+  corr_init(&c, &cfg);
+  double x[NX * NZ], y[NX * NZ], z[NX * NZ], u[NX * NZ], v[NX * NZ], w[NX * NZ];
+  for (int i = 0; i < NX; i++)
+    for (int k = 0; k < NZ; k++) {
+      const int a = i * NZ + k;
+      x[a] = (i + 0.5) * lx / NX, z[a] = (k + 0.5) * lz / NZ, y[a] = 0.3;
+      u[a] = amp_a * cos(tp * M * x[a] / lx) + amp_b * cos(tp * NM * z[a] / lz);
+      v[a] = amp_c * cos(tp * M * x[a] / lx + phi);
+      w[a] = amp_d * sin(tp * NM * z[a] / lz);
+    }
+  const struct stats_snapshot snap = {
+      .n = NX * NZ, .x = x, .y = y, .z = z, .u = u, .v = v, .w = w, .t = 1.0};
+  corr_sample(&c, &snap);
+  corr_sample(&c, &snap);
+  double rx[4 * NX], rz[4 * NZ], ex[3 * (NX / 2 + 1)], ez[3 * (NZ / 2 + 1)], worst = 0.0;
+  corr_results(&c, rx, rz, ex, ez);
+  for (int i = 0; i < NX; i++) {
+    const double l = i * lx / NX;
+    const double want[4] = {0.5 * amp_a * amp_a * cos(tp * M * l / lx) + 0.5 * amp_b * amp_b,
+                            0.5 * amp_c * amp_c * cos(tp * M * l / lx), 0.5 * amp_d * amp_d,
+                            0.5 * amp_a * amp_c * cos(tp * M * l / lx + phi)};
+    for (int q = 0; q < 4; q++) worst = fmax(worst, fabs(rx[q * NX + i] - want[q]));
+  }
+  for (int k = 0; k < NZ; k++) {
+    const double l = k * lz / NZ;
+    const double want[4] = {0.5 * amp_a * amp_a + 0.5 * amp_b * amp_b * cos(tp * NM * l / lz),
+                            0.5 * amp_c * amp_c, 0.5 * amp_d * amp_d * cos(tp * NM * l / lz),
+                            0.5 * amp_a * amp_c * cos(phi)};
+    for (int q = 0; q < 4; q++) worst = fmax(worst, fabs(rz[q * NZ + k] - want[q]));
+  }
+  EXPECT(worst < 1e-6, "two-point correlation off by %.3e", worst);
+  /* spectra: Parseval and the energy at the forced wavenumbers */
+  double sx = 0, sz = 0;
+  for (int m = 0; m <= NX / 2; m++) sx += ex[m] * tp / lx;
+  for (int m = 0; m <= NZ / 2; m++) sz += ez[m] * tp / lz;
+  const double uu0 = 0.5 * (amp_a * amp_a + amp_b * amp_b);
+  const double e_m = ex[M] * tp / lx, e_n = ez[NM] * tp / lz;
+  const double werr = fmax(fmax(fabs(sx - uu0), fabs(sz - uu0)),
+                           fmax(fabs(e_m - 0.5 * amp_a * amp_a), fabs(e_n - 0.5 * amp_b * amp_b)));
+  EXPECT(werr < 1e-6, "spectra off by %.3e", werr);
+  printf(
+      "correlations: sinusoidal field on a %d x %d plane, largest error of R_ij(l) %.2e, of "
+      "the spectra (Parseval, forced modes) %.2e\n",
+      NX, NZ, worst, werr);
+  corr_free(&c);
+}
+
+/* Acceptance 1: tracks from Ornstein-Uhlenbeck processes of known time scale give
+   rho^L(tau) = exp(-tau/T), D(tau) = 2 var (1 - exp(-tau/T)) and T_L within 3 standard
+   errors of Eq. 5.61 applied to exp(-tau/T) (T (1 - e^-4), times the trapezoid factor). */
+static void test_lagr_ou(void) {
+  enum { NPART = 2000, RELEASES = 40, NLAG = 40 };
+  const double T = 1.0, Ta = 0.25, dt = 0.125, horizon = 5.0;
+  const struct lagr_config cfg = {.n_levels = 1,
+                                  .y = {0.5},
+                                  .y_plus = {50},
+                                  .x0 = 0.0,
+                                  .half = 0.05,
+                                  .lx = 10.0,
+                                  .lz = 0.0,
+                                  .delta = 1.0,
+                                  .horizon = horizon,
+                                  .release_every = horizon,
+                                  .n_lags = NLAG,
+                                  .pdf_bins = 10};
+  struct lagr g;
+  lagr_init(&g, &cfg);
+  static double x[NPART], y[NPART], z[NPART], u[NPART], v[NPART], w[NPART], ax[NPART];
+  static double zero[NPART];
+  static int64_t id[NPART];
+  const double f = exp(-dt / T), fa = exp(-dt / Ta);
+  for (int p = 0; p < NPART; p++) {
+    id[p] = p, x[p] = 0.0, y[p] = 0.5, z[p] = 0.0;
+    u[p] = 3.0 + gauss(7000000 + 3 * p), v[p] = gauss(7000001 + 3 * p), w[p] = 0.0;
+    ax[p] = gauss(7000002 + 3 * p);
+  }
+  const long steps = (long)(RELEASES * horizon / dt) + 1;
+  for (long n = 0; n < steps; n++) {
+    const struct stats_snapshot snap = {.n = NPART,
+                                        .x = x,
+                                        .y = y,
+                                        .z = z,
+                                        .u = u,
+                                        .v = v,
+                                        .w = w,
+                                        .ax = ax,
+                                        .ay = zero,
+                                        .az = zero,
+                                        .id = id,
+                                        .t = n * dt};
+    lagr_sample(&g, &snap);
+    for (int p = 0; p < NPART; p++) {
+      const uint64_t k = 100000000ULL + ((uint64_t)n * NPART + (uint64_t)p) * 4;
+      u[p] = 3.0 + f * (u[p] - 3.0) + sqrt(1 - f * f) * gauss(k);
+      v[p] = f * v[p] + sqrt(1 - f * f) * gauss(k + 1);
+      w[p] = 0.1 * gauss(k + 2); /* uncorrelated */
+      ax[p] = fa * ax[p] + sqrt(1 - fa * fa) * gauss(k + 3);
+    }
+  }
+  const size_t nlag = NLAG + 1;
+  double fn[LF_LEN * (NLAG + 1)], tl[3];
+  lagr_functions(&g, 0, fn, tl);
+  double dr = 0, da = 0, dd = 0;
+  for (size_t k = 0; k < nlag; k++) {
+    const double tau = k * horizon / NLAG;
+    dr = fmax(dr, fabs(fn[LF_RHO_L * nlag + k] - exp(-tau / T)));
+    dr = fmax(dr, fabs(fn[(LF_RHO_L + 1) * nlag + k] - exp(-tau / T)));
+    da = fmax(da, fabs(fn[LF_RHO_A * nlag + k] - exp(-tau / Ta)));
+    dd = fmax(dd, fabs(fn[LF_D * nlag + k] - 2.0 * (1.0 - exp(-tau / T))));
+  }
+  const double q = dt / (2 * T), expect = T * (1 - exp(-4.0)) * q / tanh(q);
+  const double *W = g.tl; /* u: [n, mean, M2] over the releases */
+  const double se = sqrt(W[SCAL_M2] / (W[SCAL_N] - 1) / W[SCAL_N]);
+  printf(
+      "Lagrangian OU tracks (%d particles x %.0f releases, T = %g): max |rho_L - exp(-tau/T)| "
+      "%.4f, max |rho_a - exp(-tau/T_a)| %.4f, max |D_u - 2(1 - exp)| %.4f; T_L merged %.4f, "
+      "release mean %.4f +- %.4f, expected %.4f (%.2f standard errors)\n",
+      NPART, g.releases, T, dr, da, dd, tl[0], W[SCAL_MEAN], se, expect,
+      (W[SCAL_MEAN] - expect) / se);
+  EXPECT(g.releases >= RELEASES - 1, "releases %g", g.releases);
+  EXPECT(dr < 0.02 && da < 0.02 && dd < 0.04, "Lagrangian correlations off");
+  EXPECT(fabs(W[SCAL_MEAN] - expect) < 3 * se, "T_L of the releases not within 3 se");
+  EXPECT(fabs(tl[0] - expect) < 3 * se, "merged T_L not within 3 se");
+  lagr_free(&g);
+}
+
+/* Acceptance 1: tracks with a known y-distribution at a station give its PDF and moments. */
+static void test_lagr_pdf(void) {
+  enum { NPART = 20000, BINS = 50 };
+  const double sy = 0.1, dt = 0.0625, X = 0.5;
+  const struct lagr_config cfg = {.n_levels = 1,
+                                  .y = {0.5},
+                                  .x0 = 0.0,
+                                  .half = 0.05,
+                                  .lx = 10.0,
+                                  .delta = 1.0,
+                                  .horizon = 1.0,
+                                  .release_every = 100.0,
+                                  .n_lags = 16,
+                                  .n_stations = 1,
+                                  .station = {X},
+                                  .pdf_bins = BINS};
+  struct lagr g;
+  lagr_init(&g, &cfg);
+  static double x[NPART], y[NPART], z[NPART], u[NPART], g0[NPART];
+  static int64_t id[NPART];
+  for (int p = 0; p < NPART; p++) id[p] = p, g0[p] = gauss(9000000 + p), u[p] = 1.0;
+  for (int n = 0; n <= 16; n++) {
+    const double t = n * dt;
+    for (int p = 0; p < NPART; p++) /* x = U t, y drifts linearly: N(0.5, sy^2) at x = X */
+      x[p] = t, y[p] = 0.5 + sy * g0[p] * t / X, z[p] = 0.0;
+    const struct stats_snapshot snap = {
+        .n = NPART, .x = x, .y = y, .z = z, .u = u, .v = u, .w = u, .id = id, .t = t};
+    lagr_sample(&g, &snap);
+  }
+  const double *P = g.pdf, n = P[BINS], mu = P[BINS + 1] / n, var = P[BINS + 2] / n - mu * mu;
+  const double se_mu = sy / sqrt(n), se_var = sy * sy * sqrt(2.0 / n), width = 2.0 / BINS;
+  double worst = 0.0; /* per-bin deviation from the Gaussian in units of its Poisson error */
+  for (int b = 0; b < BINS; b++) {
+    const double lo = b * width, hi = lo + width;
+    const double pexp =
+        0.5 * (erf((hi - 0.5) / (sy * sqrt(2.0))) - erf((lo - 0.5) / (sy * sqrt(2.0))));
+    if (pexp * n < 5) continue;
+    worst = fmax(worst, fabs(P[b] - pexp * n) / sqrt(pexp * n));
+  }
+  printf(
+      "Lagrangian PDF at x - x0 = %g: %.0f tracks, mu_y = %.5f (exact 0.5, %.2f se), "
+      "variance %.6f (exact %.6f, %.2f se), largest bin deviation %.2f Poisson errors\n",
+      X, n, mu, (mu - 0.5) / se_mu, var, sy * sy, (var - sy * sy) / se_var, worst);
+  EXPECT(n == NPART, "tracks crossing the station: %g", n);
+  EXPECT(fabs(mu - 0.5) < 3 * se_mu && fabs(var - sy * sy) < 3 * se_var, "PDF moments off");
+  EXPECT(worst < 4.5, "PDF histogram off");
+  lagr_free(&g);
+}
+
+/* SPH interpolation (Eq. 5.56): on a lattice of particle layers, a linear profile is
+   reproduced exactly at the profile points at least 2h from the walls (the plane-averaged
+   kernel is symmetric), and a constant everywhere. */
+static void test_sph_profiles(void) {
+  enum { NL = 39, NCOL = 3 };
+  const double dr = 0.05, h = 1.3 * dr;
+  struct euler_config cfg = config();
+  cfg.nb = NL, cfg.y0 = 0.5 * dr, cfg.y1 = 2.0 - 0.5 * dr, cfg.method = EULER_SPH, cfg.h = h;
+  cfg.dim = 3;
+  struct euler e;
+  euler_init(&e, &cfg);
+  static double y[NL * NCOL], u[NL * NCOL], v[NL * NCOL], w[NL * NCOL], p[NL * NCOL];
+  static double rho[NL * NCOL], m[NL * NCOL];
+  for (int j = 0; j < NL; j++)
+    for (int k = 0; k < NCOL; k++) {
+      const int a = j * NCOL + k;
+      y[a] = (j + 1) * dr, u[a] = 0.3 + 2.0 * y[a], v[a] = 0.7, w[a] = 0.0, p[a] = 5.0;
+      rho[a] = 1000.0, m[a] = 1000.0 * dr * dr * dr;
+    }
+  const struct stats_snapshot snap = {.n = NL * NCOL,
+                                      .y = y,
+                                      .u = u,
+                                      .v = v,
+                                      .w = w,
+                                      .p = p,
+                                      .rho = rho,
+                                      .m = m,
+                                      .t = 0.5,
+                                      .wall_fx = {0, 0}};
+  euler_sample(&e, &snap);
+  struct euler_result r;
+  finalise(&e, &r);
+  double lin = 0.0, con = 0.0;
+  for (int b = 0; b < NL; b++) {
+    con = fmax(con, fabs(r.prof[EP_V][b] - 0.7));
+    if (r.prof[EP_Y][b] > 2 * h + dr && r.prof[EP_Y][b] < 2.0 - 2 * h - dr)
+      lin = fmax(lin, fabs(r.prof[EP_U][b] - (0.3 + 2.0 * r.prof[EP_Y][b])));
+  }
+  printf(
+      "SPH interpolation profiles: linear field error %.2e away from the walls, constant "
+      "field error %.2e everywhere\n",
+      lin, con);
+  EXPECT(lin < 1e-12 && con < 1e-12, "SPH interpolation profiles off");
+  euler_result_free(&r);
+  euler_free(&e);
+}
+
+int main(void) {
+  double *buf = malloc(6 * NP * sizeof(double));
+  test_known_field(buf);
+  test_merge();
+  test_round_trip(buf);
+  test_corr();
+  test_sph_profiles();
+  test_lagr_ou();
+  test_lagr_pdf();
+  free(buf);
+  printf(failures ? "FAILED (%d)\n" : "all passed\n", failures);
+  return failures ? 1 : 0;
+}
