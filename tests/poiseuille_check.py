@@ -17,6 +17,7 @@ Subcommands (each runs chansph, reads its netCDF output, prints the numbers, exi
                                (nu + l(y)^2 |u'|) u' with l = C_S Delta_G (1 - exp(-y+/A+))
 """
 import argparse
+import hashlib
 import math
 import os
 import subprocess
@@ -28,6 +29,8 @@ import numpy as np
 
 
 def run(args, scene, name, sets, threads=None):
+    if sets:  # tests of one scene with different settings run in parallel: separate directories
+        name += "_" + hashlib.md5(" ".join(sets).encode()).hexdigest()[:8]
     out = os.path.join(args.runs, name)
     cmd = [args.chansph, "run", scene, "--out", out, "--overwrite"]
     for s in sets:
