@@ -7,18 +7,20 @@
 
 #include "scene.h"
 
-enum command { CMD_HELP, CMD_VERSION, CMD_RUN, CMD_BENCH, CMD_SCENE_DOC };
+enum command { CMD_HELP, CMD_VERSION, CMD_RUN, CMD_BENCH, CMD_SCENE_DOC, CMD_RESUME };
 
 /** Parsed command line. */
 struct cli {
   enum command cmd;
-  const char *scene; /*!< scene file (bench: optional) */
-  char out[2048];    /*!< run directory */
-  int n_set;         /*!< number of --set overrides */
-  char **set;        /*!< the overrides (pointers into argv) */
-  int overwrite;     /*!< --overwrite */
-  int fpe;           /*!< --fpe: trap floating-point exceptions */
-  long steps;        /*!< bench: --steps */
+  const char *scene;    /*!< scene file (bench: optional) */
+  char out[2048];       /*!< run directory */
+  int n_set;            /*!< number of --set overrides */
+  char **set;           /*!< the overrides (pointers into argv) */
+  int overwrite;        /*!< --overwrite */
+  int fpe;              /*!< --fpe: trap floating-point exceptions */
+  long steps;           /*!< bench: --steps */
+  long max_steps;       /*!< run/resume: --max-steps, steps of this process (0: no limit) */
+  const char *walltime; /*!< run/resume: --walltime HH:MM:SS (NULL: none) */
 };
 
 /**

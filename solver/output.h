@@ -11,6 +11,7 @@
 #include "health.h"
 #include "profile.h"
 #include "run.h"
+#include "state.h"
 
 /** Output state of a run. */
 struct output {
@@ -32,6 +33,33 @@ struct output {
  * @return CHANSPH_OK or CHANSPH_ERR with a message
  */
 int output_open(struct output *o, const char *dir, const struct scene *sc, int overwrite);
+
+/**
+ * @brief Reopen the directory of a run being resumed: log.txt is appended to, scene.used.ini
+ *        rewritten with the (possibly changed) scene, accumulators sized from the scene; their
+ *        contents come from the checkpoint through output_state().
+ * @return CHANSPH_OK or CHANSPH_ERR with a message
+ */
+int output_reopen(struct output *o, const char *dir, const struct scene *sc);
+
+/**
+ * @brief Append the output state to a list: the profile accumulators, the time series (sized
+ *        on reading) and the time of the next stats.nc rewrite.
+ */
+void output_state(struct output *o, struct state_list *L);
+
+/** @brief Log a line to stdout and log.txt (printf-style). */
+void output_log(struct output *o, const char *fmt, ...);
+
+/** @brief Start the clocks of a resumed run (no record: the series holds the state's row). */
+void output_resume(struct output *o, struct sim *S);
+
+/**
+ * @brief The run stops before its end (checkpointed): rewrite stats.nc with what was gathered,
+ *        log why and the timing report.
+ * @return CHANSPH_OK or CHANSPH_ERR
+ */
+int output_stop(struct output *o, struct sim *S, const char *why);
 
 /** @brief Record the initial state and start the clocks. */
 void output_begin(struct output *o, struct sim *S);
