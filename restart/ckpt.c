@@ -36,7 +36,11 @@ static void fail(char *err, size_t errlen, const char *fmt, ...) {
   va_start(ap, fmt);
   vsnprintf(what, sizeof what, fmt, ap);
   va_end(ap);
-  snprintf(err, errlen, "%s (HDF5: %s)", what, h5_error(h5));
+  h5_error(h5);
+  if (strcmp(h5, "unknown HDF5 error"))
+    snprintf(err, errlen, "%s (HDF5: %s)", what, h5);
+  else
+    snprintf(err, errlen, "%s", what);
 }
 
 static hid_t mem_type(enum state_type t) {
@@ -181,6 +185,9 @@ static int sync_path(const char *path, int dir) {
   return rc;
 }
 
+/* The file is built in memory (HDF5 core driver) and written to disk when it is closed: one
+   large write, and a full disk or a file-size limit fails cleanly in H5Fclose (with the sec2
+   driver, HDF5 1.10 crashes at exit after a failed close). */
 int ckpt_write(const char *path, const struct state_list *L, const char *scene, long step,
                double time, char *err, size_t errlen) {
   H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
@@ -191,11 +198,13 @@ int ckpt_write(const char *path, const struct state_list *L, const char *scene, 
   H5Pset_obj_track_times(fcpl, 0);
   H5Pset_obj_track_times(gcpl, 0);
   H5Pset_libver_bounds(fapl, H5F_LIBVER_V18, H5F_LIBVER_V18); /* checksummed metadata */
+  H5Pset_fapl_core(fapl, (size_t)1 << 20, 1);
   const hid_t file = H5Fcreate(tmp, H5F_ACC_TRUNC, fcpl, fapl);
   H5Pclose(fcpl), H5Pclose(fapl);
   if (file < 0) {
-    fail(err, errlen, "cannot create checkpoint %s (%s)", tmp, strerror(errno));
+    fail(err, errlen, "cannot write checkpoint %s (%s)", tmp, strerror(errno));
     H5Pclose(gcpl);
+    remove(tmp);
     return 1;
   }
   int rc = 0;
@@ -226,15 +235,11 @@ int ckpt_write(const char *path, const struct state_list *L, const char *scene, 
     fail(err, errlen, "cannot write the completion mark of checkpoint %s", tmp);
     rc = 1;
   }
-  if (!rc && H5Fflush(file, H5F_SCOPE_GLOBAL) < 0) {
-    fail(err, errlen, "cannot flush checkpoint %s", tmp);
-    rc = 1;
-  }
-  if (H5Fclose(file) < 0 && !rc) {
-    fail(err, errlen, "cannot close checkpoint %s", tmp);
-    rc = 1;
-  }
   H5Pclose(gcpl);
+  if (H5Fclose(file) < 0 && !rc) {
+    fail(err, errlen, "cannot write checkpoint %s", tmp);
+    rc = 1;
+  }
   if (!rc && sync_path(tmp, 0)) {
     snprintf(err, errlen, "cannot fsync checkpoint %s: %s", tmp, strerror(errno));
     rc = 1;

@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "ckpt.h"
 #include "error.h"
@@ -71,7 +72,7 @@ struct skipped {
 };
 
 static void skip(struct skipped *sk, const char *path, const char *why) {
-  warn("%s; trying the previous checkpoint", why);
+  warn("%s; skipping this checkpoint", why);
   if (sk->n < 16) {
     snprintf(sk->path[sk->n], sizeof sk->path[0], "%s", path);
     snprintf(sk->why[sk->n], sizeof sk->why[0], "%s", why);
@@ -164,7 +165,10 @@ int restart_resume(const char *dir, int n_set, char *const *set, struct scene *s
   if (tmp) output_log(o, "resume: removed %d temporary file(s) of interrupted writes\n", tmp);
   for (int i = 0; i < sk.n; i++) {
     char to[4200];
+    struct stat st;
     snprintf(to, sizeof to, "%s.skipped", sk.path[i]);
+    for (int k = 1; lstat(to, &st) == 0 && k < 1000; k++) /* never replace an earlier one */
+      snprintf(to, sizeof to, "%s.skipped.%d", sk.path[i], k);
     const int moved = rename(sk.path[i], to) == 0;
     output_log(o, "resume: skipped %s%s: %s\n", sk.path[i], moved ? " (renamed *.skipped)" : "",
                sk.why[i]);

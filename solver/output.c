@@ -209,6 +209,7 @@ void output_begin(struct output *o, struct sim *S) {
 }
 
 void output_resume(struct output *o, struct sim *S) {
+  timer_reset(); /* the phase report covers this process's steps */
   o->wall0 = o->last_wall = timer_now();
   o->t0 = S->t, o->last_step = S->step;
   output_log(o, "chansph %s: resumed at step %ld, t = %.9g s: %zu fluid + %zu vertex particles\n",

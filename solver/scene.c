@@ -453,9 +453,14 @@ static void value_text(const struct scene *s, int k, char *buf, size_t n) {
     case T_LONG:
       snprintf(buf, n, "%ld", *(const long *)field);
       break;
-    case T_DOUBLE:
-      snprintf(buf, n, "%.17g", *(const double *)field);
+    case T_DOUBLE: { /* the shortest text that reads back to the same double */
+      const double v = *(const double *)field;
+      for (int digits = 15; digits <= 17; digits++) {
+        snprintf(buf, n, "%.*g", digits, v);
+        if (strtod(buf, NULL) == v) break;
+      }
       break;
+    }
     case T_CHOICE: {
       char key[80];
       snprintf(key, sizeof key, "%s.%s", keys[k].section, keys[k].name);
