@@ -4,6 +4,7 @@
 # usage: restart_signals.sh CHANSPH SCENE RUNS
 set -u
 chansph=$1 scene=$2 runs=$3
+export OMP_NUM_THREADS=${OMP_NUM_THREADS:-1} # timing checks: no spinning threads on a busy machine
 status=0
 fail() { echo "FAIL: $*"; status=1; }
 long=(--set time.t_end=1000 --set output.t_average_start=0 --set checkpoint.every_minutes=0)
