@@ -8,7 +8,7 @@ chansph=$1 scene=$2 runs=$3 kills=$4 seed=$5
 shift 5
 here=$(cd "$(dirname "$0")/.." && pwd)
 export OMP_NUM_THREADS=${OMP_NUM_THREADS:-1}
-ref=$runs/kill_ref dir=$runs/kill_$kills
+ref=$runs/kill_${kills}_ref dir=$runs/kill_$kills
 rm -rf "$ref" "$dir"
 t0=$(date +%s.%N)
 "$chansph" run "$scene" --out "$ref" "$@" > /dev/null || { echo "FAIL: reference run"; exit 1; }
