@@ -50,6 +50,10 @@ for ((job = 1; job <= max_jobs; job++)); do
       ;;
     75)
       fails=0
+      if grep "^stopped at step" "$dir/log.txt" 2> /dev/null | tail -n 1 | grep -q "(STOP file)"; then
+        echo "chain: stopped by $dir/STOP; continue with: $0 $dir"
+        exit 75
+      fi
       ;;
     1 | 2 | 3 | 74)
       echo "chain: chansph exited with $rc (see docs/batch-jobs.md); stopping the chain" >&2

@@ -52,6 +52,12 @@ struct trigger {
 };
 
 /**
+ * @brief Call first in main: the walltime counts from here, and the signal handlers are
+ *        installed at once (a signal during start-up stops the run after its first step).
+ */
+void trigger_mark_start(void);
+
+/**
  * @brief Install the signal handlers (SIGTERM, SIGINT, SIGUSR1 set a flag; SIGXFSZ is ignored so
  *        that a file-size limit turns into a write error) and start the clocks.
  * @param[out] T triggers

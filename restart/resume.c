@@ -13,6 +13,7 @@
 #include "error.h"
 #include "restart.h"
 #include "rotate.h"
+#include "timers.h"
 
 /** Keys a resume may change (docs/batch-jobs.md); every other key is refused. */
 static const char *const changeable[] = {"time.t_end",
@@ -83,7 +84,7 @@ static void skip(struct skipped *sk, const char *path, const char *why) {
 /* Read one candidate; on failure everything it set up is released. */
 static int try_one(const char *dir, const char *path, int n_set, char *const *set, struct scene *sc,
                    struct sim *S, struct output *o, struct skipped *sk, struct scene *old,
-                   int *fatal) {
+                   int *fatal, double *seconds) {
   char err[2048];
   struct ckpt_info info;
   if (ckpt_info(path, &info, err, sizeof err)) {
@@ -114,6 +115,7 @@ static int try_one(const char *dir, const char *path, int n_set, char *const *se
   struct state_list L = {0};
   sim_state(S, &L);
   output_state(o, &L);
+  const double t0 = timer_now();
   const int rc = ckpt_read(path, &L, err, sizeof err);
   state_free(&L);
   if (!rc && S->step != info.step)
@@ -130,6 +132,7 @@ static int try_one(const char *dir, const char *path, int n_set, char *const *se
   const size_t differ = sim_restored(S);
   if (differ)
     die("restoring %s is not bitwise: %zu wall values differ from the stored ones", path, differ);
+  *seconds = timer_now() - t0;
   return CHANSPH_OK;
 }
 
@@ -147,10 +150,11 @@ int restart_resume(const char *dir, int n_set, char *const *set, struct scene *s
   memset(&sk, 0, sizeof sk);
   struct scene old;
   int fatal = 0, found = -1;
+  double seconds = 0.0;
   char path[4096];
   for (int i = n - 1; i >= 0 && !fatal && found < 0; i--) {
     rotate_path(path, sizeof path, dir, steps[i]);
-    if (!try_one(dir, path, n_set, set, sc, S, o, &sk, &old, &fatal)) found = i;
+    if (!try_one(dir, path, n_set, set, sc, S, o, &sk, &old, &fatal, &seconds)) found = i;
   }
   free(steps);
   if (fatal) return CHANSPH_ERR;
@@ -161,7 +165,8 @@ int restart_resume(const char *dir, int n_set, char *const *set, struct scene *s
         dir, n);
     return CHANSPH_ERR;
   }
-  output_log(o, "resume: from %s (step %ld, t = %.9g s)\n", path, S->step, S->t);
+  output_log(o, "resume: from %s (step %ld, t = %.9g s; read and restored in %.3f s)\n", path,
+             S->step, S->t, seconds);
   if (tmp) output_log(o, "resume: removed %d temporary file(s) of interrupted writes\n", tmp);
   for (int i = 0; i < sk.n; i++) {
     char to[4200];

@@ -28,6 +28,26 @@ static const double MARGIN_FIXED = 1.0;
 /** Write rate assumed before the first checkpoint of a process was timed [bytes/s]. */
 static const double RATE_GUESS = 50e6;
 
+/** Wall clock at trigger_mark_start() [s], or 0. */
+static double process_start;
+
+static void install_handlers(void) {
+  struct sigaction sa;
+  memset(&sa, 0, sizeof sa);
+  sa.sa_handler = on_signal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGTERM, &sa, NULL);
+  sigaction(SIGUSR1, &sa, NULL);
+  sa.sa_flags = SA_RESETHAND; /* a second Ctrl-C interrupts at once */
+  sigaction(SIGINT, &sa, NULL);
+  signal(SIGXFSZ, SIG_IGN); /* a file-size limit: write() fails with EFBIG, reported */
+}
+
+void trigger_mark_start(void) {
+  process_start = timer_now();
+  install_handlers();
+}
+
 void trigger_init(struct trigger *T, const char *dir, const struct scene *sc, double walltime,
                   long max_steps, long step, double state_bytes) {
   memset(T, 0, sizeof *T);
@@ -40,16 +60,9 @@ void trigger_init(struct trigger *T, const char *dir, const struct scene *sc, do
   T->last_step = step;
   T->bytes = state_bytes;
   T->write_seconds = 0.2 + state_bytes / RATE_GUESS;
-  struct sigaction sa;
-  memset(&sa, 0, sizeof sa);
-  sa.sa_handler = on_signal;
-  sigemptyset(&sa.sa_mask);
-  sigaction(SIGTERM, &sa, NULL);
-  sigaction(SIGUSR1, &sa, NULL);
-  sa.sa_flags = SA_RESETHAND; /* a second Ctrl-C interrupts at once */
-  sigaction(SIGINT, &sa, NULL);
-  signal(SIGXFSZ, SIG_IGN); /* a file-size limit: write() fails with EFBIG, reported */
-  T->wall_start = T->last_wall = T->step_wall = timer_now();
+  if (!process_start) install_handlers();
+  T->last_wall = T->step_wall = timer_now();
+  T->wall_start = process_start ? process_start : T->last_wall;
 }
 
 static int stop_file(struct trigger *T) {

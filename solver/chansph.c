@@ -89,6 +89,7 @@ static int run(struct scene *sc, const struct cli *c) {
 }
 
 int main(int argc, char **argv) {
+  trigger_mark_start();
   MPI_Init(&argc, &argv);
   int size = 1, rc = 0;
   MPI_Comm_size(MPI_COMM_WORLD, &size);

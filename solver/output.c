@@ -199,7 +199,7 @@ void output_begin(struct output *o, struct sim *S) {
   struct diag d;
   record(o, S, &d);
   o->wall0 = o->last_wall = timer_now();
-  o->t0 = S->t, o->last_step = S->step;
+  o->t0 = S->t, o->last_step = o->step0 = S->step;
   output_log(o,
              "chansph %s: %zu fluid + %zu vertex particles, h = %.6g, dt limits: acoustic "
              "%.3e s, viscous %.3e s; output in %s\n",
@@ -211,7 +211,7 @@ void output_begin(struct output *o, struct sim *S) {
 void output_resume(struct output *o, struct sim *S) {
   timer_reset(); /* the phase report covers this process's steps */
   o->wall0 = o->last_wall = timer_now();
-  o->t0 = S->t, o->last_step = S->step;
+  o->t0 = S->t, o->last_step = o->step0 = S->step;
   output_log(o, "chansph %s: resumed at step %ld, t = %.9g s: %zu fluid + %zu vertex particles\n",
              CHANSPH_VERSION, S->step, S->t, S->P.n_fluid, S->P.n_vertex);
 }
@@ -278,7 +278,7 @@ int output_finish(struct output *o, struct sim *S) {
   TRY(write_stats(o, S));
   if (S->sc->particles) TRY(write_particles(o, S));
   output_log(o, "finished: %ld steps, t = %.6g s in %.2f s wall (%.3e particle-steps/s)\n", S->step,
-             S->t, wall, wall > 0 ? (double)S->P.n_fluid * S->step / wall : 0.0);
+             S->t, wall, wall > 0 ? (double)S->P.n_fluid * (S->step - o->step0) / wall : 0.0);
   timer_report(stdout, wall);
   if (o->log) timer_report(o->log, wall);
   output_log(o, "results: %s/stats.nc%s\n", o->dir, S->sc->particles ? ", particles.nc" : "");

@@ -25,6 +25,7 @@ struct output {
   double t0;           /*!< simulated time at the start of the loop [s] */
   double last_wall;    /*!< wall clock of the last log line [s] */
   long last_step;      /*!< step of the last log line */
+  long step0;          /*!< step at the start of the loop (0, or where a resume started) */
 };
 
 /**
