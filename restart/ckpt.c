@@ -188,8 +188,8 @@ static int sync_path(const char *path, int dir) {
 /* The file is built in memory (HDF5 core driver) and written to disk when it is closed: one
    large write, and a full disk or a file-size limit fails cleanly in H5Fclose (with the sec2
    driver, HDF5 1.10 crashes at exit after a failed close). */
-int ckpt_write(const char *path, const struct state_list *L, const char *scene, long step,
-               double time, char *err, size_t errlen) {
+int ckpt_write_fields(const char *path, const char *format, const struct state_list *L,
+                      const char *scene, long step, double time, char *err, size_t errlen) {
   H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
   char tmp[4096];
   snprintf(tmp, sizeof tmp, "%s.tmp", path);
@@ -198,7 +198,8 @@ int ckpt_write(const char *path, const struct state_list *L, const char *scene, 
   H5Pset_obj_track_times(fcpl, 0);
   H5Pset_obj_track_times(gcpl, 0);
   H5Pset_libver_bounds(fapl, H5F_LIBVER_V18, H5F_LIBVER_V18); /* checksummed metadata */
-  H5Pset_fapl_core(fapl, (size_t)1 << 20, 1);
+  /* one allocation for the whole file: the state plus room for the metadata */
+  H5Pset_fapl_core(fapl, ckpt_state_bytes(L) + (scene ? strlen(scene) : 0) + ((size_t)1 << 20), 1);
   const hid_t file = H5Fcreate(tmp, H5F_ACC_TRUNC, fcpl, fapl);
   H5Pclose(fcpl), H5Pclose(fapl);
   if (file < 0) {
@@ -210,7 +211,7 @@ int ckpt_write(const char *path, const struct state_list *L, const char *scene, 
   int rc = 0;
   const int64_t step64 = step;
   const int32_t major = CKPT_VERSION_MAJOR, minor = CKPT_VERSION_MINOR;
-  if (put_attr_text(file, "format", CKPT_FORMAT) ||
+  if (put_attr_text(file, "format", format) ||
       put_attr_num(file, "format_version_major", H5T_STD_I32LE, H5T_NATIVE_INT32, &major) ||
       put_attr_num(file, "format_version_minor", H5T_STD_I32LE, H5T_NATIVE_INT32, &minor) ||
       put_attr_text(file, "code_version", CHANSPH_VERSION) ||
@@ -221,7 +222,7 @@ int ckpt_write(const char *path, const struct state_list *L, const char *scene, 
   }
   char *scene_copy = (char *)scene;
   struct state_field sf = {.name = "scene", .type = STATE_TEXT, .data = &scene_copy};
-  if (!rc && write_field(file, &sf, gcpl)) {
+  if (!rc && scene && write_field(file, &sf, gcpl)) {
     fail(err, errlen, "cannot write dataset /scene of checkpoint %s", tmp);
     rc = 1;
   }
@@ -261,6 +262,11 @@ int ckpt_write(const char *path, const struct state_list *L, const char *scene, 
     return 1;
   }
   return 0;
+}
+
+int ckpt_write(const char *path, const struct state_list *L, const char *scene, long step,
+               double time, char *err, size_t errlen) {
+  return ckpt_write_fields(path, CKPT_FORMAT, L, scene, step, time, err, errlen);
 }
 
 static int get_attr_int(hid_t obj, const char *name, hid_t mtype, void *v) {

@@ -45,6 +45,14 @@ int ckpt_write(const char *path, const struct state_list *L, const char *scene, 
                double time, char *err, size_t errlen);
 
 /**
+ * @brief The writer behind ckpt_write(), for other HDF5 files of the same rules (particle
+ *        snapshots): root attribute "format" = format, version, step, time, completion mark.
+ * @param[in] scene scene text for dataset /scene, or NULL for none
+ */
+int ckpt_write_fields(const char *path, const char *format, const struct state_list *L,
+                      const char *scene, long step, double time, char *err, size_t errlen);
+
+/**
  * @brief Open a checkpoint and check it: HDF5 structure, format name, version (a newer major
  *        version is refused), completion mark; read step, time and scene text.
  * @param[in] path file

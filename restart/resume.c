@@ -28,7 +28,8 @@ static const char *const changeable[] = {"time.t_end",
                                          "run.threads",
                                          "checkpoint.every_steps",
                                          "checkpoint.every_minutes",
-                                         "checkpoint.keep"};
+                                         "checkpoint.keep",
+                                         "snapshots.every"};
 enum { N_CHANGEABLE = sizeof changeable / sizeof changeable[0] };
 
 static int is_changeable(const char *key) {

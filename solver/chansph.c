@@ -15,6 +15,7 @@
 #include "output.h"
 #include "restart.h"
 #include "run.h"
+#include "snapshot.h"
 
 /** Write a checkpoint and tell the triggers how long it took. */
 static int save(struct output *out, struct sim *S, struct trigger *T) {
@@ -63,6 +64,10 @@ static int run(struct scene *sc, const struct cli *c) {
       break;
     }
     output_step(&out, &S);
+    if (snapshot_due(&S) && snapshot_write(out.dir, &S)) {
+      rc = EXIT_IOERR;
+      break;
+    }
     why = trigger_check(&T, S.step);
     if (why == TRIG_NONE) continue;
     if (save(&out, &S, &T)) {

@@ -163,6 +163,10 @@ static const struct key keys[] = {
     {"checkpoint", "keep", T_INT, "3", 1, 1e6, 0, NULL, "-",
      "Checkpoints kept in DIR/checkpoints; older ones are deleted after a successful write.",
      OFF(ckpt_keep)},
+    {"snapshots", "every", T_DOUBLE, "0", 0, BIG, 0, NULL, "s",
+     "Simulated time between particle snapshots DIR/snapshots/snap_<step>.h5 with the index "
+     "DIR/snapshots/particles.xdmf for ParaView (0 = none; docs/formats.md).",
+     OFF(snap_every)},
 };
 enum { N_KEYS = sizeof keys / sizeof keys[0] };
 

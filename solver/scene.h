@@ -75,6 +75,8 @@ struct scene {
   long ckpt_every_steps;     /*!< steps between checkpoints; 0 = not by steps */
   double ckpt_every_minutes; /*!< wall-clock minutes between checkpoints; 0 = not by time */
   int ckpt_keep;             /*!< checkpoints kept in DIR/checkpoints */
+  /* [snapshots] */
+  double snap_every; /*!< simulated time between particle snapshots [s]; 0 = none */
 
   /* bookkeeping, not keys */
   char path[512]; /*!< scene file path */

@@ -25,6 +25,14 @@ for f in stats.nc particles.nc; do
     echo "$name $f: DIFFERENT"; status=1
   fi
 done
+if [ -d "$full/snapshots" ]; then
+  snaps=$(cd "$full/snapshots" && ls snap_*.h5)
+  [ "$snaps" = "$(cd "$part/snapshots" && ls snap_*.h5)" ] || { echo "$name snapshots: DIFFERENT files"; status=1; }
+  for s in $snaps; do
+    h5diff "$full/snapshots/$s" "$part/snapshots/$s" > /dev/null || { echo "$name $s: DIFFERENT"; status=1; }
+  done
+  echo "$name snapshots: $(echo $snaps | wc -w) files compared"
+fi
 last=$(cd "$full/checkpoints" && ls ckpt_*.h5 | tail -n 1)
 if h5diff "$full/checkpoints/$last" "$part/checkpoints/$last" > /dev/null; then
   echo "$name $last: h5diff finds no difference"
