@@ -132,6 +132,32 @@ int restart_save(struct output *o, struct sim *S, double *seconds) {
   return CHANSPH_OK;
 }
 
+/* Snapshots of an earlier run: refused, or removed with --overwrite (with their index). */
+static int remove_snapshots(const char *dir, int overwrite) {
+  char path[4096];
+  snprintf(path, sizeof path, "%s/snapshots", dir);
+  DIR *d = opendir(path);
+  if (!d) return CHANSPH_OK;
+  int rc = CHANSPH_OK;
+  for (struct dirent *e; (e = readdir(d)) && rc == CHANSPH_OK;) {
+    if (strncmp(e->d_name, "snap_", 5) && strcmp(e->d_name, "particles.xdmf")) continue;
+    char file[4400];
+    snprintf(file, sizeof file, "%s/%s", path, e->d_name);
+    if (!overwrite) {
+      error_input(
+          "%s: the output directory holds snapshots of an earlier run; choose another "
+          "--out DIR or pass --overwrite",
+          file);
+      rc = CHANSPH_ERR;
+    } else if (remove(file)) {
+      error_input("%s: cannot remove (%s)", file, strerror(errno));
+      rc = CHANSPH_ERR;
+    }
+  }
+  closedir(d);
+  return rc;
+}
+
 int restart_prepare_new(const char *dir, int overwrite) {
   long *steps;
   const int n = rotate_list(dir, &steps);
@@ -153,5 +179,5 @@ int restart_prepare_new(const char *dir, int overwrite) {
   }
   free(steps);
   if (rc == CHANSPH_OK) rotate_remove_tmp(dir);
-  return rc;
+  return rc == CHANSPH_OK ? remove_snapshots(dir, overwrite) : rc;
 }
