@@ -107,7 +107,14 @@ static int try_one(const char *dir, const char *path, int n_set, char *const *se
     *fatal = 1;
     return CHANSPH_ERR;
   }
-  sim_init(S, sc);
+  /* the initial condition is replaced by the checkpoint: do not read init.from again */
+  struct scene bare = *sc;
+  bare.init_from[0] = '\0';
+  if (sim_init(S, &bare)) {
+    *fatal = 1;
+    return CHANSPH_ERR;
+  }
+  S->sc = sc;
   if (output_reopen(o, dir, sc)) {
     sim_free(S);
     *fatal = 1;

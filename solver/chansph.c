@@ -44,9 +44,11 @@ static int run(struct scene *sc, const struct cli *c) {
     if (restart_resume(c->out, c->n_set, c->set, sc, &S, &out)) return EXIT_INPUT;
     output_resume(&out, &S);
   } else {
-    if (restart_prepare_new(c->out, c->overwrite) || output_open(&out, c->out, sc, c->overwrite))
+    if (sim_init(&S, sc)) return EXIT_INPUT; /* before the run directory exists */
+    if (restart_prepare_new(c->out, c->overwrite) || output_open(&out, c->out, sc, c->overwrite)) {
+      sim_free(&S);
       return EXIT_INPUT;
-    sim_init(&S, sc);
+    }
     output_begin(&out, &S);
   }
   if (sc->threads > 0) omp_set_num_threads(sc->threads);

@@ -135,7 +135,7 @@ int cli_bench_scene(struct scene *sc, const struct cli *c) {
 int cli_bench(const struct scene *sc, long steps) {
   struct sim S;
   const double t_setup = timer_now();
-  sim_init(&S, sc);
+  if (sim_init(&S, sc)) return 1;
   const double setup = timer_now() - t_setup;
   long nbr = 0;
   for (size_t a = 0; a < S.P.n; a++)

@@ -38,6 +38,11 @@ struct particles {
   double *pr2;          /*!< p / rho^2 [m^5/(kg s^2)] */
   double *vol;          /*!< volume m / rho [m^dim] */
   double *ax, *ay, *az; /*!< acceleration without the driving force [m/s^2] */
+  /* turbulence model (turb.h), allocated only when used, NULL otherwise; recomputed from the
+     state after every step, so not permuted */
+  double *nur;       /*!< eddy viscosity nu_r [m^2/s] */
+  double *kr;        /*!< residual kinetic energy k_r [m^2/s^2] */
+  double *twx, *twz; /*!< wall-law stress u_tau^2 e_t of the nearest wall [m^2/s^2] */
   /* sort scratch */
   double *tmp;
   int64_t *tmp_i;
@@ -45,9 +50,10 @@ struct particles {
 
 /** Wall values on the vertex lattice: index (wall * nx + i) * nz + k, wall 0 at y = 0. */
 struct walls {
-  int nx, nz;  /*!< vertices per wall along x and z */
-  double *rho; /*!< wall density [kg/m^3] */
-  double *p;   /*!< wall pressure [Pa] */
+  int nx, nz;      /*!< vertices per wall along x and z */
+  double *rho;     /*!< wall density [kg/m^3] */
+  double *p;       /*!< wall pressure [Pa] */
+  double *tx, *tz; /*!< wall stress rho_s u_tau u_tau (Ferrand Eq. 38) [Pa]; NULL unless used */
 };
 
 /**

@@ -5,23 +5,34 @@
 #include <string.h>
 
 #include "error.h"
+#include "init.h"
 #include "reduce.h"
 #include "timers.h"
+#include "turb.h"
 
-/** Laminar Poiseuille velocity of a body acceleration f: u = f y (2 delta - y) / (2 nu). */
-static double laminar_u(const struct scene *sc, double y) {
-  double f = sc->force;
-  if (sc->drive_mode == DRIVE_FLUX) f = 3.0 * sc->nu * sc->u_bulk / (sc->delta * sc->delta);
-  return f * y * (2.0 * sc->delta - y) / (2.0 * sc->nu);
+double sim_viscosity(const struct scene *sc, double t) {
+  if (!(sc->nu_start > 0.0) || t >= sc->nu_ramp_end) return sc->nu;
+  if (t <= sc->nu_ramp_begin) return sc->nu_start;
+  const double f = (t - sc->nu_ramp_begin) / (sc->nu_ramp_end - sc->nu_ramp_begin);
+  return sc->nu_start + f * (sc->nu - sc->nu_start);
 }
 
-void sim_init(struct sim *S, const struct scene *sc) {
+/* Model terms of the current state, at the viscosity of the schedule. */
+static void model_update(struct sim *S) {
+  S->M.nu = sim_viscosity(S->sc, S->t);
+  S->nu_max = turb_update(&S->M, &S->P, &S->nb, &S->W);
+}
+
+int sim_init(struct sim *S, const struct scene *sc) {
   memset(S, 0, sizeof *S);
   S->sc = sc;
   sph_model_init(&S->M, sc);
   part_create(&S->P, &S->W, sc);
-  if (sc->init_profile == INIT_LAMINAR)
-    for (size_t a = 0; a < S->P.n_fluid; a++) S->P.u[a] = laminar_u(sc, S->P.y[a]);
+  turb_init(&S->M, &S->P, &S->W);
+  if (init_fields(sc, &S->P)) {
+    part_destroy(&S->P, &S->W);
+    return CHANSPH_ERR;
+  }
   for (int k = 0; k < 4; k++) S->scratch[k] = part_alloc("diag_scratch", S->P.n * sizeof(double));
   S->ksum_new = part_alloc("kernel_sum_new", S->P.n * sizeof(double));
   nbr_init(&S->nb, sc, S->P.n);
@@ -31,9 +42,12 @@ void sim_init(struct sim *S, const struct scene *sc) {
   nbr_build(&S->nb, &S->P, &S->M.k, S->ksum_new);
   sph_density(&S->M, &S->P, S->ksum_new, 0.0);
   sph_walls(&S->M, &S->P, &S->nb, &S->W);
+  model_update(S);
+  return CHANSPH_OK;
 }
 
 void sim_free(struct sim *S) {
+  turb_free(&S->P, &S->W);
   nbr_free(&S->nb);
   for (int k = 0; k < 4; k++) part_free(S->scratch[k]);
   part_free(S->ksum_new);
@@ -73,7 +87,7 @@ static double time_step(struct sim *S, const struct force_info *fi) {
   const struct scene *sc = S->sc;
   const double h = S->M.h;
   S->dt_limits[0] = sc->cfl * h / sc->c0;
-  S->dt_limits[1] = sc->c_visc * h * h / sc->nu;
+  S->dt_limits[1] = sc->c_visc * h * h / S->nu_max; /* largest nu + nu_r */
   S->dt_limits[2] = fi->amax > 0.0 ? sc->c_force * sqrt(h / fi->amax) : INFINITY;
   S->dt_limits[3] = sc->c_gamma > 0.0 && fi->gvmax > 0.0 ? sc->c_gamma / fi->gvmax : INFINITY;
   if (sc->dt_fixed > 0.0) {
@@ -126,6 +140,7 @@ void sim_step(struct sim *S) {
   nbr_build(&S->nb, P, &S->M.k, S->ksum_new);
   sph_density(&S->M, P, S->ksum_new, dt);
   sph_walls(&S->M, P, &S->nb, &S->W);
+  model_update(S);
 }
 
 void sim_diag(struct sim *S, struct diag *d) {
@@ -208,6 +223,7 @@ size_t sim_restored(struct sim *S) {
      and gamma are set to the values they already hold */
   sph_density(&S->M, P, P->ksum, 0.0);
   sph_walls(&S->M, P, &S->nb, &S->W);
+  model_update(S);
   size_t differ = 0;
   for (size_t i = 0; i < nv; i++)
     differ += memcmp(&old[i], &S->W.rho[i], sizeof(double)) != 0 ||

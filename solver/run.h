@@ -26,6 +26,7 @@ struct sim {
   double dt;              /*!< last time step [s] */
   double fx;              /*!< last streamwise body acceleration [m/s^2] */
   double dt_limits[4];    /*!< last limits: acoustic, viscous, force, wall [s] */
+  double nu_max;          /*!< largest nu + nu_r of the current state [m^2/s] */
   double *scratch[4];     /*!< per-particle scratch for deterministic sums */
   double *ksum_new;       /*!< kernel sums at the new positions, from the neighbour pass */
   char violation[320];    /*!< a fixed dt broke a stability limit: what, where (else empty) */
@@ -42,12 +43,18 @@ struct diag {
   double min_gamma;        /*!< [-] */
 };
 
+/** @brief Kinematic viscosity of the schedule at time t (fluid.nu_start ramped to fluid.nu;
+           the Jimenez-Moin start-up of thesis Sec. 6.1.1) [m^2/s]. */
+double sim_viscosity(const struct scene *sc, double t);
+
 /**
- * @brief Create particles from the scene, sort them, compute kernel sums, gamma and wall values.
+ * @brief Create particles from the scene, sort them, compute kernel sums, gamma, wall values
+ *        and the model terms.
  * @param[out] S simulation
  * @param[in] sc validated scene (kept by pointer)
+ * @return CHANSPH_OK, or CHANSPH_ERR after a message (init.from unreadable or mismatched)
  */
-void sim_init(struct sim *S, const struct scene *sc);
+int sim_init(struct sim *S, const struct scene *sc);
 
 /** @brief Free the simulation. */
 void sim_free(struct sim *S);

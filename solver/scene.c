@@ -13,7 +13,7 @@
 
 #include "error.h"
 
-enum key_type { T_INT, T_LONG, T_DOUBLE, T_CHOICE };
+enum key_type { T_INT, T_LONG, T_DOUBLE, T_CHOICE, T_STRING };
 enum { REQUIRED = 1, LO_OPEN = 2 };
 
 /** One scene key: where it lives, its type, default, range and documentation. */
@@ -73,6 +73,12 @@ static const struct key keys[] = {
      "lattice, as a function of the wall distance (lattice): the same equilibrium, but a "
      "uniform pressure still resists wall-normal disorder (docs/theory.md).",
      OFF(wall_pressure)},
+    {"sph", "pressure_gradient", T_CHOICE, "standard", 0, 0, 0, "standard|corrected", "-",
+     "Pressure gradient: the symmetric Grad^{gamma,1} with its wall term (thesis Eq. 3.17), or "
+     "the first-order corrected difference form Eq. 2.90 (k = 0) with the matrix L of Eq. "
+     "2.88 built from fluid and vertex neighbours, exact for linear pressure fields and without "
+     "a wall term (Sec. 6.2.2-6.2.3; docs/theory.md).",
+     OFF(pgrad)},
     {"sph", "wall_dmin", T_DOUBLE, "1", 0, BIG, LO_OPEN, NULL, "dr",
      "Lower bound delta r of the wall distance in the wall shear term (thesis Eq. 2.148), in "
      "units of dr.",
@@ -80,6 +86,43 @@ static const struct key keys[] = {
     {"sph", "eta2", T_DOUBLE, "1e-4", 0, 1, 0, NULL, "h^2",
      "Regularisation added to r^2 in the viscous term (thesis Sec. 2.3.3), in units of h^2.",
      OFF(eta2)},
+    {"les", "model", T_CHOICE, "none", 0, 0, 0, "none|smagorinsky", "-",
+     "Sub-grid model: none (quasi-DNS: no model term is computed) or the Smagorinsky eddy "
+     "viscosity nu_r = l_S^2 S (thesis Eq. 5.45-5.47); needs sph.viscous = violeau (Eq. 2.100 "
+     "with variable viscosity).",
+     OFF(les)},
+    {"les", "cs", T_DOUBLE, "0.065", 0, 1, LO_OPEN, NULL, "-",
+     "Smagorinsky constant C_S: 0.065 (Moin & Kim 1982, used in the thesis) or 0.158 (Lilly's "
+     "analysis for the Wendland kernel, thesis App. B).",
+     OFF(cs)},
+    {"les", "filter_width", T_DOUBLE, "2", 0, 10, LO_OPEN, NULL, "h",
+     "Filter width Delta_G in units of h (thesis Sec. 5.2.2.1: 2h for the Wendland kernel).",
+     OFF(filter_h)},
+    {"les", "strain", T_CHOICE, "gradient", 0, 0, 0, "gradient|violeau_issa", "-",
+     "Rate of strain S = (2 S:S)^(1/2) from the full velocity gradient (first-order corrected, "
+     "thesis Eq. 2.88-2.90) or from the Violeau-Issa estimate with its wall term (Eq. 5.48; "
+     "docs/theory.md).",
+     OFF(strain)},
+    {"les", "van_driest", T_INT, "1", 0, 1, 0, NULL, "-",
+     "van Driest damping l_S = C_S Delta_G (1 - exp(-y+/A+)) (thesis Eq. 5.50 with the sign "
+     "corrected), y+ from the local friction velocity of the nearest wall; also damps k_r.",
+     OFF(van_driest)},
+    {"les", "a_plus", T_DOUBLE, "25", 0, BIG, LO_OPEN, NULL, "-", "A+ of the van Driest damping.",
+     OFF(a_plus)},
+    {"les", "cy", T_DOUBLE, "0.044", 0, 1, 0, NULL, "-",
+     "Yoshizawa constant C_Y of the residual kinetic energy k_r = 2 C_Y (Delta_G S)^2 (thesis "
+     "Eq. 5.49), added to the pressure as 2/3 rho k_r (Eq. 5.42); 0 leaves it out.",
+     OFF(cy)},
+    {"wall", "law", T_CHOICE, "laminar", 0, 0, 0, "laminar|log|reichardt", "-",
+     "Wall law of the wall shear term: laminar (thesis Eq. 2.146-2.148, the particle's own "
+     "velocity), log law (Eq. 5.51, linear below y+ = 11.06) or Reichardt (Eq. 5.53); the "
+     "turbulent laws are solved for u_tau per near-wall particle and carried to the wall "
+     "vertices (Ferrand Eq. 38).",
+     OFF(wall_law)},
+    {"wall", "kappa", T_DOUBLE, "0.41", 0, 1, LO_OPEN, NULL, "-",
+     "von Karman constant of the wall laws (thesis Eq. 5.33).", OFF(kappa)},
+    {"wall", "b", T_DOUBLE, "5.2", -BIG, BIG, 0, NULL, "-",
+     "Intercept B of the log law (thesis Eq. 5.33).", OFF(log_b)},
     {"fluid", "nu", T_DOUBLE, NULL, 0, BIG, REQUIRED | LO_OPEN, NULL, "m^2/s",
      "Kinematic viscosity.", OFF(nu)},
     {"fluid", "rho0", T_DOUBLE, "1000", 0, BIG, LO_OPEN, NULL, "kg/m^3", "Reference density.",
@@ -97,6 +140,14 @@ static const struct key keys[] = {
      "Wall-normal body acceleration; enters the momentum equation, the wall pressure "
      "(thesis Eq. 2.143, 3.63) and the volume diffusion (Eq. 3.61).",
      OFF(gravity_y)},
+    {"fluid", "nu_start", T_DOUBLE, "0", 0, BIG, 0, NULL, "m^2/s",
+     "Viscosity schedule (Jimenez & Moin 1991, thesis Sec. 6.1.1): nu_start until "
+     "nu_ramp_begin, then linear in time to nu at nu_ramp_end; 0 = constant nu.",
+     OFF(nu_start)},
+    {"fluid", "nu_ramp_begin", T_DOUBLE, "0", 0, BIG, 0, NULL, "s", "Start of the viscosity ramp.",
+     OFF(nu_ramp_begin)},
+    {"fluid", "nu_ramp_end", T_DOUBLE, "0", 0, BIG, 0, NULL, "s",
+     "End of the viscosity ramp (at least nu_ramp_begin).", OFF(nu_ramp_end)},
     {"drive", "mode", T_CHOICE, "force", 0, 0, 0, "force|flux", "-",
      "Drive the flow by a constant body force or by a controlled volume flux.", OFF(drive_mode)},
     {"drive", "force", T_DOUBLE, "0", -BIG, BIG, 0, NULL, "m/s^2",
@@ -127,10 +178,40 @@ static const struct key keys[] = {
      OFF(c_gamma)},
     {"time", "max_steps", T_LONG, "0", 0, 1e18, 0, NULL, "-",
      "Stop after this many steps even if t_end is not reached (0 = no limit).", OFF(max_steps)},
-    {"init", "profile", T_CHOICE, "rest", 0, 0, 0, "rest|laminar", "-",
-     "Initial velocity: at rest, or the laminar Poiseuille profile of the force (force mode) "
-     "or of the target bulk velocity (flux mode).",
+    {"init", "profile", T_CHOICE, "rest", 0, 0, 0, "rest|laminar|reichardt", "-",
+     "Initial mean velocity: at rest; the laminar Poiseuille profile of the force (force mode) "
+     "or of the target bulk velocity (flux mode); or Reichardt's turbulent profile (thesis Eq. "
+     "5.53) with u_tau = (force delta)^(1/2) (force mode) or the u_tau whose profile has the "
+     "target bulk velocity (flux mode).",
      OFF(init_profile)},
+    {"init", "streaks", T_DOUBLE, "0", 0, BIG, 0, NULL, "m/s",
+     "Amplitude of streamwise streaks u' = A 4 (y/2delta)(1 - y/2delta) cos(2 pi k z / lz) "
+     "(3-D; divergence-free).",
+     OFF(init_streaks)},
+    {"init", "streak_kz", T_INT, "2", 1, 1e6, 0, NULL, "-", "Streak pairs across lz.",
+     OFF(init_streak_kz)},
+    {"init", "modes", T_DOUBLE, "0", 0, BIG, 0, NULL, "m/s",
+     "Amplitude of divergence-free sinusoidal modes: spanwise rolls from the stream function "
+     "psi(x, y) and, in 3-D, streamwise rolls from psi(y, z), both vanishing with their "
+     "normal derivative at the walls (thesis Sec. 6.1.1; docs/theory.md).",
+     OFF(init_modes)},
+    {"init", "mode_kx", T_INT, "1", 1, 1e6, 0, NULL, "-", "Periods of the modes along lx.",
+     OFF(init_mode_kx)},
+    {"init", "mode_kz", T_INT, "1", 1, 1e6, 0, NULL, "-", "Periods of the modes along lz.",
+     OFF(init_mode_kz)},
+    {"init", "noise", T_DOUBLE, "0", 0, BIG, 0, NULL, "m/s",
+     "Amplitude of uniform random noise on each velocity component, from the counter-based "
+     "Philox generator (Random123) keyed by seed and particle id: independent of threads and "
+     "ranks.",
+     OFF(init_noise)},
+    {"init", "seed", T_LONG, "1", 0, 1e15, 0, NULL, "-", "Key of the random noise.",
+     OFF(init_seed)},
+    {"init", "from", T_STRING, "", 0, 0, 0, NULL, "-",
+     "particles.nc of an earlier run with the same domain: with the same particle count its "
+     "positions and velocities are taken as they are (by id); otherwise its velocity field is "
+     "interpolated (Shepard) onto this scene's lattice, e.g. a coarse LES to start a finer "
+     "run. Overrides profile; streaks, modes and noise are added on top.",
+     OFF(init_from)},
     {"output", "log_every", T_INT, "100", 1, 1e9, 0, NULL, "steps",
      "Steps between progress lines (stdout and DIR/log.txt).", OFF(log_every)},
     {"output", "series_every", T_INT, "10", 1, 1e9, 0, NULL, "steps",
@@ -208,6 +289,11 @@ static const char *set_value(struct scene *s, int k, const char *text) {
   const struct key *K = &keys[k];
   char *end = NULL;
   void *field = (char *)s + K->offset;
+  if (K->type == T_STRING) { /* char[512] fields */
+    if (strlen(text) >= 512) return "is longer than 511 characters";
+    strcpy((char *)field, text);
+    return NULL;
+  }
   if (K->type == T_CHOICE) {
     const size_t len = strlen(text);
     int idx = 0;
@@ -238,6 +324,10 @@ static const char *set_value(struct scene *s, int k, const char *text) {
 }
 
 static void range_text(const struct key *K, char *buf, size_t n) {
+  if (K->type == T_STRING) {
+    snprintf(buf, n, "text");
+    return;
+  }
   if (K->type == T_CHOICE) {
     snprintf(buf, n, "%s", K->choices);
     return;
@@ -345,6 +435,18 @@ static void validate(struct parse_state *ps) {
   if (s->drive_mode == DRIVE_FLUX && s->u_bulk == 0.0)
     inconsistent(ps, "drive.mode", "flux mode needs drive.u_bulk != 0 (got %g)%.0s", s->u_bulk,
                  0.0);
+  if (s->les != LES_NONE && s->viscous != VISCOUS_VIOLEAU)
+    inconsistent(ps, "les.model",
+                 "the eddy viscosity needs the variable-viscosity operator: set sph.viscous = "
+                 "violeau (thesis Eq. 2.100)%.0s%.0s",
+                 0.0, 0.0);
+  if ((s->les != LES_NONE || s->wall_law != 0) && two_delta < 4.0 * h * (1.0 - 1e-12))
+    inconsistent(ps, "domain.delta",
+                 "wall laws and LES need 2 delta = %g >= 4h = %g (no particle near both walls)",
+                 two_delta, 4.0 * h);
+  if (s->nu_start > 0.0 && s->nu_ramp_end < s->nu_ramp_begin)
+    inconsistent(ps, "fluid.nu_ramp_end", "the ramp ends (%g) before it begins (%g)",
+                 s->nu_ramp_end, s->nu_ramp_begin);
   if (s->t_average_start > s->t_end)
     inconsistent(ps, "output.t_average_start", "averaging start %g is after t_end = %g",
                  s->t_average_start, s->t_end);
@@ -465,6 +567,9 @@ static void value_text(const struct scene *s, int k, char *buf, size_t n) {
       }
       break;
     }
+    case T_STRING:
+      snprintf(buf, n, "%s", (const char *)field);
+      break;
     case T_CHOICE: {
       char key[80];
       snprintf(key, sizeof key, "%s.%s", keys[k].section, keys[k].name);
@@ -481,7 +586,7 @@ char *scene_text(const struct scene *s) {
   out[0] = '\0';
   const char *section = "";
   for (int k = 0; k < N_KEYS; k++) {
-    char val[64], line[256];
+    char val[600], line[800];
     value_text(s, k, val, sizeof val);
     int m = 0;
     if (strcmp(section, keys[k].section)) {

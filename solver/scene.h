@@ -18,7 +18,10 @@ enum wall_pressure {
   WALL_PRESSURE_ANALYTIC = 2
 };
 enum laplacian_norm { LAPNORM_WALL_NORMAL = 0, LAPNORM_TRACE = 1, LAPNORM_NONE = 2 };
-enum init_profile { INIT_REST = 0, INIT_LAMINAR = 1 };
+enum init_profile { INIT_REST = 0, INIT_LAMINAR = 1, INIT_REICHARDT = 2 };
+enum les_model { LES_NONE = 0, LES_SMAGORINSKY = 1 };
+enum les_strain { STRAIN_GRADIENT = 0, STRAIN_VIOLEAU_ISSA = 1 };
+enum pressure_gradient { PGRAD_STANDARD = 0, PGRAD_CORRECTED = 1 };
 
 /** Every parameter of a run, with units. Derived quantities are marked. */
 struct scene {
@@ -37,6 +40,19 @@ struct scene {
   int lap_norm;      /*!< enum laplacian_norm */
   int wall_weight;   /*!< enum wall_weight */
   int wall_pressure; /*!< enum wall_pressure */
+  int pgrad;         /*!< enum pressure_gradient */
+  /* [les] */
+  int les;         /*!< enum les_model */
+  double cs;       /*!< Smagorinsky constant C_S [-] */
+  double filter_h; /*!< filter width Delta_G over h [-] */
+  int strain;      /*!< enum les_strain */
+  int van_driest;  /*!< van Driest damping on (1) or off (0) */
+  double a_plus;   /*!< A+ of the damping [-] */
+  double cy;       /*!< Yoshizawa constant C_Y [-]; 0 = no residual kinetic energy */
+  /* [wall] */
+  int wall_law; /*!< enum wall_law (walllaw.h) */
+  double kappa; /*!< von Karman constant [-] */
+  double log_b; /*!< log-law intercept B [-] */
   /* [fluid] */
   double nu;           /*!< kinematic viscosity [m^2/s] */
   double rho0;         /*!< reference density [kg/m^3] */
@@ -44,6 +60,8 @@ struct scene {
   double zeta;         /*!< Tait exponent [-] */
   double p_background; /*!< background pressure over rho0 c0^2 [-] */
   double gravity_y;    /*!< wall-normal body acceleration [m/s^2] */
+  double nu_start;     /*!< viscosity at t = 0 of the schedule [m^2/s]; 0 = no schedule */
+  double nu_ramp_begin, nu_ramp_end; /*!< the schedule ramps nu_start -> nu over this [s] */
   /* [drive] */
   int drive_mode; /*!< enum drive_mode */
   double force;   /*!< body acceleration along x in force mode [m/s^2] */
@@ -58,7 +76,15 @@ struct scene {
   double c_gamma;  /*!< factor of Eq. 2.163 [-]; 0 disables */
   long max_steps;  /*!< stop after this many steps (0 = no limit) */
   /* [init] */
-  int init_profile; /*!< enum init_profile */
+  int init_profile;    /*!< enum init_profile */
+  double init_streaks; /*!< amplitude of streamwise streaks [m/s] */
+  int init_streak_kz;  /*!< streaks across lz [-] */
+  double init_modes;   /*!< amplitude of the divergence-free sinusoidal modes [m/s] */
+  int init_mode_kx;    /*!< their wavenumber along x (periods in lx) [-] */
+  int init_mode_kz;    /*!< their wavenumber along z (periods in lz) [-] */
+  double init_noise;   /*!< amplitude of the random noise per component [m/s] */
+  long init_seed;      /*!< key of the counter-based generator [-] */
+  char init_from[512]; /*!< particles.nc of an earlier run to start from, or empty */
   /* [output] */
   int log_every;          /*!< steps between log lines */
   int series_every;       /*!< steps between time-series records */

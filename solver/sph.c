@@ -32,7 +32,56 @@ void sph_model_init(struct model *M, const struct scene *s) {
   M->lap_norm = s->lap_norm;
   M->wall_weight = s->wall_weight;
   M->wall_pressure = s->wall_pressure;
+  M->pgrad = s->pgrad;
+  M->les = s->les != LES_NONE;
+  M->strain = s->strain;
+  M->van_driest = s->van_driest;
+  M->cs = s->cs, M->delta_g = s->filter_h * M->h, M->a_plus = s->a_plus;
+  M->cy = s->cy;
+  M->law = wall_law_make(s->wall_law, s->kappa, s->log_b);
+  M->wall_tau = M->les || s->wall_law != WALL_LAW_LAMINAR;
   sph_lattice_excess_table(M);
+  sph_violeau_table(M);
+}
+
+/** Integral over the half-space y > q (units of h) of y^2 F(r) ((n+2) x_t^2 / r^2 + 1), with
+    x_t^2 the mean square of one wall-parallel component (r^2 - y^2)/(n - 1). */
+static double violeau_wall_moment(int dim, double q) {
+  if (q >= 2.0) return 0.0;
+  const struct kernel K = kernel_make(dim, 1.0);
+  const double n = dim, gp = (n + 2.0) / (n - 1.0);
+  enum { PANELS = 8 };
+  double sum = 0.0;
+  for (int py = 0; py < PANELS; py++)
+    for (int iy = 0; iy < 12; iy++) {
+      const double ya = q + (2.0 - q) * py / PANELS, yl = (2.0 - q) / PANELS;
+      const double y = ya + yl * wall_gl12_t[iy], wy = yl * wall_gl12_w[iy];
+      const double rmax = sqrt(fmax(0.0, 4.0 - y * y)); /* radial extent in the plane */
+      double inner = 0.0;
+      for (int pr = 0; pr < PANELS; pr++)
+        for (int ir = 0; ir < 12; ir++) {
+          const double rl = rmax / PANELS, rho = rl * (pr + wall_gl12_t[ir]);
+          const double wr = rl * wall_gl12_w[ir], r2 = rho * rho + y * y, r = sqrt(r2);
+          const double g = y * y * kernel_f(&K, r) * (gp * rho * rho / r2 + 1.0);
+          inner += wr * g * (dim == 3 ? 2.0 * M_PI * rho : 2.0); /* both sides of x in 2-D */
+        }
+      sum += wy * inner;
+    }
+  return sum;
+}
+
+void sph_violeau_table(struct model *M) {
+  for (int k = 0; k <= VIOLEAU_KNOTS; k++)
+    M->vio_m2[k] = violeau_wall_moment(M->dim, 2.0 * k / VIOLEAU_KNOTS);
+}
+
+double sph_violeau_moment(const struct model *M, double q) {
+  if (q >= 2.0) return 0.0;
+  if (q <= 0.0) return M->vio_m2[0];
+  const double f = q * VIOLEAU_KNOTS / 2.0;
+  const int k = (int)f;
+  const double t = f - k;
+  return (1.0 - t) * M->vio_m2[k] + t * M->vio_m2[k + 1];
 }
 
 void sph_lattice_excess_table(struct model *M) {
@@ -128,32 +177,80 @@ void sph_walls(const struct model *M, struct particles *P, const struct nbr *nb,
   timer_pop();
 }
 
-void sph_wall_values(const struct model *M, const struct walls *W, int wall, double x, double z,
-                     double *rho, double *p) {
+/** Foot of a particle on the wall lattice: corner indices and weights of the (bi)linear
+    interpolation (the vertices sit at x = (i + 1/2) dr, z = (k + 1/2) dr). */
+struct foot {
+  size_t c00, c01, c10, c11;
+  double tx, tz;
+};
+
+static inline struct foot wall_foot(const struct model *M, const struct walls *W, int wall,
+                                    double x, double z) {
   const double fx = x / M->dr - 0.5;
   const double ix = floor(fx), tx = fx - ix;
   int i0 = (int)ix % W->nx;
   if (i0 < 0) i0 += W->nx;
   const int i1 = (i0 + 1) % W->nx;
   const size_t off = (size_t)wall * W->nx * W->nz;
-  const double *rw = W->rho + off, *pw = W->p + off;
-  if (M->dim == 2) {
-    *rho = (1.0 - tx) * rw[i0] + tx * rw[i1];
-    *p = (1.0 - tx) * pw[i0] + tx * pw[i1];
-    return;
-  }
+  struct foot f = {off + i0, off + i0, off + i1, off + i1, tx, 0.0};
+  if (M->dim == 2) return f;
   const double fz = z / M->dr - 0.5;
   const double iz = floor(fz), tz = fz - iz;
   int k0 = (int)iz % W->nz;
   if (k0 < 0) k0 += W->nz;
   const int k1 = (k0 + 1) % W->nz;
-  const int nz = W->nz;
-  const size_t c00 = (size_t)i0 * nz + k0, c01 = (size_t)i0 * nz + k1;
-  const size_t c10 = (size_t)i1 * nz + k0, c11 = (size_t)i1 * nz + k1;
-  *rho = (1.0 - tx) * ((1.0 - tz) * rw[c00] + tz * rw[c01]) +
-         tx * ((1.0 - tz) * rw[c10] + tz * rw[c11]);
-  *p = (1.0 - tx) * ((1.0 - tz) * pw[c00] + tz * pw[c01]) +
-       tx * ((1.0 - tz) * pw[c10] + tz * pw[c11]);
+  const size_t nz = (size_t)W->nz;
+  f.c00 = off + i0 * nz + k0, f.c01 = off + i0 * nz + k1;
+  f.c10 = off + i1 * nz + k0, f.c11 = off + i1 * nz + k1;
+  f.tz = tz;
+  return f;
+}
+
+static inline double foot_value(const struct model *M, const struct foot *f, const double *v) {
+  if (M->dim == 2) return (1.0 - f->tx) * v[f->c00] + f->tx * v[f->c10];
+  return (1.0 - f->tx) * ((1.0 - f->tz) * v[f->c00] + f->tz * v[f->c01]) +
+         f->tx * ((1.0 - f->tz) * v[f->c10] + f->tz * v[f->c11]);
+}
+
+void sph_wall_values(const struct model *M, const struct walls *W, int wall, double x, double z,
+                     double *rho, double *p) {
+  const struct foot f = wall_foot(M, W, wall, x, z);
+  *rho = foot_value(M, &f, W->rho);
+  *p = foot_value(M, &f, W->p);
+}
+
+double sph_wall_field(const struct model *M, const struct walls *W, const double *v, int wall,
+                      double x, double z) {
+  const struct foot f = wall_foot(M, W, wall, x, z);
+  return foot_value(M, &f, v);
+}
+
+void sph_solve_sym(int dim, const double A[6], const double g[3], double x[3]) {
+  if (dim == 2) {
+    const double det = A[0] * A[3] - A[1] * A[1];
+    const double tr = A[0] + A[3];
+    if (!(fabs(det) > 1e-12 * tr * tr)) { /* degenerate support: uncorrected */
+      x[0] = tr > 0 ? 2.0 * g[0] / tr : 0.0, x[1] = tr > 0 ? 2.0 * g[1] / tr : 0.0, x[2] = 0.0;
+      return;
+    }
+    x[0] = (A[3] * g[0] - A[1] * g[1]) / det;
+    x[1] = (A[0] * g[1] - A[1] * g[0]) / det;
+    x[2] = 0.0;
+    return;
+  }
+  /* A = [a b c; b d e; c e f] stored as {a, b, c, d, e, f} */
+  const double a = A[0], b = A[1], c = A[2], d = A[3], e = A[4], f = A[5];
+  const double c0 = d * f - e * e, c1 = c * e - b * f, c2 = b * e - c * d;
+  const double det = a * c0 + b * c1 + c * c2;
+  const double tr = a + d + f;
+  if (!(fabs(det) > 1e-12 * tr * tr * tr)) {
+    for (int i = 0; i < 3; i++) x[i] = tr > 0 ? 3.0 * g[i] / tr : 0.0;
+    return;
+  }
+  const double c4 = a * f - c * c, c5 = b * c - a * e, c8 = a * d - b * b;
+  x[0] = (c0 * g[0] + c1 * g[1] + c2 * g[2]) / det;
+  x[1] = (c1 * g[0] + c4 * g[1] + c5 * g[2]) / det;
+  x[2] = (c2 * g[0] + c5 * g[1] + c8 * g[2]) / det;
 }
 
 void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb,
@@ -169,7 +266,11 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
   const double dgrav = M->e.rho0 / (M->e.c0 * M->e.c0) * M->gy; /* Eq. 3.61 */
   const double dplus2 = M->dim + 2.0;
   const int violeau = M->viscous == VISCOUS_VIOLEAU;
-  const int discrete = !violeau && M->wall_weight == WALL_WEIGHT_DISCRETE;
+  const int discrete = M->wall_weight == WALL_WEIGHT_DISCRETE;
+  const double np2 = M->dim + 2.0; /* Violeau weight (n + 2) x_i^2 / r^2 + 1, see m1x */
+  const int les = M->les, corrected = M->pgrad == PGRAD_CORRECTED;
+  const int wall_law = M->law.law != WALL_LAW_LAMINAR;
+  const double *restrict nur = P->nur;
   double amax2 = 0.0, gvmax = 0.0;
 #pragma omp parallel for schedule(static) reduction(max : amax2, gvmax)
   for (size_t a = 0; a < P->n; a++) {
@@ -183,6 +284,12 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
     double mom2 = 0;                  /* sum V_b r_ab . grad w_ab, Laplacian normalisation */
     double momyy = 0;                 /* sum V_b y_ab^2 F_ab, wall-normal normalisation */
     double mom1 = 0;                  /* sum V_b y_ab f_ab, discrete wall weight */
+    /* Violeau: sum V_b y_ab^k F_ab ((n+2) x_i^2/r^2 + 1), k = 1, 2, for i = x and z */
+    double m1x = 0, m2x = 0, m1z = 0, m2z = 0;
+    double A[6] = {0, 0, 0, 0, 0, 0}; /* corrected gradient: -sum V_b f r_ab (x) r_ab */
+    double gc[3] = {0, 0, 0};         /* corrected gradient: sum V_b (p_b - p_a) f r_ab */
+    const double pm_a = corrected ? pa * ra * ra : 0.0;
+    const double mu_a = les ? ra * (nu + nur[a]) : 0.0;
     for (int j = 0; j < cnt; j++) {
       const int32_t b = nl[j];
       const double dx = nbr_wrap(x[a] - x[b], M->lx), dy = y[a] - y[b];
@@ -190,12 +297,29 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
       const double r2 = dx * dx + dy * dy + dz * dz, r = sqrt(r2);
       const double f = kernel_f(K, r); /* grad_a w_ab = f r_ab */
       const double rb = rho[b], mb = m[b], vb = vol[b];
-      const double pp = mb * (pa + pr2[b]) * f;
-      gpx += pp * dx, gpy += pp * dy, gpz += pp * dz;
+      if (corrected) {
+        const double vf = vb * f, dp = pr2[b] * rb * rb - pm_a;
+        A[0] -= vf * dx * dx, A[1] -= vf * dx * dy, A[2] -= vf * dx * dz;
+        A[3] -= vf * dy * dy, A[4] -= vf * dy * dz, A[5] -= vf * dz * dz;
+        gc[0] += vf * dp * dx, gc[1] += vf * dp * dy, gc[2] += vf * dp * dz;
+      } else {
+        const double pp = mb * (pa + pr2[b]) * f;
+        gpx += pp * dx, gpy += pp * dy, gpz += pp * dz;
+      }
       const double ux = u[a] - u[b], uy = v[a] - v[b], uz = w[a] - w[b];
       const double vf = vb * f;
       mom2 += vf * r2, momyy += vf * dy * dy, mom1 += vf * dy;
       if (violeau) {
+        const double gx = vf * (np2 * dx * dx / (r2 + eta2) + 1.0) * dy;
+        const double gz = vf * (np2 * dz * dz / (r2 + eta2) + 1.0) * dy;
+        m1x += gx, m2x += gx * dy, m1z += gz, m2z += gz * dy;
+      }
+      if (les) { /* Eq. 2.100 with f = mu = rho (nu + nu_r) */
+        const double coef = vb * 0.5 * (mu_a + rb * (nu + nur[b])) * f / (r2 + eta2);
+        const double vr = dplus2 * (ux * dx + uy * dy + uz * dz);
+        vx += coef * (vr * dx + r2 * ux), vy += coef * (vr * dy + r2 * uy);
+        vz += coef * (vr * dz + r2 * uz);
+      } else if (violeau) {
         const double coef = vb * 0.5 * (ra + rb) * f / (r2 + eta2);
         const double vr = dplus2 * (ux * dx + uy * dy + uz * dz);
         vx += coef * (vr * dx + r2 * ux), vy += coef * (vr * dy + r2 * uy);
@@ -212,17 +336,30 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
     }
     const double ig = 1.0 / P->gam[a];
     double axa = -ig * gpx, aya = -ig * gpy, aza = -ig * gpz;
-    double kappa = 1.0;
-    if (M->lap_norm != LAPNORM_NONE) { /* discrete + analytic part behind the walls */
+    if (corrected) { /* -(1/rho_a) L_a g, L_a = A^-1 (Eq. 2.88, 2.90 with k = 0) */
+      double gr[3];
+      sph_solve_sym(M->dim, A, gc, gr);
+      axa = -gr[0] * ira, aya = -gr[1] * ira, aza = -gr[2] * ira;
+    }
+    double kappa = 1.0, kx = 1.0, kz = 1.0; /* normalisation; Violeau: of the x and z parts */
+    if (M->lap_norm != LAPNORM_NONE) {      /* discrete + analytic part behind the walls */
       const double qb = y[a] * ih, qt = (M->ly - y[a]) * ih;
-      if (M->lap_norm == LAPNORM_TRACE)
+      if (M->lap_norm == LAPNORM_TRACE) {
         kappa = -M->dim / (mom2 + wall_moment2(M->dim, qb) + wall_moment2(M->dim, qt));
-      else
+        kx = kz = kappa;
+      } else if (violeau) { /* its own y-y moments: -2 in the full space */
+        const double wm = sph_violeau_moment(M, qb) + sph_violeau_moment(M, qt);
+        kx = -2.0 / (m2x + wm);
+        kz = M->dim == 3 ? -2.0 / (m2z + wm) : kx;
+        kappa = 0.5 * (kx + kz);
+      } else {
         kappa = -1.0 / (momyy + wall_moment_yy(M->dim, qb) + wall_moment_yy(M->dim, qt));
+        kx = kz = kappa;
+      }
     }
     const double lap = nu * ig * kappa; /* nu / gamma_a, normalised */
-    const double vis = violeau ? lap / ra : lap;
-    axa += vis * vx, aya += vis * vy, aza += vis * vz;
+    const double vis = les ? ig / ra : violeau ? nu * ig / ra : nu * ig;
+    axa += vis * kx * vx, aya += vis * kappa * vy, aza += vis * kz * vz;
     /* wall terms: pressure (Eq. 3.17, k = 1) and wall shear (Eq. 2.147-2.148) */
     double gv = 0.0;
     for (int wall = 0; wall < 2; wall++) {
@@ -240,12 +377,26 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
       const double pw = M->wall_pressure == WALL_PRESSURE_LATTICE      ? dg + lattice_excess(M, q)
                         : M->wall_pressure == WALL_PRESSURE_CONSISTENT ? fmax(dg, ny * mom1)
                                                                        : dg;
-      aya += ig * rs * (pa + ps / (rs * rs)) * pw * ny;
-      /* |grad gamma_as|, or the discrete first moment that makes the Morris operator exact
-         for a velocity varying linearly with the wall distance (docs/theory.md) */
-      const double weight = discrete ? fmax(0.0, ny * mom1) : dg;
-      const double shear = 2.0 * lap * weight / (d > M->wall_dmin ? d : M->wall_dmin);
-      axa -= shear * u[a], aza -= shear * w[a];
+      if (!corrected) aya += ig * rs * (pa + ps / (rs * rs)) * pw * ny;
+      if (wall_law) { /* -(2 / gamma_a) rho_s u_tau,s u_tau,s |grad gamma_as| / rho_a (Eq. 2.144-
+                         2.145) with the vertex values of Ferrand Eq. 38 at the foot */
+        const struct foot ft = wall_foot(M, W, wall, x[a], z[a]);
+        const double sw = 2.0 * ig * dg * ira;
+        axa -= sw * foot_value(M, &ft, W->tx), aza -= sw * foot_value(M, &ft, W->tz);
+      } else {
+        /* |grad gamma_as|, or the discrete first moment that makes the Morris operator exact
+           for a velocity varying linearly with the wall distance (docs/theory.md) */
+        const double dw = 2.0 * nu * ig / (d > M->wall_dmin ? d : M->wall_dmin);
+        if (violeau) { /* half the first moment of its x and z parts */
+          const double wx = discrete ? 0.5 * fmax(0.0, ny * m1x) : dg;
+          const double wz = discrete ? 0.5 * fmax(0.0, ny * m1z) : dg;
+          axa -= dw * kx * wx * u[a], aza -= dw * kz * wz * w[a];
+        } else {
+          const double weight = discrete ? fmax(0.0, ny * mom1) : dg;
+          const double shear = 2.0 * lap * weight / (d > M->wall_dmin ? d : M->wall_dmin);
+          axa -= shear * u[a], aza -= shear * w[a];
+        }
+      }
       const double g = fabs(dg * v[a]);
       if (g > gv) gv = g;
     }

@@ -11,25 +11,37 @@
 #include "nbr.h"
 #include "part.h"
 #include "scene.h"
+#include "walllaw.h"
 
-enum { LATTICE_KNOTS = 16 };
+enum { LATTICE_KNOTS = 16, VIOLEAU_KNOTS = 128 };
 
 /** Constants of the discretisation, derived once from the scene. */
 struct model {
-  int dim;                     /*!< 2 or 3 */
-  int viscous;                 /*!< enum viscous_form */
-  struct kernel k;             /*!< Wendland kernel */
-  struct eos e;                /*!< Tait equation of state */
-  double lx, ly, lz;           /*!< domain [m]; ly = 2 delta */
-  double dr, h;                /*!< spacing and smoothing length [m] */
-  double nu;                   /*!< kinematic viscosity [m^2/s] */
-  double inv_xi;               /*!< 1 / xi of the volume diffusion [-] */
-  double gy;                   /*!< wall-normal body acceleration [m/s^2] */
-  double wall_dmin;            /*!< delta r of Eq. 2.148 [m] */
-  double eta2;                 /*!< regularisation of r^2 in the viscous term [m^2] */
-  int lap_norm;                /*!< enum laplacian_norm */
-  int wall_weight;             /*!< enum wall_weight: weight of the wall shear term */
-  int wall_pressure;           /*!< enum wall_pressure: weight of the pressure wall term */
+  int dim;                    /*!< 2 or 3 */
+  int viscous;                /*!< enum viscous_form */
+  struct kernel k;            /*!< Wendland kernel */
+  struct eos e;               /*!< Tait equation of state */
+  double lx, ly, lz;          /*!< domain [m]; ly = 2 delta */
+  double dr, h;               /*!< spacing and smoothing length [m] */
+  double nu;                  /*!< kinematic viscosity [m^2/s] */
+  double inv_xi;              /*!< 1 / xi of the volume diffusion [-] */
+  double gy;                  /*!< wall-normal body acceleration [m/s^2] */
+  double wall_dmin;           /*!< delta r of Eq. 2.148 [m] */
+  double eta2;                /*!< regularisation of r^2 in the viscous term [m^2] */
+  int lap_norm;               /*!< enum laplacian_norm */
+  int wall_weight;            /*!< enum wall_weight: weight of the wall shear term */
+  int wall_pressure;          /*!< enum wall_pressure: weight of the pressure wall term */
+  int pgrad;                  /*!< enum pressure_gradient */
+  int les;                    /*!< eddy viscosity on (enum les_model) */
+  int strain;                 /*!< enum les_strain */
+  int van_driest;             /*!< damping on */
+  double cs, delta_g, a_plus; /*!< C_S [-], Delta_G [m], A+ [-] */
+  double cy;                  /*!< Yoshizawa C_Y [-]; 0 = off */
+  struct wall_law_def law;    /*!< wall law of the wall shear term */
+  int wall_tau;               /*!< wall stresses carried to the vertices (turb.h) */
+  /** Violeau's operator: its wall-normal second moment int y^2 F ((n+2) x_t^2/r^2 + 1) dV over
+      the half-space behind a wall at q = d/h, at q = 2 k / VIOLEAU_KNOTS [-] */
+  double vio_m2[VIOLEAU_KNOTS + 1];
   int n_lat;                   /*!< knots of the lattice excess of the pressure wall weight */
   double lat_q[LATTICE_KNOTS]; /*!< their wall distances d/h, increasing, the last one 2 */
   double lat_e[LATTICE_KNOTS]; /*!< excess of sum_b V_b (r_ab . n) F_ab over |grad gamma| [1/m] */
@@ -52,6 +64,17 @@ void sph_model_init(struct model *M, const struct scene *s);
  * @param[in,out] M model (lat_q, lat_e, n_lat)
  */
 void sph_lattice_excess_table(struct model *M);
+
+/**
+ * @brief Tabulate the wall moment of Violeau's operator (model.vio_m2) by Gauss-Legendre
+ *        quadrature: the normalisation and the discrete wall weight of Eq. 2.100 in the
+ *        channel (docs/theory.md, "Violeau's operator at a wall").
+ * @param[in,out] M model
+ */
+void sph_violeau_table(struct model *M);
+
+/** @brief Violeau's wall moment at q = d/h (linear in the table; 0 for q >= 2). */
+double sph_violeau_moment(const struct model *M, double q);
 
 /**
  * @brief Density update of thesis Eq. 3.64 from the kernel sums at the current positions:
@@ -98,5 +121,17 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
  */
 void sph_wall_values(const struct model *M, const struct walls *W, int wall, double x, double z,
                      double *rho, double *p);
+
+/**
+ * @brief Solve A x = g for a symmetric positive definite A (2x2 or 3x3, stored as
+ *        {xx, xy, xz, yy, yz, zz}): applies L = A^-1 of thesis Eq. 2.88. A degenerate A (an
+ *        isolated particle) falls back to the isotropic dim / trace(A).
+ */
+void sph_solve_sym(int dim, const double A[6], const double g[3], double x[3]);
+
+/** @brief One wall lattice field f (nx nz values per wall) at the foot of a particle, with the
+           same interpolation as sph_wall_values. */
+double sph_wall_field(const struct model *M, const struct walls *W, const double *f, int wall,
+                      double x, double z);
 
 #endif

@@ -8,6 +8,9 @@ Subcommands (each runs chansph, reads its netCDF output, prints the numbers, exi
   longrun SCENE --steps N      N steps: no particle lost or through a wall, density drift, gamma
   convergence SCENE            error at 2 delta/dr = 20, 40, 80 and the observed order
   study SCENE2D SCENE3D --doc DIR   error against wall-clock time for four resolutions (PNG + table)
+  smagorinsky SCENE --max-l2 E   steady laminar flow with the Smagorinsky model on, against the
+                               semi-analytical profile of tau(y) = f (delta - y) =
+                               (nu + l(y)^2 |u'|) u' with l = C_S Delta_G (1 - exp(-y+/A+))
 """
 import argparse
 import math
@@ -210,11 +213,56 @@ def cmd_study(args):
     return True
 
 
+def scene_attr(out, section, key):
+    """A value of the resolved scene stored in stats.nc."""
+    text = attrs(os.path.join(out, "stats.nc"))["scene"]
+    part = text.split("[%s]" % section, 1)[1].split("\n[", 1)[0]
+    for line in part.splitlines():
+        if "=" in line and line.split("=")[0].strip() == key:
+            return line.split("=", 1)[1].strip()
+    raise KeyError(key)
+
+
+def smagorinsky_profile(a, out, y):
+    """u(y) of the steady channel with nu + nu_r, nu_r = l^2 |u'| (thesis Eq. 5.46-5.47, 5.50)."""
+    f, delta, nu = a["body_force"], a["delta"], a["nu"]
+    h = float(scene_attr(out, "sph", "h_over_dr")) * float(scene_attr(out, "domain", "dr"))
+    cs = float(scene_attr(out, "les", "cs"))
+    dg = float(scene_attr(out, "les", "filter_width")) * h
+    damp = int(scene_attr(out, "les", "van_driest"))
+    aplus = float(scene_attr(out, "les", "a_plus"))
+    utau = math.sqrt(f * delta)
+    yy = np.linspace(0.0, delta, 200001)
+    tau = f * (delta - yy)
+    l = cs * dg * ((1.0 - np.exp(-yy * utau / nu / aplus)) if damp else np.ones_like(yy))
+    du = 2.0 * tau / (nu + np.sqrt(nu * nu + 4.0 * l * l * tau))
+    u = np.concatenate(([0.0], np.cumsum(0.5 * (du[1:] + du[:-1]) * np.diff(yy))))
+    return np.interp(np.minimum(y, 2 * delta - y), yy, u)
+
+
+def cmd_smagorinsky(args):
+    sets = ["les.model=smagorinsky", "sph.viscous=violeau"] + args.set
+    out, wall = run(args, args.scene, "smagorinsky_" + os.path.basename(args.scene)[:-4], sets)
+    with netCDF4.Dataset(os.path.join(out, "stats.nc")) as d:
+        a = {k: d.getncattr(k) for k in d.ncattrs()}
+        y, u = d["y_mean"][:].filled(np.nan), d["u_mean"][:].filled(np.nan)
+    ua = smagorinsky_profile(a, out, y)
+    ok = np.isfinite(u)
+    err = math.sqrt(np.sum((u[ok] - ua[ok]) ** 2) / np.sum(ua[ok] ** 2))
+    ul = laminar(a, y)
+    shift = math.sqrt(np.sum((ul[ok] - ua[ok]) ** 2) / np.sum(ua[ok] ** 2))
+    print("Smagorinsky channel %dD (%s): relative L2 error of u_mean = %.3e (limit %.3g); the model "
+          "moves the profile by %.3e from the laminar one; %.1f s wall"
+          % (a["dimension"], " ".join(args.set), err, args.max_l2, shift, wall))
+    return err <= args.max_l2 and shift > 5 * err
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
     p.add_argument("--chansph", default="build/chansph")
     p.add_argument("--runs", default="build/test-runs")
-    p.add_argument("what", choices=["steady", "startup", "flux", "longrun", "convergence", "study"])
+    p.add_argument("what", choices=["steady", "startup", "flux", "longrun", "convergence", "study",
+                                      "smagorinsky"])
     p.add_argument("scene")
     p.add_argument("scene3d", nargs="?")
     p.add_argument("--max-l2", type=float, default=0.01)

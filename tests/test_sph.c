@@ -15,7 +15,7 @@ static int check(const char *name, char **set, int nset) {
   struct scene sc;
   if (scene_load(&sc, NULL, nset, set)) return 1;
   struct sim S;
-  sim_init(&S, &sc);
+  if (sim_init(&S, &sc)) return 1;
   const struct model *M = &S.M;
   const struct particles *P = &S.P;
   double worst = 0.0;

@@ -5,6 +5,10 @@
 #                analogues) against quadrature; Ferrand Eq. 51-52 segments
 #   test_nbr:    cell-list neighbour search against brute force, sort order and permutation
 #   test_reduce: deterministic blocked sums, bitwise across thread counts
+#   test_turb:   model terms (strain, van Driest, Smagorinsky, Yoshizawa, Violeau-Issa,
+#                wall-law stresses, Violeau wall moment) against closed forms
+#   test_walllaw: wall-law friction velocity (thesis Eq. 2.146, 5.51, 5.53): residual over
+#                y+ 1e-6..1e6, any speed and viscosity
 
 add_executable(test_kernel test_kernel.c)
 target_link_libraries(test_kernel PRIVATE chansph_core)
@@ -30,3 +34,21 @@ add_executable(test_sph test_sph.c)
 target_link_libraries(test_sph PRIVATE chansph_core)
 add_test(NAME unit_sph COMMAND test_sph)
 set_tests_properties(unit_sph PROPERTIES LABELS unit)
+
+add_executable(test_walllaw test_walllaw.c)
+target_link_libraries(test_walllaw PRIVATE chansph_core m)
+add_test(NAME unit_walllaw COMMAND test_walllaw)
+set_tests_properties(unit_walllaw PROPERTIES LABELS unit)
+
+add_executable(test_turb test_turb.c)
+target_link_libraries(test_turb PRIVATE chansph_core)
+add_test(NAME unit_turb COMMAND test_turb)
+set_tests_properties(unit_turb PROPERTIES LABELS unit)
+
+# Taylor-Green check of the pressure gradient (thesis Sec. 6.2.2); the table and plot of
+# docs/validation/taylor_green.md come from tests/taylor_green_doc.py
+add_executable(taylor_green taylor_green.c)
+target_link_libraries(taylor_green PRIVATE chansph_core)
+add_test(NAME taylor_green_lattice COMMAND taylor_green --check)
+add_test(NAME taylor_green_jittered COMMAND taylor_green --jitter 0.2 --check)
+set_tests_properties(taylor_green_lattice taylor_green_jittered PROPERTIES LABELS "validation;models")

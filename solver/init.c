@@ -1,0 +1,276 @@
+/** @file init.c @brief Implementation of init.h. */
+#include "init.h"
+
+#include <Random123/philox.h>
+#include <math.h>
+#include <netcdf.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "error.h"
+#include "kernel.h"
+#include "walllaw.h"
+
+double init_noise(long seed, long long id, int stream) {
+  philox4x64_ctr_t c = {{(uint64_t)id, (uint64_t)stream, 0x636861u, 0}};
+  philox4x64_key_t k = {{(uint64_t)seed, 0x7370683132333435u}};
+  const philox4x64_ctr_t r = philox4x64(c, k);
+  return (double)(r.v[0] >> 11) * 0x1.0p-52 - 1.0; /* 53 random bits -> [-1, 1) */
+}
+
+/** Bulk velocity of the Reichardt profile of a friction velocity, midpoint rule in y+. */
+static double reichardt_bulk(const struct wall_law_def *L, double ut, double nu, double delta) {
+  enum { N = 4000 };
+  double s = 0.0;
+  for (int i = 0; i < N; i++) {
+    const double y = (i + 0.5) * delta / N;
+    s += wall_law_uplus(L, y * ut / nu);
+  }
+  return ut * s / N;
+}
+
+double init_reichardt_utau(const struct scene *sc) {
+  if (sc->drive_mode == DRIVE_FORCE) return sqrt(fabs(sc->force) * sc->delta);
+  const struct wall_law_def L = wall_law_make(WALL_LAW_REICHARDT, sc->kappa, sc->log_b);
+  const double target = fabs(sc->u_bulk);
+  double lo = 0.0, hi = sqrt(3.0 * sc->nu * target / sc->delta); /* the laminar u_tau */
+  while (reichardt_bulk(&L, hi, sc->nu, sc->delta) < target) hi *= 2.0;
+  for (int it = 0; it < 200 && hi - lo > 1e-15 * hi; it++) {
+    const double mid = 0.5 * (lo + hi);
+    if (reichardt_bulk(&L, mid, sc->nu, sc->delta) < target)
+      lo = mid;
+    else
+      hi = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+/** Mean velocity at height y. */
+static double mean_u(const struct scene *sc, const struct wall_law_def *L, double ut, double y) {
+  const double yw = fmin(y, 2.0 * sc->delta - y);
+  if (sc->init_profile == INIT_LAMINAR) {
+    double f = sc->force;
+    if (sc->drive_mode == DRIVE_FLUX) f = 3.0 * sc->nu * sc->u_bulk / (sc->delta * sc->delta);
+    return f * y * (2.0 * sc->delta - y) / (2.0 * sc->nu);
+  }
+  if (sc->init_profile == INIT_REICHARDT) {
+    const double sign =
+        sc->drive_mode == DRIVE_FLUX ? (sc->u_bulk < 0 ? -1.0 : 1.0) : (sc->force < 0 ? -1.0 : 1.0);
+    return sign * ut * wall_law_uplus(L, yw * ut / sc->nu);
+  }
+  return 0.0;
+}
+
+/* ---- start from an earlier run (particles.nc) ---- */
+
+/** Value of key in [section] of a scene text, or NAN. */
+static double scene_text_value(const char *text, const char *section, const char *key) {
+  char head[64];
+  snprintf(head, sizeof head, "[%s]", section);
+  const char *s = strstr(text, head);
+  if (!s) return NAN;
+  for (const char *l = strchr(s, '\n'); l && l[1] && l[1] != '['; l = strchr(l + 1, '\n')) {
+    const size_t n = strlen(key);
+    if (!strncmp(l + 1, key, n) && (l[1 + n] == ' ' || l[1 + n] == '=')) {
+      const char *eq = strchr(l + 1, '=');
+      return eq ? strtod(eq + 1, NULL) : NAN;
+    }
+  }
+  return NAN;
+}
+
+struct source {
+  size_t n;
+  double *col[8]; /* x y z u v w rho mass */
+  long long *id;
+  double lx, ly, lz, h;
+  int dim;
+};
+
+static void source_free(struct source *src) {
+  for (int c = 0; c < 8; c++) free(src->col[c]);
+  free(src->id);
+}
+
+static int read_source(const char *path, const struct scene *sc, struct source *src) {
+  memset(src, 0, sizeof *src);
+  int nc, rc, dimid, vid;
+  if ((rc = nc_open(path, NC_NOWRITE, &nc))) {
+    error_input("%s (init.from): cannot open: %s", path, nc_strerror(rc));
+    return CHANSPH_ERR;
+  }
+  size_t n = 0, alen = 0;
+  char *text = NULL;
+  static const char *const names[8] = {"x", "y", "z", "u", "v", "w", "rho", "mass"};
+  int ok = !nc_inq_dimid(nc, "particle", &dimid) && !nc_inq_dimlen(nc, dimid, &n) &&
+           !nc_inq_attlen(nc, NC_GLOBAL, "scene", &alen);
+  if (ok) {
+    text = calloc(alen + 1, 1);
+    ok = text && !nc_get_att_text(nc, NC_GLOBAL, "scene", text);
+  }
+  src->n = n;
+  for (int c = 0; ok && c < 8; c++) {
+    src->col[c] = malloc((n ? n : 1) * sizeof(double));
+    ok = src->col[c] && !nc_inq_varid(nc, names[c], &vid) &&
+         !nc_get_var_double(nc, vid, src->col[c]);
+    if (!ok) error_input("%s (init.from): variable '%s' missing or unreadable", path, names[c]);
+  }
+  if (ok) {
+    src->id = malloc((n ? n : 1) * sizeof(long long));
+    ok = src->id && !nc_inq_varid(nc, "id", &vid) && !nc_get_var_longlong(nc, vid, src->id);
+  }
+  nc_close(nc);
+  if (!ok) {
+    error_input(
+        "%s (init.from): not a chansph particles.nc (needs dimension 'particle', "
+        "variables x y z u v w rho mass id and the 'scene' attribute)",
+        path);
+    free(text), source_free(src);
+    return CHANSPH_ERR;
+  }
+  const double dim = scene_text_value(text, "domain", "dimension");
+  const double delta = scene_text_value(text, "domain", "delta");
+  const double lx = scene_text_value(text, "domain", "lx");
+  const double lz = scene_text_value(text, "domain", "lz");
+  const double dr = scene_text_value(text, "domain", "dr");
+  const double hdr = scene_text_value(text, "sph", "h_over_dr");
+  free(text);
+  const double tol = 1e-9 * sc->lx;
+  if (dim != sc->dim || fabs(delta - sc->delta) > tol || fabs(lx - sc->lx) > tol ||
+      (sc->dim == 3 && fabs(lz - sc->lz) > tol) || !(dr > 0.0) || !(hdr > 0.0)) {
+    error_input(
+        "%s (init.from): its domain (dimension %g, delta %g, lx %g, lz %g) differs from "
+        "this scene's (dimension %d, delta %g, lx %g, lz %g)",
+        path, dim, delta, lx, lz, sc->dim, sc->delta, sc->lx, sc->lz);
+    source_free(src);
+    return CHANSPH_ERR;
+  }
+  src->dim = sc->dim, src->lx = lx, src->ly = 2.0 * delta, src->lz = sc->dim == 3 ? lz : 1.0;
+  src->h = hdr * dr;
+  return CHANSPH_OK;
+}
+
+static inline double wrap(double d, double l) {
+  return d - l * floor(d / l + 0.5);
+}
+
+/** Shepard interpolation of the source velocity onto the fluid particles of P. */
+static void interpolate(const struct source *src, struct particles *P) {
+  const double cell = 2.0 * src->h;
+  const int nx = (int)fmax(1.0, floor(src->lx / cell)), ny = (int)fmax(1.0, floor(src->ly / cell));
+  const int nz = src->dim == 3 ? (int)fmax(1.0, floor(src->lz / cell)) : 1;
+  const size_t ncell = (size_t)nx * ny * nz;
+  size_t *start = calloc(ncell + 1, sizeof *start), *fill = malloc(ncell * sizeof *fill);
+  size_t *order = malloc((src->n ? src->n : 1) * sizeof *order);
+  int *cellof = malloc((src->n ? src->n : 1) * sizeof *cellof);
+  if (!start || !fill || !order || !cellof) die("out of memory interpolating init.from");
+  const double *sx = src->col[0], *sy = src->col[1], *sz = src->col[2];
+#define CELL_OF(X, Y, Z)                                         \
+  (((int)fmin(nz - 1, fmax(0, floor((Z) / src->lz * nz))) * ny + \
+    (int)fmin(ny - 1, fmax(0, floor((Y) / src->ly * ny)))) *     \
+       nx +                                                      \
+   (int)fmin(nx - 1, fmax(0, floor((X) / src->lx * nx))))
+  for (size_t b = 0; b < src->n; b++) {
+    const double xb = sx[b] - src->lx * floor(sx[b] / src->lx);
+    const double zb = src->dim == 3 ? sz[b] - src->lz * floor(sz[b] / src->lz) : 0.0;
+    cellof[b] = CELL_OF(xb, sy[b], zb);
+    start[cellof[b] + 1]++;
+  }
+  for (size_t c = 0; c < ncell; c++) start[c + 1] += start[c];
+  memcpy(fill, start, ncell * sizeof *fill);
+  for (size_t b = 0; b < src->n; b++) order[fill[cellof[b]]++] = b; /* by file order */
+  const struct kernel K = kernel_make(src->dim, src->h);
+  const int rz = src->dim == 3 ? 1 : 0;
+#pragma omp parallel for schedule(static)
+  for (size_t a = 0; a < P->n_fluid; a++) {
+    const double xa = P->x[a], ya = P->y[a], za = P->z[a];
+    const int cx = (int)fmin(nx - 1, floor(xa / src->lx * nx));
+    const int cy = (int)fmin(ny - 1, floor(ya / src->ly * ny));
+    const int cz = src->dim == 3 ? (int)fmin(nz - 1, floor(za / src->lz * nz)) : 0;
+    double sw = 0.0, su = 0.0, sv = 0.0, swz = 0.0;
+    for (int k = -rz; k <= rz; k++)
+      for (int j = -1; j <= 1; j++)
+        for (int i = -1; i <= 1; i++) {
+          if (cy + j < 0 || cy + j >= ny) continue;
+          if ((nx < 3 && i != 0) || (src->dim == 3 && nz < 3 && k != 0)) continue;
+          const int ix = (cx + i + nx) % nx, iz = src->dim == 3 ? (cz + k + nz) % nz : 0;
+          const size_t c = ((size_t)iz * ny + cy + j) * nx + ix;
+          for (size_t q = start[c]; q < start[c + 1]; q++) {
+            const size_t b = order[q];
+            const double dx = wrap(xa - sx[b], src->lx), dy = ya - sy[b];
+            const double dz = src->dim == 3 ? wrap(za - sz[b], src->lz) : 0.0;
+            const double wv =
+                src->col[7][b] / src->col[6][b] * kernel_w(&K, sqrt(dx * dx + dy * dy + dz * dz));
+            sw += wv, su += wv * src->col[3][b], sv += wv * src->col[4][b];
+            swz += wv * src->col[5][b];
+          }
+        }
+    P->u[a] = sw > 0 ? su / sw : 0.0, P->v[a] = sw > 0 ? sv / sw : 0.0;
+    P->w[a] = sw > 0 ? swz / sw : 0.0;
+  }
+#undef CELL_OF
+  free(start), free(fill), free(order), free(cellof);
+}
+
+static int from_file(const struct scene *sc, struct particles *P) {
+  struct source src;
+  TRY(read_source(sc->init_from, sc, &src));
+  if (src.n == P->n_fluid) { /* same resolution: the state itself, by id */
+    for (size_t b = 0; b < src.n; b++) {
+      const long long id = src.id[b];
+      if (id < 0 || (size_t)id >= P->n_fluid) {
+        error_input("%s (init.from): particle id %lld out of range 0..%zu", sc->init_from, id,
+                    P->n_fluid - 1);
+        source_free(&src);
+        return CHANSPH_ERR;
+      }
+      const size_t a = (size_t)id; /* fresh lattice: fluid particle a has id a */
+      P->x[a] = src.col[0][b], P->y[a] = src.col[1][b], P->z[a] = src.col[2][b];
+      P->u[a] = src.col[3][b], P->v[a] = src.col[4][b], P->w[a] = src.col[5][b];
+      P->rho[a] = src.col[6][b];
+    }
+    msg("init: positions, velocities and densities of %zu particles from %s\n", src.n,
+        sc->init_from);
+  } else {
+    interpolate(&src, P);
+    msg("init: velocity interpolated from %zu particles of %s onto %zu particles\n", src.n,
+        sc->init_from, P->n_fluid);
+  }
+  source_free(&src);
+  return CHANSPH_OK;
+}
+
+int init_fields(const struct scene *sc, struct particles *P) {
+  const struct wall_law_def L = wall_law_make(WALL_LAW_REICHARDT, sc->kappa, sc->log_b);
+  const double ut = sc->init_profile == INIT_REICHARDT ? init_reichardt_utau(sc) : 0.0;
+  if (sc->init_from[0]) {
+    TRY(from_file(sc, P));
+  } else {
+    for (size_t a = 0; a < P->n_fluid; a++) P->u[a] = mean_u(sc, &L, ut, P->y[a]);
+  }
+  const double two_d = 2.0 * sc->delta;
+  const double alpha = 2.0 * M_PI * sc->init_mode_kx / sc->lx;
+  const double beta = sc->dim == 3 ? 2.0 * M_PI * sc->init_mode_kz / sc->lz : 0.0;
+  const double bs = sc->dim == 3 ? 2.0 * M_PI * sc->init_streak_kz / sc->lz : 0.0;
+  for (size_t a = 0; a < P->n_fluid; a++) {
+    const double eta = P->y[a] / two_d, x = P->x[a], z = P->z[a];
+    if (sc->init_streaks > 0.0 && sc->dim == 3)
+      P->u[a] += sc->init_streaks * 4.0 * eta * (1.0 - eta) * cos(bs * z);
+    if (sc->init_modes > 0.0) {
+      /* g = 16 eta^2 (1 - eta)^2 vanishes with its slope at both walls; psi = A g sin / k */
+      const double A = sc->init_modes, g = 16.0 * eta * eta * (1 - eta) * (1 - eta);
+      const double dg = 32.0 * eta * (1 - eta) * (1 - 2 * eta) / two_d; /* dg/dy */
+      P->u[a] += A * dg / alpha * sin(alpha * x), P->v[a] -= A * g * cos(alpha * x);
+      if (sc->dim == 3) P->v[a] += A * g * cos(beta * z), P->w[a] -= A * dg / beta * sin(beta * z);
+    }
+    if (sc->init_noise > 0.0) {
+      const long long id = (long long)P->id[a];
+      P->u[a] += sc->init_noise * init_noise(sc->init_seed, id, 0);
+      P->v[a] += sc->init_noise * init_noise(sc->init_seed, id, 1);
+      if (sc->dim == 3) P->w[a] += sc->init_noise * init_noise(sc->init_seed, id, 2);
+    }
+  }
+  if (ut > 0.0) msg("init: Reichardt profile with u_tau = %.6g m/s\n", ut);
+  return CHANSPH_OK;
+}

@@ -1,0 +1,59 @@
+/**
+ * @file turb.h
+ * @brief The turbulence model terms: wall-law stresses on the wall vertices, and the
+ *        Smagorinsky eddy viscosity with van Driest damping and Yoshizawa's residual kinetic
+ *        energy (thesis Sec. 5.2.2). Quasi-DNS with the laminar wall law never calls it.
+ *
+ * Order within a step (run.c): after the density and the wall values of the new positions,
+ * turb_update computes
+ *  1. the wall-law stress u_tau^2 e_t of every fluid particle within 2h of a wall (walllaw.h),
+ *  2. the wall stress rho_s u_tau u_tau of the vertices by Shepard interpolation (Ferrand
+ *     Eq. 38),
+ *  3. with LES: the rate of strain S, the local y+ from the wall stress at the foot of the
+ *     nearest wall, nu_r = l_S^2 S and k_r,
+ *  4. with C_Y > 0: k_r of the vertices (Shepard), and the pressure of fluid and vertex
+ *     particles as seen by the forces becomes p + 2/3 rho k_r (Eq. 5.42: pr2 and the wall
+ *     pressure; P->p stays the equation-of-state pressure).
+ * Everything is a gather over the neighbour list: bitwise independent of the thread count.
+ */
+#ifndef CHANSPH_TURB_H
+#define CHANSPH_TURB_H
+
+#include "nbr.h"
+#include "part.h"
+#include "sph.h"
+
+/** @brief Allocate the model arrays a scene needs (none for quasi-DNS, laminar wall law). */
+void turb_init(const struct model *M, struct particles *P, struct walls *W);
+
+/** @brief Free them. */
+void turb_free(struct particles *P, struct walls *W);
+
+/**
+ * @brief Model terms of the current state (see the file comment).
+ * @param[in] M model (M->nu is the viscosity of the schedule at this time)
+ * @param[in,out] P particles (twx, twz, nur, kr, pr2)
+ * @param[in] nb neighbour list of the current positions
+ * @param[in,out] W wall lattice (tx, tz; p gains 2/3 rho k_r)
+ * @return the largest nu + nu_r over the fluid particles [m^2/s], for the viscous time step
+ */
+double turb_update(const struct model *M, struct particles *P, const struct nbr *nb,
+                   struct walls *W);
+
+/**
+ * @brief Rate of strain from the first-order corrected velocity gradient of one particle
+ *        (thesis Eq. 2.88-2.90 with k = 0): G = [sum_b V_b (v_b - v_a) (x) grad w_ab] L_a^T,
+ *        S = (2 S:S)^(1/2), S = (G + G^T)/2. Exposed for the unit tests.
+ * @param dim 2 or 3
+ * @param A -sum_b V_b F_ab r_ab (x) r_ab, as {xx, xy, xz, yy, yz, zz}
+ * @param B sum_b V_b (v_b - v_a)_i F_ab (r_ab)_j, row-major 3x3
+ * @return S [1/s]
+ */
+double turb_strain_gradient(int dim, const double A[6], const double B[9]);
+
+/**
+ * @brief van Driest damping 1 - exp(-y+/A+) (thesis Eq. 5.50, sign corrected).
+ */
+double turb_van_driest(double yplus, double a_plus);
+
+#endif
