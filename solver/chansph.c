@@ -4,6 +4,7 @@
  */
 #define _GNU_SOURCE /* feenableexcept */
 #include <fenv.h>
+#include <math.h>
 #include <mpi.h>
 #include <omp.h>
 #include <stdio.h>
@@ -57,6 +58,9 @@ static int run(struct scene *sc, const struct cli *c) {
   int rc = EXIT_DONE, why = TRIG_NONE;
   while (!sim_done(&S)) {
     sim_step(&S);
+    if (c->inject_id >= 0 && S.step == c->inject_step)
+      for (size_t a = 0; a < S.P.n; a++)
+        if (S.P.id[a] == c->inject_id) S.P.u[a] = NAN; /* fault injection (tests only) */
     struct health_report rep;
     if (S.violation[0]) snprintf(rep.what, sizeof rep.what, "%s", S.violation);
     if (S.violation[0] ||

@@ -14,6 +14,7 @@ void cli_usage(void) {
   printf(
       "usage:\n"
       "  chansph run SCENE.ini [--out DIR] [--set section.key=value ...] [--overwrite] [--fpe]\n"
+      "              [--inject-nan STEP:ID]  (test aid: u of particle ID becomes NaN after STEP)\n"
       "  chansph resume DIR [--set section.key=value ...] [--fpe]\n"
       "      run and resume also take --max-steps N and --walltime HH:MM:SS\n"
       "  chansph bench [SCENE.ini] [--steps N] [--set section.key=value ...]\n"
@@ -31,6 +32,7 @@ int cli_parse(int argc, char **argv, struct cli *c) {
   memset(c, 0, sizeof *c);
   c->set = calloc((size_t)argc + 1, sizeof *c->set);
   c->steps = 50;
+  c->inject_id = -1;
   if (argc < 2) {
     c->cmd = CMD_HELP;
     return CHANSPH_OK;
@@ -82,7 +84,15 @@ int cli_parse(int argc, char **argv, struct cli *c) {
       c->overwrite = 1;
     else if (!strcmp(a, "--fpe"))
       c->fpe = 1;
-    else if (a[0] != '-' && !c->scene)
+    else if (!strcmp(a, "--inject-nan") && i + 1 < argc) {
+      char *end;
+      c->inject_step = strtol(argv[++i], &end, 10);
+      c->inject_id = *end == ':' ? strtoll(end + 1, &end, 10) : -1;
+      if (*end || c->inject_step < 0 || c->inject_id < 0) {
+        error_input("--inject-nan %s: expected STEP:ID with non-negative integers", argv[i]);
+        return CHANSPH_ERR;
+      }
+    } else if (a[0] != '-' && !c->scene)
       c->scene = a;
     else {
       error_input("unexpected argument '%s'%s", a,

@@ -19,6 +19,8 @@ struct cli {
   int overwrite;        /*!< --overwrite */
   int fpe;              /*!< --fpe: trap floating-point exceptions */
   long steps;           /*!< bench: --steps */
+  long inject_step;     /*!< --inject-nan STEP:ID (fault injection for the stability tests) */
+  long long inject_id;  /*!< particle whose u becomes NaN after that step; -1 = none */
   long max_steps;       /*!< run/resume: --max-steps, steps of this process (0: no limit) */
   const char *walltime; /*!< run/resume: --walltime HH:MM:SS (NULL: none) */
 };

@@ -248,6 +248,9 @@ int init_fields(const struct scene *sc, struct particles *P) {
     TRY(from_file(sc, P));
   } else {
     for (size_t a = 0; a < P->n_fluid; a++) P->u[a] = mean_u(sc, &L, ut, P->y[a]);
+    if (sc->init_profile == INIT_WAVE) /* thesis Sec. 3.1.2 */
+      for (size_t a = 0; a < P->n_fluid; a++)
+        P->v[a] = sc->init_wave * sin(4.0 * M_PI * P->y[a] / (2.0 * sc->delta));
   }
   const double two_d = 2.0 * sc->delta;
   const double alpha = 2.0 * M_PI * sc->init_mode_kx / sc->lx;

@@ -65,9 +65,11 @@ void nbr_sort(struct nbr *nb, struct particles *P) {
       if (z >= nb->lz) z -= nb->lz;
       P->z[a] = z;
     }
-    const int ix = clampi((int)(x * nb->cx), nb->nx);
-    const int iy = clampi((int)(P->y[a] * nb->cy), nb->ny);
-    const int iz = nb->dim == 3 ? clampi((int)(z * nb->cz), nb->nz) : 0;
+    /* clamped in floating point first: a NaN or huge coordinate (a failing run, reported by
+       the health check after this step) must not overflow the integer conversion */
+    const int ix = clampi((int)fmin(fmax(x * nb->cx, 0.0), nb->nx), nb->nx);
+    const int iy = clampi((int)fmin(fmax(P->y[a] * nb->cy, 0.0), nb->ny), nb->ny);
+    const int iz = nb->dim == 3 ? clampi((int)fmin(fmax(z * nb->cz, 0.0), nb->nz), nb->nz) : 0;
     cell[a] = (iz * nb->ny + iy) * nb->nx + ix;
   }
   memset(start, 0, (nb->ncell + 1) * sizeof *start);

@@ -87,7 +87,7 @@ static double time_step(struct sim *S, const struct force_info *fi) {
   const struct scene *sc = S->sc;
   const double h = S->M.h;
   S->dt_limits[0] = sc->cfl * h / sc->c0;
-  S->dt_limits[1] = sc->c_visc * h * h / S->nu_max; /* largest nu + nu_r */
+  S->dt_limits[1] = S->nu_max > 0.0 ? sc->c_visc * h * h / S->nu_max : INFINITY; /* nu + nu_r */
   S->dt_limits[2] = fi->amax > 0.0 ? sc->c_force * sqrt(h / fi->amax) : INFINITY;
   S->dt_limits[3] = sc->c_gamma > 0.0 && fi->gvmax > 0.0 ? sc->c_gamma / fi->gvmax : INFINITY;
   if (sc->dt_fixed > 0.0) {

@@ -123,8 +123,9 @@ static const struct key keys[] = {
      "von Karman constant of the wall laws (thesis Eq. 5.33).", OFF(kappa)},
     {"wall", "b", T_DOUBLE, "5.2", -BIG, BIG, 0, NULL, "-",
      "Intercept B of the log law (thesis Eq. 5.33).", OFF(log_b)},
-    {"fluid", "nu", T_DOUBLE, NULL, 0, BIG, REQUIRED | LO_OPEN, NULL, "m^2/s",
-     "Kinematic viscosity.", OFF(nu)},
+    {"fluid", "nu", T_DOUBLE, NULL, 0, BIG, REQUIRED, NULL, "m^2/s",
+     "Kinematic viscosity (0: inviscid, e.g. the energy experiment of thesis Sec. 3.1.2).",
+     OFF(nu)},
     {"fluid", "rho0", T_DOUBLE, "1000", 0, BIG, LO_OPEN, NULL, "kg/m^3", "Reference density.",
      OFF(rho0)},
     {"fluid", "c0", T_DOUBLE, NULL, 0, BIG, REQUIRED | LO_OPEN, NULL, "m/s",
@@ -178,12 +179,16 @@ static const struct key keys[] = {
      OFF(c_gamma)},
     {"time", "max_steps", T_LONG, "0", 0, 1e18, 0, NULL, "-",
      "Stop after this many steps even if t_end is not reached (0 = no limit).", OFF(max_steps)},
-    {"init", "profile", T_CHOICE, "rest", 0, 0, 0, "rest|laminar|reichardt", "-",
+    {"init", "profile", T_CHOICE, "rest", 0, 0, 0, "rest|laminar|reichardt|wave", "-",
      "Initial mean velocity: at rest; the laminar Poiseuille profile of the force (force mode) "
      "or of the target bulk velocity (flux mode); or Reichardt's turbulent profile (thesis Eq. "
      "5.53) with u_tau = (force delta)^(1/2) (force mode) or the u_tau whose profile has the "
-     "target bulk velocity (flux mode).",
+     "target bulk velocity (flux mode); or the wall-normal wave v = init.wave sin(4 pi y / "
+     "(2 delta)) of the energy experiment of thesis Sec. 3.1.2.",
      OFF(init_profile)},
+    {"init", "wave", T_DOUBLE, "0", -BIG, BIG, 0, NULL, "m/s",
+     "Amplitude of the wall-normal wave of profile = wave (the thesis uses c0/10).",
+     OFF(init_wave)},
     {"init", "streaks", T_DOUBLE, "0", 0, BIG, 0, NULL, "m/s",
      "Amplitude of streamwise streaks u' = A 4 (y/2delta)(1 - y/2delta) cos(2 pi k z / lz) "
      "(3-D; divergence-free).",
@@ -440,6 +445,8 @@ static void validate(struct parse_state *ps) {
                  "the eddy viscosity needs the variable-viscosity operator: set sph.viscous = "
                  "violeau (thesis Eq. 2.100)%.0s%.0s",
                  0.0, 0.0);
+  if ((s->les != LES_NONE || s->wall_law != 0) && !(s->nu > 0.0))
+    inconsistent(ps, "fluid.nu", "wall laws and LES need nu > 0 (got %g)%.0s", s->nu, 0.0);
   if ((s->les != LES_NONE || s->wall_law != 0) && two_delta < 4.0 * h * (1.0 - 1e-12))
     inconsistent(ps, "domain.delta",
                  "wall laws and LES need 2 delta = %g >= 4h = %g (no particle near both walls)",

@@ -18,7 +18,7 @@ enum wall_pressure {
   WALL_PRESSURE_ANALYTIC = 2
 };
 enum laplacian_norm { LAPNORM_WALL_NORMAL = 0, LAPNORM_TRACE = 1, LAPNORM_NONE = 2 };
-enum init_profile { INIT_REST = 0, INIT_LAMINAR = 1, INIT_REICHARDT = 2 };
+enum init_profile { INIT_REST = 0, INIT_LAMINAR = 1, INIT_REICHARDT = 2, INIT_WAVE = 3 };
 enum les_model { LES_NONE = 0, LES_SMAGORINSKY = 1 };
 enum les_strain { STRAIN_GRADIENT = 0, STRAIN_VIOLEAU_ISSA = 1 };
 enum pressure_gradient { PGRAD_STANDARD = 0, PGRAD_CORRECTED = 1 };
@@ -77,6 +77,7 @@ struct scene {
   long max_steps;  /*!< stop after this many steps (0 = no limit) */
   /* [init] */
   int init_profile;    /*!< enum init_profile */
+  double init_wave;    /*!< amplitude of the wall-normal wave [m/s] */
   double init_streaks; /*!< amplitude of streamwise streaks [m/s] */
   int init_streak_kz;  /*!< streaks across lz [-] */
   double init_modes;   /*!< amplitude of the divergence-free sinusoidal modes [m/s] */

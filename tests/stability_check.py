@@ -1,0 +1,173 @@
+#!/usr/bin/python3
+"""Stability on stiff and extreme cases (issue 3; docs/stability.md). Each subcommand runs
+chansph, prints its numbers and exits 1 unless the case ends with a correct result or with the
+specific error it must give.
+
+  viscous      Re = 0.1 Poiseuille, dt set by the viscous limit: profile within --max-l2
+  impact       a particle thrown at a wall at c0/2: no penetration, gamma sane, run healthy
+  mach         the same channel at Ma = 0.1 and 0.3: density variation reported, no blow-up
+  flux-step    a flux-driven channel whose target doubles (and halves) suddenly: converges
+  les5200      coarse LES at Re_tau = 5200: 1000 steps with finite fields
+  nan          a NaN injected into one particle after step 60: exit 3 at that step's health
+               check, naming step, particle id and position; stats.nc written before is kept
+"""
+import argparse
+import math
+import os
+import re
+import subprocess
+import sys
+
+import netCDF4
+import numpy as np
+
+
+def run(args, scene, name, sets, extra=(), expect=0):
+    out = os.path.join(args.runs, "stability_" + name)
+    cmd = [args.chansph, "run", scene, "--out", out, "--overwrite"] + list(extra)
+    for s in sets:
+        cmd += ["--set", s]
+    res = subprocess.run(cmd, capture_output=True, text=True)
+    if res.returncode != expect:
+        sys.stdout.write(res.stdout[-3000:] + res.stderr[-3000:])
+        sys.exit("FAIL: chansph exited with %d (expected %d): %s"
+                 % (res.returncode, expect, " ".join(cmd)))
+    return out, res
+
+
+def series(out, name):
+    with netCDF4.Dataset(os.path.join(out, "stats.nc")) as d:
+        return d[name][:].filled(np.nan)
+
+
+def profile_error(out):
+    with netCDF4.Dataset(os.path.join(out, "stats.nc")) as d:
+        a = {k: d.getncattr(k) for k in d.ncattrs()}
+        y, u = d["y_mean"][:].filled(np.nan), d["u_mean"][:].filled(np.nan)
+    ua = a["body_force"] * y * (2 * a["delta"] - y) / (2 * a["nu"])
+    ok = np.isfinite(u)
+    return math.sqrt(np.sum((u[ok] - ua[ok]) ** 2) / np.sum(ua[ok] ** 2))
+
+
+def cmd_viscous(args):
+    # u_max = f (2 delta)^2 / (8 nu) = 1 m/s with nu = 10: Re = u_max 2 delta / nu = 0.1
+    out, res = run(args, args.scene, "viscous",
+                   ["fluid.nu=10", "drive.force=80", "time.t_end=0.1",
+                    "output.t_average_start=0.08", "output.log_every=100000"])
+    dt = series(out, "dt")
+    err = profile_error(out)
+    h = 1.3 * 0.05
+    print("Re = 0.1: dt = %.3e s (viscous limit 0.125 h^2/nu = %.3e s, acoustic %.3e s), "
+          "%d steps, relative L2 error of u_mean %.3e (limit %.3g)"
+          % (dt[-1], 0.125 * h * h / 10, 0.8 * h / 10, round(0.1 / dt[-1]), err, args.max_l2))
+    return err <= args.max_l2 and abs(dt[-1] - 0.125 * h * h / 10) < 1e-12
+
+
+def cmd_impact(args):
+    base, _ = run(args, args.scene, "impact_base", ["time.t_end=0.0052", "output.t_average_start=0",
+                                                    "output.log_every=1"])
+    src = os.path.join(base, "particles.nc")
+    mod = os.path.join(args.runs, "stability_impact_start.nc")
+    with netCDF4.Dataset(src) as d, netCDF4.Dataset(mod, "w") as o:
+        for k in d.ncattrs():
+            o.setncattr(k, d.getncattr(k))
+        for name, dim in d.dimensions.items():
+            o.createDimension(name, len(dim))
+        for name, var in d.variables.items():
+            v = o.createVariable(name, var.dtype, var.dimensions)
+            v.setncatts({k: var.getncattr(k) for k in var.ncattrs()})
+            v[:] = var[:]
+        y = d["y"][:]
+        who = int(np.argmin(y))
+        c0 = 10.0
+        o["v"][who] = -0.5 * c0  # straight at the wall y = 0 at half the speed of sound
+        pid, y0 = int(d["id"][who]), float(y[who])
+    out, res = run(args, args.scene, "impact",
+                   ["init.from=" + mod, "time.t_end=0.2", "output.t_average_start=0",
+                    "output.log_every=1"])
+    gmin = series(out, "min_gamma")
+    with netCDF4.Dataset(os.path.join(out, "particles.nc")) as d:
+        ymin = float(d["y"][:].min())
+    print("particle %d at y = %.4f thrown at the wall at c0/2 = 5 m/s: no health report, "
+          "smallest y at the end %.4e m, min gamma over the run %.4f"
+          % (pid, y0, ymin, np.nanmin(gmin)))
+    return ymin > 0.0 and np.nanmin(gmin) > 0.5
+
+
+def cmd_mach(args):
+    ok = True
+    for c0, mach in ((10.0, 0.1), (10.0 / 3.0, 0.3)):
+        out, res = run(args, args.scene, "mach%g" % mach,
+                       ["fluid.c0=%.17g" % c0, "output.log_every=100000"])
+        rmin, rmax = series(out, "rho_min"), series(out, "rho_max")
+        err = profile_error(out)
+        var = (np.nanmax(rmax) - np.nanmin(rmin)) / 1000.0
+        print("Ma = %.1f (c0 = %.4g m/s): density range over the run [%.2f, %.2f] kg/m^3 "
+              "(%.2f%% of rho0; Ma^2 = %.2f%%), relative L2 error of u_mean %.3e"
+              % (mach, c0, np.nanmin(rmin), np.nanmax(rmax), 100 * var, 100 * mach * mach, err))
+        ok &= bool(np.isfinite(var)) and err < 0.05
+    return ok
+
+
+def cmd_flux_step(args):
+    base, _ = run(args, args.scene, "flux_base", ["output.log_every=100000"])
+    src = os.path.join(base, "particles.nc")
+    ok = True
+    for factor in (2.0, 0.5):
+        target = 0.7 * factor
+        out, _ = run(args, args.scene, "flux_step%g" % factor,
+                     ["init.from=" + src, "drive.u_bulk=%.17g" % target, "time.t_end=12",
+                      "output.log_every=100000"])
+        t, ub = series(out, "time"), series(out, "u_bulk")
+        late = t >= 0.8 * t[-1]
+        rel = np.max(np.abs(ub[late] - target)) / target
+        t90 = t[np.argmax(np.abs(ub - target) <= 0.1 * abs(target - 0.7))]
+        print("target %.2f -> %.2f m/s: within 10%% of the step after %.3f s; over the last 20%% "
+              "of the run max relative error %.2e (limit %.1e)" % (0.7, target, t90, rel,
+                                                                 args.max_rel))
+        ok &= rel <= args.max_rel
+    return ok
+
+
+def cmd_les5200(args):
+    out, res = run(args, args.scene, "les5200",
+                   ["fluid.nu=%.17g" % (1 / 5200.0), "fluid.c0=270", "time.max_steps=1000",
+                    "output.log_every=250"])
+    speed, rmin, rmax = series(out, "max_speed"), series(out, "rho_min"), series(out, "rho_max")
+    finite = all(np.all(np.isfinite(a)) for a in (speed, rmin, rmax))
+    steps = int(re.search(r"finished: (\d+) steps", res.stdout).group(1))
+    print("Re_tau = 5200 LES, dr = 0.1 delta (Delta+ = 520): %d steps, max speed %.2f m/s, "
+          "density [%.1f, %.1f], all finite: %s" % (steps, np.nanmax(speed), np.nanmin(rmin),
+                                                    np.nanmax(rmax), finite))
+    return finite and steps == 1000
+
+
+def cmd_nan(args):
+    out, res = run(args, args.scene, "nan", ["output.write_every=0.05", "output.log_every=10"],
+                   extra=["--inject-nan", "60:7"], expect=3)
+    text = res.stderr + res.stdout
+    m = re.search(r"non-finite value at step (\d+) \(t = [^)]*\): particle id (\d+) at \(", text)
+    print("NaN injected into particle 7 after step 60: %s" % (m.group(0) if m else text[-500:]))
+    with netCDF4.Dataset(os.path.join(out, "stats.nc")) as d:
+        t_kept = float(d["time"][-1])
+    print("stats.nc kept, readable, last record at t = %.4f s" % t_kept)
+    return bool(m) and int(m.group(1)) == 60 and t_kept > 0
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
+    p.add_argument("--chansph", default="build/chansph")
+    p.add_argument("--runs", default="build/test-runs")
+    p.add_argument("what", choices=["viscous", "impact", "mach", "flux-step", "les5200", "nan"])
+    p.add_argument("scene")
+    p.add_argument("--max-l2", type=float, default=0.01)
+    p.add_argument("--max-rel", type=float, default=1e-3)
+    args = p.parse_args()
+    os.makedirs(args.runs, exist_ok=True)
+    ok = globals()["cmd_" + args.what.replace("-", "_")](args)
+    print("PASS" if ok else "FAIL")
+    sys.exit(0 if ok else 1)
+
+
+if __name__ == "__main__":
+    main()
