@@ -155,7 +155,44 @@ static inline double wrap(double d, double l) {
   return d - l * floor(d / l + 0.5);
 }
 
-/** Shepard interpolation of the source velocity onto the fluid particles of P. */
+/** Solve A x = R (m <= 4 unknowns, 3 right-hand sides) by Gaussian elimination with partial
+    pivoting; out[f] = x[0] of right-hand side f. Returns 1 if A is (nearly) singular. */
+static int solve_small(int m, double A[4][4], double R[4][3], double out[3]) {
+  double scale = 0.0;
+  for (int r = 0; r < m; r++) scale = fmax(scale, fabs(A[r][r]));
+  for (int col = 0; col < m; col++) {
+    int piv = col;
+    for (int r = col + 1; r < m; r++)
+      if (fabs(A[r][col]) > fabs(A[piv][col])) piv = r;
+    if (!(fabs(A[piv][col]) > 1e-12 * scale)) return 1;
+    for (int cc = 0; cc < m; cc++) {
+      const double t = A[col][cc];
+      A[col][cc] = A[piv][cc], A[piv][cc] = t;
+    }
+    for (int f = 0; f < 3; f++) {
+      const double t = R[col][f];
+      R[col][f] = R[piv][f], R[piv][f] = t;
+    }
+    for (int r = col + 1; r < m; r++) {
+      const double l = A[r][col] / A[col][col];
+      for (int cc = col; cc < m; cc++) A[r][cc] -= l * A[col][cc];
+      for (int f = 0; f < 3; f++) R[r][f] -= l * R[col][f];
+    }
+  }
+  for (int f = 0; f < 3; f++) {
+    double x[4] = {0, 0, 0, 0};
+    for (int r = m - 1; r >= 0; r--) {
+      double t = R[r][f];
+      for (int cc = r + 1; cc < m; cc++) t -= A[r][cc] * x[cc];
+      x[r] = t / A[r][r];
+    }
+    out[f] = x[0];
+  }
+  return 0;
+}
+
+/** Interpolation of the source velocity onto the fluid particles of P (linear moving least
+    squares with the source's kernel). */
 static void interpolate(const struct source *src, struct particles *P) {
   const double cell = 2.0 * src->h;
   const int nx = (int)fmax(1.0, floor(src->lx / cell)), ny = (int)fmax(1.0, floor(src->ly / cell));
@@ -188,7 +225,11 @@ static void interpolate(const struct source *src, struct particles *P) {
     const int cx = (int)fmin(nx - 1, floor(xa / src->lx * nx));
     const int cy = (int)fmin(ny - 1, floor(ya / src->ly * ny));
     const int cz = src->dim == 3 ? (int)fmin(nz - 1, floor(za / src->lz * nz)) : 0;
-    double sw = 0.0, su = 0.0, sv = 0.0, swz = 0.0;
+    /* linear moving least squares: fit v(r) = c0 + c . (r_b - r_a) with kernel weights, so
+       that linear fields (and the near-wall profile) are interpolated exactly; Shepard (c0
+       alone) if the fit is singular */
+    const int m = src->dim + 1;
+    double A[4][4] = {{0}}, R[4][3] = {{0}};
     for (int k = -rz; k <= rz; k++)
       for (int j = -1; j <= 1; j++)
         for (int i = -1; i <= 1; i++) {
@@ -198,16 +239,24 @@ static void interpolate(const struct source *src, struct particles *P) {
           const size_t c = ((size_t)iz * ny + cy + j) * nx + ix;
           for (size_t q = start[c]; q < start[c + 1]; q++) {
             const size_t b = order[q];
-            const double dx = wrap(xa - sx[b], src->lx), dy = ya - sy[b];
-            const double dz = src->dim == 3 ? wrap(za - sz[b], src->lz) : 0.0;
+            const double dx = wrap(sx[b] - xa, src->lx), dy = sy[b] - ya;
+            const double dz = src->dim == 3 ? wrap(sz[b] - za, src->lz) : 0.0;
             const double wv =
                 src->col[7][b] / src->col[6][b] * kernel_w(&K, sqrt(dx * dx + dy * dy + dz * dz));
-            sw += wv, su += wv * src->col[3][b], sv += wv * src->col[4][b];
-            swz += wv * src->col[5][b];
+            const double basis[4] = {1.0, dx, dy, dz};
+            for (int r = 0; r < m; r++) {
+              for (int cc = 0; cc < m; cc++) A[r][cc] += wv * basis[r] * basis[cc];
+              for (int f = 0; f < 3; f++) R[r][f] += wv * basis[r] * src->col[3 + f][b];
+            }
           }
         }
-    P->u[a] = sw > 0 ? su / sw : 0.0, P->v[a] = sw > 0 ? sv / sw : 0.0;
-    P->w[a] = sw > 0 ? swz / sw : 0.0;
+    double out[3];
+    if (A[0][0] > 0.0 && solve_small(m, A, R, out) == 0) {
+      P->u[a] = out[0], P->v[a] = out[1], P->w[a] = src->dim == 3 ? out[2] : 0.0;
+    } else {
+      const double s0 = A[0][0] > 0.0 ? 1.0 / A[0][0] : 0.0;
+      P->u[a] = R[0][0] * s0, P->v[a] = R[0][1] * s0, P->w[a] = src->dim == 3 ? R[0][2] * s0 : 0.0;
+    }
   }
 #undef CELL_OF
   free(start), free(fill), free(order), free(cellof);

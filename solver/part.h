@@ -42,7 +42,7 @@ struct particles {
      state after every step, so not permuted */
   double *nur;       /*!< eddy viscosity nu_r [m^2/s] */
   double *kr;        /*!< residual kinetic energy k_r [m^2/s^2] */
-  double *twx, *twz; /*!< wall-law stress u_tau^2 e_t of the nearest wall [m^2/s^2] */
+  double *twx, *twz; /*!< wall-law stress rho u_tau^2 e_t of the nearest wall [Pa] */
   /* sort scratch */
   double *tmp;
   int64_t *tmp_i;

@@ -61,6 +61,26 @@ static inline double nearest_wall(const struct model *M, double y, int *wall) {
   return *wall ? top : y;
 }
 
+/** Shepard sums at vertex s over its fluid neighbours: returns alpha = sum_b V_b w_bs and sets
+    out[k] = sum_b V_b w_bs f_k,b for the nf fields f (Ferrand Eq. 38 without the 1/alpha). */
+static double vertex_sums(const struct model *M, const struct particles *P, const struct nbr *nb,
+                          size_t s, int nf, const double *const *f, double *out) {
+  const double *restrict x = P->x, *restrict y = P->y, *restrict z = P->z;
+  const int32_t *nl = nb->list + s * (size_t)nb->stride;
+  double alpha = 0.0;
+  for (int k = 0; k < nf; k++) out[k] = 0.0;
+  for (int j = 0; j < nb->count[s]; j++) {
+    const int32_t b = nl[j];
+    if (P->kind[b] != KIND_FLUID) continue;
+    const double dx = nbr_wrap(x[s] - x[b], M->lx), dy = y[s] - y[b];
+    const double dz = M->dim == 3 ? nbr_wrap(z[s] - z[b], M->lz) : 0.0;
+    const double vw = P->m[b] / P->rho[b] * kernel_w(&M->k, sqrt(dx * dx + dy * dy + dz * dz));
+    alpha += vw;
+    for (int k = 0; k < nf; k++) out[k] += vw * f[k][b];
+  }
+  return alpha;
+}
+
 double turb_update(const struct model *M, struct particles *P, const struct nbr *nb,
                    struct walls *W) {
   if (!M->wall_tau) return M->nu;
@@ -72,7 +92,7 @@ double turb_update(const struct model *M, struct particles *P, const struct nbr 
   const double *restrict m = P->m, *restrict rho = P->rho;
   const uint8_t *restrict kind = P->kind;
   double *restrict twx = P->twx, *restrict twz = P->twz;
-  /* 1. wall-law stress of the near-wall particles: u_tau^2 along their tangential velocity */
+  /* 1. wall-law stress of the near-wall particles: rho u_tau^2 along their tangential velocity */
 #pragma omp parallel for schedule(static)
   for (size_t a = 0; a < P->n; a++) {
     twx[a] = twz[a] = 0.0;
@@ -83,27 +103,20 @@ double turb_update(const struct model *M, struct particles *P, const struct nbr 
     const double ut = sqrt(u[a] * u[a] + w[a] * w[a]);
     if (!(ut > 0.0)) continue;
     const double utau = wall_law_utau(&M->law, ut, d > M->wall_dmin ? d : M->wall_dmin, nu);
-    const double s = utau * utau / ut;
+    const double s = rho[a] * utau * utau / ut; /* rho_a u_tau,a u_tau,a of Ferrand Eq. 38 */
     twx[a] = s * u[a], twz[a] = s * w[a];
   }
   /* 2. vertex values rho_s u_tau u_tau = (1/alpha) sum_b V_b rho_b u_tau,b u_tau,b w_bs
         (Ferrand Eq. 38) */
+  const double *tw[2] = {P->twx, P->twz};
 #pragma omp parallel for schedule(static)
   for (size_t s = 0; s < P->n; s++) {
     if (kind[s] != KIND_VERTEX) continue;
-    const int32_t *nl = nb->list + s * (size_t)nb->stride;
-    double alpha = 0.0, sx = 0.0, sz = 0.0;
-    for (int j = 0; j < nb->count[s]; j++) {
-      const int32_t b = nl[j];
-      if (kind[b] != KIND_FLUID) continue;
-      const double dx = nbr_wrap(x[s] - x[b], M->lx), dy = y[s] - y[b];
-      const double dz = M->dim == 3 ? nbr_wrap(z[s] - z[b], M->lz) : 0.0;
-      const double vw = m[b] / rho[b] * kernel_w(K, sqrt(dx * dx + dy * dy + dz * dz));
-      alpha += vw, sx += vw * rho[b] * twx[b], sz += vw * rho[b] * twz[b];
-    }
+    double sum[2];
+    const double alpha = vertex_sums(M, P, nb, s, 2, tw, sum);
     const size_t slot = part_vertex_slot(P, P->id[s]);
-    W->tx[slot] = alpha > 0.0 ? sx / alpha : 0.0;
-    W->tz[slot] = alpha > 0.0 ? sz / alpha : 0.0;
+    W->tx[slot] = alpha > 0.0 ? sum[0] / alpha : 0.0;
+    W->tz[slot] = alpha > 0.0 ? sum[1] / alpha : 0.0;
   }
   if (!M->les) {
     timer_pop();
@@ -175,16 +188,9 @@ double turb_update(const struct model *M, struct particles *P, const struct nbr 
         P->pr2[s] += 2.0 / 3.0 * kr[s] / rho[s];
         continue;
       }
-      const int32_t *nl = nb->list + s * (size_t)nb->stride;
-      double alpha = 0.0, sk = 0.0;
-      for (int j = 0; j < nb->count[s]; j++) {
-        const int32_t b = nl[j];
-        if (kind[b] != KIND_FLUID) continue;
-        const double dx = nbr_wrap(x[s] - x[b], M->lx), dy = y[s] - y[b];
-        const double dz = M->dim == 3 ? nbr_wrap(z[s] - z[b], M->lz) : 0.0;
-        const double vw = m[b] / rho[b] * kernel_w(K, sqrt(dx * dx + dy * dy + dz * dz));
-        alpha += vw, sk += vw * kr[b];
-      }
+      const double *krf[1] = {kr};
+      double sk;
+      const double alpha = vertex_sums(M, P, nb, s, 1, krf, &sk);
       const double ks = alpha > 0.0 ? sk / alpha : 0.0, extra = 2.0 / 3.0 * rho[s] * ks;
       P->pr2[s] += extra / (rho[s] * rho[s]);
       W->p[part_vertex_slot(P, P->id[s])] += extra;

@@ -6,7 +6,7 @@
  *
  * Order within a step (run.c): after the density and the wall values of the new positions,
  * turb_update computes
- *  1. the wall-law stress u_tau^2 e_t of every fluid particle within 2h of a wall (walllaw.h),
+ *  1. the wall-law stress rho u_tau^2 e_t of every fluid particle within 2h of a wall (walllaw.h),
  *  2. the wall stress rho_s u_tau u_tau of the vertices by Shepard interpolation (Ferrand
  *     Eq. 38),
  *  3. with LES: the rate of strain S, the local y+ from the wall stress at the foot of the

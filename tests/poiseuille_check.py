@@ -8,6 +8,8 @@ Subcommands (each runs chansph, reads its netCDF output, prints the numbers, exi
   longrun SCENE --steps N      N steps: no particle lost or through a wall, density drift, gamma
   convergence SCENE            error at 2 delta/dr = 20, 40, 80 and the observed order
   study SCENE2D SCENE3D --doc DIR   error against wall-clock time for four resolutions (PNG + table)
+  restart-finer SCENE --max-l2 E  start a run at dr/2 from the steady particles.nc of a run at
+                               dr (init.from, Shepard interpolation): initial profile error
   smagorinsky SCENE --max-l2 E   steady laminar flow with the Smagorinsky model on, against the
                                semi-analytical profile of tau(y) = f (delta - y) =
                                (nu + l(y)^2 |u'|) u' with l = C_S Delta_G (1 - exp(-y+/A+))
@@ -240,6 +242,23 @@ def smagorinsky_profile(a, out, y):
     return np.interp(np.minimum(y, 2 * delta - y), yy, u)
 
 
+def cmd_restart_finer(args):
+    coarse, _ = run(args, args.scene, "coarse_" + os.path.basename(args.scene)[:-4], args.set)
+    dr = float(scene_attr(coarse, "domain", "dr"))
+    fine, _ = run(args, args.scene, "finer_" + os.path.basename(args.scene)[:-4],
+                  args.set + ["domain.dr=%.17g" % (dr / 2), "time.max_steps=1",
+                              "init.from=" + os.path.join(coarse, "particles.nc")])
+    a = attrs(os.path.join(coarse, "stats.nc"))
+    with netCDF4.Dataset(os.path.join(fine, "particles.nc")) as d:
+        y, u = d["y"][:], d["u"][:]
+    ua = laminar(a, y)
+    err = math.sqrt(np.sum((u - ua) ** 2) / np.sum(ua ** 2))
+    print("finer run (dr %.4g -> %.4g, %d particles) started from the coarse particles.nc: "
+          "relative L2 error of u against the steady profile %.3e (limit %.3g)"
+          % (dr, dr / 2, len(y), err, args.max_l2))
+    return err <= args.max_l2
+
+
 def cmd_smagorinsky(args):
     sets = ["les.model=smagorinsky", "sph.viscous=violeau"] + args.set
     out, wall = run(args, args.scene, "smagorinsky_" + os.path.basename(args.scene)[:-4], sets)
@@ -262,7 +281,7 @@ def main():
     p.add_argument("--chansph", default="build/chansph")
     p.add_argument("--runs", default="build/test-runs")
     p.add_argument("what", choices=["steady", "startup", "flux", "longrun", "convergence", "study",
-                                      "smagorinsky"])
+                                      "smagorinsky", "restart-finer"])
     p.add_argument("scene")
     p.add_argument("scene3d", nargs="?")
     p.add_argument("--max-l2", type=float, default=0.01)
@@ -274,7 +293,7 @@ def main():
                    help="convergence: error falls at each halving, or from dr to dr/4")
     args = p.parse_args()
     os.makedirs(args.runs, exist_ok=True)
-    ok = globals()["cmd_" + args.what](args)
+    ok = globals()["cmd_" + args.what.replace("-", "_")](args)
     print("PASS" if ok else "FAIL")
     sys.exit(0 if ok else 1)
 

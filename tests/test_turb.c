@@ -12,7 +12,7 @@
  *    the foot of the nearest wall;
  *  - the Violeau-Issa strain (Eq. 5.48 solved for S) away from the walls equals
  *    |g| (-(1/(rho_a gamma_a)) sum_b V_b (rho_a + rho_b)/2 y_ab^2 F_ab)^(1/2), summed here;
- *  - the wall-law stress of every near-wall particle is u_tau(U, max(d, dr))^2 along its
+ *  - the wall-law stress of every near-wall particle is rho u_tau(U, max(d, dr))^2 along its
  *    velocity, with u_tau from walllaw.h (Reichardt);
  *  - Violeau's wall moment table (sph.c): -1 at the wall (half of the full-space -2) to 1e-8
  *    and 0 at q = 2.
@@ -105,7 +105,8 @@ static int check_channel(int damping, int strain) {
     if (d < two_h) { /* wall-law stress of the particle */
       const double U = fabs(P->u[a]);
       const double ut = wall_law_utau(L, U, fmax(d, M->wall_dmin), M->nu);
-      const double err = fabs(P->twx[a] - ut * ut * (P->u[a] > 0 ? 1 : -1)) / (ut * ut);
+      const double want = P->rho[a] * ut * ut * (P->u[a] > 0 ? 1 : -1);
+      const double err = fabs(P->twx[a] - want) / fabs(want);
       if (err > worst_tau) worst_tau = err;
       n_wall++;
       continue;
