@@ -214,7 +214,8 @@ static const struct key keys[] = {
     {"init", "from", T_STRING, "", 0, 0, 0, NULL, "-",
      "particles.nc of an earlier run with the same domain: with the same particle count its "
      "positions and velocities are taken as they are (by id); otherwise its velocity field is "
-     "interpolated (linear moving least squares) onto this scene's lattice, e.g. a coarse LES to start a finer "
+     "interpolated (linear moving least squares) onto this scene's lattice, e.g. a coarse LES to "
+     "start a finer "
      "run. Overrides profile; streaks, modes and noise are added on top.",
      OFF(init_from)},
     {"output", "log_every", T_INT, "100", 1, 1e9, 0, NULL, "steps",
