@@ -16,19 +16,48 @@
 #include "extract.h"
 #include "health.h"
 #include "output.h"
+#include "restart.h"
 #include "run.h"
+#include "snapshot.h"
 
-/** Run a scene into a directory; returns the process exit code. */
-static int run(const struct scene *sc, const struct cli *c) {
-  struct sim S;
-  if (sim_init(&S, sc)) return 1; /* before the run directory exists: nothing to clean up */
-  struct output out;
-  if (output_open(&out, c->out, sc, c->overwrite)) {
-    sim_free(&S);
-    return 1;
+/** Write a checkpoint and tell the triggers how long it took. */
+static int save(struct output *out, struct sim *S, struct trigger *T) {
+  double seconds = 0.0;
+  if (restart_save(out, S, &seconds)) {
+    output_log(out,
+               "error: stopped at step %ld: cannot write a checkpoint (the previous ones are "
+               "intact); fix the cause, then `chansph resume %s`\n",
+               S->step, out->dir);
+    return CHANSPH_ERR;
   }
-  output_begin(&out, &S);
-  int rc = 0;
+  trigger_wrote(T, S->step, seconds);
+  return CHANSPH_OK;
+}
+
+/** Run a scene, or resume a run, in a directory; returns the process exit code. */
+static int run(struct scene *sc, const struct cli *c) {
+  double walltime = 0.0;
+  if (c->walltime && trigger_parse_walltime(c->walltime, &walltime)) {
+    error_input("--walltime %s: expected HH:MM:SS, MM:SS or seconds", c->walltime);
+    return EXIT_INPUT;
+  }
+  struct output out;
+  struct sim S;
+  if (c->cmd == CMD_RESUME) {
+    if (restart_resume(c->out, c->n_set, c->set, sc, &S, &out)) return EXIT_INPUT;
+    output_resume(&out, &S);
+  } else {
+    if (sim_init(&S, sc)) return EXIT_INPUT; /* before the run directory exists */
+    if (restart_prepare_new(c->out, c->overwrite) || output_open(&out, c->out, sc, c->overwrite)) {
+      sim_free(&S);
+      return EXIT_INPUT;
+    }
+    output_begin(&out, &S);
+  }
+  if (sc->threads > 0) omp_set_num_threads(sc->threads);
+  struct trigger T;
+  trigger_init(&T, c->out, sc, walltime, c->max_steps, S.step, restart_state_bytes(&out, &S));
+  int rc = EXIT_DONE, why = TRIG_NONE;
   while (!sim_done(&S)) {
     sim_step(&S);
     if (c->inject_id >= 0 && S.step == c->inject_step)
@@ -39,18 +68,41 @@ static int run(const struct scene *sc, const struct cli *c) {
     if (S.violation[0] ||
         (S.step % sc->health_every == 0 && health_check(&S.M, &S.P, S.step, S.t, &rep))) {
       output_fail(&out, &S, &rep);
-      rc = 3;
+      rc = EXIT_NUMERICAL;
       break;
     }
     output_step(&out, &S);
+    if (snapshot_due(&S) && snapshot_write(out.dir, &S)) {
+      rc = EXIT_IOERR;
+      break;
+    }
+    why = trigger_check(&T, S.step);
+    if (why == TRIG_NONE) continue;
+    if (save(&out, &S, &T)) {
+      rc = EXIT_IOERR;
+      break;
+    }
+    if (why != TRIG_PERIODIC) {
+      rc = EXIT_RESUBMIT;
+      break;
+    }
   }
-  if (rc == 0 && output_finish(&out, &S)) rc = 1;
+  if (rc == EXIT_DONE && T.last_step != S.step && save(&out, &S, &T)) rc = EXIT_IOERR;
+  if (rc == EXIT_DONE && output_finish(&out, &S)) rc = EXIT_IOERR;
+  if (rc == EXIT_RESUBMIT) {
+    if (output_stop(&out, &S, trigger_text(&T, why)))
+      rc = EXIT_IOERR;
+    else
+      output_log(&out, "checkpointed: continue with `chansph resume %s` (exit code %d)\n", out.dir,
+                 EXIT_RESUBMIT);
+  }
   output_close(&out);
   sim_free(&S);
   return rc;
 }
 
 int main(int argc, char **argv) {
+  trigger_mark_start();
   /* post-processing commands: serial, no MPI */
   if (argc > 1 && !strcmp(argv[1], "extract")) return extract_main(argc - 2, argv + 2);
   if (argc > 1 && !strcmp(argv[1], "compare"))
@@ -74,6 +126,9 @@ int main(int argc, char **argv) {
         "implemented yet",
         size);
     rc = 1;
+  } else if (c.cmd == CMD_RESUME) {
+    if (c.fpe) feenableexcept(FE_DIVBYZERO | FE_INVALID | FE_OVERFLOW);
+    rc = run(&sc, &c);
   } else if ((c.cmd == CMD_BENCH ? cli_bench_scene(&sc, &c)
                                  : scene_load(&sc, c.scene, c.n_set, c.set))) {
     rc = 1;

@@ -15,6 +15,8 @@ void cli_usage(void) {
       "usage:\n"
       "  chansph run SCENE.ini [--out DIR] [--set section.key=value ...] [--overwrite] [--fpe]\n"
       "              [--inject-nan STEP:ID]  (test aid: u of particle ID becomes NaN after STEP)\n"
+      "  chansph resume DIR [--set section.key=value ...] [--fpe]\n"
+      "      run and resume also take --max-steps N and --walltime HH:MM:SS\n"
       "  chansph bench [SCENE.ini] [--steps N] [--set section.key=value ...]\n"
       "  chansph scene-doc            print the scene key reference (docs/scenes.md)\n"
       "  chansph extract STATS.nc [--var a,b] [--units wall|outer] [--format csv|tsv]\n"
@@ -22,8 +24,11 @@ void cli_usage(void) {
       "  chansph compare STATS.nc --dns FILE [--out DIR]   errors against DNS, PNG plots\n"
       "  chansph --version | --help\n"
       "run writes DIR/log.txt, scene.used.ini, stats.nc, particles.nc (default DIR:\n"
-      "runs/<scene name>). Threads: OMP_NUM_THREADS or run.threads. Exit codes: 0 done,\n"
-      "1 input error, 2 internal error, 3 numerical failure (health check).\n");
+      "runs/<scene name>) and DIR/checkpoints/ckpt_<step>.h5; resume continues a run from\n"
+      "its newest valid checkpoint. Threads: OMP_NUM_THREADS or run.threads. Exit codes: 0 done,\n"
+      "1 input error, 2 internal error, 3 numerical failure (health check), 74 cannot write\n"
+      "a checkpoint or output, 75 checkpointed before the end (signal, DIR/STOP, --walltime,\n"
+      "--max-steps): resume me (docs/batch-jobs.md).\n");
 }
 
 int cli_parse(int argc, char **argv, struct cli *c) {
@@ -38,6 +43,8 @@ int cli_parse(int argc, char **argv, struct cli *c) {
   const char *cmd = argv[1];
   if (!strcmp(cmd, "run"))
     c->cmd = CMD_RUN;
+  else if (!strcmp(cmd, "resume"))
+    c->cmd = CMD_RESUME;
   else if (!strcmp(cmd, "bench"))
     c->cmd = CMD_BENCH;
   else if (!strcmp(cmd, "scene-doc"))
@@ -67,7 +74,16 @@ int cli_parse(int argc, char **argv, struct cli *c) {
         error_input("--steps %s: expected a positive integer", argv[i]);
         return CHANSPH_ERR;
       }
-    } else if (!strcmp(a, "--overwrite"))
+    } else if (!strcmp(a, "--max-steps") && has_next) {
+      char *end;
+      c->max_steps = strtol(argv[++i], &end, 10);
+      if (*end || c->max_steps < 1) {
+        error_input("--max-steps %s: expected a positive integer", argv[i]);
+        return CHANSPH_ERR;
+      }
+    } else if (!strcmp(a, "--walltime") && has_next)
+      c->walltime = argv[++i];
+    else if (!strcmp(a, "--overwrite"))
       c->overwrite = 1;
     else if (!strcmp(a, "--fpe"))
       c->fpe = 1;
@@ -83,7 +99,8 @@ int cli_parse(int argc, char **argv, struct cli *c) {
       c->scene = a;
     else {
       error_input("unexpected argument '%s'%s", a,
-                  (!strcmp(a, "--set") || !strcmp(a, "--out") || !strcmp(a, "--steps"))
+                  (!strcmp(a, "--set") || !strcmp(a, "--out") || !strcmp(a, "--steps") ||
+                   !strcmp(a, "--max-steps") || !strcmp(a, "--walltime"))
                       ? " (missing value)"
                       : "");
       cli_usage();
@@ -94,6 +111,14 @@ int cli_parse(int argc, char **argv, struct cli *c) {
     error_input("run: missing SCENE.ini");
     cli_usage();
     return CHANSPH_ERR;
+  }
+  if (c->cmd == CMD_RESUME) {
+    if (!c->scene) {
+      error_input("resume: missing DIR (the run directory)");
+      cli_usage();
+      return CHANSPH_ERR;
+    }
+    snprintf(c->out, sizeof c->out, "%s", c->scene);
   }
   if (c->cmd == CMD_RUN && !c->out[0]) {
     const char *base = strrchr(c->scene, '/');

@@ -7,20 +7,22 @@
 
 #include "scene.h"
 
-enum command { CMD_HELP, CMD_VERSION, CMD_RUN, CMD_BENCH, CMD_SCENE_DOC };
+enum command { CMD_HELP, CMD_VERSION, CMD_RUN, CMD_BENCH, CMD_SCENE_DOC, CMD_RESUME };
 
 /** Parsed command line. */
 struct cli {
   enum command cmd;
-  const char *scene;   /*!< scene file (bench: optional) */
-  char out[2048];      /*!< run directory */
-  int n_set;           /*!< number of --set overrides */
-  char **set;          /*!< the overrides (pointers into argv) */
-  int overwrite;       /*!< --overwrite */
-  int fpe;             /*!< --fpe: trap floating-point exceptions */
-  long steps;          /*!< bench: --steps */
-  long inject_step;    /*!< --inject-nan STEP:ID (fault injection for the stability tests) */
-  long long inject_id; /*!< particle whose u becomes NaN after that step; -1 = none */
+  const char *scene;    /*!< scene file (bench: optional) */
+  char out[2048];       /*!< run directory */
+  int n_set;            /*!< number of --set overrides */
+  char **set;           /*!< the overrides (pointers into argv) */
+  int overwrite;        /*!< --overwrite */
+  int fpe;              /*!< --fpe: trap floating-point exceptions */
+  long steps;           /*!< bench: --steps */
+  long inject_step;     /*!< --inject-nan STEP:ID (fault injection for the stability tests) */
+  long long inject_id;  /*!< particle whose u becomes NaN after that step; -1 = none */
+  long max_steps;       /*!< run/resume: --max-steps, steps of this process (0: no limit) */
+  const char *walltime; /*!< run/resume: --walltime HH:MM:SS (NULL: none) */
 };
 
 /**

@@ -39,25 +39,13 @@ static int exists(const char *dir, const char *name) {
   return stat(path, &st) == 0;
 }
 
-int output_open(struct output *o, const char *dir, const struct scene *sc, int overwrite) {
-  memset(o, 0, sizeof *o);
-  snprintf(o->dir, sizeof o->dir, "%s", dir);
-  static const char *const results[] = {"stats.nc", "log.txt", "particles.nc"};
-  for (size_t i = 0; i < sizeof results / sizeof results[0] && !overwrite; i++)
-    if (exists(dir, results[i])) {
-      error_input(
-          "%s/%s: the output directory already holds results of a run; choose "
-          "another --out DIR or pass --overwrite",
-          dir, results[i]);
-      return CHANSPH_ERR;
-    }
-  if (mkdir_p(dir)) {
-    error_input("%s: cannot create the output directory (%s)", dir, strerror(errno));
-    return CHANSPH_ERR;
-  }
+/* Shared by output_open and output_reopen: log.txt (mode "w" or "a"), scene.used.ini,
+   empty accumulators. */
+static int open_common(struct output *o, const char *dir, const struct scene *sc,
+                       const char *log_mode) {
   char path[4096];
   snprintf(path, sizeof path, "%s/log.txt", dir);
-  o->log = fopen(path, "w");
+  o->log = fopen(path, log_mode);
   if (!o->log) {
     error_input("%s: cannot open for writing (%s)", path, strerror(errno));
     return CHANSPH_ERR;
@@ -124,8 +112,53 @@ void output_stats_config(const struct scene *sc, struct stats_config *cfg) {
   }
 }
 
-/* A line to stdout and log.txt. */
-static void logline(struct output *o, const char *fmt, ...) {
+int output_open(struct output *o, const char *dir, const struct scene *sc, int overwrite) {
+  memset(o, 0, sizeof *o);
+  snprintf(o->dir, sizeof o->dir, "%s", dir);
+  static const char *const results[] = {"stats.nc", "log.txt", "particles.nc"};
+  for (size_t i = 0; i < sizeof results / sizeof results[0] && !overwrite; i++)
+    if (exists(dir, results[i])) {
+      error_input(
+          "%s/%s: the output directory already holds results of a run; choose "
+          "another --out DIR or pass --overwrite",
+          dir, results[i]);
+      return CHANSPH_ERR;
+    }
+  if (mkdir_p(dir)) {
+    error_input("%s: cannot create the output directory (%s)", dir, strerror(errno));
+    return CHANSPH_ERR;
+  }
+  return open_common(o, dir, sc, "w");
+}
+
+int output_reopen(struct output *o, const char *dir, const struct scene *sc) {
+  memset(o, 0, sizeof *o);
+  snprintf(o->dir, sizeof o->dir, "%s", dir);
+  return open_common(o, dir, sc, "a");
+}
+
+/* The time series grows during a run: make room for the stored rows. */
+static void *series_reserve(void *owner, int rank, const size_t *dims) {
+  struct series *ts = owner;
+  if (rank != 2 || dims[1] != (size_t)ts->ncol) return NULL;
+  if (dims[0] > ts->cap) {
+    double *d = realloc(ts->data, (dims[0] ? dims[0] : 1) * (size_t)ts->ncol * sizeof *d);
+    if (!d) return NULL;
+    ts->data = d, ts->cap = dims[0] ? dims[0] : 1;
+  }
+  ts->n = dims[0];
+  return ts->data;
+}
+
+void output_state(struct output *o, struct state_list *L) {
+  stats_state(&o->st, L); /* every engine's accumulators (stats/...) */
+  const size_t dims[2] = {o->ts.n, (size_t)o->ts.ncol};
+  struct state_field *f = state_add(L, "stats/series", STATE_F64, 2, dims, o->ts.data, NULL);
+  f->reserve = series_reserve, f->owner = &o->ts;
+  state_add(L, "output/next_write", STATE_F64, 0, NULL, &o->next_write, "s");
+}
+
+void output_log(struct output *o, const char *fmt, ...) {
   char buf[1024];
   va_list ap;
   va_start(ap, fmt);
@@ -152,11 +185,11 @@ static void log_progress(struct output *o, struct sim *S, const struct diag *d) 
   const double done = S->t - o->t0, left = S->sc->t_end - S->t;
   const double eta = done > 0.0 ? (now - o->wall0) * left / done : 0.0;
   const long es = (long)fmax(0.0, eta);
-  logline(o,
-          "step %8ld  t %.6e  dt %.3e  u_bulk %.6e  force %.6e  max|v| %.4e  rho [%.6g, %.6g]"
-          "  min_gamma %.4f  %.3e p-steps/s  ETA %02ld:%02ld:%02ld\n",
-          S->step, S->t, S->dt, d->u_bulk, S->fx, d->max_speed, d->rho_min, d->rho_max,
-          d->min_gamma, rate, es / 3600, es / 60 % 60, es % 60);
+  output_log(o,
+             "step %8ld  t %.6e  dt %.3e  u_bulk %.6e  force %.6e  max|v| %.4e  rho [%.6g, %.6g]"
+             "  min_gamma %.4f  %.3e p-steps/s  ETA %02ld:%02ld:%02ld\n",
+             S->step, S->t, S->dt, d->u_bulk, S->fx, d->max_speed, d->rho_min, d->rho_max,
+             d->min_gamma, rate, es / 3600, es / 60 % 60, es % 60);
   o->last_wall = now, o->last_step = S->step;
 }
 
@@ -202,13 +235,21 @@ void output_begin(struct output *o, struct sim *S) {
   struct diag d;
   record(o, S, &d);
   o->wall0 = o->last_wall = timer_now();
-  o->t0 = S->t, o->last_step = S->step;
-  logline(o,
-          "chansph %s: %zu fluid + %zu vertex particles, h = %.6g, dt limits: acoustic "
-          "%.3e s, viscous %.3e s; output in %s\n",
-          CHANSPH_VERSION, S->P.n_fluid, S->P.n_vertex, S->M.h, S->sc->cfl * S->M.h / S->sc->c0,
-          S->sc->c_visc * S->M.h * S->M.h / S->sc->nu, o->dir);
+  o->t0 = S->t, o->last_step = o->step0 = S->step;
+  output_log(o,
+             "chansph %s: %zu fluid + %zu vertex particles, h = %.6g, dt limits: acoustic "
+             "%.3e s, viscous %.3e s; output in %s\n",
+             CHANSPH_VERSION, S->P.n_fluid, S->P.n_vertex, S->M.h, S->sc->cfl * S->M.h / S->sc->c0,
+             S->sc->c_visc * S->M.h * S->M.h / S->sc->nu, o->dir);
   log_progress(o, S, &d);
+}
+
+void output_resume(struct output *o, struct sim *S) {
+  timer_reset(); /* the phase report covers this process's steps */
+  o->wall0 = o->last_wall = timer_now();
+  o->t0 = S->t, o->last_step = o->step0 = S->step;
+  output_log(o, "chansph %s: resumed at step %ld, t = %.9g s: %zu fluid + %zu vertex particles\n",
+             CHANSPH_VERSION, S->step, S->t, S->P.n_fluid, S->P.n_vertex);
 }
 
 void output_step(struct output *o, struct sim *S) {
@@ -251,7 +292,7 @@ void output_step(struct output *o, struct sim *S) {
   if (S->t >= o->next_write) {
     char line[1024];
     stats_convergence_line(&o->st, line, sizeof line);
-    logline(o, "%s", line);
+    output_log(o, "%s", line);
     if (write_stats(o, S)) die("stopping: cannot write statistics");
     while (o->next_write <= S->t) o->next_write += sc->write_every;
   }
@@ -298,16 +339,26 @@ int output_finish(struct output *o, struct sim *S) {
   const double wall = timer_now() - o->wall0;
   char line[1024];
   stats_convergence_line(&o->st, line, sizeof line);
-  logline(o, "%s", line);
-  logline(o, "statistics engine: %.3f MB (%lld snapshots)\n", stats_memory(&o->st) / 1048576.0,
-          (long long)o->st.samples);
+  output_log(o, "%s", line);
+  output_log(o, "statistics engine: %.3f MB (%lld snapshots)\n", stats_memory(&o->st) / 1048576.0,
+             (long long)o->st.samples);
   TRY(write_stats(o, S));
   if (S->sc->particles) TRY(write_particles(o, S));
-  logline(o, "finished: %ld steps, t = %.6g s in %.2f s wall (%.3e particle-steps/s)\n", S->step,
-          S->t, wall, wall > 0 ? (double)S->P.n_fluid * S->step / wall : 0.0);
+  output_log(o, "finished: %ld steps, t = %.6g s in %.2f s wall (%.3e particle-steps/s)\n", S->step,
+             S->t, wall, wall > 0 ? (double)S->P.n_fluid * (S->step - o->step0) / wall : 0.0);
   timer_report(stdout, wall);
   if (o->log) timer_report(o->log, wall);
-  logline(o, "results: %s/stats.nc%s\n", o->dir, S->sc->particles ? ", particles.nc" : "");
+  output_log(o, "results: %s/stats.nc%s\n", o->dir, S->sc->particles ? ", particles.nc" : "");
+  return CHANSPH_OK;
+}
+
+int output_stop(struct output *o, struct sim *S, const char *why) {
+  const double wall = timer_now() - o->wall0;
+  TRY(write_stats(o, S));
+  output_log(o, "stopped at step %ld, t = %.9g s (%s) after %.2f s wall\n", S->step, S->t, why,
+             wall);
+  timer_report(stdout, wall);
+  if (o->log) timer_report(o->log, wall);
   return CHANSPH_OK;
 }
 

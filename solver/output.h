@@ -11,6 +11,7 @@
 #include "health.h"
 #include "run.h"
 #include "series.h"
+#include "state.h"
 #include "stats.h"
 
 /** Output state of a run. */
@@ -25,6 +26,7 @@ struct output {
   double t0;         /*!< simulated time at the start of the loop [s] */
   double last_wall;  /*!< wall clock of the last log line [s] */
   long last_step;    /*!< step of the last log line */
+  long step0;        /*!< step at the start of the loop (0, or where a resume started) */
 };
 
 /**
@@ -36,6 +38,34 @@ int output_open(struct output *o, const char *dir, const struct scene *sc, int o
 
 /** @brief The statistics engine's configuration from the scene (bins, windows, engines). */
 void output_stats_config(const struct scene *sc, struct stats_config *cfg);
+
+/**
+ * @brief Reopen the directory of a run being resumed: log.txt is appended to, scene.used.ini
+ *        rewritten with the (possibly changed) scene, accumulators sized from the scene; their
+ *        contents come from the checkpoint through output_state().
+ * @return CHANSPH_OK or CHANSPH_ERR with a message
+ */
+int output_reopen(struct output *o, const char *dir, const struct scene *sc);
+
+/**
+ * @brief Append the output state to a list: every statistics engine's accumulators
+ *        (stats_state), the time series (sized on reading) and the time of the next stats.nc
+ *        rewrite. Rebuild the list before each checkpoint: growing arrays move.
+ */
+void output_state(struct output *o, struct state_list *L);
+
+/** @brief Log a line to stdout and log.txt (printf-style). */
+void output_log(struct output *o, const char *fmt, ...);
+
+/** @brief Start the clocks of a resumed run (no record: the series holds the state's row). */
+void output_resume(struct output *o, struct sim *S);
+
+/**
+ * @brief The run stops before its end (checkpointed): rewrite stats.nc with what was gathered,
+ *        log why and the timing report.
+ * @return CHANSPH_OK or CHANSPH_ERR
+ */
+int output_stop(struct output *o, struct sim *S, const char *why);
 
 /** @brief Record the initial state and start the clocks. */
 void output_begin(struct output *o, struct sim *S);

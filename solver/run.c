@@ -193,3 +193,61 @@ int sim_done(const struct sim *S) {
   if (S->sc->max_steps > 0 && S->step >= S->sc->max_steps) return 1;
   return S->t >= S->sc->t_end * (1.0 - 1e-12);
 }
+
+void sim_state(struct sim *S, struct state_list *L) {
+  _Static_assert(sizeof(long) == sizeof(int64_t), "long must be 64-bit");
+  _Static_assert(sizeof(int) == sizeof(int32_t), "int must be 32-bit");
+  struct particles *P = &S->P;
+  state_add(L, "sim/step", STATE_I64, 0, NULL, &S->step, NULL);
+  state_add(L, "sim/time", STATE_F64, 0, NULL, &S->t, "s");
+  state_add(L, "sim/dt", STATE_F64, 0, NULL, &S->dt, "s");
+  state_add(L, "sim/body_force", STATE_F64, 0, NULL, &S->fx, "m/s^2");
+  state_add(L, "drive/force", STATE_F64, 0, NULL, &S->drive.force, "m/s^2");
+  state_add(L, "drive/ub_prev", STATE_F64, 0, NULL, &S->drive.ub_prev, "m/s");
+  state_add(L, "drive/dt_prev", STATE_F64, 0, NULL, &S->drive.dt_prev, "s");
+  state_add(L, "drive/started", STATE_I32, 0, NULL, &S->drive.started, NULL);
+  const size_t n[1] = {P->n};
+  state_add(L, "particles/id", STATE_I64, 1, n, P->id, NULL);
+  state_add(L, "particles/kind", STATE_U8, 1, n, P->kind, NULL);
+  struct {
+    const char *name;
+    double *data;
+    const char *units;
+  } const f[] = {{"particles/x", P->x, "m"},
+                 {"particles/y", P->y, "m"},
+                 {"particles/z", P->z, "m"},
+                 {"particles/u", P->u, "m/s"},
+                 {"particles/v", P->v, "m/s"},
+                 {"particles/w", P->w, "m/s"},
+                 {"particles/rho", P->rho, "kg/m^3"},
+                 {"particles/p", P->p, "Pa"},
+                 {"particles/mass", P->m, "kg"},
+                 {"particles/gamma", P->gam, "1"},
+                 {"particles/kernel_sum", P->ksum, "kg/m^dim"}};
+  for (size_t i = 0; i < sizeof f / sizeof f[0]; i++)
+    state_add(L, f[i].name, STATE_F64, 1, n, f[i].data, f[i].units);
+  const size_t nw[1] = {P->n_vertex};
+  state_add(L, "walls/rho", STATE_F64, 1, nw, S->W.rho, "kg/m^3");
+  state_add(L, "walls/p", STATE_F64, 1, nw, S->W.p, "Pa");
+}
+
+size_t sim_restored(struct sim *S) {
+  struct particles *P = &S->P;
+  const size_t nv = P->n_vertex;
+  double *old = part_alloc("restore_check", 2 * nv * sizeof(double));
+  memcpy(old, S->W.rho, nv * sizeof(double));
+  memcpy(old + nv, S->W.p, nv * sizeof(double));
+  nbr_sort(&S->nb, P);
+  nbr_build(&S->nb, P, &S->M.k, S->ksum_new);
+  /* dt = 0: pressure, sound speed, p/rho^2 and volume from the stored density; the kernel sum
+     and gamma are set to the values they already hold */
+  sph_density(&S->M, P, P->ksum, 0.0);
+  sph_walls(&S->M, P, &S->nb, &S->W);
+  model_update(S);
+  size_t differ = 0;
+  for (size_t i = 0; i < nv; i++)
+    differ += memcmp(&old[i], &S->W.rho[i], sizeof(double)) != 0 ||
+              memcmp(&old[nv + i], &S->W.p[i], sizeof(double)) != 0;
+  part_free(old);
+  return differ;
+}

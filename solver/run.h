@@ -11,6 +11,7 @@
 #include "part.h"
 #include "scene.h"
 #include "sph.h"
+#include "state.h"
 
 /** Everything a running simulation holds. */
 struct sim {
@@ -66,6 +67,23 @@ void sim_free(struct sim *S);
  *        update of velocity then position (Eq. 2.159), re-sort, density (Eq. 3.64), walls.
  */
 void sim_step(struct sim *S);
+
+/**
+ * @brief Append the state a continuation needs to a list (particles in memory order with their
+ *        ids, wall values, step, time, last dt and force, flux-controller history).
+ * @param[in] S simulation (after sim_init; the fields point into its memory)
+ * @param[in,out] L list
+ */
+void sim_state(struct sim *S, struct state_list *L);
+
+/**
+ * @brief After the fields of sim_state() were filled from a checkpoint: re-sort the particles
+ *        (order by cell, then id), rebuild the neighbour list and the quantities derived from
+ *        the stored state (pressure, sound speed, volumes, wall values), bitwise as the step
+ *        that produced them.
+ * @return 0, or the number of wall values that differ from the stored ones (not bitwise)
+ */
+size_t sim_restored(struct sim *S);
 
 /** @brief Diagnostics of the current state (deterministic sums). */
 void sim_diag(struct sim *S, struct diag *d);

@@ -300,6 +300,20 @@ static const struct key keys[] = {
      OFF(health_every)},
     {"run", "threads", T_INT, "0", 0, 4096, 0, NULL, "-",
      "OpenMP threads; 0 keeps OMP_NUM_THREADS (or all cores).", OFF(threads)},
+    /* [checkpoint]: restart/ (docs/checkpoint-format.md, docs/batch-jobs.md) */
+    {"checkpoint", "every_steps", T_LONG, "0", 0, 1e18, 0, NULL, "steps",
+     "Steps between checkpoints in DIR/checkpoints (0 = not by steps). A run also checkpoints "
+     "at its end, on SIGTERM/SIGINT/SIGUSR1, a STOP file, --max-steps and --walltime.",
+     OFF(ckpt_every_steps)},
+    {"checkpoint", "every_minutes", T_DOUBLE, "30", 0, BIG, 0, NULL, "min",
+     "Wall-clock minutes between checkpoints (0 = not by time).", OFF(ckpt_every_minutes)},
+    {"checkpoint", "keep", T_INT, "3", 1, 1e6, 0, NULL, "-",
+     "Checkpoints kept in DIR/checkpoints; older ones are deleted after a successful write.",
+     OFF(ckpt_keep)},
+    {"snapshots", "every", T_DOUBLE, "0", 0, BIG, 0, NULL, "s",
+     "Simulated time between particle snapshots DIR/snapshots/snap_<step>.h5 with the index "
+     "DIR/snapshots/particles.xdmf for ParaView (0 = none; docs/formats.md).",
+     OFF(snap_every)},
 };
 enum { N_KEYS = sizeof keys / sizeof keys[0] };
 
@@ -538,14 +552,15 @@ static void validate(struct parse_state *ps) {
     inconsistent(ps, "time.dt", "fixed dt = %g is larger than t_end = %g", s->dt_fixed, s->t_end);
 }
 
-int scene_load(struct scene *s, const char *path, int n_set, char *const *set) {
+/* scene_load and scene_load_text: fp (if not NULL) is read and closed. */
+static int load(struct scene *s, const char *path, FILE *fp, int n_set, char *const *set) {
   memset(s, 0, sizeof *s);
   struct parse_state ps = {.s = s, .file = path ? path : "(defaults)"};
   for (int k = 0; k < N_KEYS; k++)
     if (keys[k].def && set_value(s, k, keys[k].def)) die("bad default of key %s", keys[k].name);
   if (path) {
     snprintf(s->path, sizeof s->path, "%s", path);
-    ps.fp = fopen(path, "r");
+    ps.fp = fp;
     if (!ps.fp) {
       error_input("%s: cannot open scene file", path);
       return CHANSPH_ERR;
@@ -579,6 +594,28 @@ int scene_load(struct scene *s, const char *path, int n_set, char *const *set) {
     }
   if (ps.errors == 0) validate(&ps);
   return ps.errors ? CHANSPH_ERR : CHANSPH_OK;
+}
+
+int scene_load(struct scene *s, const char *path, int n_set, char *const *set) {
+  return load(s, path, path ? fopen(path, "r") : NULL, n_set, set);
+}
+
+int scene_load_text(struct scene *s, const char *name, const char *text, int n_set,
+                    char *const *set) {
+  FILE *fp = fmemopen((void *)text, strlen(text), "r");
+  if (!fp) die("fmemopen failed for %s", name);
+  return load(s, name, fp, n_set, set);
+}
+
+int scene_key_count(void) {
+  return N_KEYS;
+}
+
+static void value_text(const struct scene *s, int k, char *buf, size_t n);
+
+void scene_key(const struct scene *s, int k, char *name, char *value) {
+  snprintf(name, 64, "%s.%s", keys[k].section, keys[k].name);
+  value_text(s, k, value, SCENE_VALUE_MAX);
 }
 
 double scene_h(const struct scene *s) {
@@ -620,9 +657,14 @@ static void value_text(const struct scene *s, int k, char *buf, size_t n) {
     case T_LONG:
       snprintf(buf, n, "%ld", *(const long *)field);
       break;
-    case T_DOUBLE:
-      snprintf(buf, n, "%.17g", *(const double *)field);
+    case T_DOUBLE: { /* the shortest text that reads back to the same double */
+      const double v = *(const double *)field;
+      for (int digits = 15; digits <= 17; digits++) {
+        snprintf(buf, n, "%.*g", digits, v);
+        if (strtod(buf, NULL) == v) break;
+      }
       break;
+    }
     case T_LIST: {
       const struct scene_list *L = field;
       size_t m = 0;

@@ -124,6 +124,12 @@ struct scene {
   int health_every; /*!< steps between full health checks */
   /* [run] */
   int threads; /*!< OpenMP threads; 0 = OMP_NUM_THREADS / all */
+  /* [checkpoint] */
+  long ckpt_every_steps;     /*!< steps between checkpoints; 0 = not by steps */
+  double ckpt_every_minutes; /*!< wall-clock minutes between checkpoints; 0 = not by time */
+  int ckpt_keep;             /*!< checkpoints kept in DIR/checkpoints */
+  /* [snapshots] */
+  double snap_every; /*!< simulated time between particle snapshots [s]; 0 = none */
 
   /* bookkeeping, not keys */
   char path[512]; /*!< scene file path */
@@ -137,6 +143,31 @@ struct scene {
  * @return CHANSPH_OK or CHANSPH_ERR after printing every problem with file, line and key
  */
 int scene_load(struct scene *s, const char *path, int n_set, char *const *set);
+
+/**
+ * @brief Like scene_load(), but the scene is a text in memory (e.g. from a checkpoint).
+ * @param[out] s the scene
+ * @param[in] name what to call the text in messages (e.g. "ckpt_000100.h5:/scene")
+ * @param[in] text INI text
+ * @param[in] n_set, set overrides
+ * @return CHANSPH_OK or CHANSPH_ERR
+ */
+int scene_load_text(struct scene *s, const char *name, const char *text, int n_set,
+                    char *const *set);
+
+/** @brief Number of keys in the scene table. */
+int scene_key_count(void);
+
+enum { SCENE_VALUE_MAX = 640 }; /*!< room for any key's value text (paths, lists) */
+
+/**
+ * @brief Name and current value of key k, as "section.key" and as scene text.
+ * @param[in] s scene
+ * @param[in] k key index, 0 .. scene_key_count()-1
+ * @param[out] name buffer of at least 64 bytes
+ * @param[out] value buffer of at least SCENE_VALUE_MAX bytes
+ */
+void scene_key(const struct scene *s, int k, char *name, char *value);
 
 /**
  * @brief Derived smoothing length h = h_over_dr * dr [m].

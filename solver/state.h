@@ -22,9 +22,11 @@
 enum { STATE_MAX_RANK = 3 };
 
 enum state_type {
-  STATE_F64, /*!< double */
-  STATE_I64, /*!< int64_t */
-  STATE_TEXT /*!< a NUL-terminated string (data is char *), stored as a string */
+  STATE_F64,  /*!< double */
+  STATE_I64,  /*!< int64_t (also long on LP64 systems) */
+  STATE_TEXT, /*!< a string: data is a char ** to a malloc'd string; reading replaces it */
+  STATE_I32,  /*!< int32_t (also int) */
+  STATE_U8    /*!< uint8_t (flags, particle kinds) */
 };
 
 struct state_field {

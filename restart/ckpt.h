@@ -1,0 +1,78 @@
+/**
+ * @file ckpt.h
+ * @brief The checkpoint file: a state list (solver/state.h) as one HDF5 dataset per field,
+ *        with a format version, a completion mark and a Fletcher32 checksum on every dataset
+ *        (docs/checkpoint-format.md).
+ *
+ * Files are written to NAME.tmp, flushed, fsync'ed and renamed, and the directory is fsync'ed:
+ * a crash at any moment leaves either the previous files or the complete new one. Readers
+ * verify everything they read and name the file, the dataset and the check that failed.
+ */
+#ifndef CHANSPH_CKPT_H
+#define CHANSPH_CKPT_H
+
+#include <stddef.h>
+
+#include "state.h"
+
+/** Value of the root attribute "format". */
+#define CKPT_FORMAT "chansph-checkpoint"
+
+/** Format version: a reader refuses a newer major version; minor versions only add. */
+enum { CKPT_VERSION_MAJOR = 1, CKPT_VERSION_MINOR = 0 };
+
+/** What ckpt_info() reads from a file without reading the state. */
+struct ckpt_info {
+  long step;      /*!< step of the state */
+  double time;    /*!< simulated time of the state [s] */
+  int major;      /*!< format version of the file */
+  int minor;      /*!< format version of the file */
+  char *scene;    /*!< resolved scene text (malloc'd; free it) */
+  size_t n_bytes; /*!< file size [bytes] */
+};
+
+/**
+ * @brief Write a checkpoint atomically.
+ * @param[in] path final file name (PATH.tmp is used while writing)
+ * @param[in] L fields to write, each as a dataset at its name
+ * @param[in] scene resolved scene text (dataset /scene)
+ * @param[in] step,time state's step and time (root attributes)
+ * @param[out] err message on failure (names the file and dataset, and the system error)
+ * @param[in] errlen size of err
+ * @return 0, or nonzero on failure (the temporary file is removed; existing files untouched)
+ */
+int ckpt_write(const char *path, const struct state_list *L, const char *scene, long step,
+               double time, char *err, size_t errlen);
+
+/**
+ * @brief The writer behind ckpt_write(), for other HDF5 files of the same rules (particle
+ *        snapshots): root attribute "format" = format, version, step, time, completion mark.
+ * @param[in] scene scene text for dataset /scene, or NULL for none
+ */
+int ckpt_write_fields(const char *path, const char *format, const struct state_list *L,
+                      const char *scene, long step, double time, char *err, size_t errlen);
+
+/**
+ * @brief Open a checkpoint and check it: HDF5 structure, format name, version (a newer major
+ *        version is refused), completion mark; read step, time and scene text.
+ * @param[in] path file
+ * @param[out] info what was read (info->scene must be freed)
+ * @param[out] err,errlen message on failure
+ * @return 0 or nonzero
+ */
+int ckpt_info(const char *path, struct ckpt_info *info, char *err, size_t errlen);
+
+/**
+ * @brief Read every field of a list from a checkpoint into its memory, verifying presence,
+ *        type, shape and checksum. Fields with a reserve() callback take the stored shape.
+ * @param[in] path file
+ * @param[in,out] L fields (data and dims of reserved fields are updated)
+ * @param[out] err,errlen message on failure
+ * @return 0 or nonzero
+ */
+int ckpt_read(const char *path, struct state_list *L, char *err, size_t errlen);
+
+/** @brief Bytes a list occupies in memory (what a checkpoint of it roughly weighs). */
+size_t ckpt_state_bytes(const struct state_list *L);
+
+#endif

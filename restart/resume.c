@@ -1,0 +1,192 @@
+/**
+ * @file resume.c
+ * @brief Resume a run from its newest valid checkpoint, falling back to older ones, and check
+ *        which scene keys a resume may change.
+ */
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "ckpt.h"
+#include "error.h"
+#include "restart.h"
+#include "rotate.h"
+#include "timers.h"
+
+/** Keys a resume may change (docs/batch-jobs.md); every other key is refused. */
+static const char *const changeable[] = {"time.t_end",
+                                         "time.max_steps",
+                                         "output.log_every",
+                                         "output.series_every",
+                                         "output.stats_every",
+                                         "output.write_every",
+                                         "output.t_average_start",
+                                         "stats.window",
+                                         "output.particles",
+                                         "health.every",
+                                         "run.threads",
+                                         "checkpoint.every_steps",
+                                         "checkpoint.every_minutes",
+                                         "checkpoint.keep",
+                                         "snapshots.every"};
+enum { N_CHANGEABLE = sizeof changeable / sizeof changeable[0] };
+
+static int is_changeable(const char *key) {
+  for (int i = 0; i < N_CHANGEABLE; i++)
+    if (!strcmp(changeable[i], key)) return 1;
+  return 0;
+}
+
+/* Compare the scene of the checkpoint with the requested one; refuse forbidden changes. */
+static int check_changes(const struct scene *old, const struct scene *now, const char *path) {
+  int bad = 0;
+  for (int k = 0; k < scene_key_count(); k++) {
+    char name[64], a[SCENE_VALUE_MAX], b[SCENE_VALUE_MAX];
+    scene_key(old, k, name, a);
+    scene_key(now, k, name, b);
+    if (!strcmp(a, b) || is_changeable(name)) continue;
+    error_input(
+        "--set %s=%s: key '%s' cannot change on resume (the checkpoint %s has %s): a change "
+        "of the domain, resolution, particle count or physics would make the continuation "
+        "meaningless; start a new run instead (keys a resume may change: docs/batch-jobs.md)",
+        name, b, name, path, a);
+    bad++;
+  }
+  return bad ? CHANSPH_ERR : CHANSPH_OK;
+}
+
+/* Log the accepted changes. */
+static void log_changes(struct output *o, const struct scene *old, const struct scene *now) {
+  for (int k = 0; k < scene_key_count(); k++) {
+    char name[64], a[SCENE_VALUE_MAX], b[SCENE_VALUE_MAX];
+    scene_key(old, k, name, a);
+    scene_key(now, k, name, b);
+    if (strcmp(a, b)) output_log(o, "resume: %s changed from %s to %s\n", name, a, b);
+  }
+}
+
+/** Files passed over, with the reason. */
+struct skipped {
+  int n;
+  char path[16][4096];
+  char why[16][2048];
+};
+
+static void skip(struct skipped *sk, const char *path, const char *why) {
+  warn("%s; skipping this checkpoint", why);
+  if (sk->n < 16) {
+    snprintf(sk->path[sk->n], sizeof sk->path[0], "%s", path);
+    snprintf(sk->why[sk->n], sizeof sk->why[0], "%s", why);
+    sk->n++;
+  }
+}
+
+/* Read one candidate; on failure everything it set up is released. */
+static int try_one(const char *dir, const char *path, int n_set, char *const *set, struct scene *sc,
+                   struct sim *S, struct output *o, struct skipped *sk, struct scene *old,
+                   int *fatal, double *seconds) {
+  char err[2048];
+  struct ckpt_info info;
+  if (ckpt_info(path, &info, err, sizeof err)) {
+    skip(sk, path, err);
+    return CHANSPH_ERR;
+  }
+  char name[4200];
+  snprintf(name, sizeof name, "%s:/scene", path);
+  if (scene_load_text(old, name, info.scene, 0, NULL)) {
+    snprintf(err, sizeof err, "%.1900s: the stored scene is not valid for this chansph (above)",
+             path);
+    skip(sk, path, err);
+    free(info.scene);
+    return CHANSPH_ERR;
+  }
+  const int bad = scene_load_text(sc, name, info.scene, n_set, set) || check_changes(old, sc, path);
+  free(info.scene);
+  if (bad) {
+    *fatal = 1;
+    return CHANSPH_ERR;
+  }
+  /* the initial condition is replaced by the checkpoint: do not read init.from again */
+  struct scene bare = *sc;
+  bare.init_from[0] = '\0';
+  if (sim_init(S, &bare)) {
+    *fatal = 1;
+    return CHANSPH_ERR;
+  }
+  S->sc = sc;
+  if (output_reopen(o, dir, sc)) {
+    sim_free(S);
+    *fatal = 1;
+    return CHANSPH_ERR;
+  }
+  struct state_list L = {0};
+  sim_state(S, &L);
+  output_state(o, &L);
+  const double t0 = timer_now();
+  const int rc = ckpt_read(path, &L, err, sizeof err);
+  state_free(&L);
+  if (!rc && S->step != info.step)
+    snprintf(err, sizeof err,
+             "%.1900s: dataset /sim/step (%ld) differs from the root attribute 'step' "
+             "(%ld)",
+             path, S->step, info.step);
+  if (rc || S->step != info.step) {
+    skip(sk, path, err);
+    output_close(o);
+    sim_free(S);
+    return CHANSPH_ERR;
+  }
+  const size_t differ = sim_restored(S);
+  if (differ)
+    die("restoring %s is not bitwise: %zu wall values differ from the stored ones", path, differ);
+  *seconds = timer_now() - t0;
+  return CHANSPH_OK;
+}
+
+int restart_resume(const char *dir, int n_set, char *const *set, struct scene *sc, struct sim *S,
+                   struct output *o) {
+  long *steps;
+  const int n = rotate_list(dir, &steps);
+  if (n == 0) {
+    error_input("%s/checkpoints: no checkpoint to resume from (is %s the directory of a run?)", dir,
+                dir);
+    return CHANSPH_ERR;
+  }
+  const int tmp = rotate_remove_tmp(dir);
+  static struct skipped sk;
+  memset(&sk, 0, sizeof sk);
+  struct scene old;
+  int fatal = 0, found = -1;
+  double seconds = 0.0;
+  char path[4096];
+  for (int i = n - 1; i >= 0 && !fatal && found < 0; i--) {
+    rotate_path(path, sizeof path, dir, steps[i]);
+    if (!try_one(dir, path, n_set, set, sc, S, o, &sk, &old, &fatal, &seconds)) found = i;
+  }
+  free(steps);
+  if (fatal) return CHANSPH_ERR;
+  if (found < 0) {
+    error_input(
+        "%s/checkpoints: none of the %d checkpoint(s) is valid (see above); nothing was "
+        "deleted",
+        dir, n);
+    return CHANSPH_ERR;
+  }
+  output_log(o, "resume: from %s (step %ld, t = %.9g s; read and restored in %.3f s)\n", path,
+             S->step, S->t, seconds);
+  if (tmp) output_log(o, "resume: removed %d temporary file(s) of interrupted writes\n", tmp);
+  for (int i = 0; i < sk.n; i++) {
+    char to[4200];
+    struct stat st;
+    snprintf(to, sizeof to, "%s.skipped", sk.path[i]);
+    for (int k = 1; lstat(to, &st) == 0 && k < 1000; k++) /* never replace an earlier one */
+      snprintf(to, sizeof to, "%s.skipped.%d", sk.path[i], k);
+    const int moved = rename(sk.path[i], to) == 0;
+    output_log(o, "resume: skipped %s%s: %s\n", sk.path[i], moved ? " (renamed *.skipped)" : "",
+               sk.why[i]);
+  }
+  log_changes(o, &old, sc);
+  return CHANSPH_OK;
+}

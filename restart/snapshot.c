@@ -1,0 +1,151 @@
+/** @file snapshot.c @brief Implementation of snapshot.h. */
+#include "snapshot.h"
+
+#include <dirent.h>
+#include <errno.h>
+#include <hdf5.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "ckpt.h"
+#include "error.h"
+#include "timers.h"
+
+int snapshot_due(const struct sim *S) {
+  const double every = S->sc->snap_every;
+  if (every <= 0.0 || S->step == 0) return 0;
+  return floor(S->t / every) != floor((S->t - S->dt) / every);
+}
+
+/* Time attribute of a snapshot file, or NAN. */
+static double snap_time(const char *path) {
+  H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+  double t = NAN;
+  const hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (f < 0) return t;
+  const hid_t a = H5Aopen(f, "time", H5P_DEFAULT);
+  if (a < 0 || H5Aread(a, H5T_NATIVE_DOUBLE, &t) < 0) t = NAN;
+  if (a >= 0) H5Aclose(a);
+  H5Fclose(f);
+  return t;
+}
+
+static int cmp_name(const void *a, const void *b) {
+  return strcmp(*(char *const *)a, *(char *const *)b);
+}
+
+static void item(FILE *x, const char *file, const char *ds, size_t n, int cols, const char *type,
+                 int prec) {
+  fprintf(x,
+          "        <DataItem Dimensions=\"%zu%s\" NumberType=\"%s\" Precision=\"%d\" "
+          "Format=\"HDF\">%s:/%s</DataItem>\n",
+          n, cols == 3 ? " 3" : "", type, prec, file, ds);
+}
+
+/* Rewrite DIR/snapshots/particles.xdmf from the snapshot files present. */
+static int write_xdmf(const char *sdir, size_t n) {
+  DIR *d = opendir(sdir);
+  if (!d) return -1;
+  char **names = NULL;
+  size_t nn = 0, cap = 0;
+  for (struct dirent *e; (e = readdir(d));) {
+    const size_t len = strlen(e->d_name);
+    if (strncmp(e->d_name, "snap_", 5) || len < 9 || strcmp(e->d_name + len - 3, ".h5")) continue;
+    if (nn == cap) {
+      cap = cap ? 2 * cap : 64;
+      char **t = realloc(names, cap * sizeof *t);
+      if (!t) die("out of memory");
+      names = t;
+    }
+    names[nn++] = strdup(e->d_name);
+  }
+  closedir(d);
+  qsort(names, nn, sizeof *names, cmp_name);
+  char path[4200], tmp[4300];
+  snprintf(path, sizeof path, "%s/particles.xdmf", sdir);
+  snprintf(tmp, sizeof tmp, "%s.tmp", path);
+  FILE *x = fopen(tmp, "w");
+  int rc = x ? 0 : -1;
+  if (x) {
+    fprintf(x,
+            "<?xml version=\"1.0\" ?>\n<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n"
+            "<Xdmf Version=\"3.0\">\n  <Domain>\n"
+            "    <Grid Name=\"particles\" GridType=\"Collection\" "
+            "CollectionType=\"Temporal\">\n");
+    for (size_t i = 0; i < nn; i++) {
+      char file[4400];
+      snprintf(file, sizeof file, "%s/%s", sdir, names[i]);
+      const double t = snap_time(file);
+      if (isnan(t)) continue;
+      fprintf(x,
+              "      <Grid Name=\"%.*s\" GridType=\"Uniform\">\n"
+              "        <Time Value=\"%.17g\"/>\n"
+              "        <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"%zu\" "
+              "NodesPerElement=\"1\"/>\n        <Geometry GeometryType=\"XYZ\">\n",
+              (int)(strlen(names[i]) - 3), names[i], t, n);
+      item(x, names[i], "position", n, 3, "Float", 8);
+      fprintf(x, "        </Geometry>\n");
+      static const char *const attr[4][2] = {
+          {"velocity", "Vector"}, {"pressure", "Scalar"}, {"density", "Scalar"}, {"id", "Scalar"}};
+      for (int k = 0; k < 4; k++) {
+        fprintf(x, "        <Attribute Name=\"%s\" AttributeType=\"%s\" Center=\"Node\">\n",
+                attr[k][0], attr[k][1]);
+        item(x, names[i], attr[k][0], n, k == 0 ? 3 : 1, k == 3 ? "Int" : "Float", 8);
+        fprintf(x, "        </Attribute>\n");
+      }
+      fprintf(x, "      </Grid>\n");
+    }
+    fprintf(x, "    </Grid>\n  </Domain>\n</Xdmf>\n");
+    if (fclose(x) || rename(tmp, path)) rc = -1;
+  }
+  for (size_t i = 0; i < nn; i++) free(names[i]);
+  free(names);
+  if (rc) remove(tmp);
+  return rc;
+}
+
+int snapshot_write(const char *dir, const struct sim *S) {
+  timer_push("snapshot");
+  const struct particles *P = &S->P;
+  const size_t n = P->n_fluid;
+  double *pos = malloc(3 * n * sizeof *pos), *vel = malloc(3 * n * sizeof *vel);
+  double *pr = malloc(n * sizeof *pr), *rho = malloc(n * sizeof *rho);
+  int64_t *id = malloc(n * sizeof *id);
+  if (!pos || !vel || !pr || !rho || !id) die("out of memory writing a snapshot");
+  for (size_t a = 0; a < P->n; a++) {
+    if (P->kind[a] != KIND_FLUID) continue;
+    const size_t r = (size_t)P->id[a]; /* fluid ids are 0 .. n_fluid-1 */
+    pos[3 * r] = P->x[a], pos[3 * r + 1] = P->y[a], pos[3 * r + 2] = P->z[a];
+    vel[3 * r] = P->u[a], vel[3 * r + 1] = P->v[a], vel[3 * r + 2] = P->w[a];
+    pr[r] = P->p[a], rho[r] = P->rho[a], id[r] = P->id[a];
+  }
+  struct state_list L = {0};
+  const size_t d1[1] = {n}, d2[2] = {n, 3};
+  state_add(&L, "id", STATE_I64, 1, d1, id, NULL);
+  state_add(&L, "position", STATE_F64, 2, d2, pos, "m");
+  state_add(&L, "velocity", STATE_F64, 2, d2, vel, "m/s");
+  state_add(&L, "pressure", STATE_F64, 1, d1, pr, "Pa");
+  state_add(&L, "density", STATE_F64, 1, d1, rho, "kg/m^3");
+  char sdir[4096], path[4200], err[2048];
+  snprintf(sdir, sizeof sdir, "%s/snapshots", dir);
+  snprintf(path, sizeof path, "%s/snap_%010ld.h5", sdir, S->step);
+  int rc = CHANSPH_OK;
+  if (mkdir(sdir, 0777) && errno != EEXIST) {
+    error_input("%s: cannot create the snapshot directory (%s)", sdir, strerror(errno));
+    rc = CHANSPH_ERR;
+  } else if (ckpt_write_fields(path, "chansph-snapshot", &L, NULL, S->step, S->t, err,
+                               sizeof err)) {
+    error_input("%s", err);
+    rc = CHANSPH_ERR;
+  } else if (write_xdmf(sdir, n)) {
+    error_input("%s/particles.xdmf: cannot write (%s)", sdir, strerror(errno));
+    rc = CHANSPH_ERR;
+  }
+  state_free(&L);
+  free(pos), free(vel), free(pr), free(rho), free(id);
+  timer_pop();
+  return rc;
+}
