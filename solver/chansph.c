@@ -71,7 +71,12 @@ static int run(struct scene *sc, const struct cli *c) {
       rc = EXIT_NUMERICAL;
       break;
     }
-    output_step(&out, &S);
+    if (output_step(&out, &S)) {
+      output_log(&out, "stopped at step %ld: cannot write stats.nc (the checkpoints are intact)\n",
+                 S.step);
+      rc = EXIT_IOERR;
+      break;
+    }
     if (snapshot_due(&S) && snapshot_write(out.dir, &S)) {
       rc = EXIT_IOERR;
       break;

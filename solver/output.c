@@ -252,7 +252,7 @@ void output_resume(struct output *o, struct sim *S) {
              CHANSPH_VERSION, S->step, S->t, S->P.n_fluid, S->P.n_vertex);
 }
 
-void output_step(struct output *o, struct sim *S) {
+int output_step(struct output *o, struct sim *S) {
   const struct scene *sc = S->sc;
   if (stats_wanted(&o->st) && S->t >= sc->t_average_start && S->step % sc->stats_every == 0) {
     timer_push("stats");
@@ -293,10 +293,14 @@ void output_step(struct output *o, struct sim *S) {
     char line[1024];
     stats_convergence_line(&o->st, line, sizeof line);
     output_log(o, "%s", line);
-    if (write_stats(o, S)) die("stopping: cannot write statistics");
+    if (write_stats(o, S)) {
+      timer_pop();
+      return CHANSPH_ERR;
+    }
     while (o->next_write <= S->t) o->next_write += sc->write_every;
   }
   timer_pop();
+  return CHANSPH_OK;
 }
 
 static int write_particles(struct output *o, const struct sim *S) {

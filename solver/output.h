@@ -70,8 +70,12 @@ int output_stop(struct output *o, struct sim *S, const char *why);
 /** @brief Record the initial state and start the clocks. */
 void output_begin(struct output *o, struct sim *S);
 
-/** @brief After each step: sample statistics, record the series, log, rewrite stats.nc. */
-void output_step(struct output *o, struct sim *S);
+/**
+ * @brief After each step: sample statistics, record the series, log, rewrite stats.nc.
+ * @return CHANSPH_OK, or CHANSPH_ERR after a message when stats.nc cannot be written (the
+ *         previous stats.nc and the checkpoints are kept)
+ */
+int output_step(struct output *o, struct sim *S);
 
 /**
  * @brief Final log line, stats.nc and particles.nc, phase timing report.

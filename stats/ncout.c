@@ -3,8 +3,10 @@
 
 #include "stats.h"
 
+#include <errno.h>
 #include <fcntl.h>
 #include <netcdf.h>
+#include <netcdf_mem.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -42,18 +44,41 @@ static int def_var(int ncid, const char *name, nc_type type, int ndim, const int
   return rc;
 }
 
-/* Make the data durable, then move it into place. */
-static int commit(const char *tmp, const char *path, char *err, size_t errlen) {
-  const int fd = open(tmp, O_RDONLY);
-  if (fd < 0 || fsync(fd) != 0) {
-    snprintf(err, errlen, "cannot sync %s", tmp);
-    if (fd >= 0) close(fd);
+/* The file is built in memory (nc_create_mem) and written here with plain POSIX calls, so that a
+   full disk or a file-size limit is an error message, not a failure inside HDF5's close (which
+   HDF5 1.10 does not survive). Write the image to tmp, make it durable, move it into place. */
+static int commit(int ncid, const char *tmp, const char *path, char *err, size_t errlen) {
+  NC_memio mem = {0, NULL, 0};
+  const int rc = nc_close_memio(ncid, &mem);
+  if (rc != NC_NOERR) {
+    snprintf(err, errlen, "cannot write %s: %s (in nc_close_memio)", tmp, nc_strerror(rc));
+    free(mem.memory);
+    return 1;
+  }
+  const int fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  const char *p = mem.memory;
+  size_t left = mem.size;
+  int bad = fd < 0;
+  while (!bad && left > 0) {
+    const ssize_t w = write(fd, p, left);
+    if (w < 0 && errno == EINTR) continue;
+    if (w <= 0) {
+      bad = 1;
+      break;
+    }
+    p += w, left -= (size_t)w;
+  }
+  if (!bad && fsync(fd) != 0) bad = 1;
+  const int why = errno;
+  if (fd >= 0 && close(fd) != 0 && !bad) bad = 1;
+  free(mem.memory);
+  if (bad) {
+    snprintf(err, errlen, "cannot write %s (%s); an earlier %s is kept", tmp, strerror(why), path);
     remove(tmp);
     return 1;
   }
-  close(fd);
   if (rename(tmp, path) != 0) {
-    snprintf(err, errlen, "cannot rename %s to %s", tmp, path);
+    snprintf(err, errlen, "cannot rename %s to %s (%s)", tmp, path, strerror(errno));
     remove(tmp);
     return 1;
   }
@@ -70,7 +95,7 @@ int ncout_stats(const char *path, const struct stats *st, const struct series *t
   char tmp[4096];
   snprintf(tmp, sizeof tmp, "%s.tmp", path);
   int ncid = -1, dt;
-  NC(nc_create(tmp, NC_NETCDF4 | NC_CLOBBER, &ncid));
+  NC(nc_create_mem(tmp, NC_NETCDF4, 1 << 20, &ncid));
   NC(nc_put_att_text(ncid, NC_GLOBAL, "Conventions", 6, "CF-1.8"));
   NC(nc_put_att_text(ncid, NC_GLOBAL, "title", 36, "chansph channel-flow statistics file"));
   NC(nc_put_att_text(ncid, NC_GLOBAL, "source", 7, "chansph"));
@@ -99,9 +124,7 @@ int ncout_stats(const char *path, const struct stats *st, const struct series *t
   }
   free(col), free(vts);
   NC(rc);
-  NC(nc_close(ncid));
-  ncid = -1;
-  return commit(tmp, path, err, errlen);
+  return commit(ncid, tmp, path, err, errlen);
 }
 
 int ncout_columns(const char *path, const char *dim, size_t n, int ncol, const char *const *names,
@@ -110,7 +133,7 @@ int ncout_columns(const char *path, const char *dim, size_t n, int ncol, const c
   char tmp[4096];
   snprintf(tmp, sizeof tmp, "%s.tmp", path);
   int ncid = -1, d, vid = -1;
-  NC(nc_create(tmp, NC_NETCDF4 | NC_CLOBBER, &ncid));
+  NC(nc_create_mem(tmp, NC_NETCDF4, 1 << 20, &ncid));
   NC(nc_def_dim(ncid, dim, n, &d));
   if (ids) NC(def_var(ncid, "id", NC_INT64, 1, &d, "1", "particle id", &vid));
   int *v = malloc((size_t)ncol * sizeof *v);
@@ -130,7 +153,5 @@ int ncout_columns(const char *path, const char *dim, size_t n, int ncol, const c
   for (int c = 0; c < ncol && rc == NC_NOERR; c++) rc = nc_put_var_double(ncid, v[c], cols[c]);
   free(v);
   NC(rc);
-  NC(nc_close(ncid));
-  ncid = -1;
-  return commit(tmp, path, err, errlen);
+  return commit(ncid, tmp, path, err, errlen);
 }
