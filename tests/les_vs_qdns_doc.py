@@ -28,7 +28,7 @@ def profile(run):
     order = np.argsort(yw)
     yw, u = yw[order], u[order]
     # fold: average the two bins at the same wall distance
-    keys = np.round(yw / (1e-9 + yw.max()) * 1e6)
+    keys = np.round(yw / np.max(np.diff(yw)))  # the bins of the two halves pair up
     yf, uf = [], []
     for k in np.unique(keys):
         m = keys == k
