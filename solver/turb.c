@@ -84,7 +84,7 @@ static double vertex_sums(const struct model *M, const struct particles *P, cons
 double turb_update(const struct model *M, struct particles *P, const struct nbr *nb,
                    struct walls *W) {
   if (!M->wall_tau) return M->nu;
-  timer_push("les");
+  timer_push("wall_law");
   const struct kernel *K = &M->k;
   const double two_h = 2.0 * M->h, nu = M->nu;
   const double *restrict x = P->x, *restrict y = P->y, *restrict z = P->z;
@@ -118,10 +118,9 @@ double turb_update(const struct model *M, struct particles *P, const struct nbr 
     W->tx[slot] = alpha > 0.0 ? sum[0] / alpha : 0.0;
     W->tz[slot] = alpha > 0.0 ? sum[1] / alpha : 0.0;
   }
-  if (!M->les) {
-    timer_pop();
-    return nu;
-  }
+  timer_pop();
+  if (!M->les) return nu;
+  timer_push("les");
   /* 3. rate of strain, damping, eddy viscosity and residual kinetic energy */
   double *restrict nur = P->nur, *restrict kr = P->kr;
   const double ih = K->inv_h, dg2 = M->delta_g * M->delta_g;

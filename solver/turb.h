@@ -15,6 +15,7 @@
  *     particles as seen by the forces becomes p + 2/3 rho k_r (Eq. 5.42: pr2 and the wall
  *     pressure; P->p stays the equation-of-state pressure).
  * Everything is a gather over the neighbour list: bitwise independent of the thread count.
+ * Phases: steps 1-2 are timed as `wall_law`, steps 3-4 as `les`.
  */
 #ifndef CHANSPH_TURB_H
 #define CHANSPH_TURB_H
