@@ -1,5 +1,6 @@
 /** @file corr.c @brief Implementation of corr.h. */
 #include "corr.h"
+#include "ncutil.h"
 
 #include <fftw3.h>
 #include <math.h>
@@ -166,14 +167,7 @@ void corr_results(const struct corr *c, double *rx, double *rz, double *ex, doub
   fftw_free(in), fftw_free(r);
 }
 
-#define CK(call)                                                   \
-  do {                                                             \
-    rc = (call);                                                   \
-    if (rc != NC_NOERR) {                                          \
-      snprintf(err, errlen, "%s (in %s)", nc_strerror(rc), #call); \
-      goto done;                                                   \
-    }                                                              \
-  } while (0)
+#define CK(call) NC_TRY(call, done)
 
 int corr_nc_write(const struct corr *c, int ncid, char *err, size_t errlen) {
   const int nl = c->cfg.n_levels, nx = c->cfg.nx, nz = c->cfg.nz, nzh = c->nzh;

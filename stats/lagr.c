@@ -1,5 +1,6 @@
 /** @file lagr.c @brief Implementation of lagr.h. */
 #include "lagr.h"
+#include "ncutil.h"
 
 #include <math.h>
 #include <netcdf.h>
@@ -303,14 +304,7 @@ void lagr_functions(const struct lagr *g, int level, double *out, double *tl) {
     tl[i] = lagr_tl(out + (LF_RHO_L + i) * nlag, nlag, g->cfg.horizon / g->cfg.n_lags);
 }
 
-#define CK(call)                                                   \
-  do {                                                             \
-    rc = (call);                                                   \
-    if (rc != NC_NOERR) {                                          \
-      snprintf(err, errlen, "%s (in %s)", nc_strerror(rc), #call); \
-      goto done;                                                   \
-    }                                                              \
-  } while (0)
+#define CK(call) NC_TRY(call, done)
 
 static int put_rows(int g, int v, int level, size_t n, const double *src) {
   double *tmp = malloc(n * sizeof *tmp);

@@ -1,5 +1,6 @@
 /** @file stats.c @brief Implementation of stats.h. */
 #include "stats.h"
+#include "ncutil.h"
 
 #include <math.h>
 #include <netcdf.h>
@@ -100,14 +101,7 @@ void stats_convergence_line(const struct stats *st, char *buf, size_t len) {
   euler_result_free(&r);
 }
 
-#define CK(call)                                                   \
-  do {                                                             \
-    rc = (call);                                                   \
-    if (rc != NC_NOERR) {                                          \
-      snprintf(err, errlen, "%s (in %s)", nc_strerror(rc), #call); \
-      goto fail;                                                   \
-    }                                                              \
-  } while (0)
+#define CK(call) NC_TRY(call, fail)
 
 static int put_att_d(int ncid, int var, const char *name, double v) {
   return nc_put_att_double(ncid, var, name, NC_DOUBLE, 1, &v);
