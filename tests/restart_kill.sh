@@ -2,6 +2,8 @@
 # Acceptance 2 of issue 4: a run is killed with SIGKILL at K random moments (many of them inside
 # a checkpoint write) and resumed each time by jobs/chain.sh; its final stats.nc, particles.nc
 # and final checkpoint equal those of an uninterrupted run.
+# The scene must run well over 12 s of job time (20 kills of up to 0.6 s each); see
+# tests/CMakeLists.txt (KILL_SCENE).
 # usage: restart_kill.sh CHANSPH SCENE RUNS KILLS SEED [--set k=v ...]
 set -u
 chansph=$1 scene=$2 runs=$3 kills=$4 seed=$5
