@@ -219,10 +219,12 @@ void sph_wall_values(const struct model *M, const struct walls *W, int wall, dou
   *p = foot_value(M, &f, W->p);
 }
 
-double sph_wall_field(const struct model *M, const struct walls *W, const double *v, int wall,
-                      double x, double z) {
+void sph_wall_stress(const struct model *M, const struct walls *W, int wall, double x, double z,
+                     double *rho, double *tx, double *tz) {
   const struct foot f = wall_foot(M, W, wall, x, z);
-  return foot_value(M, &f, v);
+  *rho = foot_value(M, &f, W->rho);
+  *tx = foot_value(M, &f, W->tx);
+  *tz = foot_value(M, &f, W->tz);
 }
 
 void sph_solve_sym(int dim, const double A[6], const double g[3], double x[3]) {
@@ -372,8 +374,8 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
       if (q >= 2.0) continue;
       const double dg = wall_dgamma(M->dim, q) * ih; /* |grad gamma_as| */
       const double ny = wall ? -1.0 : 1.0;           /* inward normal */
-      double rs, ps;
-      sph_wall_values(M, W, wall, x[a], z[a], &rs, &ps);
+      const struct foot ft = wall_foot(M, W, wall, x[a], z[a]);
+      const double rs = foot_value(M, &ft, W->rho), ps = foot_value(M, &ft, W->p);
       /* pressure wall term: |grad gamma_as| plus the excess of the discrete first moment on
          the particle lattice (so that a uniform pressure leaves the lattice in equilibrium yet
          pushes a displaced particle back), or of the current particles, or nothing
@@ -384,7 +386,6 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
       if (!corrected) aya += ig * rs * (pa + ps / (rs * rs)) * pw * ny;
       if (wall_law) { /* -(2 / gamma_a) rho_s u_tau,s u_tau,s |grad gamma_as| / rho_a (Eq. 2.144-
                          2.145) with the vertex values of Ferrand Eq. 38 at the foot */
-        const struct foot ft = wall_foot(M, W, wall, x[a], z[a]);
         const double sw = 2.0 * ig * dg * ira;
         const double tx = sw * foot_value(M, &ft, W->tx);
         axa -= tx, aza -= sw * foot_value(M, &ft, W->tz);

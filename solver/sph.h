@@ -133,9 +133,9 @@ void sph_wall_values(const struct model *M, const struct walls *W, int wall, dou
  */
 void sph_solve_sym(int dim, const double A[6], const double g[3], double x[3]);
 
-/** @brief One wall lattice field f (nx nz values per wall) at the foot of a particle, with the
-           same interpolation as sph_wall_values. */
-double sph_wall_field(const struct model *M, const struct walls *W, const double *f, int wall,
-                      double x, double z);
+/** @brief Wall density and wall stress rho_s u_tau u_tau (x, z) at the foot of a particle, with
+           the same interpolation as sph_wall_values (one foot for the three fields). */
+void sph_wall_stress(const struct model *M, const struct walls *W, int wall, double x, double z,
+                     double *rho, double *tx, double *tz);
 
 #endif

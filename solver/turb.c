@@ -132,10 +132,8 @@ double turb_update(const struct model *M, struct particles *P, const struct nbr 
     /* local friction velocity at the foot on the nearest wall, y+ and the damped length */
     int wall;
     const double d = nearest_wall(M, y[a], &wall);
-    double damp = 1.0, rs = 0.0, ps = 0.0;
-    sph_wall_values(M, W, wall, x[a], z[a], &rs, &ps);
-    const double tsx = sph_wall_field(M, W, W->tx, wall, x[a], z[a]);
-    const double tsz = sph_wall_field(M, W, W->tz, wall, x[a], z[a]);
+    double damp = 1.0, rs, tsx, tsz;
+    sph_wall_stress(M, W, wall, x[a], z[a], &rs, &tsx, &tsz);
     const double utau2 = sqrt(tsx * tsx + tsz * tsz) / rs;
     if (M->van_driest) damp = turb_van_driest(d * sqrt(utau2) / nu, M->a_plus);
     const double ls2 = M->cs * M->cs * dg2 * damp * damp; /* l_S^2 */

@@ -113,10 +113,8 @@ static int check_channel(int damping, int strain) {
     }
     double damp = 1.0;
     if (damping) {
-      double rs, ps;
-      sph_wall_values(M, &S.W, wall, P->x[a], P->z[a], &rs, &ps);
-      const double tx = sph_wall_field(M, &S.W, S.W.tx, wall, P->x[a], P->z[a]);
-      const double tz = sph_wall_field(M, &S.W, S.W.tz, wall, P->x[a], P->z[a]);
+      double rs, tx, tz;
+      sph_wall_stress(M, &S.W, wall, P->x[a], P->z[a], &rs, &tx, &tz);
       const double yp = d * sqrt(sqrt(tx * tx + tz * tz) / rs) / M->nu;
       damp = 1.0 - exp(-yp / M->a_plus);
     }
