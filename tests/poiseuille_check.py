@@ -28,11 +28,13 @@ import netCDF4
 import numpy as np
 
 
-def run(args, scene, name, sets, threads=None):
-    if sets:  # tests of one scene with different settings run in parallel: separate directories
+def run_cmd(args, scene, name, sets, extra=(), expect=0, threads=None):
+    """Run chansph on a scene into RUNS/name (a directory per set of overrides: tests of one
+    scene run in parallel); exit the check unless it ends with status expect."""
+    if sets:
         name += "_" + hashlib.md5(" ".join(sets).encode()).hexdigest()[:8]
     out = os.path.join(args.runs, name)
-    cmd = [args.chansph, "run", scene, "--out", out, "--overwrite"]
+    cmd = [args.chansph, "run", scene, "--out", out, "--overwrite"] + list(extra)
     for s in sets:
         cmd += ["--set", s]
     env = dict(os.environ)
@@ -41,9 +43,15 @@ def run(args, scene, name, sets, threads=None):
     t0 = time.time()
     res = subprocess.run(cmd, capture_output=True, text=True, env=env)
     wall = time.time() - t0
-    if res.returncode != 0:
+    if res.returncode != expect:
         sys.stdout.write(res.stdout[-3000:] + res.stderr[-3000:])
-        sys.exit("FAIL: chansph exited with %d: %s" % (res.returncode, " ".join(cmd)))
+        sys.exit("FAIL: chansph exited with %d (expected %d): %s"
+                 % (res.returncode, expect, " ".join(cmd)))
+    return out, wall, res
+
+
+def run(args, scene, name, sets, threads=None):
+    out, wall, _ = run_cmd(args, scene, name, sets, threads=threads)
     return out, wall
 
 

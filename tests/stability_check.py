@@ -12,26 +12,19 @@ specific error it must give.
                check, naming step, particle id and position; stats.nc written before is kept
 """
 import argparse
-import math
 import os
 import re
-import subprocess
 import sys
 
 import netCDF4
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import poiseuille_check as pc  # noqa: E402  (shared run helper and profile error)
+
 
 def run(args, scene, name, sets, extra=(), expect=0):
-    out = os.path.join(args.runs, "stability_" + name)
-    cmd = [args.chansph, "run", scene, "--out", out, "--overwrite"] + list(extra)
-    for s in sets:
-        cmd += ["--set", s]
-    res = subprocess.run(cmd, capture_output=True, text=True)
-    if res.returncode != expect:
-        sys.stdout.write(res.stdout[-3000:] + res.stderr[-3000:])
-        sys.exit("FAIL: chansph exited with %d (expected %d): %s"
-                 % (res.returncode, expect, " ".join(cmd)))
+    out, _, res = pc.run_cmd(args, scene, "stability_" + name, sets, extra, expect)
     return out, res
 
 
@@ -41,12 +34,7 @@ def series(out, name):
 
 
 def profile_error(out):
-    with netCDF4.Dataset(os.path.join(out, "stats.nc")) as d:
-        a = {k: d.getncattr(k) for k in d.ncattrs()}
-        y, u = d["y_mean"][:].filled(np.nan), d["u_mean"][:].filled(np.nan)
-    ua = a["body_force"] * y * (2 * a["delta"] - y) / (2 * a["nu"])
-    ok = np.isfinite(u)
-    return math.sqrt(np.sum((u[ok] - ua[ok]) ** 2) / np.sum(ua[ok] ** 2))
+    return pc.steady_error(out)[0]
 
 
 def cmd_viscous(args):
