@@ -2,9 +2,11 @@
  * @file scene.c
  * @brief Table-driven scene parsing (inih), validation and documentation (STYLE items 9-11).
  */
+#define _XOPEN_SOURCE 700 /* realpath */
 #include "scene.h"
 
 #include <ini.h>
+#include <limits.h>
 #include <math.h>
 #include <stddef.h>
 #include <stdio.h>
@@ -216,7 +218,9 @@ static const struct key keys[] = {
      "positions and velocities are taken as they are (by id); otherwise its velocity field is "
      "interpolated (linear moving least squares) onto this scene's lattice, e.g. a coarse LES to "
      "start a finer "
-     "run. Overrides profile; streaks, modes and noise are added on top.",
+     "run. A relative path in a scene file is relative to the scene file's directory (on the "
+     "command line, to the working directory). Overrides profile; streaks, modes and noise are "
+     "added on top.",
      OFF(init_from)},
     {"output", "log_every", T_INT, "100", 1, 1e9, 0, NULL, "steps",
      "Steps between progress lines (stdout and DIR/log.txt).", OFF(log_every)},
@@ -552,8 +556,37 @@ static void validate(struct parse_state *ps) {
     inconsistent(ps, "time.dt", "fixed dt = %g is larger than t_end = %g", s->dt_fixed, s->t_end);
 }
 
-/* scene_load and scene_load_text: fp (if not NULL) is read and closed. */
-static int load(struct scene *s, const char *path, FILE *fp, int n_set, char *const *set) {
+/**
+ * A relative init.from written in a scene file names a file next to the scene (a shipped scene
+ * finds its shipped state from any working directory); it becomes an absolute path, so
+ * scene.used.ini and checkpoints hold a name that does not depend on where the run started.
+ * On the command line (--set) a relative path stays relative to the working directory.
+ */
+static void resolve_paths(struct parse_state *ps, const char *scene_path) {
+  struct scene *s = ps->s;
+  const int k = find_key("init", "from");
+  if (ps->where[k] <= 0 || !s->init_from[0] || s->init_from[0] == '/') return;
+  char dir[512], abs_dir[PATH_MAX], joined[PATH_MAX + 520];
+  snprintf(dir, sizeof dir, "%s", scene_path);
+  char *slash = strrchr(dir, '/');
+  if (!slash)
+    snprintf(dir, sizeof dir, ".");
+  else if (slash == dir)
+    dir[1] = '\0'; /* scene in / */
+  else
+    *slash = '\0';
+  if (!realpath(dir, abs_dir)) snprintf(abs_dir, sizeof abs_dir, "%s", dir);
+  snprintf(joined, sizeof joined, "%s/%s", abs_dir, s->init_from);
+  char clean[PATH_MAX];
+  const char *name = realpath(joined, clean) ? clean : joined; /* a missing file: init says so */
+  const char *why = set_value(s, k, name);
+  if (why) report_value(ps, k, ps->where[k], name, why);
+}
+
+/* scene_load and scene_load_text: fp (if not NULL) is read and closed. file_paths: relative
+ * paths in the text are relative to the directory of path. */
+static int load(struct scene *s, const char *path, FILE *fp, int file_paths, int n_set,
+                char *const *set) {
   memset(s, 0, sizeof *s);
   struct parse_state ps = {.s = s, .file = path ? path : "(defaults)"};
   for (int k = 0; k < N_KEYS; k++)
@@ -592,19 +625,20 @@ static int load(struct scene *s, const char *path, FILE *fp, int n_set, char *co
                   keys[k].section, keys[k].help);
       ps.errors++;
     }
+  if (ps.errors == 0 && file_paths) resolve_paths(&ps, path);
   if (ps.errors == 0) validate(&ps);
   return ps.errors ? CHANSPH_ERR : CHANSPH_OK;
 }
 
 int scene_load(struct scene *s, const char *path, int n_set, char *const *set) {
-  return load(s, path, path ? fopen(path, "r") : NULL, n_set, set);
+  return load(s, path, path ? fopen(path, "r") : NULL, 1, n_set, set);
 }
 
 int scene_load_text(struct scene *s, const char *name, const char *text, int n_set,
                     char *const *set) {
   FILE *fp = fmemopen((void *)text, strlen(text), "r");
   if (!fp) die("fmemopen failed for %s", name);
-  return load(s, name, fp, n_set, set);
+  return load(s, name, fp, 0, n_set, set);
 }
 
 int scene_key_count(void) {

@@ -2,7 +2,7 @@
 
 Usage:
     from chansph_nc import read_stats, read_particles
-    s = read_stats("runs/quickstart/stats.nc")
+    s = read_stats("runs/laminar/stats.nc")
     s["y"], s["u_mean"], s["u_mean_stderr"], s["attrs"]["u_tau"], s["series"]["u_bulk"]
     s["groups"]["correlations"]["R_uu_x"], s["groups"]["lagrangian"]["rho_L_u"]
 (docs/stats-format.md lists every variable)

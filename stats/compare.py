@@ -13,8 +13,11 @@ STATS.nc may itself be a DNS file: comparing a DNS set with itself gives zero er
 Wall units come from the run's own u_tau (stats.nc attribute u_tau). The DNS profiles are
 interpolated (linearly in y+) to the run's bin positions; the upper half of an unfolded run
 is mirrored onto the lower one. Prints the L2 (root mean square) and Linf (maximum)
-differences of U+, u_rms+, v_rms+, w_rms+ and -u'v'+ per y+ range, writes compare.csv and
-one PNG per quantity (ours with error bars of 2 standard errors, DNS, law of the wall).
+differences of U+, u_rms+, v_rms+, w_rms+ and -u'v'+ per y+ range, with the RMS over the range
+of our own standard error (batch means over the averaging windows; "stderr"): a difference much
+larger than it is a model or resolution error, one of its size is sampling noise. Writes
+compare.csv and one PNG per quantity (ours with error bars of 2 standard errors, DNS, law of
+the wall).
 """
 import argparse
 import math
@@ -154,8 +157,8 @@ def main():
     inside = (yp >= dns["yplus"][0]) & (yp <= dns["yplus"][-1])
     masks = region_masks(yp, yd)
     rows = []
-    print("%-8s %-17s %6s %12s %12s %12s" % ("quantity", "range", "points", "L2", "Linf",
-                                              "L2 relative"))
+    print("%-8s %-17s %6s %12s %12s %12s %12s" % ("quantity", "range", "points", "L2", "Linf",
+                                                   "L2 relative", "stderr"))
     for q in QUANTITIES:
         if dns.get(q) is None or ours.get(q) is None:
             print("%-8s (not in both data sets)" % q)
@@ -165,19 +168,22 @@ def main():
         for (name, _), m in zip(RANGES, masks):
             sel = m & inside & np.isfinite(diff)
             if not sel.any():
-                rows.append((q, name, 0, math.nan, math.nan, math.nan))
-                print("%-8s %-17s %6d %12s %12s %12s" % (q, name, 0, "-", "-", "-"))
+                rows.append((q, name, 0, math.nan, math.nan, math.nan, math.nan))
+                print("%-8s %-17s %6d %12s %12s %12s %12s" % (q, name, 0, "-", "-", "-", "-"))
                 continue
             l2 = math.sqrt(np.mean(diff[sel] ** 2))
             linf = float(np.max(np.abs(diff[sel])))
             scale = math.sqrt(np.mean(ref[sel] ** 2))
-            rows.append((q, name, int(sel.sum()), l2, linf, l2 / scale if scale > 0 else math.nan))
-            print("%-8s %-17s %6d %12.4e %12.4e %12.4e" % rows[-1])
+            se = ours.get(q + "_se")
+            se_rms = math.sqrt(np.mean(se[sel] ** 2)) if se is not None else math.nan
+            rows.append((q, name, int(sel.sum()), l2, linf, l2 / scale if scale > 0 else math.nan,
+                         se_rms))
+            print("%-8s %-17s %6d %12.4e %12.4e %12.4e %12.4e" % rows[-1])
     with open(os.path.join(out_dir, "compare.csv"), "w") as f:
-        f.write("# ours: %s\n# DNS: %s\nquantity,range,points,L2,Linf,L2_relative\n" %
+        f.write("# ours: %s\n# DNS: %s\nquantity,range,points,L2,Linf,L2_relative,stderr\n" %
                 (ours["source"], dns["source"]))
         for r in rows:
-            f.write("%s,%s,%d,%.6e,%.6e,%.6e\n" % r)
+            f.write("%s,%s,%d,%.6e,%.6e,%.6e,%.6e\n" % r)
     if not args.no_plots:
         plots(ours, dns, out_dir)
     print("wrote %s/compare.csv%s" % (out_dir, "" if args.no_plots else " and one PNG per quantity"))

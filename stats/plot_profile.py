@@ -2,7 +2,7 @@
 """Plot u_mean of a chansph stats.nc against its reference profile.
 
 For a laminar run the reference is the analytical Poiseuille profile of the run's body force.
-usage: stats/plot_profile.py runs/quickstart/stats.nc [-o profile.png]
+usage: stats/plot_profile.py runs/laminar/stats.nc [-o profile.png]
 """
 import argparse
 import os
