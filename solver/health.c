@@ -3,6 +3,7 @@
 
 #include <limits.h>
 #include <math.h>
+#include <mpi.h>
 #include <stdio.h>
 
 #include "timers.h"
@@ -28,8 +29,11 @@ int health_check(const struct model *M, const struct particles *P, long step, do
     if (P->kind[a] != KIND_FLUID || classify(M, P, a) == OK) continue;
     if (P->id[a] < worst) worst = P->id[a];
   }
+  /* the failing particle of lowest id over all ranks; its owner writes the report */
+  long long mine = worst;
+  MPI_Allreduce(MPI_IN_PLACE, &worst, 1, MPI_LONG_LONG, MPI_MIN, MPI_COMM_WORLD);
   int rc = OK;
-  for (size_t a = 0; worst != LLONG_MAX && a < P->n; a++) {
+  for (size_t a = 0; worst != LLONG_MAX && mine == worst && a < P->n; a++) {
     if (P->id[a] != worst || P->kind[a] != KIND_FLUID) continue;
     rc = classify(M, P, a);
     static const char *names[] = {"", "non-finite value", "particle through a wall",
@@ -40,6 +44,14 @@ int health_check(const struct model *M, const struct particles *P, long step, do
              names[rc], step, t, (long long)P->id[a], P->x[a], P->y[a], P->z[a], P->u[a], P->v[a],
              P->w[a], P->rho[a]);
     break;
+  }
+  if (worst != LLONG_MAX) { /* share the owner's report */
+    int owner[2] = {rc, 0}, rank;
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    owner[1] = rc != OK ? rank : -1;
+    MPI_Allreduce(MPI_IN_PLACE, owner, 2, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+    rc = owner[0];
+    MPI_Bcast(rep->what, (int)sizeof rep->what, MPI_CHAR, owner[1], MPI_COMM_WORLD);
   }
   timer_pop();
   return rc;

@@ -9,12 +9,17 @@
 #include "kernel.h"
 #include "timers.h"
 
-void nbr_init(struct nbr *nb, const struct scene *s, size_t n) {
+int nbr_columns(const struct scene *s) {
+  const double cell = 2.0 * scene_h(s) / NBR_REACH;
+  return (int)floor(s->lx / cell * (1.0 + 1e-12));
+}
+
+void nbr_init(struct nbr *nb, const struct scene *s, size_t n, int ix0, int nxo, int halo) {
   memset(nb, 0, sizeof *nb);
   const double two_h = 2.0 * scene_h(s), cell = two_h / NBR_REACH;
   nb->dim = s->dim;
   nb->lx = s->lx, nb->ly = 2.0 * s->delta, nb->lz = s->dim == 3 ? s->lz : 1.0;
-  nb->nx = (int)floor(nb->lx / cell * (1.0 + 1e-12));
+  nb->nx = nbr_columns(s);
   nb->ny = (int)floor(nb->ly / cell * (1.0 + 1e-12));
   nb->nz = s->dim == 3 ? (int)floor(nb->lz / cell * (1.0 + 1e-12)) : 1;
   if (nb->ny < 1) nb->ny = 1;
@@ -23,18 +28,33 @@ void nbr_init(struct nbr *nb, const struct scene *s, size_t n) {
         2 * NBR_REACH + 1, NBR_REACH);
   nb->cx = nb->nx / nb->lx, nb->cy = nb->ny / nb->ly, nb->cz = nb->nz / nb->lz;
   nb->support2 = two_h * two_h;
-  nb->ncell = (size_t)nb->nx * nb->ny * nb->nz;
-  nb->start = part_alloc("cell_start", (nb->ncell + 1) * sizeof(size_t));
-  nb->pos = part_alloc("cell_fill", nb->ncell * sizeof(size_t));
-  nb->cap = n;
-  nb->perm = part_alloc("sort_perm", n * sizeof(size_t));
-  nb->cell = part_alloc("cell_of", n * sizeof(int));
-  nb->count = part_alloc("nbr_count", n * sizeof(int));
+  nbr_set_range(nb, ix0, nxo, halo);
   /* expected neighbours in the support, with head room; nbr_build grows it if needed */
   const double per = s->dim == 3 ? 4.0 / 3.0 * M_PI * pow(2.0 * s->h_over_dr, 3)
                                  : M_PI * pow(2.0 * s->h_over_dr, 2);
   nb->stride = (int)(1.5 * per) + 8;
-  nb->list = part_alloc("nbr_list", n * (size_t)nb->stride * sizeof(int32_t));
+  nbr_reserve(nb, n);
+}
+
+void nbr_set_range(struct nbr *nb, int ix0, int nxo, int halo) {
+  nb->ix0 = ix0, nb->nxo = nxo, nb->halo = halo;
+  const size_t rows = (size_t)nb->ny * nb->nz;
+  nb->ncell_own = (size_t)nxo * rows;
+  nb->ncell = nb->ncell_own + 2 * (size_t)halo * rows;
+  part_free(nb->start), part_free(nb->pos);
+  nb->start = part_alloc("cell_start", (nb->ncell + 1) * sizeof(size_t));
+  nb->pos = part_alloc("cell_fill", nb->ncell * sizeof(size_t));
+}
+
+void nbr_reserve(struct nbr *nb, size_t n) {
+  if (n <= nb->cap) return;
+  const size_t cap = nb->cap ? n + n / 2 : n;
+  part_free(nb->perm), part_free(nb->cell), part_free(nb->count), part_free(nb->list);
+  nb->cap = cap;
+  nb->perm = part_alloc("sort_perm", cap * sizeof(size_t));
+  nb->cell = part_alloc("cell_of", cap * sizeof(int));
+  nb->count = part_alloc("nbr_count", cap * sizeof(int));
+  nb->list = part_alloc("nbr_list", cap * (size_t)nb->stride * sizeof(int32_t));
 }
 
 void nbr_free(struct nbr *nb) {
@@ -47,50 +67,75 @@ static inline int clampi(int i, int n) {
   return i < 0 ? 0 : i >= n ? n - 1 : i;
 }
 
-void nbr_sort(struct nbr *nb, struct particles *P) {
-  timer_push("sort");
-  const size_t n = P->n;
-  int *restrict cell = nb->cell;
+/* Counting sort of slots [i0, i0 + n) by nb->cell[i0 + i] over cells [c0, c1) (start[] of
+   those cells counted from i0), then by id within each cell; the permutation is left in
+   nb->perm[0 .. n-1] and applied. */
+static void sort_range(struct nbr *nb, struct particles *P, size_t i0, size_t n, size_t c0,
+                       size_t c1) {
+  const int *restrict cell = nb->cell + i0;
   size_t *restrict start = nb->start;
-#pragma omp parallel for schedule(static)
-  for (size_t a = 0; a < n; a++) {
-    double x = P->x[a], z = P->z[a];
-    if (x < 0.0 || x >= nb->lx) {
-      x -= nb->lx * floor(x / nb->lx);
-      if (x >= nb->lx) x -= nb->lx; /* a tiny negative x rounds to lx above */
-      P->x[a] = x;
-    }
-    if (nb->dim == 3 && (z < 0.0 || z >= nb->lz)) {
-      z -= nb->lz * floor(z / nb->lz);
-      if (z >= nb->lz) z -= nb->lz;
-      P->z[a] = z;
-    }
-    /* clamped in floating point first: a NaN or huge coordinate (a failing run, reported by
-       the health check after this step) must not overflow the integer conversion */
-    const int ix = clampi((int)fmin(fmax(x * nb->cx, 0.0), nb->nx), nb->nx);
-    const int iy = clampi((int)fmin(fmax(P->y[a] * nb->cy, 0.0), nb->ny), nb->ny);
-    const int iz = nb->dim == 3 ? clampi((int)fmin(fmax(z * nb->cz, 0.0), nb->nz), nb->nz) : 0;
-    cell[a] = (iz * nb->ny + iy) * nb->nx + ix;
-  }
-  memset(start, 0, (nb->ncell + 1) * sizeof *start);
+  for (size_t c = c0; c <= c1; c++) start[c] = 0;
   for (size_t a = 0; a < n; a++) start[cell[a] + 1]++;
-  for (size_t c = 0; c < nb->ncell; c++) start[c + 1] += start[c];
+  start[c0] = i0;
+  for (size_t c = c0; c < c1; c++) start[c + 1] += start[c];
   /* stable scatter, then order each cell by id (insertion sort: cells are small and their
      content changes little from one step to the next) */
   size_t *restrict perm = nb->perm;
   size_t *restrict pos = nb->pos;
-  memcpy(pos, start, nb->ncell * sizeof *pos);
+  for (size_t c = c0; c < c1; c++) pos[c] = start[c] - i0;
   for (size_t a = 0; a < n; a++) perm[pos[cell[a]]++] = a;
-  const int64_t *id = P->id;
+  const int64_t *id = P->id + i0;
 #pragma omp parallel for schedule(static)
-  for (size_t c = 0; c < nb->ncell; c++)
-    for (size_t i = start[c] + 1; i < start[c + 1]; i++) {
+  for (size_t c = c0; c < c1; c++)
+    for (size_t i = start[c] - i0 + 1; i < start[c + 1] - i0; i++) {
       const size_t key = perm[i];
       size_t j = i;
-      while (j > start[c] && id[perm[j - 1]] > id[key]) perm[j] = perm[j - 1], j--;
+      while (j > start[c] - i0 && id[perm[j - 1]] > id[key]) perm[j] = perm[j - 1], j--;
       perm[j] = key;
     }
-  part_permute(P, perm);
+  part_permute(P, i0, n, perm);
+}
+
+void nbr_sort(struct nbr *nb, struct particles *P) {
+  timer_push("sort");
+  const size_t n = P->n;
+  int *restrict cell = nb->cell;
+  int stray = 0;
+#pragma omp parallel for schedule(static) reduction(max : stray)
+  for (size_t a = 0; a < n; a++) {
+    nbr_wrap_position(nb, &P->x[a], &P->z[a]);
+    /* clamped in floating point first: a NaN or huge coordinate (a failing run, reported by
+       the health check after this step) must not overflow the integer conversion */
+    const int lc = nbr_column(nb, P->x[a]) - nb->ix0;
+    const int iy = clampi((int)fmin(fmax(P->y[a] * nb->cy, 0.0), nb->ny), nb->ny);
+    const int iz =
+        nb->dim == 3 ? clampi((int)fmin(fmax(P->z[a] * nb->cz, 0.0), nb->nz), nb->nz) : 0;
+    if (lc < 0 || lc >= nb->nxo) stray = 1;
+    cell[a] = (int)nbr_owned_cell(nb, lc < 0 ? 0 : lc >= nb->nxo ? nb->nxo - 1 : lc, iy, iz);
+  }
+  if (stray) die("nbr_sort: a particle outside this rank's columns (migration missed it)");
+  sort_range(nb, P, 0, n, 0, nb->ncell_own);
+  timer_pop();
+}
+
+void nbr_sort_ghosts(struct nbr *nb, struct particles *P, size_t n_left) {
+  timer_push("sort");
+  const size_t n0 = P->n, ng = P->n_ghost;
+  const int R = nb->halo;
+  int *restrict cell = nb->cell + n0;
+#pragma omp parallel for schedule(static)
+  for (size_t g = 0; g < ng; g++) {
+    const size_t a = n0 + g;
+    const int ix = nbr_column(nb, P->x[a]); /* ghosts arrive wrapped */
+    const int h = g < n_left ? (ix - nb->ix0 + R + nb->nx) % nb->nx
+                             : R + (ix - (nb->ix0 + nb->nxo) + nb->nx) % nb->nx;
+    const int iy = clampi((int)fmin(fmax(P->y[a] * nb->cy, 0.0), nb->ny), nb->ny);
+    const int iz =
+        nb->dim == 3 ? clampi((int)fmin(fmax(P->z[a] * nb->cz, 0.0), nb->nz), nb->nz) : 0;
+    cell[g] = (int)(nb->ncell_own + ((size_t)iz * nb->ny + iy) * 2 * R + clampi(h, 2 * R));
+  }
+  /* sort_range indexes cell[] from slot i0 */
+  sort_range(nb, P, n0, ng, nb->ncell_own, nb->ncell);
   timer_pop();
 }
 
@@ -114,19 +159,36 @@ static inline int scan(const struct particles *restrict P, const struct kernel *
   return cnt;
 }
 
+/* Column slot of the stencil column lc + dx of an owned column lc, and the periodic shift of
+   its particles: the same global column and shift on any decomposition. Returns the local
+   column (owned: 0 .. nxo-1) or -1 - h for halo column h. */
+static inline int stencil_column(const struct nbr *nb, int lc, int dx, double *sx) {
+  int jl = lc + dx;
+  const int gx = nb->ix0 + jl;
+  *sx = gx < 0 ? -nb->lx : gx >= nb->nx ? nb->lx : 0.0;
+  if (!nb->halo) { /* one rank: the whole grid, periodic wrap inside it */
+    if (jl < 0) jl += nb->nx;
+    if (jl >= nb->nx) jl -= nb->nx;
+    return jl;
+  }
+  if (jl < 0) return -1 - (jl + nb->halo);
+  if (jl >= nb->nxo) return -1 - (nb->halo + jl - nb->nxo);
+  return jl;
+}
+
 void nbr_build(struct nbr *nb, const struct particles *P, const struct kernel *K, double *ksum) {
   const double w0 = kernel_w(K, 0.0);
   timer_push("neighbours");
-  if (P->n > (size_t)INT32_MAX) die("more than 2^31 particles on one rank");
+  if (P->n + P->n_ghost > (size_t)INT32_MAX) die("more than 2^31 particles on one rank");
   for (;;) {
     int overflow = 0;
     const int stride = nb->stride;
     const int R = NBR_REACH, dz_lo = nb->dim == 3 ? -R : 0, dz_hi = nb->dim == 3 ? R : 0;
 #pragma omp parallel for schedule(static) reduction(max : overflow)
-    for (size_t c = 0; c < nb->ncell; c++) {
-      const int ix = (int)(c % (size_t)nb->nx);
-      const int iy = (int)(c / (size_t)nb->nx % (size_t)nb->ny);
-      const int iz = (int)(c / ((size_t)nb->nx * nb->ny));
+    for (size_t c = 0; c < nb->ncell_own; c++) {
+      const int lc = (int)(c % (size_t)nb->nxo);
+      const int iy = (int)(c / (size_t)nb->nxo % (size_t)nb->ny);
+      const int iz = (int)(c / ((size_t)nb->nxo * nb->ny));
       for (size_t a = nb->start[c]; a < nb->start[c + 1]; a++) {
         int32_t *out = nb->list + a * (size_t)stride;
         int cnt = 0;
@@ -141,21 +203,22 @@ void nbr_build(struct nbr *nb, const struct particles *P, const struct kernel *K
           for (int dy = -R; dy <= R; dy++) {
             const int jy = iy + dy;
             if (jy < 0 || jy >= nb->ny) continue;
-            const size_t row = ((size_t)jz * nb->ny + jy) * nb->nx;
-            if (ix >= R && ix < nb->nx - R) { /* the x cells of the stencil are contiguous */
-              cnt = scan(P, K, a, nb->start[row + ix - R], nb->start[row + ix + R + 1], 0.0, sz,
-                         nb->support2, out, cnt, stride, &sum);
+            const size_t row = (size_t)jz * nb->ny + jy;
+            const int gx = nb->ix0 + lc;
+            if (lc >= R && lc < nb->nxo - R && gx >= R && gx < nb->nx - R) {
+              /* the x cells of the stencil are contiguous and unshifted */
+              const size_t c0 = row * nb->nxo + lc;
+              cnt = scan(P, K, a, nb->start[c0 - R], nb->start[c0 + R + 1], 0.0, sz, nb->support2,
+                         out, cnt, stride, &sum);
               continue;
             }
             for (int dx = -R; dx <= R; dx++) {
-              int jx = ix + dx;
-              double sx = 0.0;
-              if (jx < 0)
-                jx += nb->nx, sx = -nb->lx;
-              else if (jx >= nb->nx)
-                jx -= nb->nx, sx = nb->lx;
-              cnt = scan(P, K, a, nb->start[row + jx], nb->start[row + jx + 1], sx, sz,
-                         nb->support2, out, cnt, stride, &sum);
+              double sx;
+              const int col = stencil_column(nb, lc, dx, &sx);
+              const size_t cc =
+                  col >= 0 ? row * nb->nxo + col : nb->ncell_own + row * 2 * nb->halo + (-1 - col);
+              cnt = scan(P, K, a, nb->start[cc], nb->start[cc + 1], sx, sz, nb->support2, out, cnt,
+                         stride, &sum);
             }
           }
         }

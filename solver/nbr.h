@@ -11,6 +11,7 @@
 #ifndef CHANSPH_NBR_H
 #define CHANSPH_NBR_H
 
+#include <math.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -21,42 +22,95 @@
     (fewer distance checks than 3 cells of size 2h: 125 h^3 instead of 216 h^3 in 3-D). */
 enum { NBR_REACH = 2 };
 
-/** Cell grid and neighbour list. */
+/**
+ * Cell grid and neighbour list. The grid is global (cells of the whole channel, column ix
+ * along x, row iy, plane iz); a rank owns the columns ix0 .. ix0+nxo-1 and, with several ranks,
+ * keeps `halo` columns of ghosts on each side. Local cell numbers: the owned cells first,
+ * (iz * ny + iy) * nxo + (ix - ix0), then the halo cells, ncell_own + (iz * ny + iy) * 2 halo + h
+ * with h < halo for the left halo and h >= halo for the right one. The stencil of a particle
+ * visits the same global cells in the same order on any decomposition, and the particles of a
+ * cell are ordered by id, so neighbour sums are bitwise independent of the number of ranks.
+ */
 struct nbr {
   int dim;
-  int nx, ny, nz;    /*!< cells per direction */
+  int nx, ny, nz;    /*!< cells per direction (global) */
+  int ix0, nxo;      /*!< owned columns: ix0 .. ix0 + nxo - 1 */
+  int halo;          /*!< halo columns on each side (0: one rank, periodic wrap in the grid) */
+  size_t ncell_own;  /*!< owned cells */
   double lx, ly, lz; /*!< domain lengths [m] (ly = 2 delta) */
   double cx, cy, cz; /*!< inverse cell sizes [1/m] */
   double support2;   /*!< (2h)^2 [m^2] */
-  size_t ncell;
-  size_t *start; /*!< particles of cell c are start[c] .. start[c+1]-1 */
-  size_t *pos;   /*!< fill position of each cell (sort scratch) */
-  size_t *perm;  /*!< sort scratch */
-  int *cell;     /*!< cell of each particle (sort scratch) */
-  size_t cap;    /*!< particles the arrays hold */
+  size_t ncell;      /*!< owned + halo cells */
+  size_t *start;     /*!< particles of cell c are start[c] .. start[c+1]-1 */
+  size_t *pos;       /*!< fill position of each cell (sort scratch) */
+  size_t *perm;      /*!< sort scratch */
+  int *cell;         /*!< cell of each particle (sort scratch) */
+  size_t cap;        /*!< particles the arrays hold */
   /* neighbour list */
   int stride;    /*!< list slots per particle */
   int *count;    /*!< neighbours of each particle (excluding itself) */
   int32_t *list; /*!< neighbours of a: list[a*stride .. a*stride+count[a]-1] */
 };
 
+/** @brief Columns of the global cell grid along x for a scene (what nbr_init uses). */
+int nbr_columns(const struct scene *s);
+
 /**
  * @brief Set up the cell grid for a domain.
  * @param[out] nb neighbour structure
  * @param[in] s scene
- * @param[in] n particles
+ * @param[in] n particle slots (grown later by nbr_reserve)
+ * @param[in] ix0,nxo owned columns (0 and nbr_columns(s) on one rank)
+ * @param[in] halo halo columns on each side (0 on one rank, else NBR_REACH)
  */
-void nbr_init(struct nbr *nb, const struct scene *s, size_t n);
+void nbr_init(struct nbr *nb, const struct scene *s, size_t n, int ix0, int nxo, int halo);
+
+/** @brief Change the owned columns (after a re-partition); the particles must be sorted again. */
+void nbr_set_range(struct nbr *nb, int ix0, int nxo, int halo);
+
+/** @brief Make the per-particle arrays hold at least n slots. */
+void nbr_reserve(struct nbr *nb, size_t n);
+
+/** @brief Global column of the position x (already wrapped into [0, lx)). */
+static inline int nbr_column(const struct nbr *nb, double x) {
+  const int ix = (int)fmin(fmax(x * nb->cx, 0.0), nb->nx);
+  return ix < 0 ? 0 : ix >= nb->nx ? nb->nx - 1 : ix;
+}
+
+/** @brief Wrap x (and z in 3-D) of particle a into the periodic box. */
+static inline void nbr_wrap_position(const struct nbr *nb, double *x, double *z) {
+  if (*x < 0.0 || *x >= nb->lx) {
+    *x -= nb->lx * floor(*x / nb->lx);
+    if (*x >= nb->lx) *x -= nb->lx; /* a tiny negative x rounds to lx above */
+  }
+  if (nb->dim == 3 && (*z < 0.0 || *z >= nb->lz)) {
+    *z -= nb->lz * floor(*z / nb->lz);
+    if (*z >= nb->lz) *z -= nb->lz;
+  }
+}
 
 /** @brief Free the grid and the list. */
 void nbr_free(struct nbr *nb);
 
 /**
- * @brief Wrap periodic coordinates, then reorder the particles by cell and by id in a cell.
+ * @brief Wrap periodic coordinates, then reorder the owned particles (slots 0 .. P->n - 1) by
+ *        cell and by id in a cell. Every owned particle must lie in an owned column.
  * @param[in,out] nb grid
  * @param[in,out] P particles
  */
 void nbr_sort(struct nbr *nb, struct particles *P);
+
+/**
+ * @brief Order the ghosts (slots P->n .. P->n + P->n_ghost - 1) by halo cell and id. The first
+ *        n_left ghosts belong to the left halo, the others to the right one. On return
+ *        nb->perm[i] is the ghost (0-based, in the order before) that went to ghost slot i.
+ */
+void nbr_sort_ghosts(struct nbr *nb, struct particles *P, size_t n_left);
+
+/** @brief Owned cells of local column lc (0 .. nxo-1): cell (iz * ny + iy) * nxo + lc. */
+static inline size_t nbr_owned_cell(const struct nbr *nb, int lc, int iy, int iz) {
+  return ((size_t)iz * nb->ny + iy) * nb->nxo + lc;
+}
 
 /**
  * @brief Build the neighbour list of every particle (pairs closer than 2h, self excluded) and,

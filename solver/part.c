@@ -57,6 +57,7 @@ void part_create(struct particles *P, struct walls *W, const struct scene *s) {
   P->n_fluid = (size_t)nx * (size_t)(ny - 1) * (size_t)nz;
   P->n_vertex = 2 * (size_t)nx * (size_t)nz;
   P->n = P->n_fluid + P->n_vertex;
+  P->cap = P->n;
   const size_t nd = P->n * sizeof(double);
   P->x = part_alloc("x", nd), P->y = part_alloc("y", nd), P->z = part_alloc("z", nd);
   P->u = part_alloc("u", nd), P->v = part_alloc("v", nd), P->w = part_alloc("w", nd);
@@ -102,20 +103,65 @@ void part_destroy(struct particles *P, struct walls *W) {
   P->id = NULL, P->kind = NULL, P->tmp_i = NULL;
 }
 
-static void permute_d(double **arr, double **tmp, const size_t *perm, size_t n) {
-  double *restrict src = *arr, *restrict dst = *tmp;
-#pragma omp parallel for schedule(static)
-  for (size_t i = 0; i < n; i++) dst[i] = src[perm[i]];
-  *tmp = src, *arr = dst;
+static void grow(void *pp, const char *label, size_t elem, size_t used, size_t cap) {
+  void **p = pp;
+  if (!*p) return; /* an optional array that is not in use */
+  void *fresh = part_alloc(label, cap * elem);
+  memcpy(fresh, *p, used * elem);
+  part_free(*p);
+  *p = fresh;
 }
 
-void part_permute(struct particles *P, const size_t *perm) {
-  double **arrs[] = {&P->x,   &P->y, &P->z,   &P->u,    &P->v,    &P->w,
-                     &P->rho, &P->m, &P->gam, &P->ksum, &P->ddiff};
-  for (size_t i = 0; i < sizeof arrs / sizeof arrs[0]; i++) permute_d(arrs[i], &P->tmp, perm, P->n);
-  int64_t *restrict dst = P->tmp_i;
-  uint8_t *restrict kind_tmp = (uint8_t *)P->tmp; /* P->tmp is free after the doubles */
-  for (size_t i = 0; i < P->n; i++) dst[i] = P->id[perm[i]], kind_tmp[i] = P->kind[perm[i]];
-  P->tmp_i = P->id, P->id = dst;
-  memcpy(P->kind, kind_tmp, P->n);
+void part_reserve(struct particles *P, size_t n) {
+  if (n <= P->cap) return;
+  const size_t cap = n + n / 2, used = P->n + P->n_ghost, d = sizeof(double);
+  struct {
+    double **a;
+    const char *label;
+  } const f[] = {{&P->x, "x"},
+                 {&P->y, "y"},
+                 {&P->z, "z"},
+                 {&P->u, "u"},
+                 {&P->v, "v"},
+                 {&P->w, "w"},
+                 {&P->rho, "rho"},
+                 {&P->m, "mass"},
+                 {&P->gam, "gamma"},
+                 {&P->ksum, "kernel_sum"},
+                 {&P->ddiff, "diffusion"},
+                 {&P->p, "pressure"},
+                 {&P->c, "sound"},
+                 {&P->pr2, "p_over_rho2"},
+                 {&P->vol, "volume"},
+                 {&P->ax, "ax"},
+                 {&P->ay, "ay"},
+                 {&P->az, "az"},
+                 {&P->nur, "nu_r"},
+                 {&P->kr, "k_r"},
+                 {&P->twx, "wall_law_tx"},
+                 {&P->twz, "wall_law_tz"},
+                 {&P->tmp, "sort_scratch"}};
+  for (size_t i = 0; i < sizeof f / sizeof f[0]; i++) grow(f[i].a, f[i].label, d, used, cap);
+  grow(&P->id, "id", sizeof(int64_t), used, cap);
+  grow(&P->tmp_i, "sort_scratch_i", sizeof(int64_t), used, cap);
+  grow(&P->kind, "kind", 1, used, cap);
+  P->cap = cap;
+}
+
+static void permute_d(double *arr, double *tmp, size_t i0, size_t n, const size_t *perm) {
+  const double *restrict src = arr + i0;
+  double *restrict dst = tmp;
+#pragma omp parallel for schedule(static)
+  for (size_t i = 0; i < n; i++) dst[i] = src[perm[i]];
+  memcpy(arr + i0, tmp, n * sizeof(double));
+}
+
+void part_permute(struct particles *P, size_t i0, size_t n, const size_t *perm) {
+  double *arrs[] = {P->x, P->y, P->z, P->u, P->v, P->w, P->rho, P->m, P->gam, P->ksum, P->ddiff};
+  for (size_t i = 0; i < sizeof arrs / sizeof arrs[0]; i++) permute_d(arrs[i], P->tmp, i0, n, perm);
+  int64_t *restrict id = P->tmp_i;
+  uint8_t *restrict kind = (uint8_t *)P->tmp; /* P->tmp is free after the doubles */
+  for (size_t i = 0; i < n; i++) id[i] = P->id[i0 + perm[i]], kind[i] = P->kind[i0 + perm[i]];
+  memcpy(P->id + i0, id, n * sizeof(int64_t));
+  memcpy(P->kind + i0, kind, n);
 }

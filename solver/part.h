@@ -17,11 +17,18 @@
 
 enum part_kind { KIND_FLUID = 0, KIND_VERTEX = 1 };
 
-/** All particles of this rank. Vertex particles sit on the walls and never move. */
+/**
+ * All particles of this rank. Vertex particles sit on the walls and never move.
+ * Slots 0 .. n-1 hold the particles this rank owns (every pass computes them); with several
+ * MPI ranks, slots n .. n+n_ghost-1 hold copies of the neighbouring ranks' particles within the
+ * kernel support (ghosts, dd.h), which passes only read.
+ */
 struct particles {
-  size_t n;        /*!< fluid + vertex particles */
-  size_t n_fluid;  /*!< fluid particles */
-  size_t n_vertex; /*!< vertex particles (both walls) */
+  size_t n;        /*!< owned fluid + vertex particles of this rank */
+  size_t n_ghost;  /*!< ghost particles after the owned ones (0 on one rank) */
+  size_t cap;      /*!< slots every per-particle array holds (>= n + n_ghost) */
+  size_t n_fluid;  /*!< fluid particles of the whole run (ids 0 .. n_fluid-1) */
+  size_t n_vertex; /*!< vertex particles of the whole run, both walls (ids from n_fluid) */
   /* hot, permuted with the particles */
   double *x, *y, *z; /*!< position [m] */
   double *u, *v, *w; /*!< velocity [m/s] */
@@ -79,15 +86,24 @@ void part_memory_report(FILE *f);
  */
 void part_create(struct particles *P, struct walls *W, const struct scene *s);
 
+/**
+ * @brief Make every per-particle array hold at least n slots (grows by half again; keeps the
+ *        contents of slots 0 .. P->n + P->n_ghost - 1).
+ */
+void part_reserve(struct particles *P, size_t n);
+
 /** @brief Free everything part_create() allocated. */
 void part_destroy(struct particles *P, struct walls *W);
 
 /**
- * @brief Reorder the permuted arrays: new index i takes old index perm[i].
+ * @brief Reorder the permuted arrays in slots [i0, i0 + n): new slot i0 + i takes old slot
+ *        i0 + perm[i].
  * @param[in,out] P particles
+ * @param[in] i0 first slot
+ * @param[in] n slots
  * @param[in] perm permutation of 0..n-1
  */
-void part_permute(struct particles *P, const size_t *perm);
+void part_permute(struct particles *P, size_t i0, size_t n, const size_t *perm);
 
 /** @brief Wall-lattice index of a vertex particle from its id. */
 static inline size_t part_vertex_slot(const struct particles *P, int64_t id) {

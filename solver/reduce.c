@@ -6,15 +6,14 @@
 
 #include "error.h"
 
-/** Pairwise sum of a short array (fixed recursion, so the order is fixed). */
-static double pairwise(const double *x, size_t n) {
+double reduce_pairwise(const double *x, size_t n) {
   if (n <= 8) {
     double s = 0.0;
     for (size_t i = 0; i < n; i++) s += x[i];
     return s;
   }
   const size_t m = n / 2;
-  return pairwise(x, m) + pairwise(x + m, n - m);
+  return reduce_pairwise(x, m) + reduce_pairwise(x + m, n - m);
 }
 
 void reduce_sums(int nv, const double *const *x, size_t n, double *out) {
@@ -31,7 +30,7 @@ void reduce_sums(int nv, const double *const *x, size_t n, double *out) {
       blk[(size_t)v * nb + b] = s;
     }
   }
-  for (int v = 0; v < nv; v++) out[v] = nb ? pairwise(blk + (size_t)v * nb, nb) : 0.0;
+  for (int v = 0; v < nv; v++) out[v] = nb ? reduce_pairwise(blk + (size_t)v * nb, nb) : 0.0;
   free(blk);
   reduce_global_sum(out, nv);
 }

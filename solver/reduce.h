@@ -29,6 +29,9 @@ double reduce_sum(const double *x, size_t n);
  */
 void reduce_sums(int nv, const double *const *x, size_t n, double *out);
 
+/** @brief Pairwise sum of x[0..n-1] (a fixed recursion, so a fixed order). */
+double reduce_pairwise(const double *x, size_t n);
+
 /** @brief Global sum across ranks of already-local values (in place, fixed rank order). */
 void reduce_global_sum(double *v, int nv);
 

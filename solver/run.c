@@ -2,6 +2,7 @@
 #include "run.h"
 
 #include <math.h>
+#include <mpi.h>
 #include <string.h>
 
 #include "error.h"
@@ -20,37 +21,70 @@ double sim_viscosity(const struct scene *sc, double t) {
 /* Model terms of the current state, at the viscosity of the schedule. */
 static void model_update(struct sim *S) {
   S->M.nu = sim_viscosity(S->sc, S->t);
-  S->nu_max = turb_update(&S->M, &S->P, &S->nb, &S->W);
+  S->nu_max = turb_update(&S->M, &S->P, &S->nb, &S->W, &S->dd);
+  reduce_global_max(&S->nu_max, 1);
+}
+
+/* Grow every per-particle array of the simulation to n slots (dd_reserve_fn). */
+static void sim_reserve(void *ctx, size_t n) {
+  struct sim *S = ctx;
+  part_reserve(&S->P, n);
+  nbr_reserve(&S->nb, S->P.cap);
+  if (S->cap >= S->P.cap) return;
+  S->cap = S->P.cap;
+  const size_t bytes = S->cap * sizeof(double);
+  for (int k = 0; k < 4; k++)
+    part_free(S->scratch[k]), S->scratch[k] = part_alloc("diag_scratch", bytes);
+  part_free(S->ksum_new), S->ksum_new = part_alloc("kernel_sum_new", bytes);
+  if (S->wall_ax) part_free(S->wall_ax), S->wall_ax = part_alloc("wall_ax", bytes);
+}
+
+/* Neighbours, density, wall values and model terms of the current positions: sort the owned
+   particles, build the ghosts, and refresh the ghosts' copies after each pass whose results
+   the next pass reads at neighbours. dt = 0: density from the stored state. */
+static void update_state(struct sim *S, const double *ksum_old_or_null, double dt) {
+  struct particles *P = &S->P;
+  nbr_sort(&S->nb, P);
+  dd_halo(&S->dd, P, &S->nb);
+  nbr_build(&S->nb, P, &S->M.k, S->ksum_new);
+  sph_density(&S->M, P, ksum_old_or_null ? ksum_old_or_null : S->ksum_new, dt);
+  double *const dens[5] = {P->rho, P->p, P->c, P->pr2, P->vol};
+  dd_update(&S->dd, P, 5, dens); /* fluid ghosts: what sph_walls reads */
+  sph_walls(&S->M, P, &S->nb, &S->W);
+  dd_update(&S->dd, P, 5, dens); /* vertex ghosts */
+  double *const wv[2] = {S->W.rho, S->W.p};
+  dd_update_walls(&S->dd, P, 2, wv);
+  model_update(S);
 }
 
 int sim_init(struct sim *S, const struct scene *sc) {
   memset(S, 0, sizeof *S);
   S->sc = sc;
   sph_model_init(&S->M, sc);
+  /* every rank builds the same full initial state, then keeps its own columns */
   part_create(&S->P, &S->W, sc);
   turb_init(&S->M, &S->P, &S->W);
-  if (init_fields(sc, &S->P)) {
+  if (init_fields(sc, &S->P) || dd_init(&S->dd, sc, sim_reserve, S)) {
+    turb_free(&S->P, &S->W);
     part_destroy(&S->P, &S->W);
     return CHANSPH_ERR;
   }
-  for (int k = 0; k < 4; k++) S->scratch[k] = part_alloc("diag_scratch", S->P.n * sizeof(double));
-  S->ksum_new = part_alloc("kernel_sum_new", S->P.n * sizeof(double));
-  if (sc->stats_eulerian) S->wall_ax = part_alloc("wall_ax", S->P.n * sizeof(double));
+  const int ix0 = S->dd.first[S->dd.rank], nxo = S->dd.first[S->dd.rank + 1] - ix0;
+  nbr_init(&S->nb, sc, S->P.n, ix0, nxo, S->dd.halo);
+  dd_keep_owned(&S->dd, &S->P, &S->nb);
+  if (sc->stats_eulerian) S->wall_ax = part_alloc("wall_ax", sizeof(double));
+  sim_reserve(S, S->P.n);
   S->wall_fx[0] = S->wall_fx[1] = NAN;
-  nbr_init(&S->nb, sc, S->P.n);
   drive_init(&S->drive, sc);
   S->fx = S->drive.force;
-  nbr_sort(&S->nb, &S->P);
-  nbr_build(&S->nb, &S->P, &S->M.k, S->ksum_new);
-  sph_density(&S->M, &S->P, S->ksum_new, 0.0);
-  sph_walls(&S->M, &S->P, &S->nb, &S->W);
-  model_update(S);
+  update_state(S, NULL, 0.0);
   return CHANSPH_OK;
 }
 
 void sim_free(struct sim *S) {
   turb_free(&S->P, &S->W);
   nbr_free(&S->nb);
+  dd_free(&S->dd);
   for (int k = 0; k < 4; k++) part_free(S->scratch[k]);
   part_free(S->ksum_new);
   if (S->wall_ax) part_free(S->wall_ax);
@@ -78,11 +112,22 @@ static void check_fixed_dt(struct sim *S, double dt) {
     const double key = worst == 0 ? v2 : ax * ax + P->ay[a] * P->ay[a] + P->az[a] * P->az[a];
     if (key > best || (key == best && P->id[a] < P->id[who])) best = key, who = a;
   }
+  /* the particle over all ranks: largest key, then lowest id */
+  double mine[5] = {best, best >= 0.0 ? (double)P->id[who] : 0.0, 0, 0, 0};
+  if (best >= 0.0) mine[2] = P->x[who], mine[3] = P->y[who], mine[4] = P->z[who];
+  double *all = part_alloc("cfl_report", 5 * (size_t)S->dd.size * sizeof(double));
+  MPI_Allgather(mine, 5, MPI_DOUBLE, all, 5, MPI_DOUBLE, MPI_COMM_WORLD);
+  const double *w = all;
+  for (int r = 1; r < S->dd.size; r++) {
+    const double *c = all + 5 * r;
+    if (c[0] > w[0] || (c[0] == w[0] && c[0] >= 0.0 && c[1] < w[1])) w = c;
+  }
   snprintf(S->violation, sizeof S->violation,
            "CFL violation at step %ld (t = %.9g): fixed dt = %.6g s exceeds the %s limit "
            "%.6g s; particle id %lld at (%.9g, %.9g, %.9g) with %s %.6g",
-           S->step, S->t, dt, names[worst], S->dt_limits[worst], (long long)P->id[who], P->x[who],
-           P->y[who], P->z[who], worst == 0 ? "speed" : "acceleration", sqrt(best));
+           S->step, S->t, dt, names[worst], S->dt_limits[worst], (long long)w[1], w[2], w[3], w[4],
+           worst == 0 ? "speed" : "acceleration", sqrt(w[0]));
+  part_free(all);
 }
 
 /* Time step of thesis Eq. 2.160-2.164, or the fixed one. */
@@ -112,7 +157,7 @@ static double bulk_velocity(struct sim *S) {
   }
   double s[2];
   const double *arrs[2] = {vu, vol};
-  reduce_sums(2, arrs, P->n, s);
+  dd_sum(&S->dd, &S->nb, 2, arrs, s);
   return s[0] / s[1];
 }
 
@@ -127,7 +172,7 @@ static void wall_force(struct sim *S) {
     lo[a] = P->y[a] < delta ? f : 0.0, hi[a] = P->y[a] < delta ? 0.0 : f;
   }
   const double *arrs[2] = {lo, hi};
-  reduce_sums(2, arrs, P->n, S->wall_fx);
+  dd_sum(&S->dd, &S->nb, 2, arrs, S->wall_fx);
 }
 
 void sim_step(struct sim *S) {
@@ -156,11 +201,10 @@ void sim_step(struct sim *S) {
   }
   timer_pop();
   S->t += dt, S->dt = dt, S->fx = fx, S->step++;
-  nbr_sort(&S->nb, P);
-  nbr_build(&S->nb, P, &S->M.k, S->ksum_new);
-  sph_density(&S->M, P, S->ksum_new, dt);
-  sph_walls(&S->M, P, &S->nb, &S->W);
-  model_update(S);
+  if (S->dd.size > 1 && S->sc->balance_every > 0 && S->step % S->sc->balance_every == 0)
+    dd_balance(&S->dd, &S->nb, S->sc->balance_threshold);
+  dd_migrate(&S->dd, P, &S->nb);
+  update_state(S, NULL, dt);
 }
 
 void sim_diag(struct sim *S, struct diag *d) {
@@ -181,7 +225,7 @@ void sim_diag(struct sim *S, struct diag *d) {
   }
   double s[4];
   const double *arrs[4] = {vu, vol, ke, mass};
-  reduce_sums(4, arrs, P->n, s);
+  dd_sum(&S->dd, &S->nb, 4, arrs, s);
   double mx[2] = {rmax, smax}, mn[2] = {rmin, gmin};
   reduce_global_max(mx, 2);
   reduce_global_min(mn, 2);
@@ -237,13 +281,9 @@ size_t sim_restored(struct sim *S) {
   double *old = part_alloc("restore_check", 2 * nv * sizeof(double));
   memcpy(old, S->W.rho, nv * sizeof(double));
   memcpy(old + nv, S->W.p, nv * sizeof(double));
-  nbr_sort(&S->nb, P);
-  nbr_build(&S->nb, P, &S->M.k, S->ksum_new);
   /* dt = 0: pressure, sound speed, p/rho^2 and volume from the stored density; the kernel sum
      and gamma are set to the values they already hold */
-  sph_density(&S->M, P, P->ksum, 0.0);
-  sph_walls(&S->M, P, &S->nb, &S->W);
-  model_update(S);
+  update_state(S, P->ksum, 0.0);
   size_t differ = 0;
   for (size_t i = 0; i < nv; i++)
     differ += memcmp(&old[i], &S->W.rho[i], sizeof(double)) != 0 ||

@@ -6,6 +6,7 @@
 #ifndef CHANSPH_RUN_H
 #define CHANSPH_RUN_H
 
+#include "dd.h"
 #include "forcing.h"
 #include "nbr.h"
 #include "part.h"
@@ -20,6 +21,8 @@ struct sim {
   struct particles P;     /*!< particles */
   struct walls W;         /*!< wall values on the vertex lattice */
   struct nbr nb;          /*!< cells and neighbour list */
+  struct dd dd;           /*!< decomposition across MPI ranks and the ghosts */
+  size_t cap;             /*!< slots of the per-particle scratch arrays below */
   struct drive drive;     /*!< driving force state */
   long step;              /*!< steps taken */
   double t;               /*!< simulated time [s] */

@@ -304,6 +304,14 @@ static const struct key keys[] = {
      OFF(health_every)},
     {"run", "threads", T_INT, "0", 0, 4096, 0, NULL, "-",
      "OpenMP threads; 0 keeps OMP_NUM_THREADS (or all cores).", OFF(threads)},
+    {"run", "balance_every", T_INT, "100", 0, 1e9, 0, NULL, "steps",
+     "With several MPI ranks: steps between checks of the particles per rank (0 = never "
+     "re-partition). Results do not depend on the partition (docs/parallel.md).",
+     OFF(balance_every)},
+    {"run", "balance_threshold", T_DOUBLE, "0.1", 0, 100, 0, NULL, "-",
+     "Re-partition the cell columns along x when the most loaded rank holds more than (1 + "
+     "threshold) times the mean particle count.",
+     OFF(balance_threshold)},
     /* [checkpoint]: restart/ (docs/checkpoint-format.md, docs/batch-jobs.md) */
     {"checkpoint", "every_steps", T_LONG, "0", 0, 1e18, 0, NULL, "steps",
      "Steps between checkpoints in DIR/checkpoints (0 = not by steps). A run also checkpoints "

@@ -123,7 +123,9 @@ struct scene {
   /* [health] */
   int health_every; /*!< steps between full health checks */
   /* [run] */
-  int threads; /*!< OpenMP threads; 0 = OMP_NUM_THREADS / all */
+  int threads;              /*!< OpenMP threads; 0 = OMP_NUM_THREADS / all */
+  int balance_every;        /*!< steps between load-balance checks (MPI) */
+  double balance_threshold; /*!< re-partition above (1 + this) x mean particles per rank */
   /* [checkpoint] */
   long ckpt_every_steps;     /*!< steps between checkpoints; 0 = not by steps */
   double ckpt_every_minutes; /*!< wall-clock minutes between checkpoints; 0 = not by time */

@@ -82,7 +82,7 @@ static double vertex_sums(const struct model *M, const struct particles *P, cons
 }
 
 double turb_update(const struct model *M, struct particles *P, const struct nbr *nb,
-                   struct walls *W) {
+                   struct walls *W, struct dd *dd) {
   if (!M->wall_tau) return M->nu;
   timer_push("wall_law");
   const struct kernel *K = &M->k;
@@ -92,9 +92,11 @@ double turb_update(const struct model *M, struct particles *P, const struct nbr 
   const double *restrict vol = P->vol, *restrict rho = P->rho;
   const uint8_t *restrict kind = P->kind;
   double *restrict twx = P->twx, *restrict twz = P->twz;
-  /* 1. wall-law stress of the near-wall particles: rho u_tau^2 along their tangential velocity */
+  /* 1. wall-law stress of the near-wall particles: rho u_tau^2 along their tangential velocity
+        (from the particle's own values: the ghosts compute theirs too) */
+  const size_t n_all = P->n + P->n_ghost;
 #pragma omp parallel for schedule(static)
-  for (size_t a = 0; a < P->n; a++) {
+  for (size_t a = 0; a < n_all; a++) {
     twx[a] = twz[a] = 0.0;
     if (kind[a] != KIND_FLUID) continue;
     int wall;
@@ -119,6 +121,8 @@ double turb_update(const struct model *M, struct particles *P, const struct nbr 
     W->tz[slot] = alpha > 0.0 ? sum[1] / alpha : 0.0;
   }
   timer_pop();
+  double *const wt[2] = {W->tx, W->tz};
+  if (dd) dd_update_walls(dd, P, 2, wt);
   if (!M->les) return nu;
   timer_push("les");
   /* 3. rate of strain, damping, eddy viscosity and residual kinetic energy */
@@ -176,6 +180,8 @@ double turb_update(const struct model *M, struct particles *P, const struct nbr 
     if (M->cy > 0.0) kr[a] = 2.0 * M->cy * dg2 * damp * damp * S * S;
     if (nu + nur[a] > numax) numax = nu + nur[a];
   }
+  double *const nk[2] = {nur, kr};
+  if (dd) dd_update(dd, P, 2, nk); /* read at neighbours by the forces and by step 4 */
   /* 4. residual kinetic energy in the pressure: p + 2/3 rho k_r for fluid and vertices */
   if (M->cy > 0.0) {
 #pragma omp parallel for schedule(static)
@@ -193,5 +199,10 @@ double turb_update(const struct model *M, struct particles *P, const struct nbr 
     }
   }
   timer_pop();
+  if (dd && M->cy > 0.0) {
+    double *const pr[1] = {P->pr2}, *const wp[1] = {W->p};
+    dd_update(dd, P, 1, pr);
+    dd_update_walls(dd, P, 1, wp);
+  }
   return numax;
 }

@@ -20,6 +20,7 @@
 #ifndef CHANSPH_TURB_H
 #define CHANSPH_TURB_H
 
+#include "dd.h"
 #include "nbr.h"
 #include "part.h"
 #include "sph.h"
@@ -36,10 +37,13 @@ void turb_free(struct particles *P, struct walls *W);
  * @param[in,out] P particles (twx, twz, nur, kr, pr2)
  * @param[in] nb neighbour list of the current positions
  * @param[in,out] W wall lattice (tx, tz; p gains 2/3 rho k_r)
- * @return the largest nu + nu_r over the fluid particles [m^2/s], for the viscous time step
+ * @param[in,out] dd decomposition: the ghosts' copies of what the next pass reads are refreshed
+ *                   after each pass (NULL: one rank, no ghosts)
+ * @return the largest nu + nu_r over this rank's fluid particles [m^2/s], for the viscous
+ *         time step (the caller takes the maximum over the ranks)
  */
 double turb_update(const struct model *M, struct particles *P, const struct nbr *nb,
-                   struct walls *W);
+                   struct walls *W, struct dd *dd);
 
 /**
  * @brief Rate of strain from the first-order corrected velocity gradient of one particle

@@ -9,7 +9,7 @@ chansph=$1 scenes=$2 runs=$3
 work=$runs/quickstart_smoke
 rm -rf "$work" && mkdir -p "$work" && cd "$work"
 state=$(cd "$scenes/../states" && pwd)/les395_t6.nc
-"$chansph" run "$scenes/quickstart.ini" --out run --max-steps 40 --set output.stats_every=10 \
+"$chansph" run "$scenes/quickstart.ini" --out run --set time.t_end=0.013 --set output.stats_every=10 \
   > out.txt 2>&1 || { cat out.txt; echo "FAIL: quick-start scene did not run"; exit 1; }
 grep -q "of 38750 particles from $state" run/log.txt out.txt ||
   { cat out.txt; echo "FAIL: init.from did not resolve to $state"; exit 1; }
@@ -24,6 +24,6 @@ if "$chansph" run "$scenes/quickstart.ini" --out run2 --set init.from=no_such_st
   > err.txt 2>&1; then
   echo "FAIL: a missing init.from was accepted"; exit 1
 fi
-grep -q "^no_such_state.nc (init.from): cannot open" err.txt ||
+grep -q "error: no_such_state.nc (init.from): cannot open" err.txt ||
   { cat err.txt; echo "FAIL: message for a missing --set init.from"; exit 1; }
 echo "PASS: quick-start scene runs from $work, state $state"

@@ -87,7 +87,7 @@ static int run_case(const char *name, int n_set, char **set) {
     P.ddiff[a] = -2.0 * id - 0.25;
   }
   struct nbr nb;
-  nbr_init(&nb, &s, n);
+  nbr_init(&nb, &s, n, 0, nbr_columns(&s), 0);
   for (int round = 0; round < 2; round++) {
     fails += check_round(name, round, &s, &P, &nb);
     if (fails) break;

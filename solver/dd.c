@@ -1,0 +1,370 @@
+/** @file dd.c @brief Implementation of dd.h. */
+#include "dd.h"
+
+#include <math.h>
+#include <mpi.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "error.h"
+#include "reduce.h"
+#include "timers.h"
+
+/* A particle on the wire: the permuted arrays of part.h, id and kind. */
+enum { F_X, F_Y, F_Z, F_U, F_V, F_W, F_RHO, F_M, F_GAM, F_KSUM, F_DDIFF, F_ID, F_KIND, F_LEN };
+
+/* tags: a message going to the left neighbour, one going to the right */
+enum { TAG_LEFT = 11, TAG_RIGHT = 12 };
+
+static void *xrealloc(void *p, size_t bytes) {
+  void *q = realloc(p, bytes ? bytes : 1);
+  if (!q) die("out of memory in the domain decomposition (%zu bytes)", bytes);
+  return q;
+}
+
+static void reserve_buf(double **buf, size_t *cap, size_t n) {
+  if (n <= *cap) return;
+  *cap = n + n / 2;
+  *buf = xrealloc(*buf, *cap * sizeof(double));
+}
+
+static void pack(const struct particles *P, size_t a, double *r) {
+  r[F_X] = P->x[a], r[F_Y] = P->y[a], r[F_Z] = P->z[a];
+  r[F_U] = P->u[a], r[F_V] = P->v[a], r[F_W] = P->w[a];
+  r[F_RHO] = P->rho[a], r[F_M] = P->m[a], r[F_GAM] = P->gam[a];
+  r[F_KSUM] = P->ksum[a], r[F_DDIFF] = P->ddiff[a];
+  memcpy(&r[F_ID], &P->id[a], sizeof(double));
+  r[F_KIND] = P->kind[a];
+}
+
+static void unpack(struct particles *P, size_t a, const double *r) {
+  P->x[a] = r[F_X], P->y[a] = r[F_Y], P->z[a] = r[F_Z];
+  P->u[a] = r[F_U], P->v[a] = r[F_V], P->w[a] = r[F_W];
+  P->rho[a] = r[F_RHO], P->m[a] = r[F_M], P->gam[a] = r[F_GAM];
+  P->ksum[a] = r[F_KSUM], P->ddiff[a] = r[F_DDIFF];
+  memcpy(&P->id[a], &r[F_ID], sizeof(double));
+  P->kind[a] = (uint8_t)r[F_KIND];
+}
+
+static void copy_slot(struct particles *P, size_t to, size_t from) {
+  double r[F_LEN];
+  pack(P, from, r);
+  unpack(P, to, r);
+}
+
+static void partition_even(struct dd *d) {
+  for (int r = 0; r <= d->size; r++) d->first[r] = (int)((long)r * d->ncol / d->size);
+}
+
+int dd_init(struct dd *d, const struct scene *sc, dd_reserve_fn reserve, void *ctx) {
+  memset(d, 0, sizeof *d);
+  MPI_Comm_rank(MPI_COMM_WORLD, &d->rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &d->size);
+  d->ncol = nbr_columns(sc);
+  d->halo = d->size > 1 ? NBR_REACH : 0;
+  d->reserve = reserve, d->ctx = ctx;
+  d->left = (d->rank + d->size - 1) % d->size, d->right = (d->rank + 1) % d->size;
+  d->first = xrealloc(NULL, (size_t)(d->size + 1) * sizeof(int));
+  if (d->size > 1 && d->ncol < 2 * d->halo * d->size) {
+    error_input(
+        "%s: key 'domain.lx': lx = %g gives %d cell columns of size h along x; %d MPI "
+        "ranks need at least %d (each rank owns %d or more whole columns), so run on at "
+        "most %d ranks",
+        sc->path[0] ? sc->path : "(scene)", sc->lx, d->ncol, d->size, 2 * d->halo * d->size,
+        2 * d->halo, d->ncol / (2 * d->halo));
+    return CHANSPH_ERR;
+  }
+  partition_even(d);
+  return CHANSPH_OK;
+}
+
+void dd_free(struct dd *d) {
+  free(d->first), free(d->send[0]), free(d->send[1]), free(d->ghost);
+  free(d->sbuf), free(d->rbuf);
+  memset(d, 0, sizeof *d);
+}
+
+int dd_owner(const struct dd *d, int col) {
+  int lo = 0, hi = d->size - 1; /* the rank r with first[r] <= col < first[r+1] */
+  while (lo < hi) {
+    const int mid = (lo + hi + 1) / 2;
+    if (d->first[mid] <= col)
+      lo = mid;
+    else
+      hi = mid - 1;
+  }
+  return lo;
+}
+
+static int owned(const struct dd *d, int col) {
+  return col >= d->first[d->rank] && col < d->first[d->rank + 1];
+}
+
+void dd_keep_owned(struct dd *d, struct particles *P, const struct nbr *nb) {
+  size_t k = 0;
+  for (size_t a = 0; a < P->n; a++) {
+    nbr_wrap_position(nb, &P->x[a], &P->z[a]);
+    if (!owned(d, nbr_column(nb, P->x[a]))) continue;
+    if (k != a) copy_slot(P, k, a);
+    k++;
+  }
+  P->n = k, P->n_ghost = 0;
+}
+
+void dd_migrate(struct dd *d, struct particles *P, const struct nbr *nb) {
+  P->n_ghost = 0;
+  if (d->size == 1) return;
+  timer_push("halo");
+  const double t0 = MPI_Wtime();
+  const int np = d->size;
+  int *scount = calloc((size_t)np, sizeof(int)), *rcount = calloc((size_t)np, sizeof(int));
+  int *sdisp = calloc((size_t)np + 1, sizeof(int)), *rdisp = calloc((size_t)np + 1, sizeof(int));
+  int *dest = malloc((P->n ? P->n : 1) * sizeof(int));
+  if (!scount || !rcount || !sdisp || !rdisp || !dest) die("out of memory in dd_migrate");
+  size_t leaving = 0;
+  for (size_t a = 0; a < P->n; a++) {
+    nbr_wrap_position(nb, &P->x[a], &P->z[a]);
+    const int col = nbr_column(nb, P->x[a]);
+    dest[a] = owned(d, col) ? -1 : dd_owner(d, col);
+    if (dest[a] >= 0) scount[dest[a]] += F_LEN, leaving++;
+  }
+  for (int r = 0; r < np; r++) sdisp[r + 1] = sdisp[r] + scount[r];
+  reserve_buf(&d->sbuf, &d->cap_sbuf, (size_t)sdisp[np]);
+  /* pack the leaving particles by destination and compact the staying ones in order */
+  int *fill = calloc((size_t)np, sizeof(int));
+  if (!fill) die("out of memory in dd_migrate");
+  size_t k = 0;
+  for (size_t a = 0; a < P->n; a++) {
+    if (dest[a] < 0) {
+      if (k != a) copy_slot(P, k, a);
+      k++;
+      continue;
+    }
+    pack(P, a, d->sbuf + sdisp[dest[a]] + fill[dest[a]]);
+    fill[dest[a]] += F_LEN;
+  }
+  P->n = k;
+  MPI_Alltoall(scount, 1, MPI_INT, rcount, 1, MPI_INT, MPI_COMM_WORLD);
+  for (int r = 0; r < np; r++) rdisp[r + 1] = rdisp[r] + rcount[r];
+  reserve_buf(&d->rbuf, &d->cap_rbuf, (size_t)rdisp[np]);
+  MPI_Alltoallv(d->sbuf, scount, sdisp, MPI_DOUBLE, d->rbuf, rcount, rdisp, MPI_DOUBLE,
+                MPI_COMM_WORLD);
+  const size_t arriving = (size_t)rdisp[np] / F_LEN;
+  d->reserve(d->ctx, P->n + arriving);
+  for (size_t i = 0; i < arriving; i++) unpack(P, P->n + i, d->rbuf + i * F_LEN);
+  P->n += arriving;
+  for (int r = 0; r < np; r++)
+    if (scount[r]) d->messages++;
+  d->bytes += (double)sdisp[np] * sizeof(double);
+  d->migrated += (long)leaving;
+  free(scount), free(rcount), free(sdisp), free(rdisp), free(dest), free(fill);
+  d->seconds += MPI_Wtime() - t0;
+  timer_pop();
+}
+
+/* Owned slots of the local columns [c0, c1) in cell order. */
+static size_t edge_slots(const struct nbr *nb, int c0, int c1, size_t **out, size_t *cap) {
+  size_t n = 0;
+  for (int pass = 0; pass < 2; pass++) {
+    if (pass == 1) {
+      if (n > *cap) *cap = n + n / 2, *out = xrealloc(*out, *cap * sizeof(size_t));
+      n = 0;
+    }
+    for (int iz = 0; iz < nb->nz; iz++)
+      for (int iy = 0; iy < nb->ny; iy++)
+        for (int lc = c0; lc < c1; lc++) {
+          const size_t c = nbr_owned_cell(nb, lc, iy, iz);
+          for (size_t a = nb->start[c]; a < nb->start[c + 1]; a++, n++)
+            if (pass == 1) (*out)[n] = a;
+        }
+  }
+  return n;
+}
+
+/* Send nf values per entry of the send lists to both neighbours and receive theirs into
+   d->rbuf (left halo first). pack_fn fills a record for owned slot a. */
+static void exchange(struct dd *d, int nf, void (*pack_fn)(const void *, size_t, double *),
+                     const void *arg) {
+  const size_t ns = d->nsend[0] + d->nsend[1], nr = d->nrecv[0] + d->nrecv[1];
+  reserve_buf(&d->sbuf, &d->cap_sbuf, ns * (size_t)nf);
+  reserve_buf(&d->rbuf, &d->cap_rbuf, nr * (size_t)nf);
+  for (int s = 0, off = 0; s < 2; off += (int)d->nsend[s], s++)
+    for (size_t i = 0; i < d->nsend[s]; i++)
+      pack_fn(arg, d->send[s][i], d->sbuf + ((size_t)off + i) * nf);
+  MPI_Request req[4];
+  /* my left halo comes from the left neighbour's message to the right, and vice versa */
+  MPI_Irecv(d->rbuf, (int)(d->nrecv[0] * nf), MPI_DOUBLE, d->left, TAG_RIGHT, MPI_COMM_WORLD,
+            &req[0]);
+  MPI_Irecv(d->rbuf + d->nrecv[0] * nf, (int)(d->nrecv[1] * nf), MPI_DOUBLE, d->right, TAG_LEFT,
+            MPI_COMM_WORLD, &req[1]);
+  MPI_Isend(d->sbuf, (int)(d->nsend[0] * nf), MPI_DOUBLE, d->left, TAG_LEFT, MPI_COMM_WORLD,
+            &req[2]);
+  MPI_Isend(d->sbuf + d->nsend[0] * nf, (int)(d->nsend[1] * nf), MPI_DOUBLE, d->right, TAG_RIGHT,
+            MPI_COMM_WORLD, &req[3]);
+  MPI_Waitall(4, req, MPI_STATUSES_IGNORE);
+  d->messages += 2;
+  d->bytes += (double)ns * nf * sizeof(double);
+}
+
+static void pack_particle(const void *arg, size_t a, double *r) {
+  pack(arg, a, r);
+}
+
+void dd_halo(struct dd *d, struct particles *P, struct nbr *nb) {
+  P->n_ghost = 0;
+  if (d->size == 1) return;
+  timer_push("halo");
+  const double t0 = MPI_Wtime();
+  const int R = d->halo;
+  d->nsend[0] = edge_slots(nb, 0, R, &d->send[0], &d->cap_send[0]);
+  d->nsend[1] = edge_slots(nb, nb->nxo - R, nb->nxo, &d->send[1], &d->cap_send[1]);
+  /* counts: what my left neighbour sends right is my left halo */
+  unsigned long sc[2] = {d->nsend[0], d->nsend[1]}, rc[2];
+  MPI_Request req[4];
+  MPI_Irecv(&rc[0], 1, MPI_UNSIGNED_LONG, d->left, TAG_RIGHT, MPI_COMM_WORLD, &req[0]);
+  MPI_Irecv(&rc[1], 1, MPI_UNSIGNED_LONG, d->right, TAG_LEFT, MPI_COMM_WORLD, &req[1]);
+  MPI_Isend(&sc[0], 1, MPI_UNSIGNED_LONG, d->left, TAG_LEFT, MPI_COMM_WORLD, &req[2]);
+  MPI_Isend(&sc[1], 1, MPI_UNSIGNED_LONG, d->right, TAG_RIGHT, MPI_COMM_WORLD, &req[3]);
+  MPI_Waitall(4, req, MPI_STATUSES_IGNORE);
+  d->nrecv[0] = rc[0], d->nrecv[1] = rc[1];
+  exchange(d, F_LEN, pack_particle, P);
+  const size_t ng = d->nrecv[0] + d->nrecv[1];
+  d->reserve(d->ctx, P->n + ng);
+  for (size_t g = 0; g < ng; g++) unpack(P, P->n + g, d->rbuf + g * F_LEN);
+  P->n_ghost = ng;
+  nbr_sort_ghosts(nb, P, d->nrecv[0]);
+  if (ng > d->cap_ghost) d->cap_ghost = ng + ng / 2;
+  d->ghost = xrealloc(d->ghost, (d->cap_ghost ? d->cap_ghost : 1) * sizeof(size_t));
+  for (size_t i = 0; i < ng; i++) d->ghost[nb->perm[i]] = P->n + i;
+  d->seconds += MPI_Wtime() - t0;
+  timer_pop();
+}
+
+struct fields {
+  const struct particles *P;
+  int nf;
+  double *const *f;
+};
+
+static void pack_fields(const void *arg, size_t a, double *r) {
+  const struct fields *F = arg;
+  for (int k = 0; k < F->nf; k++) r[k] = F->f[k][a];
+}
+
+static void pack_walls(const void *arg, size_t a, double *r) {
+  const struct fields *F = arg;
+  const int vertex = F->P->kind[a] == KIND_VERTEX;
+  const size_t slot = vertex ? part_vertex_slot(F->P, F->P->id[a]) : 0;
+  for (int k = 0; k < F->nf; k++) r[k] = vertex ? F->f[k][slot] : 0.0;
+}
+
+void dd_update(struct dd *d, const struct particles *P, int nf, double *const *f) {
+  if (d->size == 1) return;
+  timer_push("halo");
+  const double t0 = MPI_Wtime();
+  const struct fields F = {P, nf, f};
+  exchange(d, nf, pack_fields, &F);
+  const size_t ng = d->nrecv[0] + d->nrecv[1];
+  for (size_t g = 0; g < ng; g++)
+    for (int k = 0; k < nf; k++) f[k][d->ghost[g]] = d->rbuf[g * (size_t)nf + k];
+  d->seconds += MPI_Wtime() - t0;
+  timer_pop();
+}
+
+void dd_update_walls(struct dd *d, const struct particles *P, int nf, double *const *w) {
+  if (d->size == 1) return;
+  timer_push("halo");
+  const double t0 = MPI_Wtime();
+  const struct fields F = {P, nf, w};
+  exchange(d, nf, pack_walls, &F);
+  const size_t ng = d->nrecv[0] + d->nrecv[1];
+  for (size_t g = 0; g < ng; g++) {
+    const size_t a = d->ghost[g];
+    if (P->kind[a] != KIND_VERTEX) continue;
+    const size_t slot = part_vertex_slot(P, P->id[a]);
+    for (int k = 0; k < nf; k++) w[k][slot] = d->rbuf[g * (size_t)nf + k];
+  }
+  d->seconds += MPI_Wtime() - t0;
+  timer_pop();
+}
+
+void dd_sum(const struct dd *d, const struct nbr *nb, int nv, const double *const *x, double *out) {
+  if (nv > 8) die("dd_sum: at most 8 arrays (got %d)", nv);
+  const int nxo = nb->nxo, ncol = d->ncol;
+  double *all = xrealloc(NULL, (size_t)ncol * nv * sizeof(double));
+  double *mine = all + (size_t)nb->ix0 * nv; /* this rank's columns, [column][v] */
+#pragma omp parallel for schedule(static)
+  for (int lc = 0; lc < nxo; lc++) {
+    double s[8] = {0};
+    for (int iz = 0; iz < nb->nz; iz++)
+      for (int iy = 0; iy < nb->ny; iy++) {
+        const size_t c = nbr_owned_cell(nb, lc, iy, iz);
+        for (size_t a = nb->start[c]; a < nb->start[c + 1]; a++)
+          for (int v = 0; v < nv; v++) s[v] += x[v][a];
+      }
+    for (int v = 0; v < nv; v++) mine[(size_t)lc * nv + v] = s[v];
+  }
+  if (d->size > 1) {
+    int *cnt = xrealloc(NULL, (size_t)d->size * sizeof(int));
+    int *dsp = xrealloc(NULL, (size_t)d->size * sizeof(int));
+    for (int r = 0; r < d->size; r++)
+      cnt[r] = (d->first[r + 1] - d->first[r]) * nv, dsp[r] = d->first[r] * nv;
+    MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_DATATYPE_NULL, all, cnt, dsp, MPI_DOUBLE, MPI_COMM_WORLD);
+    free(cnt), free(dsp);
+  }
+  double *col = xrealloc(NULL, (size_t)ncol * sizeof(double));
+  for (int v = 0; v < nv; v++) {
+    for (int c = 0; c < ncol; c++) col[c] = all[(size_t)c * nv + v];
+    out[v] = reduce_pairwise(col, (size_t)ncol);
+  }
+  free(col), free(all);
+}
+
+int dd_balance(struct dd *d, struct nbr *nb, double threshold) {
+  if (d->size == 1) return 0;
+  /* particles per column, gathered in column order */
+  const int ncol = d->ncol;
+  double *cnt = xrealloc(NULL, (size_t)ncol * sizeof(double));
+  memset(cnt, 0, (size_t)ncol * sizeof(double));
+  for (int lc = 0; lc < nb->nxo; lc++)
+    for (int iz = 0; iz < nb->nz; iz++)
+      for (int iy = 0; iy < nb->ny; iy++) {
+        const size_t c = nbr_owned_cell(nb, lc, iy, iz);
+        cnt[nb->ix0 + lc] += (double)(nb->start[c + 1] - nb->start[c]);
+      }
+  MPI_Allreduce(MPI_IN_PLACE, cnt, ncol, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD); /* integers */
+  double total = 0.0, most = 0.0;
+  for (int c = 0; c < ncol; c++) total += cnt[c];
+  for (int r = 0; r < d->size; r++) {
+    double n = 0.0;
+    for (int c = d->first[r]; c < d->first[r + 1]; c++) n += cnt[c];
+    most = fmax(most, n);
+  }
+  const double mean = total / d->size;
+  d->imbalance = mean > 0.0 ? most / mean : 1.0;
+  if (d->imbalance <= 1.0 + threshold) {
+    free(cnt);
+    return 0;
+  }
+  /* cut where the running count passes r * mean, keeping 2 halo columns per rank */
+  const int minw = 2 * d->halo;
+  int *nf = xrealloc(NULL, (size_t)(d->size + 1) * sizeof(int));
+  nf[0] = 0, nf[d->size] = ncol;
+  double run = 0.0;
+  int c = 0;
+  for (int r = 1; r < d->size; r++) {
+    const double target = r * mean;
+    int cut = nf[r - 1] + minw;
+    while (c < cut) run += cnt[c++];
+    while (c < ncol - (d->size - r) * minw && run + 0.5 * cnt[c] < target) run += cnt[c++];
+    nf[r] = c;
+  }
+  const int changed = memcmp(nf, d->first, (size_t)(d->size + 1) * sizeof(int)) != 0;
+  memcpy(d->first, nf, (size_t)(d->size + 1) * sizeof(int));
+  free(nf), free(cnt);
+  if (!changed) return 0;
+  nbr_set_range(nb, d->first[d->rank], d->first[d->rank + 1] - d->first[d->rank], d->halo);
+  d->rebalances++;
+  return 1;
+}

@@ -1,0 +1,111 @@
+/**
+ * @file dd.h
+ * @brief Domain decomposition across MPI ranks: slabs of whole cell columns along x.
+ *
+ * Rank r owns the cell columns first[r] .. first[r+1]-1 of the global grid (nbr.h) and the
+ * particles in them. Each step:
+ *  1. dd_migrate() sends the particles that left a rank's columns to their new owner;
+ *  2. nbr_sort() orders the owned particles by cell and id;
+ *  3. dd_halo() copies the particles of the NBR_REACH columns at each edge of every slab to the
+ *     neighbouring rank (ghosts, with their unshifted coordinates: the periodic shift is applied
+ *     by the stencil, as on one rank), and nbr_sort_ghosts() orders them;
+ *  4. after each pass that computes a per-particle value the next pass reads at neighbours,
+ *     dd_update() / dd_update_walls() refresh the ghosts' copies.
+ * Sums over all particles (dd_sum) are formed per global column in the cell order, then
+ * added over the columns in a fixed order, so every result is bitwise the same on any number
+ * of ranks and threads (docs/parallel.md).
+ */
+#ifndef CHANSPH_DD_H
+#define CHANSPH_DD_H
+
+#include <stddef.h>
+
+#include "nbr.h"
+#include "part.h"
+#include "scene.h"
+
+/** Grows every per-particle array of the simulation to hold n slots. */
+typedef void (*dd_reserve_fn)(void *ctx, size_t n);
+
+/** The decomposition and the halo bookkeeping of the current step. */
+struct dd {
+  int rank, size;        /*!< this rank, ranks */
+  int ncol;              /*!< global cell columns along x */
+  int halo;              /*!< halo columns per side (0 on one rank) */
+  int *first;            /*!< first column of each rank; first[size] = ncol */
+  int left, right;       /*!< neighbouring ranks (periodic) */
+  dd_reserve_fn reserve; /*!< grows the simulation's per-particle arrays */
+  void *ctx;             /*!< its argument */
+  /* halo of the current step: owned slots sent to the left (0) and right (1) neighbour, and
+     the ghost slot of each received particle (left halo first) */
+  size_t nsend[2], cap_send[2], *send[2];
+  size_t nrecv[2], cap_ghost, *ghost;
+  double *sbuf, *rbuf;
+  size_t cap_sbuf, cap_rbuf;
+  /* cost of the exchanges, for the log */
+  double seconds;   /*!< wall time in migration and halo exchanges [s] */
+  double bytes;     /*!< bytes sent by this rank */
+  long messages;    /*!< messages sent by this rank */
+  long migrated;    /*!< particles this rank sent to another owner */
+  long rebalances;  /*!< re-partitions done */
+  double imbalance; /*!< last max / mean particles per rank */
+};
+
+/**
+ * @brief Partition the columns of the scene's grid evenly over the ranks of MPI_COMM_WORLD.
+ * @return CHANSPH_OK, or CHANSPH_ERR after a message when the slabs would be too thin (every
+ *         rank needs 2 NBR_REACH columns: the halo must come from the neighbouring rank only)
+ */
+int dd_init(struct dd *d, const struct scene *sc, dd_reserve_fn reserve, void *ctx);
+
+/** @brief Free the bookkeeping. */
+void dd_free(struct dd *d);
+
+/** @brief Owner rank of a global column. */
+int dd_owner(const struct dd *d, int col);
+
+/**
+ * @brief Keep only the particles of this rank's columns (after every rank built the same full
+ *        initial state); their order is kept.
+ */
+void dd_keep_owned(struct dd *d, struct particles *P, const struct nbr *nb);
+
+/**
+ * @brief Drop the ghosts and send every owned particle that is not in this rank's columns to
+ *        its owner (positions are wrapped first). Collective.
+ */
+void dd_migrate(struct dd *d, struct particles *P, const struct nbr *nb);
+
+/**
+ * @brief Build the ghosts: after nbr_sort(), send the particles of the edge columns to the
+ *        neighbours, append what arrives and order it with nbr_sort_ghosts(). Collective.
+ */
+void dd_halo(struct dd *d, struct particles *P, struct nbr *nb);
+
+/**
+ * @brief Refresh the ghosts' copies of nf per-particle arrays from their owners. Collective.
+ */
+void dd_update(struct dd *d, const struct particles *P, int nf, double *const *f);
+
+/**
+ * @brief Refresh nf wall arrays (indexed by vertex slot, part_vertex_slot) at the ghost vertex
+ *        particles from their owners. Collective.
+ */
+void dd_update_walls(struct dd *d, const struct particles *P, int nf, double *const *w);
+
+/**
+ * @brief Deterministic global sums of nv per-particle arrays over the owned particles: per
+ *        global column in the cell order, then added pairwise over the columns; bitwise the
+ *        same on any number of ranks and threads. Collective.
+ * @param[in] nv arrays (at most 8)
+ */
+void dd_sum(const struct dd *d, const struct nbr *nb, int nv, const double *const *x, double *out);
+
+/**
+ * @brief Re-partition the columns by particle count when the largest rank holds more than
+ *        (1 + threshold) times the mean, then migrate. Collective.
+ * @return 1 if the partition changed
+ */
+int dd_balance(struct dd *d, struct nbr *nb, double threshold);
+
+#endif
