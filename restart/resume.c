@@ -113,7 +113,7 @@ static int try_one(const char *dir, const char *path, int n_set, char *const *se
   /* the initial condition is replaced by the checkpoint: do not read init.from again */
   struct scene bare = *sc;
   bare.init_from[0] = '\0';
-  if (sim_init(S, &bare)) {
+  if (sim_create(S, &bare)) {
     *fatal = 1;
     return CHANSPH_ERR;
   }

@@ -6,6 +6,7 @@
 #include <ctype.h>
 #include <dirent.h>
 #include <errno.h>
+#include <mpi.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -106,20 +107,29 @@ int restart_save(struct output *o, struct sim *S, double *seconds) {
   const double t0 = timer_now();
   timer_push("checkpoint");
   char path[4096], err[2048];
+  int rank = 0, rc = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   snprintf(path, sizeof path, "%s/checkpoints", o->dir);
-  if (mkdir(path, 0777) && errno != EEXIST) {
+  if (rank == 0 && mkdir(path, 0777) && errno != EEXIST) {
     error_input("%s: cannot create the checkpoint directory (%s)", path, strerror(errno));
+    rc = 1;
+  }
+  MPI_Bcast(&rc, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  if (rc) {
     timer_pop();
     return CHANSPH_ERR;
   }
+  /* on several ranks sim_state gathers the particles on rank 0, which writes the file */
   struct state_list L = {0};
   sim_state(S, &L);
   output_state(o, &L);
   rotate_path(path, sizeof path, o->dir, S->step);
-  const int rc = ckpt_write(path, &L, o->scene_text, S->step, S->t, err, sizeof err);
+  if (rank == 0) rc = ckpt_write(path, &L, o->scene_text, S->step, S->t, err, sizeof err);
+  MPI_Bcast(&rc, 1, MPI_INT, 0, MPI_COMM_WORLD);
   state_free(&L);
   timer_pop();
   *seconds = timer_now() - t0;
+  MPI_Bcast(seconds, 1, MPI_DOUBLE, 0, MPI_COMM_WORLD);
   if (rc) {
     error_input("%s", err);
     if (o->log) fprintf(o->log, "error: %s\n", err), fflush(o->log);
@@ -128,7 +138,7 @@ int restart_save(struct output *o, struct sim *S, double *seconds) {
   struct stat st;
   const double mb = stat(path, &st) ? 0.0 : (double)st.st_size / 1048576.0;
   output_log(o, "checkpoint %s (step %ld, %.2f MB, %.3f s)\n", path, S->step, mb, *seconds);
-  rotate_keep(o->dir, S->step, S->sc->ckpt_keep);
+  if (rank == 0) rotate_keep(o->dir, S->step, S->sc->ckpt_keep);
   return CHANSPH_OK;
 }
 
@@ -158,7 +168,7 @@ static int remove_snapshots(const char *dir, int overwrite) {
   return rc;
 }
 
-int restart_prepare_new(const char *dir, int overwrite) {
+static int prepare_new(const char *dir, int overwrite) {
   long *steps;
   const int n = rotate_list(dir, &steps);
   int rc = CHANSPH_OK;
@@ -180,4 +190,12 @@ int restart_prepare_new(const char *dir, int overwrite) {
   free(steps);
   if (rc == CHANSPH_OK) rotate_remove_tmp(dir);
   return rc == CHANSPH_OK ? remove_snapshots(dir, overwrite) : rc;
+}
+
+int restart_prepare_new(const char *dir, int overwrite) {
+  int rank = 0, rc = CHANSPH_OK;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  if (rank == 0) rc = prepare_new(dir, overwrite); /* the files are rank 0's to touch */
+  MPI_Bcast(&rc, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  return rc;
 }

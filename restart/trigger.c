@@ -6,6 +6,7 @@
  */
 #include <errno.h>
 #include <math.h>
+#include <mpi.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -68,13 +69,17 @@ void trigger_init(struct trigger *T, const char *dir, const struct scene *sc, do
 static int stop_file(struct trigger *T) {
   char path[4096];
   struct stat st;
+  int rank = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  if (rank != 0) return 0; /* rank 0 looks and removes it; trigger_check shares the result */
   snprintf(path, sizeof path, "%s/STOP", T->dir);
   if (stat(path, &st)) return 0;
   if (remove(path)) warn("%s: cannot remove the STOP file (%s)", path, strerror(errno));
   return 1;
 }
 
-int trigger_check(struct trigger *T, long step) {
+/* The reason on this rank alone; trigger_check() makes every rank agree. */
+static int local_check(struct trigger *T, long step) {
   const double now = timer_now();
   const double last = now - T->step_wall;
   T->step_wall = now;
@@ -94,6 +99,13 @@ int trigger_check(struct trigger *T, long step) {
   if (T->every_steps > 0 && step % T->every_steps == 0) return TRIG_PERIODIC;
   if (T->every_seconds > 0.0 && now - T->last_wall >= T->every_seconds) return TRIG_PERIODIC;
   return TRIG_NONE;
+}
+
+int trigger_check(struct trigger *T, long step) {
+  int why = local_check(T, step);
+  /* the strongest reason of any rank (signals, the STOP file and the clocks differ) */
+  MPI_Allreduce(MPI_IN_PLACE, &why, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  return why;
 }
 
 const char *trigger_text(const struct trigger *T, int why) {

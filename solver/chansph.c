@@ -125,12 +125,6 @@ int main(int argc, char **argv) {
     printf("chansph %s\n", CHANSPH_VERSION);
   } else if (c.cmd == CMD_SCENE_DOC) {
     scene_write_doc(stdout);
-  } else if (size > 1) {
-    error_input(
-        "this version runs on one MPI rank (got %d); domain decomposition is not "
-        "implemented yet",
-        size);
-    rc = 1;
   } else if (c.cmd == CMD_RESUME) {
     if (c.fpe) feenableexcept(FE_DIVBYZERO | FE_INVALID | FE_OVERFLOW);
     rc = run(&sc, &c);

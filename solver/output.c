@@ -3,6 +3,7 @@
 
 #include <errno.h>
 #include <math.h>
+#include <mpi.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
@@ -18,6 +19,18 @@ static const char *const series_names[] = {"time",    "u_bulk",    "body_force",
 static const char *const series_units[] = {"s", "m/s",   "m/s^2",  "J",      "kg", "m/s",
                                            "1", "m^dim", "kg/m^3", "kg/m^3", "s"};
 enum { N_SERIES = sizeof series_names / sizeof series_names[0] };
+
+static int rank0(void) {
+  int rank = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  return rank == 0;
+}
+
+/* Every rank takes rank 0's result of a file operation only rank 0 did. */
+static int agree(int rc) {
+  MPI_Bcast(&rc, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  return rc;
+}
 
 static int mkdir_p(const char *path) {
   char buf[2048];
@@ -41,8 +54,8 @@ static int exists(const char *dir, const char *name) {
 
 /* Shared by output_open and output_reopen: log.txt (mode "w" or "a"), scene.used.ini,
    empty accumulators. */
-static int open_common(struct output *o, const char *dir, const struct scene *sc,
-                       const char *log_mode) {
+static int open_files(struct output *o, const char *dir, const struct scene *sc,
+                      const char *log_mode) {
   char path[4096];
   snprintf(path, sizeof path, "%s/log.txt", dir);
   o->log = fopen(path, log_mode);
@@ -59,6 +72,14 @@ static int open_common(struct output *o, const char *dir, const struct scene *sc
     error_input("%s: cannot write (%s)", path, strerror(errno));
     return CHANSPH_ERR;
   }
+  return CHANSPH_OK;
+}
+
+/* Shared by output_open and output_reopen: the files (rank 0), the engines (every rank). */
+static int open_common(struct output *o, const char *dir, const struct scene *sc,
+                       const char *log_mode) {
+  if (agree(rank0() ? open_files(o, dir, sc, log_mode) : CHANSPH_OK)) return CHANSPH_ERR;
+  if (!o->scene_text) o->scene_text = scene_text(sc);
   struct stats_config cfg;
   output_stats_config(sc, &cfg);
   stats_init(&o->st, &cfg);
@@ -112,9 +133,8 @@ void output_stats_config(const struct scene *sc, struct stats_config *cfg) {
   }
 }
 
-int output_open(struct output *o, const char *dir, const struct scene *sc, int overwrite) {
-  memset(o, 0, sizeof *o);
-  snprintf(o->dir, sizeof o->dir, "%s", dir);
+/* The checks and the directory of output_open (rank 0). */
+static int make_dir(const char *dir, int overwrite) {
   static const char *const results[] = {"stats.nc", "log.txt", "particles.nc"};
   for (size_t i = 0; i < sizeof results / sizeof results[0] && !overwrite; i++)
     if (exists(dir, results[i])) {
@@ -128,6 +148,13 @@ int output_open(struct output *o, const char *dir, const struct scene *sc, int o
     error_input("%s: cannot create the output directory (%s)", dir, strerror(errno));
     return CHANSPH_ERR;
   }
+  return CHANSPH_OK;
+}
+
+int output_open(struct output *o, const char *dir, const struct scene *sc, int overwrite) {
+  memset(o, 0, sizeof *o);
+  snprintf(o->dir, sizeof o->dir, "%s", dir);
+  if (agree(rank0() ? make_dir(dir, overwrite) : CHANSPH_OK)) return CHANSPH_ERR;
   return open_common(o, dir, sc, "w");
 }
 
@@ -164,6 +191,7 @@ void output_log(struct output *o, const char *fmt, ...) {
   va_start(ap, fmt);
   vsnprintf(buf, sizeof buf, fmt, ap);
   va_end(ap);
+  if (!rank0()) return;
   fputs(buf, stdout);
   fflush(stdout);
   if (o->log) fputs(buf, o->log), fflush(o->log);
@@ -224,11 +252,13 @@ static int write_stats(struct output *o, const struct sim *S) {
       {"code_version", CHANSPH_VERSION, 0},
       {"scene", o->scene_text, 0},
   };
-  if (ncout_stats(path, &o->st, &o->ts, attrs, sizeof attrs / sizeof attrs[0], err, sizeof err)) {
+  int rc = CHANSPH_OK;
+  if (rank0() &&
+      ncout_stats(path, &o->st, &o->ts, attrs, sizeof attrs / sizeof attrs[0], err, sizeof err)) {
     error_input("%s", err);
-    return CHANSPH_ERR;
+    rc = CHANSPH_ERR;
   }
-  return CHANSPH_OK;
+  return agree(rc);
 }
 
 void output_begin(struct output *o, struct sim *S) {
@@ -306,31 +336,60 @@ int output_step(struct output *o, struct sim *S) {
 static int write_particles(struct output *o, const struct sim *S) {
   const struct particles *P = &S->P;
   const size_t n = P->n_fluid;
-  enum { NC = 10 };
-  double *buf = malloc(n * NC * sizeof *buf);
-  long long *ids = malloc(n * sizeof *ids);
-  if (!buf || !ids) die("out of memory writing particles.nc");
+  enum { NC = 10, REC = NC + 1 };
+  /* this rank's fluid particles as records (id, values), gathered on rank 0 */
+  size_t mine = 0;
+  for (size_t a = 0; a < P->n; a++) mine += P->kind[a] == KIND_FLUID;
+  double *rec = malloc((mine ? mine : 1) * REC * sizeof *rec);
+  if (!rec) die("out of memory writing particles.nc");
   const double *src[NC] = {P->x, P->y, P->z, P->u, P->v, P->w, P->rho, P->p, P->gam, P->m};
-  for (size_t a = 0; a < P->n; a++) {
+  for (size_t a = 0, k = 0; a < P->n; a++) {
     if (P->kind[a] != KIND_FLUID) continue;
-    const size_t r = (size_t)P->id[a]; /* fluid ids are 0 .. n_fluid-1 */
-    ids[r] = P->id[a];
-    for (int c = 0; c < NC; c++) buf[(size_t)c * n + r] = src[c][a];
+    rec[k * REC] = (double)P->id[a]; /* ids below 2^53 are exact */
+    for (int c = 0; c < NC; c++) rec[k * REC + 1 + c] = src[c][a];
+    k++;
   }
-  static const char *const names[NC] = {"x", "y", "z", "u", "v", "w", "rho", "p", "gamma", "mass"};
-  static const char *const units[NC] = {"m",   "m",      "m",  "m/s", "m/s",
-                                        "m/s", "kg/m^3", "Pa", "1",   "kg"};
-  const double *cols[NC];
-  for (int c = 0; c < NC; c++) cols[c] = buf + (size_t)c * n;
-  const struct nc_attr attrs[] = {
-      {"time", NULL, S->t}, {"step", NULL, (double)S->step}, {"scene", o->scene_text, 0}};
-  char path[4096], err[4096];
-  snprintf(path, sizeof path, "%s/particles.nc", o->dir);
-  const int rc =
-      ncout_columns(path, "particle", n, NC, names, units, cols, ids, attrs, 3, err, sizeof err);
-  free(buf), free(ids);
-  if (rc) error_input("%s", err);
-  return rc ? CHANSPH_ERR : CHANSPH_OK;
+  const int root = rank0();
+  int size = 1;
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  int cnt = (int)(mine * REC), *cnts = NULL, *disp = NULL;
+  double *all = NULL;
+  if (root) {
+    cnts = malloc((size_t)size * sizeof *cnts), disp = malloc((size_t)size * sizeof *disp);
+    all = malloc(n * REC * sizeof *all);
+    if (!cnts || !disp || !all) die("out of memory writing particles.nc");
+  }
+  MPI_Gather(&cnt, 1, MPI_INT, cnts, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  if (root)
+    for (int r = 0, off = 0; r < size; off += cnts[r], r++) disp[r] = off;
+  MPI_Gatherv(rec, cnt, MPI_DOUBLE, all, cnts, disp, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  free(rec), free(cnts), free(disp);
+  int rc = CHANSPH_OK;
+  if (root) {
+    double *buf = malloc(n * NC * sizeof *buf);
+    long long *ids = malloc(n * sizeof *ids);
+    if (!buf || !ids) die("out of memory writing particles.nc");
+    for (size_t k = 0; k < n; k++) {
+      const size_t r = (size_t)all[k * REC]; /* fluid ids are 0 .. n_fluid-1: by id */
+      ids[r] = (long long)r;
+      for (int c = 0; c < NC; c++) buf[(size_t)c * n + r] = all[k * REC + 1 + c];
+    }
+    static const char *const names[NC] = {"x", "y",   "z", "u",     "v",
+                                          "w", "rho", "p", "gamma", "mass"};
+    static const char *const units[NC] = {"m",   "m",      "m",  "m/s", "m/s",
+                                          "m/s", "kg/m^3", "Pa", "1",   "kg"};
+    const double *cols[NC];
+    for (int c = 0; c < NC; c++) cols[c] = buf + (size_t)c * n;
+    const struct nc_attr attrs[] = {
+        {"time", NULL, S->t}, {"step", NULL, (double)S->step}, {"scene", o->scene_text, 0}};
+    char path[4096], err[4096];
+    snprintf(path, sizeof path, "%s/particles.nc", o->dir);
+    rc = ncout_columns(path, "particle", n, NC, names, units, cols, ids, attrs, 3, err, sizeof err);
+    free(buf), free(ids);
+    if (rc) error_input("%s", err);
+  }
+  free(all);
+  return agree(rc ? CHANSPH_ERR : CHANSPH_OK);
 }
 
 int output_finish(struct output *o, struct sim *S) {
@@ -350,7 +409,7 @@ int output_finish(struct output *o, struct sim *S) {
   if (S->sc->particles) TRY(write_particles(o, S));
   output_log(o, "finished: %ld steps, t = %.6g s in %.2f s wall (%.3e particle-steps/s)\n", S->step,
              S->t, wall, wall > 0 ? (double)S->P.n_fluid * (S->step - o->step0) / wall : 0.0);
-  timer_report(stdout, wall);
+  if (rank0()) timer_report(stdout, wall);
   if (o->log) timer_report(o->log, wall);
   output_log(o, "results: %s/stats.nc%s\n", o->dir, S->sc->particles ? ", particles.nc" : "");
   return CHANSPH_OK;
@@ -361,7 +420,7 @@ int output_stop(struct output *o, struct sim *S, const char *why) {
   TRY(write_stats(o, S));
   output_log(o, "stopped at step %ld, t = %.9g s (%s) after %.2f s wall\n", S->step, S->t, why,
              wall);
-  timer_report(stdout, wall);
+  if (rank0()) timer_report(stdout, wall);
   if (o->log) timer_report(o->log, wall);
   return CHANSPH_OK;
 }

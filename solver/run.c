@@ -3,6 +3,7 @@
 
 #include <math.h>
 #include <mpi.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "error.h"
@@ -57,34 +58,50 @@ static void update_state(struct sim *S, const double *ksum_old_or_null, double d
   model_update(S);
 }
 
-int sim_init(struct sim *S, const struct scene *sc) {
+int sim_create(struct sim *S, const struct scene *sc) {
   memset(S, 0, sizeof *S);
   S->sc = sc;
   sph_model_init(&S->M, sc);
-  /* every rank builds the same full initial state, then keeps its own columns */
+  /* every rank builds the same full initial state; sim_distribute keeps its own columns */
   part_create(&S->P, &S->W, sc);
   turb_init(&S->M, &S->P, &S->W);
-  if (init_fields(sc, &S->P) || dd_init(&S->dd, sc, sim_reserve, S)) {
+  if (init_fields(sc, &S->P)) {
     turb_free(&S->P, &S->W);
     part_destroy(&S->P, &S->W);
     return CHANSPH_ERR;
   }
-  const int ix0 = S->dd.first[S->dd.rank], nxo = S->dd.first[S->dd.rank + 1] - ix0;
-  nbr_init(&S->nb, sc, S->P.n, ix0, nxo, S->dd.halo);
-  dd_keep_owned(&S->dd, &S->P, &S->nb);
   if (sc->stats_eulerian) S->wall_ax = part_alloc("wall_ax", sizeof(double));
-  sim_reserve(S, S->P.n);
   S->wall_fx[0] = S->wall_fx[1] = NAN;
   drive_init(&S->drive, sc);
   S->fx = S->drive.force;
+  return CHANSPH_OK;
+}
+
+/* Partition the columns over the ranks, keep this rank's particles, set up the grid. */
+static int sim_distribute(struct sim *S) {
+  if (dd_init(&S->dd, S->sc, sim_reserve, S)) return CHANSPH_ERR;
+  const int ix0 = S->dd.first[S->dd.rank], nxo = S->dd.first[S->dd.rank + 1] - ix0;
+  nbr_init(&S->nb, S->sc, S->P.n, ix0, nxo, S->dd.halo);
+  dd_keep_owned(&S->dd, &S->P, &S->nb);
+  sim_reserve(S, S->P.n);
+  S->distributed = 1;
+  return CHANSPH_OK;
+}
+
+int sim_init(struct sim *S, const struct scene *sc) {
+  TRY(sim_create(S, sc));
+  if (sim_distribute(S)) {
+    sim_free(S);
+    return CHANSPH_ERR;
+  }
   update_state(S, NULL, 0.0);
   return CHANSPH_OK;
 }
 
 void sim_free(struct sim *S) {
   turb_free(&S->P, &S->W);
-  nbr_free(&S->nb);
-  dd_free(&S->dd);
+  if (S->distributed) nbr_free(&S->nb), dd_free(&S->dd);
+  for (int k = 0; k < SIM_GATHER; k++) free(S->gather[k]);
   for (int k = 0; k < 4; k++) part_free(S->scratch[k]);
   part_free(S->ksum_new);
   if (S->wall_ax) part_free(S->wall_ax);
@@ -238,9 +255,91 @@ int sim_done(const struct sim *S) {
   return S->t >= S->sc->t_end * (1.0 - 1e-12);
 }
 
+/* Gather every rank's particles (placed by id) and the wall values of the vertices each rank
+   owns into rank 0's S->gather arrays, which the state list then names. */
+enum { G_ID, G_KIND, G_X, G_Y, G_Z, G_U, G_V, G_W, G_RHO, G_P, G_M, G_GAM, G_KSUM, G_LEN };
+
+static void gather_state(struct sim *S, size_t *n_all) {
+  const struct particles *P = &S->P;
+  const size_t n = P->n, nv = P->n_vertex;
+  int rank = S->dd.rank, size = S->dd.size;
+  double *rec = part_alloc("gather_send", (n ? n : 1) * (G_LEN + 2) * sizeof(double));
+  size_t k = 0;
+  for (size_t a = 0; a < n; a++, k++) {
+    double *r = rec + k * G_LEN;
+    memcpy(&r[G_ID], &P->id[a], sizeof(double));
+    const double *f[] = {P->x, P->y, P->z, P->u, P->v, P->w, P->rho, P->p, P->m, P->gam, P->ksum};
+    r[G_KIND] = P->kind[a];
+    for (int c = 0; c < G_LEN - 2; c++) r[G_X + c] = f[c][a];
+  }
+  /* wall values of the owned vertices: (slot, rho, p) after the particle records */
+  double *wrec = rec + n * G_LEN;
+  size_t nw = 0;
+  for (size_t a = 0; a < n; a++) {
+    if (P->kind[a] != KIND_VERTEX) continue;
+    const size_t slot = part_vertex_slot(P, P->id[a]);
+    wrec[3 * nw] = (double)slot, wrec[3 * nw + 1] = S->W.rho[slot], wrec[3 * nw + 2] = S->W.p[slot];
+    nw++;
+  }
+  int cnt[2] = {(int)(n * G_LEN), (int)(3 * nw)}, *all = NULL;
+  if (rank == 0) all = part_alloc("gather_counts", 2 * (size_t)size * sizeof(int));
+  MPI_Gather(cnt, 2, MPI_INT, all, 2, MPI_INT, 0, MPI_COMM_WORLD);
+  int *c0 = NULL, *d0 = NULL, *c1 = NULL, *d1 = NULL;
+  double *buf = NULL, *wbuf = NULL;
+  size_t tot = 0, wtot = 0;
+  if (rank == 0) {
+    c0 = part_alloc("gather_counts", 4 * (size_t)size * sizeof(int));
+    d0 = c0 + size, c1 = d0 + size, d1 = c1 + size;
+    for (int r = 0; r < size; r++) {
+      c0[r] = all[2 * r], c1[r] = all[2 * r + 1];
+      d0[r] = (int)tot, d1[r] = (int)wtot;
+      tot += (size_t)c0[r], wtot += (size_t)c1[r];
+    }
+    buf = part_alloc("gather_recv", (tot ? tot : 1) * sizeof(double));
+    wbuf = part_alloc("gather_recv", (wtot ? wtot : 1) * sizeof(double));
+  }
+  MPI_Gatherv(rec, cnt[0], MPI_DOUBLE, buf, c0, d0, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  MPI_Gatherv(wrec, cnt[1], MPI_DOUBLE, wbuf, c1, d1, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  part_free(rec);
+  *n_all = 0;
+  if (rank == 0) {
+    const size_t N = tot / G_LEN;
+    *n_all = N;
+    for (int k2 = 0; k2 < SIM_GATHER; k2++) free(S->gather[k2]), S->gather[k2] = NULL;
+    int64_t *id = malloc(N * sizeof *id);
+    uint8_t *kind = malloc(N ? N : 1);
+    if (!id || !kind) die("out of memory gathering the checkpoint state");
+    S->gather[G_ID] = id, S->gather[G_KIND] = kind;
+    for (int c = G_X; c < G_LEN; c++) {
+      S->gather[c] = malloc((N ? N : 1) * sizeof(double));
+      if (!S->gather[c]) die("out of memory gathering the checkpoint state");
+    }
+    for (size_t i = 0; i < N; i++) { /* by id (0 .. N-1): the same file on any rank count */
+      const double *r = buf + i * G_LEN;
+      int64_t pid;
+      memcpy(&pid, &r[G_ID], sizeof(double));
+      if (pid < 0 || (size_t)pid >= N)
+        die("gathering the state: particle id %lld out of range", (long long)pid);
+      id[pid] = pid;
+      kind[pid] = (uint8_t)r[G_KIND];
+      for (int c = G_X; c < G_LEN; c++) ((double *)S->gather[c])[pid] = r[c];
+    }
+    double *wr = malloc(2 * (nv ? nv : 1) * sizeof(double));
+    if (!wr) die("out of memory gathering the checkpoint state");
+    for (size_t i = 0; i < wtot / 3; i++) {
+      const size_t slot = (size_t)wbuf[3 * i];
+      wr[slot] = wbuf[3 * i + 1], wr[nv + slot] = wbuf[3 * i + 2];
+    }
+    S->gather[G_LEN] = wr;
+    part_free(c0), part_free(all), part_free(buf), part_free(wbuf);
+  }
+  (void)rank;
+}
+
 void sim_state(struct sim *S, struct state_list *L) {
   _Static_assert(sizeof(long) == sizeof(int64_t), "long must be 64-bit");
   _Static_assert(sizeof(int) == sizeof(int32_t), "int must be 32-bit");
+  _Static_assert(G_LEN + 1 <= SIM_GATHER, "SIM_GATHER too small");
   struct particles *P = &S->P;
   state_add(L, "sim/step", STATE_I64, 0, NULL, &S->step, NULL);
   state_add(L, "sim/time", STATE_F64, 0, NULL, &S->t, "s");
@@ -250,33 +349,47 @@ void sim_state(struct sim *S, struct state_list *L) {
   state_add(L, "drive/ub_prev", STATE_F64, 0, NULL, &S->drive.ub_prev, "m/s");
   state_add(L, "drive/dt_prev", STATE_F64, 0, NULL, &S->drive.dt_prev, "s");
   state_add(L, "drive/started", STATE_I32, 0, NULL, &S->drive.started, NULL);
-  const size_t n[1] = {P->n};
-  state_add(L, "particles/id", STATE_I64, 1, n, P->id, NULL);
-  state_add(L, "particles/kind", STATE_U8, 1, n, P->kind, NULL);
+  const size_t nv = P->n_vertex;
+  /* a running simulation writes its particles by id, gathered on rank 0 (the file does not
+     depend on the number of ranks); before sim_distribute the fields are the full arrays that
+     a resume reads into */
+  const int gathered = S->distributed;
+  size_t n_all = P->n;
+  if (gathered) {
+    gather_state(S, &n_all);
+    n_all = P->n_fluid + P->n_vertex; /* the same shape on every rank (rank 0 writes) */
+  }
+  void *const *g = (void *const *)S->gather;
+  const size_t n[1] = {n_all};
+  state_add(L, "particles/id", STATE_I64, 1, n, gathered ? g[G_ID] : P->id, NULL);
+  state_add(L, "particles/kind", STATE_U8, 1, n, gathered ? g[G_KIND] : P->kind, NULL);
   struct {
     const char *name;
     double *data;
+    int g;
     const char *units;
-  } const f[] = {{"particles/x", P->x, "m"},
-                 {"particles/y", P->y, "m"},
-                 {"particles/z", P->z, "m"},
-                 {"particles/u", P->u, "m/s"},
-                 {"particles/v", P->v, "m/s"},
-                 {"particles/w", P->w, "m/s"},
-                 {"particles/rho", P->rho, "kg/m^3"},
-                 {"particles/p", P->p, "Pa"},
-                 {"particles/mass", P->m, "kg"},
-                 {"particles/gamma", P->gam, "1"},
-                 {"particles/kernel_sum", P->ksum, "kg/m^dim"}};
+  } const f[] = {{"particles/x", P->x, G_X, "m"},
+                 {"particles/y", P->y, G_Y, "m"},
+                 {"particles/z", P->z, G_Z, "m"},
+                 {"particles/u", P->u, G_U, "m/s"},
+                 {"particles/v", P->v, G_V, "m/s"},
+                 {"particles/w", P->w, G_W, "m/s"},
+                 {"particles/rho", P->rho, G_RHO, "kg/m^3"},
+                 {"particles/p", P->p, G_P, "Pa"},
+                 {"particles/mass", P->m, G_M, "kg"},
+                 {"particles/gamma", P->gam, G_GAM, "1"},
+                 {"particles/kernel_sum", P->ksum, G_KSUM, "kg/m^dim"}};
   for (size_t i = 0; i < sizeof f / sizeof f[0]; i++)
-    state_add(L, f[i].name, STATE_F64, 1, n, f[i].data, f[i].units);
-  const size_t nw[1] = {P->n_vertex};
-  state_add(L, "walls/rho", STATE_F64, 1, nw, S->W.rho, "kg/m^3");
-  state_add(L, "walls/p", STATE_F64, 1, nw, S->W.p, "Pa");
+    state_add(L, f[i].name, STATE_F64, 1, n, gathered ? g[f[i].g] : f[i].data, f[i].units);
+  const size_t nw[1] = {nv};
+  double *wr = gathered ? S->gather[G_LEN] : NULL;
+  state_add(L, "walls/rho", STATE_F64, 1, nw, gathered ? wr : S->W.rho, "kg/m^3");
+  state_add(L, "walls/p", STATE_F64, 1, nw, gathered ? (wr ? wr + nv : NULL) : S->W.p, "Pa");
 }
 
 size_t sim_restored(struct sim *S) {
   struct particles *P = &S->P;
+  if (!S->distributed && sim_distribute(S)) die("the checkpoint's scene does not fit the ranks");
   const size_t nv = P->n_vertex;
   double *old = part_alloc("restore_check", 2 * nv * sizeof(double));
   memcpy(old, S->W.rho, nv * sizeof(double));

@@ -14,28 +14,32 @@
 #include "sph.h"
 #include "state.h"
 
+enum { SIM_GATHER = 16 }; /*!< arrays of the gathered state (sim_state on several ranks) */
+
 /** Everything a running simulation holds. */
 struct sim {
-  const struct scene *sc; /*!< the validated scene */
-  struct model M;         /*!< discretisation constants */
-  struct particles P;     /*!< particles */
-  struct walls W;         /*!< wall values on the vertex lattice */
-  struct nbr nb;          /*!< cells and neighbour list */
-  struct dd dd;           /*!< decomposition across MPI ranks and the ghosts */
-  size_t cap;             /*!< slots of the per-particle scratch arrays below */
-  struct drive drive;     /*!< driving force state */
-  long step;              /*!< steps taken */
-  double t;               /*!< simulated time [s] */
-  double dt;              /*!< last time step [s] */
-  double fx;              /*!< last streamwise body acceleration [m/s^2] */
-  double dt_limits[4];    /*!< last limits: acoustic, viscous, force, wall [s] */
-  double nu_max;          /*!< largest nu + nu_r of the current state [m^2/s] */
-  double *scratch[4];     /*!< per-particle scratch for deterministic sums */
-  double *ksum_new;       /*!< kernel sums at the new positions, from the neighbour pass */
-  double *wall_ax;        /*!< per particle x-acceleration from the walls (statistics only) */
-  double wall_fx[2];      /*!< x-force of the walls y = 0, 2 delta on the fluid, last sampled
-                               force pass (NaN if not sampled) [N, N/m in 2-D] */
-  char violation[320];    /*!< a fixed dt broke a stability limit: what, where (else empty) */
+  const struct scene *sc;   /*!< the validated scene */
+  struct model M;           /*!< discretisation constants */
+  struct particles P;       /*!< particles */
+  struct walls W;           /*!< wall values on the vertex lattice */
+  struct nbr nb;            /*!< cells and neighbour list */
+  struct dd dd;             /*!< decomposition across MPI ranks and the ghosts */
+  size_t cap;               /*!< slots of the per-particle scratch arrays below */
+  struct drive drive;       /*!< driving force state */
+  long step;                /*!< steps taken */
+  double t;                 /*!< simulated time [s] */
+  double dt;                /*!< last time step [s] */
+  double fx;                /*!< last streamwise body acceleration [m/s^2] */
+  double dt_limits[4];      /*!< last limits: acoustic, viscous, force, wall [s] */
+  double nu_max;            /*!< largest nu + nu_r of the current state [m^2/s] */
+  double *scratch[4];       /*!< per-particle scratch for deterministic sums */
+  double *ksum_new;         /*!< kernel sums at the new positions, from the neighbour pass */
+  double *wall_ax;          /*!< per particle x-acceleration from the walls (statistics only) */
+  double wall_fx[2];        /*!< x-force of the walls y = 0, 2 delta on the fluid, last sampled
+                                 force pass (NaN if not sampled) [N, N/m in 2-D] */
+  char violation[320];      /*!< a fixed dt broke a stability limit: what, where (else empty) */
+  int distributed;          /*!< 1 after the particles were split over the ranks */
+  void *gather[SIM_GATHER]; /*!< rank 0: the whole state gathered for a checkpoint */
 };
 
 /** Global diagnostics of the current state (all fluid particles). */
@@ -62,6 +66,13 @@ double sim_viscosity(const struct scene *sc, double t);
  */
 int sim_init(struct sim *S, const struct scene *sc);
 
+/**
+ * @brief The full initial state on this rank (particles, fields, drive), not yet split over
+ *        the ranks and without neighbours: sim_init() continues from it, a resume reads a
+ *        checkpoint into it (sim_state) and continues with sim_restored().
+ */
+int sim_create(struct sim *S, const struct scene *sc);
+
 /** @brief Free the simulation. */
 void sim_free(struct sim *S);
 
@@ -80,7 +91,8 @@ void sim_step(struct sim *S);
 void sim_state(struct sim *S, struct state_list *L);
 
 /**
- * @brief After the fields of sim_state() were filled from a checkpoint: re-sort the particles
+ * @brief After the fields of sim_state() were filled from a checkpoint (into sim_create()'s
+ *        full state): split the particles over the ranks, re-sort them
  *        (order by cell, then id), rebuild the neighbour list and the quantities derived from
  *        the stored state (pressure, sound speed, volumes, wall values), bitwise as the step
  *        that produced them.
