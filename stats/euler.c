@@ -7,7 +7,12 @@
 #include <string.h>
 
 #include "moments.h"
+#include "spar.h"
 #include "state.h"
+
+/* Per-(column, bin) partial of one snapshot: a moment record, then the sum of u and the count
+   (the weight sum with EULER_SPH) behind the per-snapshot bin mean of u. */
+enum { EU_PART_U = MOM_LEN, EU_PART_N, EU_PART };
 
 const struct euler_meta euler_prof_meta[EP_NPROF] = {
     [EP_Y] = {"y", "m", "wall-normal bin centre (walls at 0 and 2 delta)"},
@@ -121,12 +126,11 @@ void euler_init(struct euler *e, const struct euler_config *cfg) {
   memset(e, 0, sizeof *e);
   e->cfg = *cfg;
   if (cfg->method == EULER_SPH) build_w1(e);
-  e->tmp = xrealloc(NULL, (size_t)cfg->nb * 2 * sizeof(double));
   open_row(e, cfg->t_start);
 }
 
 void euler_free(struct euler *e) {
-  free(e->win), free(e->mom), free(e->snp), free(e->tmp);
+  free(e->win), free(e->mom), free(e->snp), free(e->part);
   memset(e, 0, sizeof *e);
 }
 
@@ -153,10 +157,21 @@ void euler_sample(struct euler *e, const struct stats_snapshot *s) {
   double *row = e->mom + e->nwin * nb * MOM_LEN;
   double *srow = e->snp + e->nwin * nb * SCAL_LEN;
   double *win = e->win + e->nwin * WIN_LEN;
-  memset(e->tmp, 0, nb * 2 * sizeof(double));
+  /* 1. per-(column, bin) partials of this rank's columns, particles in memory order (within a
+     column the same order on any decomposition) */
+  struct spar par;
+  spar_open(&par, s);
+  const size_t ncol = (size_t)par.ncol, rec = nb * EU_PART;
+  if (ncol > e->part_cap) {
+    e->part = xrealloc(e->part, ncol * rec * sizeof(double));
+    e->part_cap = ncol;
+  }
+  double *mine = e->part + (size_t)par.col0 * rec;
+  memset(mine, 0, (size_t)(par.col1 - par.col0) * rec * sizeof(double));
   const double scale = c->nb / (c->y1 - c->y0), ly = 2.0 * c->delta;
   for (size_t a = 0; a < s->n; a++) {
     if (s->skip && s->skip[a]) continue;
+    double *P = mine + (size_t)spar_lcol(&par, s, a) * rec;
     double y = s->y[a], v = s->v[a];
     const int upper = y > c->delta;
     if (c->fold && upper) y = ly - y, v = -v;
@@ -181,18 +196,33 @@ void euler_sample(struct euler *e, const struct stats_snapshot *s) {
         double one[MOM_LEN] = {0};
         one[MOM_N] = wt;
         for (int q = 0; q < MOM_NQ; q++) one[MOM_MEAN + q] = smp[q];
-        mom_merge(row + (size_t)b * MOM_LEN, one);
-        e->tmp[2 * b] += wt * s->u[a], e->tmp[2 * b + 1] += wt;
+        double *Pb = P + (size_t)b * EU_PART;
+        mom_merge(Pb, one);
+        Pb[EU_PART_U] += wt * s->u[a], Pb[EU_PART_N] += wt;
       }
       continue;
     }
     int b = (int)floor((y - c->y0) * scale);
     b = b < 0 ? 0 : b >= c->nb ? c->nb - 1 : b; /* samples outside [y0, y1]: end bins */
-    mom_add(row + (size_t)b * MOM_LEN, smp);
-    e->tmp[2 * b] += s->u[a], e->tmp[2 * b + 1] += 1.0;
+    double *Pb = P + (size_t)b * EU_PART;
+    mom_add(Pb, smp);
+    Pb[EU_PART_U] += s->u[a], Pb[EU_PART_N] += 1.0;
   }
-  for (size_t b = 0; b < nb; b++)
-    if (e->tmp[2 * b + 1] > 0.0) scal_add(srow + b * SCAL_LEN, e->tmp[2 * b] / e->tmp[2 * b + 1]);
+  /* 2. all columns on every rank (rank order is column order) */
+  spar_gather_cols(&par, e->part, rec);
+  spar_close(&par);
+  /* 3. merged in the fixed order c = 0 .. ncol - 1 into the snapshot's record of each bin,
+     which joins the window record */
+  for (size_t b = 0; b < nb; b++) {
+    double snap[MOM_LEN] = {0}, su = 0.0, sn = 0.0;
+    for (size_t col = 0; col < ncol; col++) {
+      const double *Pb = e->part + col * rec + b * EU_PART;
+      mom_merge(snap, Pb);
+      su += Pb[EU_PART_U], sn += Pb[EU_PART_N];
+    }
+    mom_merge(row + b * MOM_LEN, snap);
+    if (sn > 0.0) scal_add(srow + b * SCAL_LEN, su / sn);
+  }
   win[WIN_NSNAP] += 1.0;
   win[WIN_SUM_FX] += s->fx;
   /* wall shear stress over density: minus the wall force on the fluid per unit area */
