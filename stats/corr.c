@@ -168,10 +168,10 @@ void corr_sample(struct corr *c, const struct stats_snapshot *s) {
       e[1] += H[i].u, e[2] += H[i].v, e[3] += H[i].w, e[4] += 1.0;
   }
   /* 3. every rank's partials on every rank, in rank (= column) order */
-  const size_t nall = spar_gather_var(&par, c->ent, ne, CORR_ENT, &c->all, &c->all_cap);
+  c->nall = spar_gather_var(&par, c->ent, ne, CORR_ENT, &c->all, &c->all_cap);
   spar_close(&par);
   /* 4. the planes, identical on every rank */
-  for (size_t pl = 0; pl < npl; pl++) add_plane(c, lev[pl], pl, c->all, nall);
+  for (size_t pl = 0; pl < npl; pl++) add_plane(c, lev[pl], pl, c->all, c->nall);
 }
 
 void corr_state(struct corr *c, struct state_list *L) {

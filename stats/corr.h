@@ -51,6 +51,7 @@ struct corr {
   double *ent;     /*!< scratch: [entry][CORR_ENT] this rank's per-column partial sums */
   double *all;     /*!< scratch: the same gathered from all ranks */
   size_t hits_cap, ent_cap, all_cap; /*!< capacities (particles, entries, entries) */
+  size_t nall;                       /*!< entries gathered at the last snapshot */
 };
 
 /** A per-(plane, column, grid point) partial sum: plane np + grid point, sums of u v w, count. */
