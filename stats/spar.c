@@ -36,23 +36,30 @@ void spar_open(struct spar *p, const struct stats_snapshot *s) {
     MPI_Comm_size(p->comm, &p->size);
     MPI_Comm_rank(p->comm, &p->rank);
   }
-  if (!s->col) { /* everything in column 0 */
-    if (p->size > 1) fail("several ranks need the column of each particle (col)");
-    p->ncol = 1, p->col0 = 0, p->col1 = 1;
-    return;
-  }
+  p->range = spar_realloc(NULL, 2 * (size_t)p->size * sizeof(int));
   p->ncol = s->ncol, p->col0 = s->col0, p->col1 = s->col1;
+  if (!s->col && s->ncol == 0) { /* layout left unset: serial, everything in column 0 */
+    if (p->size > 1) fail("several ranks need the column layout (ncol, col0, col1)");
+    p->ncol = 1, p->col0 = 0, p->col1 = 1;
+  }
   if (p->ncol < 1 || p->col0 < 0 || p->col1 < p->col0 || p->col1 > p->ncol)
     fail("column range outside 0 .. ncol");
+  if (!s->col && s->n > 0 && p->col1 == p->col0)
+    fail("particles without a column on a rank without columns");
   if (p->size == 1) {
     if (p->col0 != 0 || p->col1 != p->ncol) fail("one rank must own all columns");
+    p->range[0] = p->col0, p->range[1] = p->col1;
     return;
   }
-  p->range = spar_realloc(NULL, 2 * (size_t)p->size * sizeof(int));
-  p->cnt = spar_realloc(NULL, 2 * (size_t)p->size * sizeof(int));
+  p->cnt = spar_realloc(NULL, 3 * (size_t)p->size * sizeof(int));
   p->dsp = p->cnt + p->size;
-  const int mine[2] = {p->col0, p->col1};
-  MPI_Allgather(mine, 2, MPI_INT, p->range, 2, MPI_INT, p->comm);
+  const int mine[3] = {p->col0, p->col1, p->ncol};
+  int *all = p->cnt; /* [rank][3], scratch until the first gather */
+  MPI_Allgather(mine, 3, MPI_INT, all, 3, MPI_INT, p->comm);
+  for (int r = 0; r < p->size; r++) {
+    p->range[2 * r] = all[3 * r], p->range[2 * r + 1] = all[3 * r + 1];
+    if (all[3 * r + 2] != p->ncol) fail("the ranks disagree on the number of columns");
+  }
   for (int r = 0; r < p->size; r++)
     if (p->range[2 * r] != (r ? p->range[2 * r - 1] : 0) ||
         (r == p->size - 1 && p->range[2 * r + 1] != p->ncol))
@@ -65,20 +72,10 @@ void spar_close(struct spar *p) {
 }
 
 int spar_lcol(const struct spar *p, const struct stats_snapshot *s, size_t a) {
-  if (!s->col) return 0;
+  if (!s->col) return 0; /* every particle in column col0 */
   const int c = s->col[a];
   if (c < p->col0 || c >= p->col1) fail("particle outside the rank's column range");
   return c - p->col0;
-}
-
-void spar_gather_cols(struct spar *p, double *global, size_t len) {
-  if (p->size == 1) return;
-  for (int r = 0; r < p->size; r++) {
-    const size_t c0 = (size_t)p->range[2 * r], c1 = (size_t)p->range[2 * r + 1];
-    if (c1 * len > (size_t)2147483647) fail("gather larger than 2^31 doubles");
-    p->cnt[r] = (int)((c1 - c0) * len), p->dsp[r] = (int)(c0 * len);
-  }
-  MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_DATATYPE_NULL, global, p->cnt, p->dsp, MPI_DOUBLE, p->comm);
 }
 
 size_t spar_gather_var(struct spar *p, const double *local, size_t n, size_t len, double **buf,

@@ -24,12 +24,13 @@ struct spar {
   int size, rank; /*!< ranks (1: serial, no MPI call is made) */
   int ncol;       /*!< global columns */
   int col0, col1; /*!< this rank's columns [col0, col1) */
-  int *range;     /*!< [rank][2] column ranges of all ranks (size > 1) */
+  int *range;     /*!< [rank][2] column ranges of all ranks */
   int *cnt, *dsp; /*!< scratch counts and displacements of the gathers */
 };
 
-/** @brief Read and check the layout of a snapshot (one MPI_Allgather of two ints if several
- *         ranks); aborts with a message if the column ranges are not contiguous in rank order. */
+/** @brief Read and check the layout of a snapshot (one MPI_Allgather of three ints if several
+ *         ranks); aborts with a message if the ranks disagree on ncol or their column ranges
+ *         are not contiguous in rank order over 0 .. ncol - 1. */
 void spar_open(struct spar *p, const struct stats_snapshot *s);
 
 /** @brief Free the scratch of spar_open. */
@@ -37,13 +38,6 @@ void spar_close(struct spar *p);
 
 /** @brief Local column (0 .. col1 - col0 - 1) of particle a; aborts if outside the range. */
 int spar_lcol(const struct spar *p, const struct stats_snapshot *s, size_t a);
-
-/**
- * @brief Gather per-column blocks of len doubles to every rank, in place: on entry
- *        global[c][len] holds this rank's columns c in [col0, col1); on return every column
- *        0 .. ncol - 1 (rank order is column order). Nothing to do with one rank.
- */
-void spar_gather_cols(struct spar *p, double *global, size_t len);
 
 /**
  * @brief Gather variable numbers of records of len doubles to every rank, in rank order.

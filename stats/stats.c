@@ -50,8 +50,7 @@ size_t stats_memory(const struct stats *st) {
   size_t b = 0;
   if (st->cfg.eulerian) {
     const size_t nb = (size_t)st->eu.cfg.nb;
-    b += st->eu.cap * (WIN_LEN + nb * (MOM_LEN + SCAL_LEN)) * d +
-         st->eu.part_cap * nb * (MOM_LEN + 2) * d;
+    b += st->eu.cap * (WIN_LEN + nb * (MOM_LEN + SCAL_LEN)) * d + euler_work_bytes(&st->eu);
   }
   if (st->cfg.corr.n_levels) {
     const struct corr *c = &st->co;
