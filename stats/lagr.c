@@ -16,6 +16,7 @@
 /* A particle record gathered from the ranks: id, position, velocity, acceleration (zero if
    the snapshot has none), 1 if a release candidate (fluid, in a release slab). */
 enum { LR_ID, LR_X, LR_Y, LR_Z, LR_U, LR_V, LR_W, LR_AX, LR_AY, LR_AZ, LR_CAND, LR_LEN };
+_Static_assert((int)LR_LEN == (int)LAGR_REC, "LAGR_REC in lagr.h");
 
 static void *xcalloc(size_t n, size_t size) {
   void *p = calloc(n ? n : 1, size);
@@ -218,6 +219,12 @@ static void gather(struct lagr *g, const struct stats_snapshot *s, int due) {
   g->nall = spar_gather_var(&par, g->mine, n, LR_LEN, &g->all, &g->all_cap);
   spar_close(&par);
   if (g->nall) qsort(g->all, g->nall, LR_LEN * sizeof(double), rec_cmp);
+  for (size_t i = 1; i < g->nall; i++)
+    if (g->all[i * LR_LEN + LR_ID] == g->all[(i - 1) * LR_LEN + LR_ID]) {
+      fprintf(stderr, "error: statistics: particle id %.0f held by two ranks\n",
+              g->all[i * LR_LEN + LR_ID]);
+      abort();
+    }
 }
 
 /* The gathered record of particle id, or NULL (not on any rank). */

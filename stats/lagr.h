@@ -55,6 +55,9 @@ enum {
   TR_LEN
 };
 
+/** Doubles per particle record gathered from the ranks (lagr.c). */
+enum { LAGR_REC = 11 };
+
 /** Per release slot: start time, last lag sampled, tracked particles, active flag. */
 enum { SL_T0, SL_LAST_K, SL_N, SL_ACTIVE, SL_LEN };
 

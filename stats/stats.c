@@ -64,7 +64,7 @@ size_t stats_memory(const struct stats *st) {
     const size_t nst = (size_t)(g->cfg.n_stations ? g->cfg.n_stations : 1);
     b += nl * g->nlag * LG_LEN * d * (1 + ns) + ns * SL_LEN * d + nl * 3 * SCAL_LEN * d +
          nl * nst * ((size_t)g->cfg.pdf_bins + 3) * d + g->cap * TR_LEN * d +
-         g->index_len * sizeof(long) + (g->mine_cap + g->all_cap) * 11 * d;
+         g->index_len * sizeof(long) + (g->mine_cap + g->all_cap) * LAGR_REC * d;
   }
   return b;
 }

@@ -497,7 +497,7 @@ static void run_bench(void) {
       tsum += dmax, tmax = fmax(tmax, dmax);
       gathered += (parts[k].eul && size_g > 1 ? st.eu.nsub * (size_t)c.eul.nb * (MOM_LEN + 2) : 0) +
                   (parts[k].corr && size_g > 1 ? st.co.nall * CORR_ENT : 0) +
-                  (parts[k].lagr && size_g > 1 ? st.la.nall * 11 : 0);
+                  (parts[k].lagr && size_g > 1 ? st.la.nall * LAGR_REC : 0);
     }
     if (rank_g == 0)
       printf(
