@@ -307,7 +307,12 @@ int output_step(struct output *o, struct sim *S) {
                                         .t = S->t,
                                         .fx = S->fx,
                                         .step = S->step,
-                                        .wall_fx = {S->wall_fx[0], S->wall_fx[1]}};
+                                        .wall_fx = {S->wall_fx[0], S->wall_fx[1]},
+                                        .col = NULL, /* serial: every particle in column 0 */
+                                        .ncol = 1,
+                                        .col0 = 0,
+                                        .col1 = 1,
+                                        .comm = MPI_COMM_SELF};
     stats_sample(&o->st, &snap);
     timer_pop();
   }

@@ -5,11 +5,13 @@
 #include <fftw3.h>
 #include <math.h>
 #include <netcdf.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "ncout.h"
+#include "spar.h"
 #include "state.h"
 
 static const double two_pi = 6.283185307179586;
@@ -50,27 +52,39 @@ void corr_free(struct corr *c) {
   if (c->plan) fftw_destroy_plan(c->plan);
   if (c->grid) fftw_free(c->grid);
   if (c->out) fftw_free(c->out);
-  free(c->spec), free(c->samples), free(c->empty);
+  free(c->spec), free(c->samples), free(c->empty), free(c->hits), free(c->ent), free(c->all);
   memset(c, 0, sizeof *c);
 }
 
-/* Bin the slab around height yl onto the grid (mirror: v -> -v), remove the plane means,
-   transform, and add the spectra to level l. Returns 0 if the slab holds no particle. */
-static int add_plane(struct corr *c, int l, double yl, int mirror, const struct stats_snapshot *s) {
+/* One particle of a slab: sort key (plane, local column, grid point), memory position, values. */
+struct hit {
+  uint64_t key;
+  size_t a;
+  double u, v, w;
+};
+
+static int hit_cmp(const void *pa, const void *pb) {
+  const struct hit *x = pa, *y = pb;
+  if (x->key != y->key) return x->key < y->key ? -1 : 1;
+  return x->a < y->a ? -1 : x->a > y->a;
+}
+
+/* Bin the gathered partials of plane pl onto the grid in the order they were gathered (column
+   order for each grid point), remove the plane means, transform, and add the spectra to level
+   l. Returns 0 if the slab holds no particle. */
+static int add_plane(struct corr *c, int l, size_t pl, const double *E, size_t ne) {
   const int nx = c->cfg.nx, nz = c->cfg.nz;
   const size_t np = (size_t)nx * (size_t)nz;
   double *g = c->grid, *cnt = g + 3 * np;
   memset(g, 0, 4 * np * sizeof(double));
-  const double sx = nx / c->cfg.lx, sz = nz > 1 ? nz / c->cfg.lz : 0.0;
+  const double k0 = (double)(pl * np), k1 = (double)((pl + 1) * np);
   size_t found = 0;
-  for (size_t a = 0; a < s->n; a++) {
-    if (s->skip && s->skip[a]) continue;
-    if (fabs(s->y[a] - yl) >= c->cfg.half) continue;
-    long ix = (long)floor(s->x[a] * sx) % nx, iz = nz > 1 ? (long)floor(s->z[a] * sz) % nz : 0;
-    ix += ix < 0 ? nx : 0, iz += iz < 0 ? nz : 0;
-    const size_t q = (size_t)ix * (size_t)nz + (size_t)iz;
-    g[q] += s->u[a], g[np + q] += mirror ? -s->v[a] : s->v[a], g[2 * np + q] += s->w[a];
-    cnt[q] += 1.0, found++;
+  for (size_t k = 0; k < ne; k++) {
+    const double *e = E + k * CORR_ENT;
+    if (e[0] < k0 || e[0] >= k1) continue;
+    const size_t q = (size_t)(e[0] - k0);
+    g[q] += e[1], g[np + q] += e[2], g[2 * np + q] += e[3], cnt[q] += e[4];
+    found++;
   }
   if (!found) return 0;
   double mean[3] = {0, 0, 0}, filled = 0;
@@ -104,11 +118,60 @@ static int add_plane(struct corr *c, int l, double yl, int mirror, const struct 
 
 void corr_sample(struct corr *c, const struct stats_snapshot *s) {
   if (c->cfg.n_levels <= 0 || s->t < c->cfg.t_start) return;
+  const int nx = c->cfg.nx, nz = c->cfg.nz;
+  const size_t np = (size_t)nx * (size_t)nz;
+  const double sx = nx / c->cfg.lx, sz = nz > 1 ? nz / c->cfg.lz : 0.0;
+  /* the planes: each level, and its mirror (v -> -v) if the slabs do not overlap */
+  int lev[2 * CORR_MAX_LEVELS], mir[2 * CORR_MAX_LEVELS];
+  double yp[2 * CORR_MAX_LEVELS];
+  size_t npl = 0;
   for (int l = 0; l < c->cfg.n_levels; l++) {
     const double yl = c->cfg.y[l], ym = 2.0 * c->cfg.delta - yl;
-    add_plane(c, l, yl, 0, s);
-    if (fabs(ym - yl) >= 2.0 * c->cfg.half) add_plane(c, l, ym, 1, s);
+    lev[npl] = l, mir[npl] = 0, yp[npl++] = yl;
+    if (fabs(ym - yl) >= 2.0 * c->cfg.half) lev[npl] = l, mir[npl] = 1, yp[npl++] = ym;
   }
+  /* 1. this rank's slab particles, sorted by (plane, column, grid point), memory order within */
+  struct spar par;
+  spar_open(&par, s);
+  const uint64_t ncl = (uint64_t)(par.col1 - par.col0);
+  size_t nh = 0;
+  for (size_t a = 0; a < s->n; a++) {
+    if (s->skip && s->skip[a]) continue;
+    for (size_t pl = 0; pl < npl; pl++) {
+      if (fabs(s->y[a] - yp[pl]) >= c->cfg.half) continue;
+      long ix = (long)floor(s->x[a] * sx) % nx, iz = nz > 1 ? (long)floor(s->z[a] * sz) % nz : 0;
+      ix += ix < 0 ? nx : 0, iz += iz < 0 ? nz : 0;
+      const size_t q = (size_t)ix * (size_t)nz + (size_t)iz;
+      if (nh == c->hits_cap) {
+        c->hits_cap = c->hits_cap ? 2 * c->hits_cap : 1024;
+        c->hits = spar_realloc(c->hits, c->hits_cap * sizeof(struct hit));
+      }
+      struct hit *h = (struct hit *)c->hits + nh++;
+      h->key = ((uint64_t)pl * ncl + (uint64_t)spar_lcol(&par, s, a)) * np + q;
+      h->a = a, h->u = s->u[a], h->v = mir[pl] ? -s->v[a] : s->v[a], h->w = s->w[a];
+    }
+  }
+  struct hit *H = c->hits;
+  if (nh) qsort(H, nh, sizeof *H, hit_cmp);
+  /* 2. per-(plane, column, grid point) partial sums in that order: [plane np + q, sums of u v
+     w, count] */
+  size_t ne = 0;
+  for (size_t i = 0; i < nh;) {
+    if (ne == c->ent_cap) {
+      c->ent_cap = c->ent_cap ? 2 * c->ent_cap : 1024;
+      c->ent = spar_realloc(c->ent, c->ent_cap * CORR_ENT * sizeof(double));
+    }
+    double *e = c->ent + ne++ * CORR_ENT;
+    const uint64_t key = H[i].key, pl = key / (ncl * np), q = key % np;
+    e[0] = (double)(pl * np + q), e[1] = e[2] = e[3] = e[4] = 0.0;
+    for (; i < nh && H[i].key == key; i++)
+      e[1] += H[i].u, e[2] += H[i].v, e[3] += H[i].w, e[4] += 1.0;
+  }
+  /* 3. every rank's partials on every rank, in rank (= column) order */
+  c->nall = spar_gather_var(&par, c->ent, ne, CORR_ENT, &c->all, &c->all_cap);
+  spar_close(&par);
+  /* 4. the planes, identical on every rank */
+  for (size_t pl = 0; pl < npl; pl++) add_plane(c, lev[pl], pl, c->all, c->nall);
 }
 
 void corr_state(struct corr *c, struct state_list *L) {

@@ -47,7 +47,15 @@ struct corr {
   double *grid;    /*!< fftw_malloc'd work: 3 planes nx*nz (+ counts) */
   void *out;       /*!< fftw_malloc'd complex output, 3 x nx*nzh */
   void *plan;      /*!< r2c plan (FFTW_ESTIMATE, fixed: deterministic) */
+  void *hits;      /*!< scratch: this rank's slab particles of a snapshot */
+  double *ent;     /*!< scratch: [entry][CORR_ENT] this rank's per-column partial sums */
+  double *all;     /*!< scratch: the same gathered from all ranks */
+  size_t hits_cap, ent_cap, all_cap; /*!< capacities (particles, entries, entries) */
+  size_t nall;                       /*!< entries gathered at the last snapshot */
 };
+
+/** A per-(plane, column, grid point) partial sum: plane np + grid point, sums of u v w, count. */
+enum { CORR_ENT = 5 };
 
 /** @brief Set up (allocates only if n_levels > 0). */
 void corr_init(struct corr *c, const struct corr_config *cfg);
@@ -55,8 +63,11 @@ void corr_init(struct corr *c, const struct corr_config *cfg);
 /** @brief Free. */
 void corr_free(struct corr *c);
 
-/** @brief Add one snapshot (serial, deterministic). Implements: Eq. 5.54-5.55 on the plane
- *         grid and the spectra behind Eq. 5.57-5.59. */
+/** @brief Add one snapshot (deterministic, a collective call on s->comm). Implements: Eq.
+ *         5.54-5.55 on the plane grid and the spectra behind Eq. 5.57-5.59.
+ *         Each grid point's sums are the per-column partials (particles in memory order)
+ *         added in column order, gathered to every rank: the spectra are bitwise the same on
+ *         every rank and for any number of ranks. */
 void corr_sample(struct corr *c, const struct stats_snapshot *s);
 
 /** @brief Expose the sums to a state list. */

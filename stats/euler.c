@@ -7,7 +7,24 @@
 #include <string.h>
 
 #include "moments.h"
+#include "spar.h"
 #include "state.h"
+
+/* Per-(column, bin) partial of one snapshot: a moment record, then the sum of u and the count
+   (the weight sum with EULER_SPH) behind the per-snapshot bin mean of u. */
+enum { EU_PART_U = MOM_LEN, EU_PART_N, EU_PART };
+
+/* Scratch of euler_sample. The columns are merged over a fixed binary tree on the global
+   column index: node [lo, hi) with hi - lo >= 2 has the children [lo, mid) and [mid, hi),
+   mid = lo + (hi - lo) / 2; the leaves are the columns. A rank's range [col0, col1) is the
+   union of maximal nodes (its subtrees, at most about 2 log2 ncol); each rank merges its
+   subtrees, and every rank merges the gathered subtree records up to the root. */
+struct euler_work {
+  double *part;             /* [ncol][nb][EU_PART]: per-column partials (this rank's columns) */
+  double *mine, *all, *scr; /* subtree records: this rank's, all ranks', recursion scratch */
+  int *node;                /* [2 x nodes] lo, hi of the gathered subtrees, in gather order */
+  size_t part_cap, mine_cap, all_cap, scr_cap, node_cap; /* capacities (records, nodes) */
+};
 
 const struct euler_meta euler_prof_meta[EP_NPROF] = {
     [EP_Y] = {"y", "m", "wall-normal bin centre (walls at 0 and 2 delta)"},
@@ -121,17 +138,80 @@ void euler_init(struct euler *e, const struct euler_config *cfg) {
   memset(e, 0, sizeof *e);
   e->cfg = *cfg;
   if (cfg->method == EULER_SPH) build_w1(e);
-  e->tmp = xrealloc(NULL, (size_t)cfg->nb * 2 * sizeof(double));
   open_row(e, cfg->t_start);
 }
 
 void euler_free(struct euler *e) {
-  free(e->win), free(e->mom), free(e->snp), free(e->tmp);
+  struct euler_work *k = e->work;
+  if (k) free(k->part), free(k->mine), free(k->all), free(k->scr), free(k->node), free(k);
+  free(e->win), free(e->mom), free(e->snp);
   memset(e, 0, sizeof *e);
 }
 
 size_t euler_rows(const struct euler *e) {
   return e->nwin + (e->win[e->nwin * WIN_LEN + WIN_NSNAP] > 0.0);
+}
+
+size_t euler_work_bytes(const struct euler *e) {
+  const struct euler_work *k = e->work;
+  if (!k) return 0;
+  const size_t rec = (size_t)e->cfg.nb * EU_PART * sizeof(double);
+  return sizeof *k + (k->part_cap + k->mine_cap + k->all_cap + k->scr_cap) * rec +
+         2 * k->node_cap * sizeof(int);
+}
+
+/* a := a merged with b, bin by bin (node records of nb bins). */
+static void node_merge(double *restrict a, const double *restrict b, size_t nb) {
+  for (size_t i = 0; i < nb; i++) {
+    double *x = a + i * EU_PART;
+    const double *y = b + i * EU_PART;
+    mom_merge(x, y);
+    x[EU_PART_U] += y[EU_PART_U], x[EU_PART_N] += y[EU_PART_N];
+  }
+}
+
+/* The maximal tree nodes inside [c0, c1), left to right, appended to k->node (n of them). */
+static void subtrees(struct euler_work *k, size_t *n, int lo, int hi, int c0, int c1) {
+  if (hi <= c0 || lo >= c1 || lo >= hi) return;
+  if (c0 <= lo && hi <= c1) {
+    if (*n == k->node_cap) {
+      k->node_cap = k->node_cap ? 2 * k->node_cap : 64;
+      k->node = xrealloc(k->node, 2 * k->node_cap * sizeof(int));
+    }
+    k->node[2 * *n] = lo, k->node[2 * *n + 1] = hi, (*n)++;
+    return;
+  }
+  const int mid = lo + (hi - lo) / 2;
+  subtrees(k, n, lo, mid, c0, c1);
+  subtrees(k, n, mid, hi, c0, c1);
+}
+
+/* Record of node [lo, hi) into out: a gathered subtree record if one is that node (nodes
+   sorted by lo), else a leaf (column partial), else the merge of the two children. */
+static void node_record(struct euler_work *k, size_t nb, int lo, int hi, const double *rec,
+                        size_t nn, int depth, double *out) {
+  const size_t len = nb * EU_PART;
+  size_t a = 0, b = nn;
+  while (a < b) { /* first node with node lo >= lo */
+    const size_t m = a + (b - a) / 2;
+    if (k->node[2 * m] < lo)
+      a = m + 1;
+    else
+      b = m;
+  }
+  if (a < nn && k->node[2 * a] == lo && k->node[2 * a + 1] == hi) {
+    memcpy(out, rec + a * len, len * sizeof(double));
+    return;
+  }
+  if (hi - lo == 1) {
+    memcpy(out, k->part + (size_t)lo * len, len * sizeof(double));
+    return;
+  }
+  const int mid = lo + (hi - lo) / 2;
+  double *right = k->scr + (size_t)depth * len;
+  node_record(k, nb, lo, mid, rec, nn, depth + 1, out);
+  node_record(k, nb, mid, hi, rec, nn, depth + 1, right);
+  node_merge(out, right, nb);
 }
 
 void euler_sample(struct euler *e, const struct stats_snapshot *s) {
@@ -153,10 +233,26 @@ void euler_sample(struct euler *e, const struct stats_snapshot *s) {
   double *row = e->mom + e->nwin * nb * MOM_LEN;
   double *srow = e->snp + e->nwin * nb * SCAL_LEN;
   double *win = e->win + e->nwin * WIN_LEN;
-  memset(e->tmp, 0, nb * 2 * sizeof(double));
+  /* 1. per-(column, bin) partials of this rank's columns, particles in memory order (within a
+     column the same order on any decomposition) */
+  struct spar par;
+  spar_open(&par, s);
+  if (!e->work) {
+    e->work = xrealloc(NULL, sizeof(struct euler_work));
+    memset(e->work, 0, sizeof(struct euler_work));
+  }
+  struct euler_work *k = e->work;
+  const size_t ncol = (size_t)par.ncol, len = nb * EU_PART;
+  if (ncol > k->part_cap) {
+    k->part = xrealloc(k->part, ncol * len * sizeof(double));
+    k->part_cap = ncol;
+  }
+  double *mine = k->part + (size_t)par.col0 * len;
+  memset(mine, 0, (size_t)(par.col1 - par.col0) * len * sizeof(double));
   const double scale = c->nb / (c->y1 - c->y0), ly = 2.0 * c->delta;
   for (size_t a = 0; a < s->n; a++) {
     if (s->skip && s->skip[a]) continue;
+    double *P = mine + (size_t)spar_lcol(&par, s, a) * len;
     double y = s->y[a], v = s->v[a];
     const int upper = y > c->delta;
     if (c->fold && upper) y = ly - y, v = -v;
@@ -181,18 +277,52 @@ void euler_sample(struct euler *e, const struct stats_snapshot *s) {
         double one[MOM_LEN] = {0};
         one[MOM_N] = wt;
         for (int q = 0; q < MOM_NQ; q++) one[MOM_MEAN + q] = smp[q];
-        mom_merge(row + (size_t)b * MOM_LEN, one);
-        e->tmp[2 * b] += wt * s->u[a], e->tmp[2 * b + 1] += wt;
+        double *Pb = P + (size_t)b * EU_PART;
+        mom_merge(Pb, one);
+        Pb[EU_PART_U] += wt * s->u[a], Pb[EU_PART_N] += wt;
       }
       continue;
     }
     int b = (int)floor((y - c->y0) * scale);
     b = b < 0 ? 0 : b >= c->nb ? c->nb - 1 : b; /* samples outside [y0, y1]: end bins */
-    mom_add(row + (size_t)b * MOM_LEN, smp);
-    e->tmp[2 * b] += s->u[a], e->tmp[2 * b + 1] += 1.0;
+    double *Pb = P + (size_t)b * EU_PART;
+    mom_add(Pb, smp);
+    Pb[EU_PART_U] += s->u[a], Pb[EU_PART_N] += 1.0;
   }
-  for (size_t b = 0; b < nb; b++)
-    if (e->tmp[2 * b + 1] > 0.0) scal_add(srow + b * SCAL_LEN, e->tmp[2 * b] / e->tmp[2 * b + 1]);
+  /* 2. this rank's subtrees of the column tree, merged locally */
+  int depth = 1;
+  while ((1 << (depth - 1)) < par.ncol) depth++;
+  if ((size_t)depth > k->scr_cap) {
+    k->scr = xrealloc(k->scr, (size_t)depth * len * sizeof(double));
+    k->scr_cap = (size_t)depth;
+  }
+  size_t nmine = 0;
+  subtrees(k, &nmine, 0, par.ncol, par.col0, par.col1);
+  if (nmine + 1 > k->mine_cap) { /* + 1: the root record below */
+    k->mine = xrealloc(k->mine, (nmine + 1) * len * sizeof(double));
+    k->mine_cap = nmine + 1;
+  }
+  for (size_t i = 0; i < nmine; i++)
+    node_record(k, nb, k->node[2 * i], k->node[2 * i + 1], NULL, 0, 0, k->mine + i * len);
+  /* 3. all subtrees on every rank (rank order is column order), merged up to the root: one
+     record per bin for the snapshot, identical on every rank */
+  const size_t nall = spar_gather_var(&par, k->mine, nmine, len, &k->all, &k->all_cap);
+  size_t nn = 0;
+  for (int r = 0; r < par.size; r++)
+    subtrees(k, &nn, 0, par.ncol, par.range[2 * r], par.range[2 * r + 1]);
+  spar_close(&par);
+  if (nn != nall) {
+    fprintf(stderr, "error: statistics: %zu column subtrees gathered, %zu expected\n", nall, nn);
+    abort();
+  }
+  double *snap = k->mine; /* the root record: every bin of the snapshot */
+  node_record(k, nb, 0, (int)ncol, k->all, nn, 0, snap);
+  e->nsub = nn;
+  for (size_t b = 0; b < nb; b++) {
+    const double *R = snap + b * EU_PART;
+    mom_merge(row + b * MOM_LEN, R);
+    if (R[EU_PART_N] > 0.0) scal_add(srow + b * SCAL_LEN, R[EU_PART_U] / R[EU_PART_N]);
+  }
   win[WIN_NSNAP] += 1.0;
   win[WIN_SUM_FX] += s->fx;
   /* wall shear stress over density: minus the wall force on the fluid per unit area */

@@ -14,6 +14,7 @@
 #ifndef CHANSPH_EULER_H
 #define CHANSPH_EULER_H
 
+#include <mpi.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -52,11 +53,24 @@ struct euler {
   double *win;               /*!< [row][WIN_LEN] */
   double *mom;               /*!< [row][nb][MOM_LEN] moment records of the samples */
   double *snp;               /*!< [row][nb][SCAL_LEN] moments of the per-snapshot bin means of u */
-  double *tmp;               /*!< scratch [nb][2]: per-snapshot sums of u and counts */
+  void *work;                /*!< scratch of euler_sample across ranks (euler.c) */
+  size_t nsub;               /*!< column subtrees gathered at the last snapshot (diagnostic) */
   double w1[EULER_W1_N + 1]; /*!< plane-averaged kernel W1(q), q = |y_a - y_i| / h (SPH) */
 };
 
-/** One snapshot of the particles, as plain arrays (the engine never sees solver structs). */
+/**
+ * One snapshot of the particles, as plain arrays (the engine never sees solver structs).
+ *
+ * Across MPI ranks (docs/stats-format.md, "Statistics across ranks"): the arrays hold this
+ * rank's owned particles; particle a lies in global cell column col[a] in [col0, col1); the
+ * ranks of comm own contiguous column ranges in rank order covering 0 .. ncol - 1; within a
+ * column the particles appear in the same order on any decomposition; the scalars are the
+ * same on all ranks. The engine state then comes out bitwise identical on every rank and for
+ * any number of ranks. col = NULL puts every particle in column col0; with ncol = 0 as well
+ * (the layout left unset by an initialiser) the layout is one rank owning column 0.
+ * comm = MPI_COMM_NULL (or left zero by an initialiser, or MPI not initialised) is serial and
+ * makes no MPI call.
+ */
 struct stats_snapshot {
   size_t n;                   /*!< particles */
   const double *x, *y, *z;    /*!< positions [m] */
@@ -72,6 +86,10 @@ struct stats_snapshot {
   long step;                  /*!< step number */
   double wall_fx[2];          /*!< x-force of the walls y = 0, 2 delta on the fluid [N];
                                    NaN if unknown */
+  const int *col;             /*!< global cell column of each particle, or NULL (all in col0) */
+  int ncol;                   /*!< global cell columns along x (0 with col = NULL: serial) */
+  int col0, col1;             /*!< this rank's columns [col0, col1) */
+  MPI_Comm comm;              /*!< ranks sharing the snapshot; MPI_COMM_NULL: serial */
 };
 
 /** Finished profiles: names, units and long names are in euler_prof_meta. */
@@ -134,12 +152,20 @@ void euler_init(struct euler *e, const struct euler_config *cfg);
 /** @brief Free the engine. */
 void euler_free(struct euler *e);
 
+/** @brief Bytes of the scratch of euler_sample (per-column partials, gathered subtrees). */
+size_t euler_work_bytes(const struct euler *e);
+
 /**
  * @brief Add one snapshot. Implements: thesis Eq. 5.54-5.55 (bins) or 5.56 (stats.method =
  *        sph), and the wall-stress sample of Eq. 5.13-5.14.
  *        Each fluid particle to its bin (Eq. 5.54-5.55), one wall-stress
  *        and body-force sample to the window; closes windows that ended before s->t.
- *        Serial over the particles in the given order: independent of the thread count.
+ *        The particles of each column go, in memory order, into per-(column, bin) records;
+ *        these are merged pairwise over a fixed binary tree on the global column index
+ *        (each rank merges the subtrees inside its columns, the subtree records are gathered
+ *        to every rank) into one record per bin and snapshot, merged into the window:
+ *        independent of the thread count and of the number of ranks (a collective call on
+ *        s->comm).
  */
 void euler_sample(struct euler *e, const struct stats_snapshot *s);
 

@@ -10,7 +10,13 @@
 
 #include "moments.h"
 #include "ncout.h"
+#include "spar.h"
 #include "state.h"
+
+/* A particle record gathered from the ranks: id, position, velocity, acceleration (zero if
+   the snapshot has none), 1 if a release candidate (fluid, in a release slab). */
+enum { LR_ID, LR_X, LR_Y, LR_Z, LR_U, LR_V, LR_W, LR_AX, LR_AY, LR_AZ, LR_CAND, LR_LEN };
+_Static_assert((int)LR_LEN == (int)LAGR_REC, "LAGR_REC in lagr.h");
 
 static void *xcalloc(size_t n, size_t size) {
   void *p = calloc(n ? n : 1, size);
@@ -49,7 +55,7 @@ void lagr_init(struct lagr *g, const struct lagr_config *cfg) {
 
 void lagr_free(struct lagr *g) {
   free(g->sums), free(g->slot_sums), free(g->slots), free(g->tl), free(g->pdf);
-  free(g->tracks), free(g->index);
+  free(g->tracks), free(g->index), free(g->mine), free(g->all);
   memset(g, 0, sizeof *g);
 }
 
@@ -70,12 +76,12 @@ static void reserve_tracks(struct lagr *g, size_t n) {
   g->cap = cap;
 }
 
-/* Add a track's values at the current sample to record R (lag k of its release). */
-static void contribute(const double *tr, const struct stats_snapshot *s, size_t a, double *R) {
+/* Add a track's values at the current sample (particle record p) to record R (lag k of its
+   release). */
+static void contribute(const double *tr, const double *p, double *R) {
   const double sg = tr[TR_MIRROR] != 0.0 ? -1.0 : 1.0;
-  const double vt[3] = {s->u[a], sg * s->v[a], s->w[a]};
-  const double at[3] = {s->ax ? s->ax[a] : 0.0, s->ay ? sg * s->ay[a] : 0.0,
-                        s->az ? s->az[a] : 0.0};
+  const double vt[3] = {p[LR_U], sg * p[LR_V], p[LR_W]};
+  const double at[3] = {p[LR_AX], sg * p[LR_AY], p[LR_AZ]};
   R[LG_N] += 1.0;
   for (int i = 0; i < 3; i++) {
     const double v0 = tr[TR_V0 + i], a0 = tr[TR_A0 + i];
@@ -154,45 +160,108 @@ static void retire(struct lagr *g, int slot) {
   g->releases += 1.0;
 }
 
-static void build_index(struct lagr *g, const struct stats_snapshot *s) {
-  size_t len = 0;
-  for (size_t a = 0; a < s->n; a++)
-    if (s->id[a] >= 0 && (size_t)s->id[a] + 1 > len) len = (size_t)s->id[a] + 1;
-  if (len > g->index_len) {
-    free(g->index);
-    g->index = xcalloc(len, sizeof(long));
-    g->index_len = len;
-  }
-  for (size_t i = 0; i < g->index_len; i++) g->index[i] = -1;
-  for (size_t a = 0; a < s->n; a++)
-    if (s->id[a] >= 0) g->index[s->id[a]] = (long)a;
+/* The slab of a release level a particle at height y is in: 0 (level), 1 (mirror), -1. */
+static int in_slab(const struct lagr_config *c, int l, double y) {
+  const double ym = 2.0 * c->delta - c->y[l];
+  if (fabs(y - c->y[l]) < c->half) return 0;
+  if (fabs(ym - c->y[l]) >= 2.0 * c->half && fabs(y - ym) < c->half) return 1;
+  return -1;
 }
 
+static int rec_cmp(const void *pa, const void *pb) {
+  const double a = *(const double *)pa, b = *(const double *)pb;
+  return a < b ? -1 : a > b;
+}
+
+/* The tracked particles and (if a release is due) the release candidates of all ranks, on
+   every rank, sorted by id: the Lagrangian update then runs on identical inputs everywhere. */
+static void gather(struct lagr *g, const struct stats_snapshot *s, int due) {
+  const struct lagr_config *c = &g->cfg;
+  /* mark the tracked ids (index[id] = 1; -1 elsewhere, restored below) */
+  size_t len = 0;
+  for (size_t r = 0; r < g->ntracks; r++) {
+    const double id = g->tracks[r * TR_LEN + TR_ID];
+    if (id >= 0 && (size_t)id + 1 > len) len = (size_t)id + 1;
+  }
+  if (len > g->index_len) {
+    g->index = spar_realloc(g->index, len * sizeof(long));
+    for (size_t i = g->index_len; i < len; i++) g->index[i] = -1;
+    g->index_len = len;
+  }
+  for (size_t r = 0; r < g->ntracks; r++) {
+    const double id = g->tracks[r * TR_LEN + TR_ID];
+    if (id >= 0) g->index[(size_t)id] = 1;
+  }
+  size_t n = 0;
+  for (size_t a = 0; a < s->n; a++) {
+    const int64_t id = s->id[a];
+    const int tracked = id >= 0 && (size_t)id < g->index_len && g->index[id] == 1;
+    int cand = 0;
+    if (due && !(s->skip && s->skip[a]) && fabs(wrap(s->x[a] - c->x0, c->lx)) < c->half)
+      for (int l = 0; l < c->n_levels && !cand; l++) cand = in_slab(c, l, s->y[a]) >= 0;
+    if (!tracked && !cand) continue;
+    if (n == g->mine_cap) {
+      g->mine_cap = g->mine_cap ? 2 * g->mine_cap : 256;
+      g->mine = spar_realloc(g->mine, g->mine_cap * LR_LEN * sizeof(double));
+    }
+    double *p = g->mine + n++ * LR_LEN;
+    p[LR_ID] = (double)id, p[LR_X] = s->x[a], p[LR_Y] = s->y[a], p[LR_Z] = s->z ? s->z[a] : 0.0;
+    p[LR_U] = s->u[a], p[LR_V] = s->v[a], p[LR_W] = s->w[a];
+    p[LR_AX] = s->ax ? s->ax[a] : 0.0, p[LR_AY] = s->ay ? s->ay[a] : 0.0;
+    p[LR_AZ] = s->az ? s->az[a] : 0.0, p[LR_CAND] = cand;
+  }
+  for (size_t r = 0; r < g->ntracks; r++) {
+    const double id = g->tracks[r * TR_LEN + TR_ID];
+    if (id >= 0) g->index[(size_t)id] = -1;
+  }
+  struct spar par;
+  spar_open(&par, s);
+  g->nall = spar_gather_var(&par, g->mine, n, LR_LEN, &g->all, &g->all_cap);
+  spar_close(&par);
+  if (g->nall) qsort(g->all, g->nall, LR_LEN * sizeof(double), rec_cmp);
+  for (size_t i = 1; i < g->nall; i++)
+    if (g->all[i * LR_LEN + LR_ID] == g->all[(i - 1) * LR_LEN + LR_ID]) {
+      fprintf(stderr, "error: statistics: particle id %.0f held by two ranks\n",
+              g->all[i * LR_LEN + LR_ID]);
+      abort();
+    }
+}
+
+/* The gathered record of particle id, or NULL (not on any rank). */
+static const double *find(const struct lagr *g, double id) {
+  size_t lo = 0, hi = g->nall;
+  while (lo < hi) {
+    const size_t mid = lo + (hi - lo) / 2;
+    const double m = g->all[mid * LR_LEN + LR_ID];
+    if (m == id) return g->all + mid * LR_LEN;
+    if (m < id)
+      lo = mid + 1;
+    else
+      hi = mid;
+  }
+  return NULL;
+}
+
+/* A new release in slot: the candidates in id order (the same on any decomposition). */
 static void release(struct lagr *g, int slot, const struct stats_snapshot *s) {
   const struct lagr_config *c = &g->cfg;
   double *sl = g->slots + (size_t)slot * SL_LEN;
   sl[SL_T0] = s->t, sl[SL_LAST_K] = 0.0, sl[SL_ACTIVE] = 1.0, sl[SL_N] = 0.0;
-  for (size_t a = 0; a < s->n; a++) {
-    if (s->skip && s->skip[a]) continue;
-    if (fabs(wrap(s->x[a] - c->x0, c->lx)) >= c->half) continue;
+  for (size_t i = 0; i < g->nall; i++) {
+    const double *p = g->all + i * LR_LEN;
+    if (p[LR_CAND] == 0.0) continue;
     for (int l = 0; l < c->n_levels; l++) {
-      const double ym = 2.0 * c->delta - c->y[l];
-      int mirror = -1;
-      if (fabs(s->y[a] - c->y[l]) < c->half)
-        mirror = 0;
-      else if (fabs(ym - c->y[l]) >= 2.0 * c->half && fabs(s->y[a] - ym) < c->half)
-        mirror = 1;
+      const int mirror = in_slab(c, l, p[LR_Y]);
       if (mirror < 0) continue;
       reserve_tracks(g, g->ntracks + 1);
       double *tr = g->tracks + g->ntracks * TR_LEN;
       memset(tr, 0, TR_LEN * sizeof(double));
       const double sg = mirror ? -1.0 : 1.0;
-      tr[TR_SLOT] = slot, tr[TR_LEVEL] = l, tr[TR_MIRROR] = mirror, tr[TR_ID] = (double)s->id[a];
-      tr[TR_V0] = s->u[a], tr[TR_V0 + 1] = sg * s->v[a], tr[TR_V0 + 2] = s->w[a];
-      tr[TR_A0] = s->ax ? s->ax[a] : 0.0, tr[TR_A0 + 1] = s->ay ? sg * s->ay[a] : 0.0;
-      tr[TR_A0 + 2] = s->az ? s->az[a] : 0.0;
-      tr[TR_LAST] = s->x[a], tr[TR_LAST + 1] = s->y[a], tr[TR_LAST + 2] = s->z ? s->z[a] : 0.0;
-      contribute(tr, s, a, slot_rec(g, slot, l, 0));
+      tr[TR_SLOT] = slot, tr[TR_LEVEL] = l, tr[TR_MIRROR] = mirror, tr[TR_ID] = p[LR_ID];
+      tr[TR_V0] = p[LR_U], tr[TR_V0 + 1] = sg * p[LR_V], tr[TR_V0 + 2] = p[LR_W];
+      tr[TR_A0] = p[LR_AX], tr[TR_A0 + 1] = sg * p[LR_AY], tr[TR_A0 + 2] = p[LR_AZ];
+      tr[TR_LAST] = p[LR_X], tr[TR_LAST + 1] = p[LR_Y], tr[TR_LAST + 2] = p[LR_Z];
+      contribute(tr, p, slot_rec(g, slot, l, 0));
       g->ntracks++, sl[SL_N] += 1.0;
       break;
     }
@@ -204,32 +273,31 @@ void lagr_sample(struct lagr *g, const struct stats_snapshot *s) {
   if (c->n_levels <= 0 || s->t < c->t_start) return;
   const int due = s->t >= g->next_release;
   if (!g->ntracks && !due) return;
-  build_index(g, s);
+  gather(g, s, due);
   const double dtau = c->horizon / c->n_lags, ly = 2.0 * c->delta;
   const size_t nbin = (size_t)c->pdf_bins + 3;
   /* displacements, station crossings and lag samples of the tracked particles */
   for (size_t r = 0; r < g->ntracks; r++) {
     double *tr = g->tracks + r * TR_LEN;
-    const int64_t id = (int64_t)tr[TR_ID];
-    const long a = id >= 0 && (size_t)id < g->index_len ? g->index[id] : -1;
-    if (a < 0) continue; /* left this rank (not with one rank) */
-    const double z = s->z ? s->z[a] : 0.0;
-    const double dx = wrap(s->x[a] - tr[TR_LAST], c->lx), dz = wrap(z - tr[TR_LAST + 2], c->lz);
+    const double *p = find(g, tr[TR_ID]);
+    if (!p) continue; /* on no rank (lost) */
+    const double x = p[LR_X], y = p[LR_Y], z = p[LR_Z];
+    const double dx = wrap(x - tr[TR_LAST], c->lx), dz = wrap(z - tr[TR_LAST + 2], c->lz);
     const double dprev = tr[TR_DISP], yprev = tr[TR_LAST + 1];
     tr[TR_DISP] += dx, tr[TR_DISP + 2] += dz;
-    tr[TR_DISP + 1] += (tr[TR_MIRROR] != 0.0 ? -1.0 : 1.0) * (s->y[a] - yprev);
-    tr[TR_LAST] = s->x[a], tr[TR_LAST + 1] = s->y[a], tr[TR_LAST + 2] = z;
+    tr[TR_DISP + 1] += (tr[TR_MIRROR] != 0.0 ? -1.0 : 1.0) * (y - yprev);
+    tr[TR_LAST] = x, tr[TR_LAST + 1] = y, tr[TR_LAST + 2] = z;
     const int l = (int)tr[TR_LEVEL];
     for (int st = 0; st < c->n_stations; st++) {
       const unsigned bit = 1u << st;
       if (((unsigned)tr[TR_DONE] & bit) || tr[TR_DISP] < c->station[st]) continue;
       const double f = dx != 0.0 ? (c->station[st] - dprev) / dx : 1.0;
-      double y = yprev + f * (s->y[a] - yprev); /* y where the track crossed the station */
-      if (tr[TR_MIRROR] != 0.0) y = ly - y;
+      double yc = yprev + f * (y - yprev); /* y where the track crossed the station */
+      if (tr[TR_MIRROR] != 0.0) yc = ly - yc;
       double *P = g->pdf + ((size_t)l * (size_t)c->n_stations + (size_t)st) * nbin;
-      int b = (int)floor(y / ly * c->pdf_bins);
+      int b = (int)floor(yc / ly * c->pdf_bins);
       b = b < 0 ? 0 : b >= c->pdf_bins ? c->pdf_bins - 1 : b;
-      P[b] += 1.0, P[c->pdf_bins] += 1.0, P[c->pdf_bins + 1] += y, P[c->pdf_bins + 2] += y * y;
+      P[b] += 1.0, P[c->pdf_bins] += 1.0, P[c->pdf_bins + 1] += yc, P[c->pdf_bins + 2] += yc * yc;
       tr[TR_DONE] = (double)((unsigned)tr[TR_DONE] | bit);
     }
   }
@@ -241,8 +309,8 @@ void lagr_sample(struct lagr *g, const struct stats_snapshot *s) {
       for (size_t r = 0; r < g->ntracks; r++) {
         const double *tr = g->tracks + r * TR_LEN;
         if (tr[TR_SLOT] != (double)sl) continue;
-        const long a = g->index[(int64_t)tr[TR_ID]];
-        if (a >= 0) contribute(tr, s, (size_t)a, slot_rec(g, sl, (int)tr[TR_LEVEL], (size_t)k));
+        const double *p = find(g, tr[TR_ID]);
+        if (p) contribute(tr, p, slot_rec(g, sl, (int)tr[TR_LEVEL], (size_t)k));
       }
       S[SL_LAST_K] = k;
     }

@@ -55,6 +55,9 @@ enum {
   TR_LEN
 };
 
+/** Doubles per particle record gathered from the ranks (lagr.c). */
+enum { LAGR_REC = 11 };
+
 /** Per release slot: start time, last lag sampled, tracked particles, active flag. */
 enum { SL_T0, SL_LAST_K, SL_N, SL_ACTIVE, SL_LEN };
 
@@ -90,8 +93,10 @@ struct lagr {
   size_t ntracks, cap; /*!< tracked particles, capacity */
   double next_release; /*!< time of the next release [s] */
   double releases;     /*!< completed releases */
-  long *index;         /*!< scratch: array index of each id */
+  long *index;         /*!< scratch: marks of the tracked ids (-1 between samples) */
   size_t index_len;    /*!< its length */
+  double *mine, *all;  /*!< scratch: this rank's / all ranks' particle records (sorted by id) */
+  size_t mine_cap, all_cap, nall; /*!< capacities (records), records gathered */
 };
 
 /** @brief Set up (allocates only if n_levels > 0). */
@@ -100,8 +105,11 @@ void lagr_init(struct lagr *g, const struct lagr_config *cfg);
 /** @brief Free. */
 void lagr_free(struct lagr *g);
 
-/** @brief Add one snapshot: releases, lag samples, PDF crossings (serial, deterministic).
- *         Implements: the set-up of thesis Sec. 6.1.3 and the sums of Eq. 5.60-5.68. */
+/** @brief Add one snapshot: releases, lag samples, PDF crossings (deterministic, a collective
+ *         call on s->comm). Implements: the set-up of thesis Sec. 6.1.3 and the sums of Eq.
+ *         5.60-5.68. The tracked particles and the release candidates of all ranks are gathered
+ *         to every rank and sorted by id; releases take the candidates in id order, so the
+ *         state is bitwise the same on every rank and for any number of ranks. */
 void lagr_sample(struct lagr *g, const struct stats_snapshot *s);
 
 /** @brief Expose the complete state to a state list (rebuild before each checkpoint). */

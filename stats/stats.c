@@ -50,12 +50,13 @@ size_t stats_memory(const struct stats *st) {
   size_t b = 0;
   if (st->cfg.eulerian) {
     const size_t nb = (size_t)st->eu.cfg.nb;
-    b += st->eu.cap * (WIN_LEN + nb * (MOM_LEN + SCAL_LEN)) * d + 2 * nb * d;
+    b += st->eu.cap * (WIN_LEN + nb * (MOM_LEN + SCAL_LEN)) * d + euler_work_bytes(&st->eu);
   }
   if (st->cfg.corr.n_levels) {
     const struct corr *c = &st->co;
     const size_t nk = (size_t)c->cfg.nx * (size_t)c->nzh, np = (size_t)c->cfg.nx * c->cfg.nz;
-    b += (size_t)c->cfg.n_levels * (nk * CS_LEN + 2) * d + 4 * np * d + 3 * nk * 2 * d;
+    b += (size_t)c->cfg.n_levels * (nk * CS_LEN + 2) * d + 4 * np * d + 3 * nk * 2 * d +
+         (c->ent_cap + c->all_cap) * CORR_ENT * d + c->hits_cap * (4 * d + sizeof(size_t));
   }
   if (st->cfg.lagr.n_levels) {
     const struct lagr *g = &st->la;
@@ -63,7 +64,7 @@ size_t stats_memory(const struct stats *st) {
     const size_t nst = (size_t)(g->cfg.n_stations ? g->cfg.n_stations : 1);
     b += nl * g->nlag * LG_LEN * d * (1 + ns) + ns * SL_LEN * d + nl * 3 * SCAL_LEN * d +
          nl * nst * ((size_t)g->cfg.pdf_bins + 3) * d + g->cap * TR_LEN * d +
-         g->index_len * sizeof(long);
+         g->index_len * sizeof(long) + (g->mine_cap + g->all_cap) * LAGR_REC * d;
   }
   return b;
 }

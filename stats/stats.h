@@ -45,7 +45,9 @@ void stats_free(struct stats *st);
 /** @brief True if the scene requested any engine (else the solver need not build snapshots). */
 int stats_wanted(const struct stats *st);
 
-/** @brief Hand one snapshot to every requested engine. */
+/** @brief Hand one snapshot to every requested engine. With several ranks (s->comm) a
+ *         collective call: every rank calls it with its part of the snapshot, and every rank
+ *         ends with the same state (docs/stats-format.md, "Statistics across ranks"). */
 void stats_sample(struct stats *st, const struct stats_snapshot *s);
 
 /**
