@@ -1,6 +1,7 @@
 /** @file cli.c @brief Implementation of cli.h. */
 #include "cli.h"
 
+#include <mpi.h>
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -150,27 +151,48 @@ int cli_bench(const struct scene *sc, long steps) {
   const double t_setup = timer_now();
   if (sim_init(&S, sc)) return 1;
   const double setup = timer_now() - t_setup;
-  long nbr = 0;
+  const int root = S.dd.rank == 0, ranks = S.dd.size;
+  double nbr = 0.0, mine = (double)S.P.n;
   for (size_t a = 0; a < S.P.n; a++)
     if (S.P.kind[a] == KIND_FLUID) nbr += S.nb.count[a];
+  MPI_Allreduce(MPI_IN_PLACE, &nbr, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
   const int warm = 3;
   for (int i = 0; i < warm; i++) sim_step(&S);
   timer_reset();
+  const double halo0 = S.dd.seconds, bytes0 = S.dd.bytes, msg0 = (double)S.dd.messages;
+  MPI_Barrier(MPI_COMM_WORLD);
   const double t0 = timer_now(), sim0 = S.t;
   for (long i = 0; i < steps; i++) sim_step(&S);
+  MPI_Barrier(MPI_COMM_WORLD);
   const double wall = timer_now() - t0, simt = S.t - sim0;
-  printf("chansph bench: %dD, %zu fluid + %zu vertex particles, %d threads\n", sc->dim, S.P.n_fluid,
-         S.P.n_vertex, omp_get_max_threads());
-  printf("neighbours per fluid particle (within 2h, self excluded): %.2f\n",
-         (double)nbr / (double)S.P.n_fluid);
-  printf("set-up %.3f s; %d warm-up steps, then %ld timed steps in %.3f s (%.3f ms/step)\n", setup,
-         warm, steps, wall, 1e3 * wall / steps);
-  printf("dt = %.4e s (limits: acoustic %.3e, viscous %.3e, force %.3e, wall %.3e)\n", S.dt,
-         S.dt_limits[0], S.dt_limits[1], S.dt_limits[2], S.dt_limits[3]);
-  printf("wall seconds per simulated second: %.1f\n", simt > 0 ? wall / simt : 0.0);
-  timer_report(stdout, wall);
-  part_memory_report(stdout);
-  printf("particle-steps/s: %.0f\n", (double)S.P.n_fluid * steps / wall);
+  /* the exchanges per rank: max and mean of time, bytes and messages; particles per rank */
+  double x[4] = {S.dd.seconds - halo0, S.dd.bytes - bytes0, (double)S.dd.messages - msg0, mine};
+  double mx[4], sum[4];
+  MPI_Allreduce(x, mx, 4, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  MPI_Allreduce(x, sum, 4, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  if (root) {
+    printf("chansph bench: %dD, %zu fluid + %zu vertex particles, %d MPI ranks x %d threads\n",
+           sc->dim, S.P.n_fluid, S.P.n_vertex, ranks, omp_get_max_threads());
+    printf("neighbours per fluid particle (within 2h, self excluded): %.2f\n",
+           nbr / (double)S.P.n_fluid);
+    printf("set-up %.3f s; %d warm-up steps, then %ld timed steps in %.3f s (%.3f ms/step)\n",
+           setup, warm, steps, wall, 1e3 * wall / steps);
+    printf("dt = %.4e s (limits: acoustic %.3e, viscous %.3e, force %.3e, wall %.3e)\n", S.dt,
+           S.dt_limits[0], S.dt_limits[1], S.dt_limits[2], S.dt_limits[3]);
+    printf("wall seconds per simulated second: %.1f\n", simt > 0 ? wall / simt : 0.0);
+    if (ranks > 1) {
+      printf("particles per rank: max %.0f, mean %.1f (imbalance %.3f)\n", mx[3], sum[3] / ranks,
+             mx[3] / (sum[3] / ranks));
+      printf(
+          "halo exchange and migration per step: %.3f ms max over ranks (%.1f%% of the "
+          "step), %.3f ms mean; %.1f kB and %.1f messages sent per rank per step (mean)\n",
+          1e3 * mx[0] / steps, 100.0 * mx[0] / wall, 1e3 * sum[0] / ranks / steps,
+          sum[1] / ranks / steps / 1024.0, sum[2] / ranks / steps);
+    }
+    timer_report(stdout, wall);
+    part_memory_report(stdout);
+    printf("particle-steps/s: %.0f\n", (double)S.P.n_fluid * steps / wall);
+  }
   sim_free(&S);
   return 0;
 }

@@ -12,7 +12,25 @@
 #include "timers.h"
 
 /* A particle on the wire: the permuted arrays of part.h, id and kind. */
-enum { F_X, F_Y, F_Z, F_U, F_V, F_W, F_RHO, F_M, F_GAM, F_KSUM, F_DDIFF, F_ID, F_KIND, F_LEN };
+enum {
+  F_X,
+  F_Y,
+  F_Z,
+  F_U,
+  F_V,
+  F_W,
+  F_RHO,
+  F_M,
+  F_GAM,
+  F_KSUM,
+  F_DDIFF,
+  F_AX,
+  F_AY,
+  F_AZ,
+  F_ID,
+  F_KIND,
+  F_LEN
+};
 
 /* tags: a message going to the left neighbour, one going to the right */
 enum { TAG_LEFT = 11, TAG_RIGHT = 12 };
@@ -34,6 +52,7 @@ static void pack(const struct particles *P, size_t a, double *r) {
   r[F_U] = P->u[a], r[F_V] = P->v[a], r[F_W] = P->w[a];
   r[F_RHO] = P->rho[a], r[F_M] = P->m[a], r[F_GAM] = P->gam[a];
   r[F_KSUM] = P->ksum[a], r[F_DDIFF] = P->ddiff[a];
+  r[F_AX] = P->ax[a], r[F_AY] = P->ay[a], r[F_AZ] = P->az[a];
   memcpy(&r[F_ID], &P->id[a], sizeof(double));
   r[F_KIND] = P->kind[a];
 }
@@ -43,6 +62,7 @@ static void unpack(struct particles *P, size_t a, const double *r) {
   P->u[a] = r[F_U], P->v[a] = r[F_V], P->w[a] = r[F_W];
   P->rho[a] = r[F_RHO], P->m[a] = r[F_M], P->gam[a] = r[F_GAM];
   P->ksum[a] = r[F_KSUM], P->ddiff[a] = r[F_DDIFF];
+  P->ax[a] = r[F_AX], P->ay[a] = r[F_AY], P->az[a] = r[F_AZ];
   memcpy(&P->id[a], &r[F_ID], sizeof(double));
   P->kind[a] = (uint8_t)r[F_KIND];
 }
@@ -367,4 +387,45 @@ int dd_balance(struct dd *d, struct nbr *nb, double threshold) {
   nbr_set_range(nb, d->first[d->rank], d->first[d->rank + 1] - d->first[d->rank], d->halo);
   d->rebalances++;
   return 1;
+}
+
+size_t dd_check_ids(const struct dd *d, const struct particles *P, size_t n_total, long step) {
+  int cnt = (int)P->n, *cnts = NULL, *disp = NULL;
+  int64_t *all = NULL;
+  if (d->rank == 0) {
+    cnts = xrealloc(NULL, (size_t)d->size * sizeof(int));
+    disp = xrealloc(NULL, (size_t)d->size * sizeof(int));
+  }
+  MPI_Gather(&cnt, 1, MPI_INT, cnts, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  size_t total = 0;
+  if (d->rank == 0) {
+    for (int r = 0; r < d->size; r++) disp[r] = (int)total, total += (size_t)cnts[r];
+    all = xrealloc(NULL, (total ? total : 1) * sizeof(int64_t));
+  }
+  MPI_Gatherv(P->id, cnt, MPI_INT64_T, all, cnts, disp, MPI_INT64_T, 0, MPI_COMM_WORLD);
+  long long bad = -1;
+  int dup = 0;
+  if (d->rank == 0) {
+    unsigned char *seen = calloc(n_total ? n_total : 1, 1);
+    if (!seen) die("out of memory checking the particle ids");
+    for (size_t i = 0; i < total && bad < 0; i++) {
+      const int64_t id = all[i];
+      if (id < 0 || (size_t)id >= n_total || seen[id])
+        bad = (long long)id, dup = 1;
+      else
+        seen[id] = 1;
+    }
+    for (size_t id = 0; id < n_total && bad < 0; id++)
+      if (!seen[id]) bad = (long long)id;
+    free(seen), free(all), free(cnts), free(disp);
+  }
+  MPI_Bcast(&bad, 1, MPI_LONG_LONG, 0, MPI_COMM_WORLD);
+  MPI_Bcast(&dup, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  unsigned long long t = total;
+  MPI_Bcast(&t, 1, MPI_UNSIGNED_LONG_LONG, 0, MPI_COMM_WORLD);
+  if (bad >= 0)
+    die("run.check_ids: after step %ld particle id %lld is %s (%llu particles on %d ranks, "
+        "expected %zu)",
+        step, bad, dup ? "held twice or out of range" : "lost", t, d->size, n_total);
+  return (size_t)t;
 }

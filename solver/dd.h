@@ -102,6 +102,13 @@ void dd_update_walls(struct dd *d, const struct particles *P, int nf, double *co
 void dd_sum(const struct dd *d, const struct nbr *nb, int nv, const double *const *x, double *out);
 
 /**
+ * @brief Debug check: every id 0 .. n_total-1 is owned by exactly one rank (gathered on rank 0).
+ *        Collective. Dies with the step and the first missing or duplicated id otherwise.
+ * @return the number of owned particles over all ranks (n_total when the check passes)
+ */
+size_t dd_check_ids(const struct dd *d, const struct particles *P, size_t n_total, long step);
+
+/**
  * @brief Re-partition the columns by particle count when the largest rank holds more than
  *        (1 + threshold) times the mean, then migrate. Collective.
  * @return 1 if the partition changed

@@ -271,6 +271,10 @@ void output_begin(struct output *o, struct sim *S) {
              "%.3e s, viscous %.3e s; output in %s\n",
              CHANSPH_VERSION, S->P.n_fluid, S->P.n_vertex, S->M.h, S->sc->cfl * S->M.h / S->sc->c0,
              S->sc->c_visc * S->M.h * S->M.h / S->sc->nu, o->dir);
+  if (S->dd.size > 1)
+    output_log(o, "decomposition: %d MPI ranks, slabs of %d-%d of the %d cell columns along x\n",
+               S->dd.size, S->dd.ncol / S->dd.size, (S->dd.ncol + S->dd.size - 1) / S->dd.size,
+               S->dd.ncol);
   log_progress(o, S, &d);
 }
 
@@ -287,6 +291,14 @@ int output_step(struct output *o, struct sim *S) {
   if (stats_wanted(&o->st) && S->t >= sc->t_average_start && S->step % sc->stats_every == 0) {
     timer_push("stats");
     const struct particles *P = &S->P;
+    /* the engine merges per global column in a fixed order: rank-independent results */
+    if (P->n > o->col_cap) {
+      free(o->col);
+      o->col_cap = P->n + P->n / 2;
+      o->col = malloc(o->col_cap * sizeof *o->col);
+      if (!o->col) die("out of memory for the statistics snapshot");
+    }
+    for (size_t a = 0; a < P->n; a++) o->col[a] = nbr_column(&S->nb, P->x[a]);
     const struct stats_snapshot snap = {.n = P->n,
                                         .x = P->x,
                                         .y = P->y,
@@ -308,11 +320,11 @@ int output_step(struct output *o, struct sim *S) {
                                         .fx = S->fx,
                                         .step = S->step,
                                         .wall_fx = {S->wall_fx[0], S->wall_fx[1]},
-                                        .col = NULL, /* serial: every particle in column 0 */
-                                        .ncol = 1,
-                                        .col0 = 0,
-                                        .col1 = 1,
-                                        .comm = MPI_COMM_SELF};
+                                        .col = o->col,
+                                        .ncol = S->dd.ncol,
+                                        .col0 = S->dd.first[S->dd.rank],
+                                        .col1 = S->dd.first[S->dd.rank + 1],
+                                        .comm = MPI_COMM_WORLD};
     stats_sample(&o->st, &snap);
     timer_pop();
   }
@@ -397,6 +409,21 @@ static int write_particles(struct output *o, const struct sim *S) {
   return agree(rc ? CHANSPH_ERR : CHANSPH_OK);
 }
 
+/* Cost of the decomposition over the run (collective). */
+static void log_decomposition(struct output *o, struct sim *S, double wall) {
+  const struct dd *d = &S->dd;
+  if (d->size == 1) return;
+  double x[3] = {d->seconds, d->bytes, (double)d->migrated}, mx[3], sum[3];
+  MPI_Allreduce(x, mx, 3, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  MPI_Allreduce(x, sum, 3, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  output_log(o,
+             "decomposition: %d ranks, %d cell columns; halo exchange and migration %.3f s "
+             "(max over ranks, %.1f%% of the wall time); %.2f MB sent in all; %.0f particles "
+             "migrated; %ld re-partitions (last imbalance %.3f)\n",
+             d->size, d->ncol, mx[0], wall > 0 ? 100.0 * mx[0] / wall : 0.0, sum[1] / 1048576.0,
+             sum[2], d->rebalances, d->imbalance);
+}
+
 int output_finish(struct output *o, struct sim *S) {
   struct diag d;
   if (o->ts.n == 0 || o->ts.data[(o->ts.n - 1) * (size_t)o->ts.ncol] != S->t)
@@ -412,6 +439,7 @@ int output_finish(struct output *o, struct sim *S) {
              (long long)o->st.samples);
   TRY(write_stats(o, S));
   if (S->sc->particles) TRY(write_particles(o, S));
+  log_decomposition(o, S, wall);
   output_log(o, "finished: %ld steps, t = %.6g s in %.2f s wall (%.3e particle-steps/s)\n", S->step,
              S->t, wall, wall > 0 ? (double)S->P.n_fluid * (S->step - o->step0) / wall : 0.0);
   if (rank0()) timer_report(stdout, wall);
@@ -440,6 +468,7 @@ void output_fail(struct output *o, struct sim *S, const struct health_report *re
 void output_close(struct output *o) {
   if (o->log) fclose(o->log);
   free(o->scene_text);
+  free(o->col);
   stats_free(&o->st);
   series_free(&o->ts);
   memset(o, 0, sizeof *o);

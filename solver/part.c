@@ -157,7 +157,9 @@ static void permute_d(double *arr, double *tmp, size_t i0, size_t n, const size_
 }
 
 void part_permute(struct particles *P, size_t i0, size_t n, const size_t *perm) {
-  double *arrs[] = {P->x, P->y, P->z, P->u, P->v, P->w, P->rho, P->m, P->gam, P->ksum, P->ddiff};
+  /* the accelerations too: the statistics sample them after the re-sort */
+  double *arrs[] = {P->x, P->y,   P->z,    P->u,     P->v,  P->w,  P->rho,
+                    P->m, P->gam, P->ksum, P->ddiff, P->ax, P->ay, P->az};
   for (size_t i = 0; i < sizeof arrs / sizeof arrs[0]; i++) permute_d(arrs[i], P->tmp, i0, n, perm);
   int64_t *restrict id = P->tmp_i;
   uint8_t *restrict kind = (uint8_t *)P->tmp; /* P->tmp is free after the doubles */

@@ -222,6 +222,7 @@ void sim_step(struct sim *S) {
     dd_balance(&S->dd, &S->nb, S->sc->balance_threshold);
   dd_migrate(&S->dd, P, &S->nb);
   update_state(S, NULL, dt);
+  if (S->sc->check_ids) dd_check_ids(&S->dd, P, P->n_fluid + P->n_vertex, S->step);
 }
 
 void sim_diag(struct sim *S, struct diag *d) {

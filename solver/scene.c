@@ -308,6 +308,11 @@ static const struct key keys[] = {
      "With several MPI ranks: steps between checks of the particles per rank (0 = never "
      "re-partition). Results do not depend on the partition (docs/parallel.md).",
      OFF(balance_every)},
+    {"run", "check_ids", T_INT, "0", 0, 1, 0, NULL, "-",
+     "Debug mode: after every step gather all particle ids on rank 0 and check that each id "
+     "0 .. N-1 is held by exactly one rank (none lost or duplicated by the migration); stops "
+     "with an internal error naming the step and the id otherwise.",
+     OFF(check_ids)},
     {"run", "balance_threshold", T_DOUBLE, "0.1", 0, 100, 0, NULL, "-",
      "Re-partition the cell columns along x when the most loaded rank holds more than (1 + "
      "threshold) times the mean particle count.",
