@@ -2,7 +2,8 @@
 # MPI decomposition checks (issue 6): results bitwise identical on 1, 2, 3 and 4 ranks.
 # usage: mpi_check.sh CHANSPH SCENES RUNS CASE
 #   bitwise2d  2-D channel, 200 steps, every statistics engine, ranks 1-4
-#   bitwise3d  3-D LES (Smagorinsky, Reichardt wall law), 200 steps, every engine, ranks 1-4
+#   bitwise3d  3-D LES (Smagorinsky, Reichardt wall law), 200 steps, every engine, ranks 1-4,
+#              and 2 ranks x 2 threads
 #   resume     3-D LES: 100 steps on 2 ranks, resumed on 3 to step 200; equals the 1-rank run
 #   migration  fast 2-D flow (Mach 0.5) on 3 and 4 ranks, ids checked after every step,
 #              re-partitions every 7 steps; equals the 1-rank run
@@ -65,6 +66,11 @@ case $case in
       grep -h "^decomposition" r$np.txt
     done
     for np in 2 3 4; do compare r1 r$np 200; done
+    if [ "$case" = bitwise3d ]; then # hybrid: 2 ranks x 2 threads
+      OMP_NUM_THREADS=2 mpi 2 run "$scene" --out r2x2 --overwrite "${args[@]}" > r2x2.txt 2>&1 ||
+        { tail -20 r2x2.txt; echo "FAIL: 2 ranks x 2 threads"; exit 1; }
+      compare r1 r2x2 200
+    fi
     ;;
   resume)
     scene=$scenes/les395_smoke.ini
