@@ -5,6 +5,7 @@
 #include <errno.h>
 #include <hdf5.h>
 #include <math.h>
+#include <mpi.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -111,41 +112,49 @@ int snapshot_write(const char *dir, const struct sim *S) {
   timer_push("snapshot");
   const struct particles *P = &S->P;
   const size_t n = P->n_fluid;
-  double *pos = malloc(3 * n * sizeof *pos), *vel = malloc(3 * n * sizeof *vel);
-  double *pr = malloc(n * sizeof *pr), *rho = malloc(n * sizeof *rho);
-  int64_t *id = malloc(n * sizeof *id);
-  if (!pos || !vel || !pr || !rho || !id) die("out of memory writing a snapshot");
-  for (size_t a = 0; a < P->n; a++) {
-    if (P->kind[a] != KIND_FLUID) continue;
-    const size_t r = (size_t)P->id[a]; /* fluid ids are 0 .. n_fluid-1 */
-    pos[3 * r] = P->x[a], pos[3 * r + 1] = P->y[a], pos[3 * r + 2] = P->z[a];
-    vel[3 * r] = P->u[a], vel[3 * r + 1] = P->v[a], vel[3 * r + 2] = P->w[a];
-    pr[r] = P->p[a], rho[r] = P->rho[a], id[r] = P->id[a];
-  }
-  struct state_list L = {0};
-  const size_t d1[1] = {n}, d2[2] = {n, 3};
-  state_add(&L, "id", STATE_I64, 1, d1, id, NULL);
-  state_add(&L, "position", STATE_F64, 2, d2, pos, "m");
-  state_add(&L, "velocity", STATE_F64, 2, d2, vel, "m/s");
-  state_add(&L, "pressure", STATE_F64, 1, d1, pr, "Pa");
-  state_add(&L, "density", STATE_F64, 1, d1, rho, "kg/m^3");
-  char sdir[4096], path[4200], err[2048];
-  snprintf(sdir, sizeof sdir, "%s/snapshots", dir);
-  snprintf(path, sizeof path, "%s/snap_%010ld.h5", sdir, S->step);
+  const int root = S->dd.rank == 0;
+  /* gathered on rank 0 by id, which writes the file */
+  enum { NC = 8 };
+  const double *src[NC] = {P->x, P->y, P->z, P->u, P->v, P->w, P->p, P->rho};
+  double *g = root ? malloc(NC * n * sizeof *g) : NULL;
+  if (root && !g) die("out of memory writing a snapshot");
+  dd_gather_fluid(&S->dd, P, NC, src, g);
   int rc = CHANSPH_OK;
-  if (mkdir(sdir, 0777) && errno != EEXIST) {
-    error_input("%s: cannot create the snapshot directory (%s)", sdir, strerror(errno));
-    rc = CHANSPH_ERR;
-  } else if (ckpt_write_fields(path, "chansph-snapshot", &L, NULL, S->step, S->t, err,
-                               sizeof err)) {
-    error_input("%s", err);
-    rc = CHANSPH_ERR;
-  } else if (write_xdmf(sdir, n)) {
-    error_input("%s/particles.xdmf: cannot write (%s)", sdir, strerror(errno));
-    rc = CHANSPH_ERR;
+  if (root) {
+    double *pos = malloc(3 * n * sizeof *pos), *vel = malloc(3 * n * sizeof *vel);
+    int64_t *id = malloc(n * sizeof *id);
+    if (!pos || !vel || !id) die("out of memory writing a snapshot");
+    for (size_t r = 0; r < n; r++) {
+      for (int k = 0; k < 3; k++)
+        pos[3 * r + k] = g[k * n + r], vel[3 * r + k] = g[(3 + k) * n + r];
+      id[r] = (int64_t)r;
+    }
+    struct state_list L = {0};
+    const size_t d1[1] = {n}, d2[2] = {n, 3};
+    state_add(&L, "id", STATE_I64, 1, d1, id, NULL);
+    state_add(&L, "position", STATE_F64, 2, d2, pos, "m");
+    state_add(&L, "velocity", STATE_F64, 2, d2, vel, "m/s");
+    state_add(&L, "pressure", STATE_F64, 1, d1, g + 6 * n, "Pa");
+    state_add(&L, "density", STATE_F64, 1, d1, g + 7 * n, "kg/m^3");
+    char sdir[4096], path[4200], err[2048];
+    snprintf(sdir, sizeof sdir, "%s/snapshots", dir);
+    snprintf(path, sizeof path, "%s/snap_%010ld.h5", sdir, S->step);
+    if (mkdir(sdir, 0777) && errno != EEXIST) {
+      error_input("%s: cannot create the snapshot directory (%s)", sdir, strerror(errno));
+      rc = CHANSPH_ERR;
+    } else if (ckpt_write_fields(path, "chansph-snapshot", &L, NULL, S->step, S->t, err,
+                                 sizeof err)) {
+      error_input("%s", err);
+      rc = CHANSPH_ERR;
+    } else if (write_xdmf(sdir, n)) {
+      error_input("%s/particles.xdmf: cannot write (%s)", sdir, strerror(errno));
+      rc = CHANSPH_ERR;
+    }
+    state_free(&L);
+    free(pos), free(vel), free(id);
   }
-  state_free(&L);
-  free(pos), free(vel), free(pr), free(rho), free(id);
+  free(g);
+  MPI_Bcast(&rc, 1, MPI_INT, 0, MPI_COMM_WORLD);
   timer_pop();
   return rc;
 }

@@ -429,3 +429,34 @@ size_t dd_check_ids(const struct dd *d, const struct particles *P, size_t n_tota
         step, bad, dup ? "held twice or out of range" : "lost", t, d->size, n_total);
   return (size_t)t;
 }
+
+void dd_gather_fluid(const struct dd *d, const struct particles *P, int nf, const double *const *f,
+                     double *out) {
+  const size_t n = P->n_fluid, rec = (size_t)nf + 1;
+  size_t mine = 0;
+  for (size_t a = 0; a < P->n; a++) mine += P->kind[a] == KIND_FLUID;
+  double *buf = xrealloc(NULL, (mine ? mine : 1) * rec * sizeof(double));
+  for (size_t a = 0, k = 0; a < P->n; a++) {
+    if (P->kind[a] != KIND_FLUID) continue;
+    buf[k * rec] = (double)P->id[a]; /* ids below 2^53 are exact */
+    for (int c = 0; c < nf; c++) buf[k * rec + 1 + c] = f[c][a];
+    k++;
+  }
+  int cnt = (int)(mine * rec), *cnts = NULL, *disp = NULL;
+  double *all = NULL;
+  if (d->rank == 0) {
+    cnts = xrealloc(NULL, (size_t)d->size * sizeof(int));
+    disp = xrealloc(NULL, (size_t)d->size * sizeof(int));
+    all = xrealloc(NULL, (n ? n : 1) * rec * sizeof(double));
+  }
+  MPI_Gather(&cnt, 1, MPI_INT, cnts, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  if (d->rank == 0)
+    for (int r = 0, off = 0; r < d->size; off += cnts[r], r++) disp[r] = off;
+  MPI_Gatherv(buf, cnt, MPI_DOUBLE, all, cnts, disp, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  if (d->rank == 0)
+    for (size_t k = 0; k < n; k++) {
+      const size_t id = (size_t)all[k * rec]; /* fluid ids are 0 .. n_fluid-1 */
+      for (int c = 0; c < nf; c++) out[(size_t)c * n + id] = all[k * rec + 1 + c];
+    }
+  free(buf), free(cnts), free(disp), free(all);
+}

@@ -102,6 +102,14 @@ void dd_update_walls(struct dd *d, const struct particles *P, int nf, double *co
 void dd_sum(const struct dd *d, const struct nbr *nb, int nv, const double *const *x, double *out);
 
 /**
+ * @brief Gather nf per-particle arrays of the fluid particles of all ranks on rank 0, by id:
+ *        out[k * n_fluid + id] = f[k] of the fluid particle id. Collective.
+ * @param[out] out rank 0: nf * n_fluid values (other ranks: unused, may be NULL)
+ */
+void dd_gather_fluid(const struct dd *d, const struct particles *P, int nf, const double *const *f,
+                     double *out);
+
+/**
  * @brief Debug check: every id 0 .. n_total-1 is owned by exactly one rank (gathered on rank 0).
  *        Collective. Dies with the step and the first missing or duplicated id otherwise.
  * @return the number of owned particles over all ranks (n_total when the check passes)

@@ -353,44 +353,17 @@ int output_step(struct output *o, struct sim *S) {
 static int write_particles(struct output *o, const struct sim *S) {
   const struct particles *P = &S->P;
   const size_t n = P->n_fluid;
-  enum { NC = 10, REC = NC + 1 };
-  /* this rank's fluid particles as records (id, values), gathered on rank 0 */
-  size_t mine = 0;
-  for (size_t a = 0; a < P->n; a++) mine += P->kind[a] == KIND_FLUID;
-  double *rec = malloc((mine ? mine : 1) * REC * sizeof *rec);
-  if (!rec) die("out of memory writing particles.nc");
+  enum { NC = 10 };
   const double *src[NC] = {P->x, P->y, P->z, P->u, P->v, P->w, P->rho, P->p, P->gam, P->m};
-  for (size_t a = 0, k = 0; a < P->n; a++) {
-    if (P->kind[a] != KIND_FLUID) continue;
-    rec[k * REC] = (double)P->id[a]; /* ids below 2^53 are exact */
-    for (int c = 0; c < NC; c++) rec[k * REC + 1 + c] = src[c][a];
-    k++;
-  }
   const int root = rank0();
-  int size = 1;
-  MPI_Comm_size(MPI_COMM_WORLD, &size);
-  int cnt = (int)(mine * REC), *cnts = NULL, *disp = NULL;
-  double *all = NULL;
-  if (root) {
-    cnts = malloc((size_t)size * sizeof *cnts), disp = malloc((size_t)size * sizeof *disp);
-    all = malloc(n * REC * sizeof *all);
-    if (!cnts || !disp || !all) die("out of memory writing particles.nc");
-  }
-  MPI_Gather(&cnt, 1, MPI_INT, cnts, 1, MPI_INT, 0, MPI_COMM_WORLD);
-  if (root)
-    for (int r = 0, off = 0; r < size; off += cnts[r], r++) disp[r] = off;
-  MPI_Gatherv(rec, cnt, MPI_DOUBLE, all, cnts, disp, MPI_DOUBLE, 0, MPI_COMM_WORLD);
-  free(rec), free(cnts), free(disp);
+  double *buf = root ? malloc(n * NC * sizeof *buf) : NULL;
+  if (root && !buf) die("out of memory writing particles.nc");
+  dd_gather_fluid(&S->dd, P, NC, src, buf); /* rank 0: by id */
   int rc = CHANSPH_OK;
   if (root) {
-    double *buf = malloc(n * NC * sizeof *buf);
     long long *ids = malloc(n * sizeof *ids);
-    if (!buf || !ids) die("out of memory writing particles.nc");
-    for (size_t k = 0; k < n; k++) {
-      const size_t r = (size_t)all[k * REC]; /* fluid ids are 0 .. n_fluid-1: by id */
-      ids[r] = (long long)r;
-      for (int c = 0; c < NC; c++) buf[(size_t)c * n + r] = all[k * REC + 1 + c];
-    }
+    if (!ids) die("out of memory writing particles.nc");
+    for (size_t r = 0; r < n; r++) ids[r] = (long long)r;
     static const char *const names[NC] = {"x", "y",   "z", "u",     "v",
                                           "w", "rho", "p", "gamma", "mass"};
     static const char *const units[NC] = {"m",   "m",      "m",  "m/s", "m/s",
@@ -402,10 +375,10 @@ static int write_particles(struct output *o, const struct sim *S) {
     char path[4096], err[4096];
     snprintf(path, sizeof path, "%s/particles.nc", o->dir);
     rc = ncout_columns(path, "particle", n, NC, names, units, cols, ids, attrs, 3, err, sizeof err);
-    free(buf), free(ids);
+    free(ids);
     if (rc) error_input("%s", err);
   }
-  free(all);
+  free(buf);
   return agree(rc ? CHANSPH_ERR : CHANSPH_OK);
 }
 
