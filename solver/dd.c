@@ -96,6 +96,19 @@ int dd_init(struct dd *d, const struct scene *sc, dd_reserve_fn reserve, void *c
     return CHANSPH_ERR;
   }
   partition_even(d);
+  const struct scene_list *L = &sc->partition;
+  if (L->n > 0) { /* columns per rank from the scene */
+    int sum = 0, ok = L->n == d->size;
+    for (int r = 0; r < L->n; r++) sum += (int)L->v[r], ok = ok && (int)L->v[r] >= 2 * d->halo;
+    if (!ok || sum != d->ncol) {
+      error_input(
+          "%s: key 'run.partition': %d entries summing to %d; this run needs %d entries "
+          "(one per rank), each at least %d, summing to the %d cell columns",
+          sc->path[0] ? sc->path : "(scene)", L->n, sum, d->size, 2 * d->halo, d->ncol);
+      return CHANSPH_ERR;
+    }
+    for (int r = 0; r < d->size; r++) d->first[r + 1] = d->first[r] + (int)L->v[r];
+  }
   return CHANSPH_OK;
 }
 
@@ -380,8 +393,16 @@ int dd_balance(struct dd *d, struct nbr *nb, double threshold) {
     while (c < ncol - (d->size - r) * minw && run + 0.5 * cnt[c] < target) run += cnt[c++];
     nf[r] = c;
   }
-  const int changed = memcmp(nf, d->first, (size_t)(d->size + 1) * sizeof(int)) != 0;
-  memcpy(d->first, nf, (size_t)(d->size + 1) * sizeof(int));
+  double new_most = 0.0; /* keep the cuts unless the new ones lower the largest load */
+  for (int r = 0; r < d->size; r++) {
+    double n = 0.0;
+    for (int k = nf[r]; k < nf[r + 1]; k++) n += cnt[k];
+    new_most = fmax(new_most, n);
+  }
+  /* ... by at least half the excess over the mean: no flipping between equivalent cuts */
+  const int changed = new_most < mean + 0.5 * (most - mean) &&
+                      memcmp(nf, d->first, (size_t)(d->size + 1) * sizeof(int)) != 0;
+  if (changed) memcpy(d->first, nf, (size_t)(d->size + 1) * sizeof(int));
   free(nf), free(cnt);
   if (!changed) return 0;
   nbr_set_range(nb, d->first[d->rank], d->first[d->rank + 1] - d->first[d->rank], d->halo);

@@ -329,6 +329,18 @@ int output_step(struct output *o, struct sim *S) {
     timer_pop();
   }
   timer_push("output");
+  if (S->dd.rebalances != o->rebalances) {
+    const struct dd *dd = &S->dd;
+    char cols[256] = "";
+    for (int r = 0, k = 0; r < dd->size && k < (int)sizeof cols - 16; r++)
+      k += snprintf(cols + k, sizeof cols - (size_t)k, "%s%d", r ? " " : "",
+                    dd->first[r + 1] - dd->first[r]);
+    output_log(o,
+               "load balance: step %ld, imbalance %.3f (max / mean particles per rank): "
+               "columns per rank now %s\n",
+               S->step, dd->imbalance, cols);
+    o->rebalances = dd->rebalances;
+  }
   struct diag d;
   int have = 0;
   if (S->step % sc->series_every == 0) record(o, S, &d), have = 1;

@@ -29,6 +29,7 @@ struct output {
   long step0;        /*!< step at the start of the loop (0, or where a resume started) */
   int *col;          /*!< global cell column of each owned particle (statistics snapshots) */
   size_t col_cap;    /*!< entries col holds */
+  long rebalances;   /*!< re-partitions already reported in the log */
 };
 
 /**

@@ -123,10 +123,11 @@ struct scene {
   /* [health] */
   int health_every; /*!< steps between full health checks */
   /* [run] */
-  int threads;              /*!< OpenMP threads; 0 = OMP_NUM_THREADS / all */
-  int balance_every;        /*!< steps between load-balance checks (MPI) */
-  int check_ids;            /*!< debug: check every step that each id is on exactly one rank */
-  double balance_threshold; /*!< re-partition above (1 + this) x mean particles per rank */
+  int threads;                 /*!< OpenMP threads; 0 = OMP_NUM_THREADS / all */
+  int balance_every;           /*!< steps between load-balance checks (MPI) */
+  int check_ids;               /*!< debug: check every step that each id is on exactly one rank */
+  struct scene_list partition; /*!< cell columns per rank at the start (empty: even split) */
+  double balance_threshold;    /*!< re-partition above (1 + this) x mean particles per rank */
   /* [checkpoint] */
   long ckpt_every_steps;     /*!< steps between checkpoints; 0 = not by steps */
   double ckpt_every_minutes; /*!< wall-clock minutes between checkpoints; 0 = not by time */
