@@ -4,6 +4,7 @@
  *        which scene keys a resume may change.
  */
 #include <errno.h>
+#include <mpi.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -92,7 +93,8 @@ static int try_one(const char *dir, const char *path, int n_set, char *const *se
                    int *fatal, double *seconds) {
   char err[2048];
   struct ckpt_info info;
-  if (ckpt_info(path, &info, err, sizeof err)) {
+  if (ckpt_agree(ckpt_info(path, &info, err, sizeof err), err, sizeof err)) {
+    free(info.scene);
     skip(sk, path, err);
     return CHANSPH_ERR;
   }
@@ -128,7 +130,9 @@ static int try_one(const char *dir, const char *path, int n_set, char *const *se
   sim_state(S, &L);
   output_state(o, &L);
   const double t0 = timer_now();
-  const int rc = ckpt_read(path, &L, err, sizeof err);
+  /* each rank reads its id block of the particles and all other fields; a checksum error
+     seen by any rank skips the file on all */
+  const int rc = ckpt_agree(ckpt_read(path, &L, err, sizeof err), err, sizeof err);
   state_free(&L);
   if (!rc && S->step != info.step)
     snprintf(err, sizeof err,
@@ -157,7 +161,10 @@ int restart_resume(const char *dir, int n_set, char *const *set, struct scene *s
                 dir);
     return CHANSPH_ERR;
   }
-  const int tmp = rotate_remove_tmp(dir);
+  int rank = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Barrier(MPI_COMM_WORLD); /* every rank listed the files before rank 0 removes any */
+  const int tmp = rank == 0 ? rotate_remove_tmp(dir) : 0;
   static struct skipped sk;
   memset(&sk, 0, sizeof sk);
   struct scene old;
@@ -186,7 +193,7 @@ int restart_resume(const char *dir, int n_set, char *const *set, struct scene *s
     snprintf(to, sizeof to, "%s.skipped", sk.path[i]);
     for (int k = 1; lstat(to, &st) == 0 && k < 1000; k++) /* never replace an earlier one */
       snprintf(to, sizeof to, "%s.skipped.%d", sk.path[i], k);
-    const int moved = rename(sk.path[i], to) == 0;
+    const int moved = rank == 0 && rename(sk.path[i], to) == 0; /* rank 0's files */
     output_log(o, "resume: skipped %s%s: %s\n", sk.path[i], moved ? " (renamed *.skipped)" : "",
                sk.why[i]);
   }
