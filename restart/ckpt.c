@@ -190,6 +190,8 @@ static int write_field(hid_t file, const struct state_field *f, hid_t gcpl, int 
     if (chunk[0] > rows) chunk[0] = rows ? rows : 1;
     H5Pset_chunk(dcpl, rank, chunk);
     H5Pset_fletcher32(dcpl);
+    /* parallel HDF5 allocates chunks when the dataset is created: no fill-value writes */
+    if (par) H5Pset_fill_time(dcpl, H5D_FILL_TIME_NEVER);
   }
   const hid_t sp = H5Screate_simple(rank, dims, NULL);
   const hid_t ds = H5Dcreate2(file, f->name, ftype, sp, H5P_DEFAULT, dcpl, H5P_DEFAULT);
@@ -244,6 +246,20 @@ static int sync_dir(const char *path, char *err, size_t errlen) {
   return 0;
 }
 
+/* Parallel writes: rank 0 first makes sure the file fits (file-size limit, free space) by
+   allocating its estimated size, because HDF5 1.10 cannot fail cleanly inside a collective
+   write: an I/O error on one rank leaves the others waiting in HDF5's own MPI calls. */
+static int probe_space(const char *tmp, size_t bytes, char *err, size_t errlen) {
+  const int fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  int e = fd < 0 ? errno : posix_fallocate(fd, 0, (off_t)bytes);
+  if (fd >= 0 && close(fd) && !e) e = errno;
+  if (!e) return 0;
+  snprintf(err, errlen, "cannot write checkpoint %s (%s; %zu bytes needed)", tmp, strerror(e),
+           bytes);
+  remove(tmp);
+  return 1;
+}
+
 /* Serial (par = 0): the file is built in memory (HDF5 core driver) and written to disk when it
    is closed: one large write, and a full disk or a file-size limit fails cleanly in H5Fclose
    (with the sec2 driver, HDF5 1.10 crashes at exit after a failed close).
@@ -271,6 +287,14 @@ static int write_file(const char *path, const char *format, const struct state_l
   } else { /* one allocation for the whole file: the state plus room for the metadata */
     H5Pset_fapl_core(fapl, ckpt_state_bytes(L) + (scene ? strlen(scene) : 0) + ((size_t)1 << 20),
                      1);
+  }
+  if (par) { /* the state, the scene and room for the metadata (4 kB a dataset, 64 kB) */
+    const size_t need = ckpt_state_bytes(L) + (scene ? strlen(scene) : 0) +
+                        4096 * (size_t)(L->n + 1) + ((size_t)1 << 16);
+    if (ckpt_agree(me == 0 ? probe_space(tmp, need, err, errlen) : 0, err, errlen)) {
+      H5Pclose(fcpl), H5Pclose(fapl), H5Pclose(gcpl);
+      return 1;
+    }
   }
   const hid_t file = H5Fcreate(tmp, H5F_ACC_TRUNC, fcpl, fapl);
   H5Pclose(fcpl), H5Pclose(fapl);
