@@ -139,6 +139,14 @@ static int make_parents(hid_t file, const char *name, hid_t gcpl) {
   return 0;
 }
 
+/* Close an HDF5 object without clearing the error stack of a failed call before it (every
+   successful API call clears it; fail() reports its innermost message). */
+static void close_keeping_errors(hid_t id, herr_t (*close)(hid_t)) {
+  const hid_t stack = H5Eget_current_stack();
+  close(id);
+  if (stack >= 0) H5Eset_current_stack(stack);
+}
+
 /* Write this rank's part of a dataset collectively (parallel HDF5): the rows of a distributed
    field, all of a replicated field on rank 0, nothing on the other ranks. */
 static herr_t write_part(hid_t ds, hid_t mtype, hid_t fsp, int rank, const hsize_t *start,
@@ -153,7 +161,8 @@ static herr_t write_part(hid_t ds, hid_t mtype, hid_t fsp, int rank, const hsize
   const hid_t dxpl = H5Pcreate(H5P_DATASET_XFER);
   H5Pset_dxpl_mpio(dxpl, H5FD_MPIO_COLLECTIVE); /* filtered (Fletcher32) writes need it */
   if (rc >= 0) rc = H5Dwrite(ds, mtype, msp, fsp, dxpl, buf);
-  H5Pclose(dxpl), H5Sclose(msp);
+  close_keeping_errors(dxpl, H5Pclose);
+  close_keeping_errors(msp, H5Sclose);
   return rc;
 }
 
@@ -540,7 +549,7 @@ static herr_t read_rows(hid_t ds, const struct state_field *f, hid_t fsp, void *
   const hid_t msp = H5Screate_simple(f->rank, count, NULL);
   herr_t rc = H5Sselect_hyperslab(fsp, H5S_SELECT_SET, start, NULL, count, NULL);
   if (rc >= 0) rc = H5Dread(ds, mem_type(f->type), msp, fsp, H5P_DEFAULT, dst);
-  H5Sclose(msp);
+  close_keeping_errors(msp, H5Sclose);
   return rc;
 }
 
