@@ -201,12 +201,13 @@ case $case in
   ckpt_bench)
     scene=$scenes/les395_small.ini
     for np in 1 2; do
-      mpi $np run "$scene" --out b$np --overwrite --max-steps 1 > b$np.txt 2>&1
+      mpi $np run "$scene" --out b$np --overwrite --max-steps 4 --set checkpoint.every_steps=1 \
+        --set checkpoint.keep=10 > b$np.txt 2>&1
       [ $? -eq 75 ] || { tail b$np.txt; echo "FAIL: $np ranks"; exit 1; }
-      mpi $np resume b$np --max-steps 2 > b${np}r.txt 2>&1
+      mpi $np resume b$np --max-steps 1 > b${np}r.txt 2>&1
       [ $? -eq 75 ] || { tail b${np}r.txt; echo "FAIL: resume on $np ranks"; exit 1; }
       echo "$np rank(s): $(grep -h "fluid +" b$np.txt | head -1)"
-      grep -h "^checkpoint " b$np/log.txt | sed "s/^/  write: /"
+      grep -h "^checkpoint .*h5 (step [1-4]," b$np/log.txt | sed "s/^/  write: /"
       grep -h "^resume: from" b$np/log.txt | sed "s/^/  read:  /"
     done
     ;;
