@@ -1,9 +1,10 @@
-/** @file ckpt.c @brief Implementation of ckpt.h (serial HDF5). */
+/** @file ckpt.c @brief Implementation of ckpt.h (serial and parallel HDF5). */
 #include "ckpt.h"
 
 #include <errno.h>
 #include <fcntl.h>
 #include <hdf5.h>
+#include <mpi.h>
 #include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -86,11 +87,18 @@ static size_t type_size(enum state_type t) {
   return sizes[t];
 }
 
+/* Elements of a field in the file (all rows of a distributed field). */
+static size_t file_count(const struct state_field *f) {
+  size_t n = 1;
+  for (int i = 0; i < f->rank; i++) n *= i == 0 && f->total ? f->total : f->dims[i];
+  return n;
+}
+
 size_t ckpt_state_bytes(const struct state_list *L) {
   size_t b = 0;
   for (int i = 0; i < L->n; i++)
     b += L->f[i].type == STATE_TEXT ? strlen(*(char **)L->f[i].data)
-                                    : state_count(&L->f[i]) * type_size(L->f[i].type);
+                                    : file_count(&L->f[i]) * type_size(L->f[i].type);
   return b;
 }
 
@@ -131,17 +139,48 @@ static int make_parents(hid_t file, const char *name, hid_t gcpl) {
   return 0;
 }
 
-/* One dataset: chunked, Fletcher32; scalars and strings as one-element 1-D datasets. */
-static int write_field(hid_t file, const struct state_field *f, hid_t gcpl) {
+/* Close an HDF5 object without clearing the error stack of a failed call before it (every
+   successful API call clears it; fail() reports its innermost message). */
+static void close_keeping_errors(hid_t id, herr_t (*close)(hid_t)) {
+  const hid_t stack = H5Eget_current_stack();
+  close(id);
+  if (stack >= 0) H5Eset_current_stack(stack);
+}
+
+/* Write this rank's part of a dataset collectively (parallel HDF5): the rows of a distributed
+   field, all of a replicated field on rank 0, nothing on the other ranks. */
+static herr_t write_part(hid_t ds, hid_t mtype, hid_t fsp, int rank, const hsize_t *start,
+                         const hsize_t *count, int mine, const void *buf) {
+  const hsize_t one[STATE_MAX_RANK] = {1, 1, 1};
+  const hid_t msp = H5Screate_simple(rank, mine ? count : one, NULL);
+  herr_t rc = 0;
+  if (mine)
+    rc = H5Sselect_hyperslab(fsp, H5S_SELECT_SET, start, NULL, count, NULL);
+  else
+    rc = H5Sselect_none(fsp) < 0 || H5Sselect_none(msp) < 0 ? -1 : 0;
+  const hid_t dxpl = H5Pcreate(H5P_DATASET_XFER);
+  H5Pset_dxpl_mpio(dxpl, H5FD_MPIO_COLLECTIVE); /* filtered (Fletcher32) writes need it */
+  if (rc >= 0) rc = H5Dwrite(ds, mtype, msp, fsp, dxpl, buf);
+  close_keeping_errors(dxpl, H5Pclose);
+  close_keeping_errors(msp, H5Sclose);
+  return rc;
+}
+
+/* One dataset: chunked, Fletcher32; scalars and strings as one-element 1-D datasets. A
+   distributed field is stored with its total rows. par: parallel file, every rank calls. */
+static int write_field(hid_t file, const struct state_field *f, hid_t gcpl, int par, int me) {
   if (make_parents(file, f->name, gcpl)) return -1;
   hsize_t dims[STATE_MAX_RANK] = {1}, chunk[STATE_MAX_RANK] = {1};
+  hsize_t start[STATE_MAX_RANK] = {0}, count[STATE_MAX_RANK] = {1};
   int rank = f->rank ? f->rank : 1;
   size_t row = type_size(f->type), n = 1;
   for (int i = 0; i < f->rank; i++) {
-    dims[i] = chunk[i] = f->dims[i];
-    n *= f->dims[i];
+    dims[i] = chunk[i] = count[i] = f->dims[i];
+    if (i == 0 && f->total) dims[0] = chunk[0] = f->total, start[0] = f->offset;
+    n *= dims[i];
     if (i > 0) row *= f->dims[i];
   }
+  if (!par && f->total && (f->offset || f->dims[0] != f->total)) return -1; /* not all rows */
   hid_t ftype = -1, mtype = -1;
   const void *buf = f->data;
   if (f->type == STATE_TEXT) {
@@ -149,7 +188,7 @@ static int write_field(hid_t file, const struct state_field *f, hid_t gcpl) {
     ftype = H5Tcopy(H5T_C_S1);
     H5Tset_size(ftype, strlen(text) + 1);
     H5Tset_strpad(ftype, H5T_STR_NULLTERM);
-    mtype = ftype, buf = text, rank = 1, dims[0] = chunk[0] = 1, n = 1;
+    mtype = ftype, buf = text, rank = 1, dims[0] = chunk[0] = count[0] = 1, n = 1;
   } else {
     ftype = file_type(f->type), mtype = mem_type(f->type);
   }
@@ -160,11 +199,17 @@ static int write_field(hid_t file, const struct state_field *f, hid_t gcpl) {
     if (chunk[0] > rows) chunk[0] = rows ? rows : 1;
     H5Pset_chunk(dcpl, rank, chunk);
     H5Pset_fletcher32(dcpl);
+    /* parallel HDF5 allocates chunks when the dataset is created: no fill-value writes */
+    if (par) H5Pset_fill_time(dcpl, H5D_FILL_TIME_NEVER);
   }
   const hid_t sp = H5Screate_simple(rank, dims, NULL);
   const hid_t ds = H5Dcreate2(file, f->name, ftype, sp, H5P_DEFAULT, dcpl, H5P_DEFAULT);
   herr_t rc = ds < 0 ? -1 : 0;
-  if (rc == 0 && n > 0) rc = H5Dwrite(ds, mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf);
+  if (rc == 0 && n > 0 && !par) rc = H5Dwrite(ds, mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf);
+  if (rc == 0 && n > 0 && par) {
+    const int mine = f->total ? count[0] > 0 : me == 0;
+    rc = write_part(ds, mtype, sp, rank, start, count, mine, buf);
+  }
   if (rc == 0 && f->units) rc = put_attr_text(ds, "units", f->units);
   if (rc == 0 && f->rank == 0) {
     const int32_t scalar = 1; /* stored as shape (1,), read back as a scalar */
@@ -185,74 +230,20 @@ static int sync_path(const char *path, int dir) {
   return rc;
 }
 
-/* The file is built in memory (HDF5 core driver) and written to disk when it is closed: one
-   large write, and a full disk or a file-size limit fails cleanly in H5Fclose (with the sec2
-   driver, HDF5 1.10 crashes at exit after a failed close). */
-int ckpt_write_fields(const char *path, const char *format, const struct state_list *L,
-                      const char *scene, long step, double time, char *err, size_t errlen) {
-  H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
-  char tmp[4096];
-  snprintf(tmp, sizeof tmp, "%s.tmp", path);
-  const hid_t fcpl = H5Pcreate(H5P_FILE_CREATE), fapl = H5Pcreate(H5P_FILE_ACCESS);
-  const hid_t gcpl = H5Pcreate(H5P_GROUP_CREATE);
-  H5Pset_obj_track_times(fcpl, 0);
-  H5Pset_obj_track_times(gcpl, 0);
-  H5Pset_libver_bounds(fapl, H5F_LIBVER_V18, H5F_LIBVER_V18); /* checksummed metadata */
-  /* one allocation for the whole file: the state plus room for the metadata */
-  H5Pset_fapl_core(fapl, ckpt_state_bytes(L) + (scene ? strlen(scene) : 0) + ((size_t)1 << 20), 1);
-  const hid_t file = H5Fcreate(tmp, H5F_ACC_TRUNC, fcpl, fapl);
-  H5Pclose(fcpl), H5Pclose(fapl);
-  if (file < 0) {
-    fail(err, errlen, "cannot write checkpoint %s (%s)", tmp, strerror(errno));
-    H5Pclose(gcpl);
-    remove(tmp);
-    return 1;
-  }
-  int rc = 0;
-  const int64_t step64 = step;
-  const int32_t major = CKPT_VERSION_MAJOR, minor = CKPT_VERSION_MINOR;
-  if (put_attr_text(file, "format", format) ||
-      put_attr_num(file, "format_version_major", H5T_STD_I32LE, H5T_NATIVE_INT32, &major) ||
-      put_attr_num(file, "format_version_minor", H5T_STD_I32LE, H5T_NATIVE_INT32, &minor) ||
-      put_attr_text(file, "code_version", CHANSPH_VERSION) ||
-      put_attr_num(file, "step", H5T_STD_I64LE, H5T_NATIVE_INT64, &step64) ||
-      put_attr_num(file, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &time)) {
-    fail(err, errlen, "cannot write the root attributes of checkpoint %s", tmp);
-    rc = 1;
-  }
-  char *scene_copy = (char *)scene;
-  struct state_field sf = {.name = "scene", .type = STATE_TEXT, .data = &scene_copy};
-  if (!rc && scene && write_field(file, &sf, gcpl)) {
-    fail(err, errlen, "cannot write dataset /scene of checkpoint %s", tmp);
-    rc = 1;
-  }
-  for (int i = 0; i < L->n && !rc; i++)
-    if (write_field(file, &L->f[i], gcpl)) {
-      fail(err, errlen, "cannot write dataset /%s of checkpoint %s", L->f[i].name, tmp);
-      rc = 1;
-    }
-  const int32_t one = 1; /* written last: a file without it is incomplete */
-  if (!rc && put_attr_num(file, "complete", H5T_STD_I32LE, H5T_NATIVE_INT32, &one)) {
-    fail(err, errlen, "cannot write the completion mark of checkpoint %s", tmp);
-    rc = 1;
-  }
-  H5Pclose(gcpl);
-  if (H5Fclose(file) < 0 && !rc) {
-    fail(err, errlen, "cannot write checkpoint %s", tmp);
-    rc = 1;
-  }
-  if (!rc && sync_path(tmp, 0)) {
-    snprintf(err, errlen, "cannot fsync checkpoint %s: %s", tmp, strerror(errno));
-    rc = 1;
-  }
-  if (!rc && rename(tmp, path)) {
-    snprintf(err, errlen, "cannot rename %s to %s: %s", tmp, path, strerror(errno));
-    rc = 1;
-  }
-  if (rc) {
-    remove(tmp);
-    return 1;
-  }
+int ckpt_agree(int rc, char *err, size_t errlen) {
+  int me = 0, size = 1, first = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &me);
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  int mine = rc ? me : size;
+  MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  if (first == size) return 0;
+  if (errlen > 0 && me != first) err[0] = '\0';
+  MPI_Bcast(err, (int)errlen, MPI_CHAR, first, MPI_COMM_WORLD);
+  return 1;
+}
+
+/* Directory of a path, fsync'ed after a rename. */
+static int sync_dir(const char *path, char *err, size_t errlen) {
   char dir[4096];
   snprintf(dir, sizeof dir, "%s", path);
   char *slash = strrchr(dir, '/');
@@ -264,9 +255,134 @@ int ckpt_write_fields(const char *path, const char *format, const struct state_l
   return 0;
 }
 
+/* Parallel writes: rank 0 first makes sure the file fits (file-size limit, free space) by
+   allocating its estimated size, because HDF5 1.10 cannot fail cleanly inside a collective
+   write: an I/O error on one rank leaves the others waiting in HDF5's own MPI calls. */
+static int probe_space(const char *tmp, size_t bytes, char *err, size_t errlen) {
+  const int fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  int e = fd < 0 ? errno : posix_fallocate(fd, 0, (off_t)bytes);
+  if (fd >= 0 && close(fd) && !e) e = errno;
+  if (!e) return 0;
+  snprintf(err, errlen, "cannot write checkpoint %s (%s; %zu bytes needed)", tmp, strerror(e),
+           bytes);
+  remove(tmp);
+  return 1;
+}
+
+/* Serial (par = 0): the file is built in memory (HDF5 core driver) and written to disk when it
+   is closed: one large write, and a full disk or a file-size limit fails cleanly in H5Fclose
+   (with the sec2 driver, HDF5 1.10 crashes at exit after a failed close).
+   Parallel (par = 1, every rank of MPI_COMM_WORLD calls): the MPI-IO driver, the same metadata
+   calls on every rank (collective metadata operations and writes), collective raw-data writes of
+   each rank's rows; after every dataset the ranks agree on the outcome, so a failure on one rank
+   stops them all at the same call. Rank 0 then fsyncs, renames and fsyncs the directory. */
+static int write_file(const char *path, const char *format, const struct state_list *L,
+                      const char *scene, long step, double time, int par, char *err,
+                      size_t errlen) {
+  H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+  int me = 0;
+  if (par) MPI_Comm_rank(MPI_COMM_WORLD, &me);
+  char tmp[4096];
+  snprintf(tmp, sizeof tmp, "%s.tmp", path);
+  const hid_t fcpl = H5Pcreate(H5P_FILE_CREATE), fapl = H5Pcreate(H5P_FILE_ACCESS);
+  const hid_t gcpl = H5Pcreate(H5P_GROUP_CREATE);
+  H5Pset_obj_track_times(fcpl, 0);
+  H5Pset_obj_track_times(gcpl, 0);
+  H5Pset_libver_bounds(fapl, H5F_LIBVER_V18, H5F_LIBVER_V18); /* checksummed metadata */
+  if (par) {
+    H5Pset_fapl_mpio(fapl, MPI_COMM_WORLD, MPI_INFO_NULL);
+    H5Pset_all_coll_metadata_ops(fapl, 1);
+    H5Pset_coll_metadata_write(fapl, 1);
+  } else { /* one allocation for the whole file: the state plus room for the metadata */
+    H5Pset_fapl_core(fapl, ckpt_state_bytes(L) + (scene ? strlen(scene) : 0) + ((size_t)1 << 20),
+                     1);
+  }
+  if (par) { /* the state, the scene and room for the metadata (4 kB a dataset, 64 kB) */
+    const size_t need = ckpt_state_bytes(L) + (scene ? strlen(scene) : 0) +
+                        4096 * (size_t)(L->n + 1) + ((size_t)1 << 16);
+    if (ckpt_agree(me == 0 ? probe_space(tmp, need, err, errlen) : 0, err, errlen)) {
+      H5Pclose(fcpl), H5Pclose(fapl), H5Pclose(gcpl);
+      return 1;
+    }
+  }
+  const hid_t file = H5Fcreate(tmp, H5F_ACC_TRUNC, fcpl, fapl);
+  H5Pclose(fcpl), H5Pclose(fapl);
+  int rc = file < 0;
+  if (rc) fail(err, errlen, "cannot write checkpoint %s (%s)", tmp, strerror(errno));
+  if (par) rc = ckpt_agree(rc, err, errlen);
+  if (rc) {
+    H5Pclose(gcpl);
+    if (file >= 0) H5Fclose(file);
+    if (me == 0) remove(tmp);
+    return 1;
+  }
+  const int64_t step64 = step;
+  const int32_t major = CKPT_VERSION_MAJOR, minor = CKPT_VERSION_MINOR;
+  if (put_attr_text(file, "format", format) ||
+      put_attr_num(file, "format_version_major", H5T_STD_I32LE, H5T_NATIVE_INT32, &major) ||
+      put_attr_num(file, "format_version_minor", H5T_STD_I32LE, H5T_NATIVE_INT32, &minor) ||
+      put_attr_text(file, "code_version", CHANSPH_VERSION) ||
+      put_attr_num(file, "step", H5T_STD_I64LE, H5T_NATIVE_INT64, &step64) ||
+      put_attr_num(file, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &time)) {
+    fail(err, errlen, "cannot write the root attributes of checkpoint %s", tmp);
+    rc = 1;
+  }
+  if (par) rc = ckpt_agree(rc, err, errlen);
+  char *scene_copy = (char *)scene;
+  struct state_field sf = {.name = "scene", .type = STATE_TEXT, .data = &scene_copy};
+  if (!rc && scene && write_field(file, &sf, gcpl, par, me)) {
+    fail(err, errlen, "cannot write dataset /scene of checkpoint %s", tmp);
+    rc = 1;
+  }
+  if (par) rc = ckpt_agree(rc, err, errlen);
+  for (int i = 0; i < L->n && !rc; i++) {
+    if (write_field(file, &L->f[i], gcpl, par, me)) {
+      fail(err, errlen, "cannot write dataset /%s of checkpoint %s", L->f[i].name, tmp);
+      rc = 1;
+    }
+    if (par) rc = ckpt_agree(rc, err, errlen);
+  }
+  const int32_t one = 1; /* written last: a file without it is incomplete */
+  if (!rc && put_attr_num(file, "complete", H5T_STD_I32LE, H5T_NATIVE_INT32, &one)) {
+    fail(err, errlen, "cannot write the completion mark of checkpoint %s", tmp);
+    rc = 1;
+  }
+  if (par) rc = ckpt_agree(rc, err, errlen);
+  H5Pclose(gcpl);
+  if (H5Fclose(file) < 0 && !rc) {
+    fail(err, errlen, "cannot write checkpoint %s", tmp);
+    rc = 1;
+  }
+  if (par) rc = ckpt_agree(rc, err, errlen);
+  if (me == 0 && !rc && sync_path(tmp, 0)) {
+    snprintf(err, errlen, "cannot fsync checkpoint %s: %s", tmp, strerror(errno));
+    rc = 1;
+  }
+  if (me == 0 && !rc && rename(tmp, path)) {
+    snprintf(err, errlen, "cannot rename %s to %s: %s", tmp, path, strerror(errno));
+    rc = 1;
+  }
+  if (me == 0 && rc) remove(tmp);
+  if (me == 0 && !rc) rc = sync_dir(path, err, errlen);
+  if (par) rc = ckpt_agree(rc, err, errlen);
+  return rc;
+}
+
+int ckpt_write_fields(const char *path, const char *format, const struct state_list *L,
+                      const char *scene, long step, double time, char *err, size_t errlen) {
+  return write_file(path, format, L, scene, step, time, 0, err, errlen);
+}
+
 int ckpt_write(const char *path, const struct state_list *L, const char *scene, long step,
                double time, char *err, size_t errlen) {
-  return ckpt_write_fields(path, CKPT_FORMAT, L, scene, step, time, err, errlen);
+  return write_file(path, CKPT_FORMAT, L, scene, step, time, 0, err, errlen);
+}
+
+int ckpt_write_all(const char *path, const struct state_list *L, const char *scene, long step,
+                   double time, char *err, size_t errlen) {
+  int size = 1;
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  return write_file(path, CKPT_FORMAT, L, scene, step, time, size > 1, err, errlen);
 }
 
 static int get_attr_int(hid_t obj, const char *name, hid_t mtype, void *v) {
@@ -423,6 +539,20 @@ static void shape_text(char *buf, size_t n, int rank, const size_t *dims) {
   if (m < (int)n) snprintf(buf + m, n - (size_t)m, rank == 1 ? ",)" : ")");
 }
 
+/* Read a field: all of it, or this rank's rows of a distributed field (independently). */
+static herr_t read_rows(hid_t ds, const struct state_field *f, hid_t fsp, void *dst) {
+  if (!f->total) return H5Dread(ds, mem_type(f->type), H5S_ALL, H5S_ALL, H5P_DEFAULT, dst);
+  if (f->dims[0] == 0) return 0;
+  hsize_t start[STATE_MAX_RANK] = {0}, count[STATE_MAX_RANK] = {0};
+  for (int i = 0; i < f->rank; i++) count[i] = f->dims[i];
+  start[0] = f->offset;
+  const hid_t msp = H5Screate_simple(f->rank, count, NULL);
+  herr_t rc = H5Sselect_hyperslab(fsp, H5S_SELECT_SET, start, NULL, count, NULL);
+  if (rc >= 0) rc = H5Dread(ds, mem_type(f->type), msp, fsp, H5P_DEFAULT, dst);
+  close_keeping_errors(msp, H5Sclose);
+  return rc;
+}
+
 static int read_field(hid_t file, struct state_field *f, const char *path, char *err,
                       size_t errlen) {
   if (f->type == STATE_TEXT) {
@@ -443,7 +573,7 @@ static int read_field(hid_t file, struct state_field *f, const char *path, char 
   for (int i = 0; i < rank && i < STATE_MAX_RANK; i++) dims[i] = (size_t)hd[i];
   const int want_rank = f->rank ? f->rank : 1;
   size_t want[STATE_MAX_RANK] = {1};
-  for (int i = 0; i < f->rank; i++) want[i] = f->dims[i];
+  for (int i = 0; i < f->rank; i++) want[i] = i == 0 && f->total ? f->total : f->dims[i];
   char have_s[96], want_s[96];
   if (!type_matches(ft, f->type)) {
     snprintf(err, errlen, "%s: dataset /%s has the wrong type (expected %s)", path, f->name,
@@ -455,7 +585,7 @@ static int read_field(hid_t file, struct state_field *f, const char *path, char 
     void *dst = f->data;
     int same = rank == want_rank;
     for (int i = 0; same && i < rank; i++) same = dims[i] == want[i];
-    if (!same && f->reserve && rank == f->rank) {
+    if (!same && f->reserve && !f->total && rank == f->rank) {
       dst = f->reserve(f->owner, rank, dims);
       if (dst) {
         f->data = dst, same = 1;
@@ -470,7 +600,7 @@ static int read_field(hid_t file, struct state_field *f, const char *path, char 
       snprintf(err, errlen,
                "%s: dataset /%s has shape %s, this run needs %s (a checkpoint of another scene?)",
                path, f->name, have_s, want_s);
-    } else if (n > 0 && H5Dread(ds, mem_type(f->type), H5S_ALL, H5S_ALL, H5P_DEFAULT, dst) < 0) {
+    } else if (n > 0 && read_rows(ds, f, sp, dst) < 0) {
       fail(err, errlen, "%s: cannot read dataset /%s (checksum mismatch or corrupt data)", path,
            f->name);
     } else {

@@ -45,6 +45,23 @@ int ckpt_write(const char *path, const struct state_list *L, const char *scene, 
                double time, char *err, size_t errlen);
 
 /**
+ * @brief Write a checkpoint collectively: every rank of MPI_COMM_WORLD calls it with the same
+ *        fields, each distributed field (state.h: offset, total) holding this rank's rows and
+ *        every other field the same on all ranks. On one rank this is ckpt_write(); on several,
+ *        parallel HDF5 (MPI-IO driver) writes PATH.tmp, each rank its own rows, rank 0 the
+ *        replicated fields, and rank 0 then fsyncs and renames it. Every rank returns the same
+ *        result and message (docs/checkpoint-format.md).
+ */
+int ckpt_write_all(const char *path, const struct state_list *L, const char *scene, long step,
+                   double time, char *err, size_t errlen);
+
+/**
+ * @brief Agree on an outcome over MPI_COMM_WORLD: returns 1 on every rank if rc was nonzero on
+ *        any, with err (size errlen) replaced by the lowest failing rank's message. Collective.
+ */
+int ckpt_agree(int rc, char *err, size_t errlen);
+
+/**
  * @brief The writer behind ckpt_write(), for other HDF5 files of the same rules (particle
  *        snapshots): root attribute "format" = format, version, step, time, completion mark.
  * @param[in] scene scene text for dataset /scene, or NULL for none
@@ -65,6 +82,9 @@ int ckpt_info(const char *path, struct ckpt_info *info, char *err, size_t errlen
 /**
  * @brief Read every field of a list from a checkpoint into its memory, verifying presence,
  *        type, shape and checksum. Fields with a reserve() callback take the stored shape.
+ *        Of a distributed field (state.h) only this rank's rows are read (a hyperslab; the
+ *        stored shape must have total rows). Not collective: each rank opens the file with the
+ *        default driver and reads independently (callers agree on the outcome: ckpt_agree).
  * @param[in] path file
  * @param[in,out] L fields (data and dims of reserved fields are updated)
  * @param[out] err,errlen message on failure

@@ -4,6 +4,7 @@
  *        which scene keys a resume may change.
  */
 #include <errno.h>
+#include <mpi.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -79,7 +80,9 @@ struct skipped {
 };
 
 static void skip(struct skipped *sk, const char *path, const char *why) {
-  warn("%s; skipping this checkpoint", why);
+  int rank = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  if (rank == 0) warn("%s; skipping this checkpoint", why); /* every rank agrees (ckpt_agree) */
   if (sk->n < 16) {
     snprintf(sk->path[sk->n], sizeof sk->path[0], "%s", path);
     snprintf(sk->why[sk->n], sizeof sk->why[0], "%s", why);
@@ -90,10 +93,11 @@ static void skip(struct skipped *sk, const char *path, const char *why) {
 /* Read one candidate; on failure everything it set up is released. */
 static int try_one(const char *dir, const char *path, int n_set, char *const *set, struct scene *sc,
                    struct sim *S, struct output *o, struct skipped *sk, struct scene *old,
-                   int *fatal, double *seconds) {
+                   int *fatal, double seconds[2]) {
   char err[2048];
   struct ckpt_info info;
-  if (ckpt_info(path, &info, err, sizeof err)) {
+  if (ckpt_agree(ckpt_info(path, &info, err, sizeof err), err, sizeof err)) {
+    free(info.scene);
     skip(sk, path, err);
     return CHANSPH_ERR;
   }
@@ -129,7 +133,10 @@ static int try_one(const char *dir, const char *path, int n_set, char *const *se
   sim_state(S, &L);
   output_state(o, &L);
   const double t0 = timer_now();
-  const int rc = ckpt_read(path, &L, err, sizeof err);
+  /* each rank reads its id block of the particles and all other fields; a checksum error
+     seen by any rank skips the file on all */
+  const int rc = ckpt_agree(ckpt_read(path, &L, err, sizeof err), err, sizeof err);
+  seconds[0] = timer_now() - t0;
   state_free(&L);
   if (!rc && S->step != info.step)
     snprintf(err, sizeof err,
@@ -145,7 +152,7 @@ static int try_one(const char *dir, const char *path, int n_set, char *const *se
   const size_t differ = sim_restored(S);
   if (differ)
     die("restoring %s is not bitwise: %zu wall values differ from the stored ones", path, differ);
-  *seconds = timer_now() - t0;
+  seconds[1] = timer_now() - t0 - seconds[0];
   return CHANSPH_OK;
 }
 
@@ -158,16 +165,19 @@ int restart_resume(const char *dir, int n_set, char *const *set, struct scene *s
                 dir);
     return CHANSPH_ERR;
   }
-  const int tmp = rotate_remove_tmp(dir);
+  int rank = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Barrier(MPI_COMM_WORLD); /* every rank listed the files before rank 0 removes any */
+  const int tmp = rank == 0 ? rotate_remove_tmp(dir) : 0;
   static struct skipped sk;
   memset(&sk, 0, sizeof sk);
   struct scene old;
   int fatal = 0, found = -1;
-  double seconds = 0.0;
+  double seconds[2] = {0.0, 0.0}; /* read, restore */
   char path[4096];
   for (int i = n - 1; i >= 0 && !fatal && found < 0; i--) {
     rotate_path(path, sizeof path, dir, steps[i]);
-    if (!try_one(dir, path, n_set, set, sc, S, o, &sk, &old, &fatal, &seconds)) found = i;
+    if (!try_one(dir, path, n_set, set, sc, S, o, &sk, &old, &fatal, seconds)) found = i;
   }
   free(steps);
   if (fatal) return CHANSPH_ERR;
@@ -178,8 +188,8 @@ int restart_resume(const char *dir, int n_set, char *const *set, struct scene *s
         dir, n);
     return CHANSPH_ERR;
   }
-  output_log(o, "resume: from %s (step %ld, t = %.9g s; read and restored in %.3f s)\n", path,
-             S->step, S->t, seconds);
+  output_log(o, "resume: from %s (step %ld, t = %.9g s; read in %.3f s, restored in %.3f s)\n",
+             path, S->step, S->t, seconds[0], seconds[1]);
   if (tmp) output_log(o, "resume: removed %d temporary file(s) of interrupted writes\n", tmp);
   for (int i = 0; i < sk.n; i++) {
     char to[4200];
@@ -187,7 +197,7 @@ int restart_resume(const char *dir, int n_set, char *const *set, struct scene *s
     snprintf(to, sizeof to, "%s.skipped", sk.path[i]);
     for (int k = 1; lstat(to, &st) == 0 && k < 1000; k++) /* never replace an earlier one */
       snprintf(to, sizeof to, "%s.skipped.%d", sk.path[i], k);
-    const int moved = rename(sk.path[i], to) == 0;
+    const int moved = rank == 0 && rename(sk.path[i], to) == 0; /* rank 0's files */
     output_log(o, "resume: skipped %s%s: %s\n", sk.path[i], moved ? " (renamed *.skipped)" : "",
                sk.why[i]);
   }

@@ -119,13 +119,13 @@ int restart_save(struct output *o, struct sim *S, double *seconds) {
     timer_pop();
     return CHANSPH_ERR;
   }
-  /* on several ranks sim_state gathers the particles on rank 0, which writes the file */
+  /* sim_state sends the particles to the ranks of their id blocks; every rank writes its
+     block (parallel HDF5 on several ranks) and learns the outcome */
   struct state_list L = {0};
   sim_state(S, &L);
   output_state(o, &L);
   rotate_path(path, sizeof path, o->dir, S->step);
-  if (rank == 0) rc = ckpt_write(path, &L, o->scene_text, S->step, S->t, err, sizeof err);
-  MPI_Bcast(&rc, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  rc = ckpt_write_all(path, &L, o->scene_text, S->step, S->t, err, sizeof err);
   state_free(&L);
   timer_pop();
   *seconds = timer_now() - t0;

@@ -145,6 +145,14 @@ void dd_keep_owned(struct dd *d, struct particles *P, const struct nbr *nb) {
   P->n = k, P->n_ghost = 0;
 }
 
+void dd_take_block(struct dd *d, struct particles *P, const struct nbr *nb, size_t lo, size_t n) {
+  for (size_t a = 0; a < n; a++)
+    if (a != lo + a) copy_slot(P, a, lo + a);
+  P->n = n, P->n_ghost = 0;
+  dd_migrate(d, P, nb);
+  d->seconds = d->bytes = 0.0, d->messages = d->migrated = 0; /* the run's counters start here */
+}
+
 void dd_migrate(struct dd *d, struct particles *P, const struct nbr *nb) {
   P->n_ghost = 0;
   if (d->size == 1) return;

@@ -71,6 +71,12 @@ int dd_owner(const struct dd *d, int col);
 void dd_keep_owned(struct dd *d, struct particles *P, const struct nbr *nb);
 
 /**
+ * @brief Keep the slots lo .. lo+n-1 (a checkpoint's id block read on this rank) as this rank's
+ *        particles and send each to the owner of its column (dd_migrate). Collective.
+ */
+void dd_take_block(struct dd *d, struct particles *P, const struct nbr *nb, size_t lo, size_t n);
+
+/**
  * @brief Drop the ghosts and send every owned particle that is not in this rank's columns to
  *        its owner (positions are wrapped first). Collective.
  */

@@ -26,6 +26,22 @@ static void model_update(struct sim *S) {
   reduce_global_max(&S->nu_max, 1);
 }
 
+/* Checkpoint blocks: rank r of size holds the ids [r N / size, (r+1) N / size) in the file. */
+static void id_block(int r, int size, size_t N, size_t *lo, size_t *hi) {
+  *lo = (size_t)((unsigned long long)r * N / (unsigned)size);
+  *hi = (size_t)((unsigned long long)(r + 1) * N / (unsigned)size);
+}
+
+static int id_block_owner(int64_t id, int size, size_t N) {
+  int r = (int)((unsigned long long)id * (unsigned)size / N);
+  size_t lo, hi;
+  for (id_block(r, size, N, &lo, &hi); (size_t)id >= hi; id_block(++r, size, N, &lo, &hi)) {
+  }
+  for (; (size_t)id < lo; id_block(--r, size, N, &lo, &hi)) {
+  }
+  return r;
+}
+
 /* Grow every per-particle array of the simulation to n slots (dd_reserve_fn). */
 static void sim_reserve(void *ctx, size_t n) {
   struct sim *S = ctx;
@@ -77,12 +93,20 @@ int sim_create(struct sim *S, const struct scene *sc) {
   return CHANSPH_OK;
 }
 
-/* Partition the columns over the ranks, keep this rank's particles, set up the grid. */
-static int sim_distribute(struct sim *S) {
+/* Partition the columns over the ranks, keep this rank's particles, set up the grid. From a
+   checkpoint read on several ranks (block = 1), this rank holds the slots of its id block
+   (sim_state), which migrate to their owners. */
+static int sim_distribute(struct sim *S, int block) {
   if (dd_init(&S->dd, S->sc, sim_reserve, S)) return CHANSPH_ERR;
   const int ix0 = S->dd.first[S->dd.rank], nxo = S->dd.first[S->dd.rank + 1] - ix0;
   nbr_init(&S->nb, S->sc, S->P.n, ix0, nxo, S->dd.halo);
-  dd_keep_owned(&S->dd, &S->P, &S->nb);
+  if (block && S->dd.size > 1) {
+    size_t lo, hi;
+    id_block(S->dd.rank, S->dd.size, S->P.n_fluid + S->P.n_vertex, &lo, &hi);
+    dd_take_block(&S->dd, &S->P, &S->nb, lo, hi - lo);
+  } else {
+    dd_keep_owned(&S->dd, &S->P, &S->nb);
+  }
   sim_reserve(S, S->P.n);
   S->distributed = 1;
   return CHANSPH_OK;
@@ -90,7 +114,7 @@ static int sim_distribute(struct sim *S) {
 
 int sim_init(struct sim *S, const struct scene *sc) {
   TRY(sim_create(S, sc));
-  if (sim_distribute(S)) {
+  if (sim_distribute(S, 0)) {
     sim_free(S);
     return CHANSPH_ERR;
   }
@@ -256,85 +280,70 @@ int sim_done(const struct sim *S) {
   return S->t >= S->sc->t_end * (1.0 - 1e-12);
 }
 
-/* Gather every rank's particles (placed by id) and the wall values of the vertices each rank
-   owns into rank 0's S->gather arrays, which the state list then names. */
+/* The particle record of the redistribution, and the arrays of S->gather it fills. */
 enum { G_ID, G_KIND, G_X, G_Y, G_Z, G_U, G_V, G_W, G_RHO, G_P, G_M, G_GAM, G_KSUM, G_LEN };
 
-static void gather_state(struct sim *S, size_t *n_all) {
+/* Send every owned particle (with the wall values of a vertex) to the rank whose id block holds
+   it (MPI_Alltoallv) and place what arrives by id into S->gather: rank r then holds the ids
+   lo .. hi-1 in order, and the wall values of the vertex slots among them (walls/ rows
+   max(lo, n_fluid) - n_fluid onwards). Collective. */
+static void block_state(struct sim *S, size_t lo, size_t hi) {
   const struct particles *P = &S->P;
-  const size_t n = P->n, nv = P->n_vertex;
-  int rank = S->dd.rank, size = S->dd.size;
-  double *rec = part_alloc("gather_send", (n ? n : 1) * (G_LEN + 2) * sizeof(double));
-  size_t k = 0;
-  for (size_t a = 0; a < n; a++, k++) {
-    double *r = rec + k * G_LEN;
+  const size_t n = P->n, N = P->n_fluid + P->n_vertex, nb = hi - lo, R = G_LEN + 2;
+  const int size = S->dd.size;
+  int *cnt = calloc(4 * (size_t)size + 2, sizeof(int)), *dest = malloc((n ? n : 1) * sizeof(int));
+  if (!cnt || !dest) die("out of memory redistributing the checkpoint state");
+  int *sdisp = cnt + size, *rcnt = sdisp + size + 1, *rdisp = rcnt + size;
+  for (size_t a = 0; a < n; a++) dest[a] = id_block_owner(P->id[a], size, N), cnt[dest[a]] += R;
+  for (int r = 0; r < size; r++) sdisp[r + 1] = sdisp[r] + cnt[r];
+  double *rec = part_alloc("ckpt_send", (n ? n : 1) * R * sizeof(double));
+  int *fill = calloc((size_t)size, sizeof(int));
+  if (!fill) die("out of memory redistributing the checkpoint state");
+  const double *f[] = {P->x, P->y, P->z, P->u, P->v, P->w, P->rho, P->p, P->m, P->gam, P->ksum};
+  for (size_t a = 0; a < n; a++) {
+    double *r = rec + sdisp[dest[a]] + fill[dest[a]];
+    fill[dest[a]] += (int)R;
     memcpy(&r[G_ID], &P->id[a], sizeof(double));
-    const double *f[] = {P->x, P->y, P->z, P->u, P->v, P->w, P->rho, P->p, P->m, P->gam, P->ksum};
     r[G_KIND] = P->kind[a];
     for (int c = 0; c < G_LEN - 2; c++) r[G_X + c] = f[c][a];
-  }
-  /* wall values of the owned vertices: (slot, rho, p) after the particle records */
-  double *wrec = rec + n * G_LEN;
-  size_t nw = 0;
-  for (size_t a = 0; a < n; a++) {
-    if (P->kind[a] != KIND_VERTEX) continue;
-    const size_t slot = part_vertex_slot(P, P->id[a]);
-    wrec[3 * nw] = (double)slot, wrec[3 * nw + 1] = S->W.rho[slot], wrec[3 * nw + 2] = S->W.p[slot];
-    nw++;
-  }
-  int cnt[2] = {(int)(n * G_LEN), (int)(3 * nw)}, *all = NULL;
-  if (rank == 0) all = part_alloc("gather_counts", 2 * (size_t)size * sizeof(int));
-  MPI_Gather(cnt, 2, MPI_INT, all, 2, MPI_INT, 0, MPI_COMM_WORLD);
-  int *c0 = NULL, *d0 = NULL, *c1 = NULL, *d1 = NULL;
-  double *buf = NULL, *wbuf = NULL;
-  size_t tot = 0, wtot = 0;
-  if (rank == 0) {
-    c0 = part_alloc("gather_counts", 4 * (size_t)size * sizeof(int));
-    d0 = c0 + size, c1 = d0 + size, d1 = c1 + size;
-    for (int r = 0; r < size; r++) {
-      c0[r] = all[2 * r], c1[r] = all[2 * r + 1];
-      d0[r] = (int)tot, d1[r] = (int)wtot;
-      tot += (size_t)c0[r], wtot += (size_t)c1[r];
+    r[G_LEN] = r[G_LEN + 1] = 0.0;
+    if (P->kind[a] == KIND_VERTEX) {
+      const size_t slot = part_vertex_slot(P, P->id[a]);
+      r[G_LEN] = S->W.rho[slot], r[G_LEN + 1] = S->W.p[slot];
     }
-    buf = part_alloc("gather_recv", (tot ? tot : 1) * sizeof(double));
-    wbuf = part_alloc("gather_recv", (wtot ? wtot : 1) * sizeof(double));
   }
-  MPI_Gatherv(rec, cnt[0], MPI_DOUBLE, buf, c0, d0, MPI_DOUBLE, 0, MPI_COMM_WORLD);
-  MPI_Gatherv(wrec, cnt[1], MPI_DOUBLE, wbuf, c1, d1, MPI_DOUBLE, 0, MPI_COMM_WORLD);
-  part_free(rec);
-  *n_all = 0;
-  if (rank == 0) {
-    const size_t N = tot / G_LEN;
-    *n_all = N;
-    for (int k2 = 0; k2 < SIM_GATHER; k2++) free(S->gather[k2]), S->gather[k2] = NULL;
-    int64_t *id = malloc(N * sizeof *id);
-    uint8_t *kind = malloc(N ? N : 1);
-    if (!id || !kind) die("out of memory gathering the checkpoint state");
-    S->gather[G_ID] = id, S->gather[G_KIND] = kind;
-    for (int c = G_X; c < G_LEN; c++) {
-      S->gather[c] = malloc((N ? N : 1) * sizeof(double));
-      if (!S->gather[c]) die("out of memory gathering the checkpoint state");
-    }
-    for (size_t i = 0; i < N; i++) { /* by id (0 .. N-1): the same file on any rank count */
-      const double *r = buf + i * G_LEN;
-      int64_t pid;
-      memcpy(&pid, &r[G_ID], sizeof(double));
-      if (pid < 0 || (size_t)pid >= N)
-        die("gathering the state: particle id %lld out of range", (long long)pid);
-      id[pid] = pid;
-      kind[pid] = (uint8_t)r[G_KIND];
-      for (int c = G_X; c < G_LEN; c++) ((double *)S->gather[c])[pid] = r[c];
-    }
-    double *wr = malloc(2 * (nv ? nv : 1) * sizeof(double));
-    if (!wr) die("out of memory gathering the checkpoint state");
-    for (size_t i = 0; i < wtot / 3; i++) {
-      const size_t slot = (size_t)wbuf[3 * i];
-      wr[slot] = wbuf[3 * i + 1], wr[nv + slot] = wbuf[3 * i + 2];
-    }
-    S->gather[G_LEN] = wr;
-    part_free(c0), part_free(all), part_free(buf), part_free(wbuf);
+  MPI_Alltoall(cnt, 1, MPI_INT, rcnt, 1, MPI_INT, MPI_COMM_WORLD);
+  rdisp[0] = 0;
+  for (int r = 1; r < size; r++) rdisp[r] = rdisp[r - 1] + rcnt[r - 1];
+  const size_t got = (size_t)(rdisp[size - 1] + rcnt[size - 1]) / R;
+  if (got != nb) die("checkpoint blocks: %zu particles arrived for the %zu ids %zu..", got, nb, lo);
+  double *buf = part_alloc("ckpt_recv", (nb ? nb : 1) * R * sizeof(double));
+  MPI_Alltoallv(rec, cnt, sdisp, MPI_DOUBLE, buf, rcnt, rdisp, MPI_DOUBLE, MPI_COMM_WORLD);
+  part_free(rec), free(fill), free(dest), free(cnt);
+  for (int k = 0; k < SIM_GATHER; k++) free(S->gather[k]), S->gather[k] = NULL;
+  const size_t w0 = lo > P->n_fluid ? lo : P->n_fluid, nw = hi > w0 ? hi - w0 : 0;
+  int64_t *id = malloc((nb ? nb : 1) * sizeof *id);
+  uint8_t *kind = malloc(nb ? nb : 1);
+  double *wr = malloc(2 * (nw ? nw : 1) * sizeof(double));
+  if (!id || !kind || !wr) die("out of memory redistributing the checkpoint state");
+  S->gather[G_ID] = id, S->gather[G_KIND] = kind, S->gather[G_LEN] = wr;
+  for (int c = G_X; c < G_LEN; c++)
+    if (!(S->gather[c] = malloc((nb ? nb : 1) * sizeof(double))))
+      die("out of memory redistributing the checkpoint state");
+  for (size_t i = 0; i < nb; i++) { /* by id: the same file on any rank count */
+    const double *r = buf + i * R;
+    int64_t pid;
+    memcpy(&pid, &r[G_ID], sizeof(double));
+    if (pid < (int64_t)lo || pid >= (int64_t)hi)
+      die("checkpoint blocks: particle id %lld outside the block %zu..%zu", (long long)pid, lo,
+          hi - 1);
+    const size_t k = (size_t)pid - lo;
+    id[k] = pid, kind[k] = (uint8_t)r[G_KIND];
+    for (int c = G_X; c < G_LEN; c++) ((double *)S->gather[c])[k] = r[c];
+    if (r[G_KIND] == KIND_VERTEX)
+      wr[(size_t)pid - w0] = r[G_LEN], wr[nw + (size_t)pid - w0] = r[G_LEN + 1];
   }
-  (void)rank;
+  part_free(buf);
 }
 
 void sim_state(struct sim *S, struct state_list *L) {
@@ -350,20 +359,24 @@ void sim_state(struct sim *S, struct state_list *L) {
   state_add(L, "drive/ub_prev", STATE_F64, 0, NULL, &S->drive.ub_prev, "m/s");
   state_add(L, "drive/dt_prev", STATE_F64, 0, NULL, &S->drive.dt_prev, "s");
   state_add(L, "drive/started", STATE_I32, 0, NULL, &S->drive.started, NULL);
-  const size_t nv = P->n_vertex;
-  /* a running simulation writes its particles by id, gathered on rank 0 (the file does not
-     depend on the number of ranks); before sim_distribute the fields are the full arrays that
-     a resume reads into */
-  const int gathered = S->distributed;
-  size_t n_all = P->n;
-  if (gathered) {
-    gather_state(S, &n_all);
-    n_all = P->n_fluid + P->n_vertex; /* the same shape on every rank (rank 0 writes) */
-  }
+  /* the particle datasets hold the ids 0 .. N-1 in order (the file does not depend on the
+     number of ranks); each rank names its id block. A running simulation first sends its
+     particles to the block owners; before sim_distribute the block is read into the slots
+     lo .. hi-1 of the full initial arrays (sim_restored then migrates the particles) */
+  const size_t N = P->n_fluid + P->n_vertex, nv = P->n_vertex;
+  int rank = 0, size = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  size_t lo, hi;
+  id_block(rank, size, N, &lo, &hi);
+  const int blocks = S->distributed;
+  if (blocks) block_state(S, lo, hi);
   void *const *g = (void *const *)S->gather;
-  const size_t n[1] = {n_all};
-  state_add(L, "particles/id", STATE_I64, 1, n, gathered ? g[G_ID] : P->id, NULL);
-  state_add(L, "particles/kind", STATE_U8, 1, n, gathered ? g[G_KIND] : P->kind, NULL);
+  const size_t n[1] = {hi - lo};
+  struct state_field *fid, *fkind;
+  fid = state_add(L, "particles/id", STATE_I64, 1, n, blocks ? g[G_ID] : P->id + lo, NULL);
+  fkind = state_add(L, "particles/kind", STATE_U8, 1, n, blocks ? g[G_KIND] : P->kind + lo, NULL);
+  fid->offset = fkind->offset = lo, fid->total = fkind->total = N;
   struct {
     const char *name;
     double *data;
@@ -380,17 +393,24 @@ void sim_state(struct sim *S, struct state_list *L) {
                  {"particles/mass", P->m, G_M, "kg"},
                  {"particles/gamma", P->gam, G_GAM, "1"},
                  {"particles/kernel_sum", P->ksum, G_KSUM, "kg/m^dim"}};
-  for (size_t i = 0; i < sizeof f / sizeof f[0]; i++)
-    state_add(L, f[i].name, STATE_F64, 1, n, gathered ? g[f[i].g] : f[i].data, f[i].units);
-  const size_t nw[1] = {nv};
-  double *wr = gathered ? S->gather[G_LEN] : NULL;
-  state_add(L, "walls/rho", STATE_F64, 1, nw, gathered ? wr : S->W.rho, "kg/m^3");
-  state_add(L, "walls/p", STATE_F64, 1, nw, gathered ? (wr ? wr + nv : NULL) : S->W.p, "Pa");
+  for (size_t i = 0; i < sizeof f / sizeof f[0]; i++) {
+    struct state_field *fi =
+        state_add(L, f[i].name, STATE_F64, 1, n, blocks ? g[f[i].g] : f[i].data + lo, f[i].units);
+    fi->offset = lo, fi->total = N;
+  }
+  /* wall values: written by the blocks (the vertex slots of each id block), read whole */
+  const size_t w0 = lo > P->n_fluid ? lo - P->n_fluid : 0;
+  const size_t nw[1] = {blocks ? (hi > P->n_fluid ? hi - P->n_fluid : 0) - w0 : nv};
+  double *wr = blocks ? S->gather[G_LEN] : NULL;
+  struct state_field *wrho, *wp;
+  wrho = state_add(L, "walls/rho", STATE_F64, 1, nw, blocks ? wr : S->W.rho, "kg/m^3");
+  wp = state_add(L, "walls/p", STATE_F64, 1, nw, blocks ? wr + nw[0] : S->W.p, "Pa");
+  if (blocks) wrho->offset = wp->offset = w0, wrho->total = wp->total = nv;
 }
 
 size_t sim_restored(struct sim *S) {
   struct particles *P = &S->P;
-  if (!S->distributed && sim_distribute(S)) die("the checkpoint's scene does not fit the ranks");
+  if (!S->distributed && sim_distribute(S, 1)) die("the checkpoint's scene does not fit the ranks");
   const size_t nv = P->n_vertex;
   double *old = part_alloc("restore_check", 2 * nv * sizeof(double));
   memcpy(old, S->W.rho, nv * sizeof(double));

@@ -14,7 +14,7 @@
 #include "sph.h"
 #include "state.h"
 
-enum { SIM_GATHER = 16 }; /*!< arrays of the gathered state (sim_state on several ranks) */
+enum { SIM_GATHER = 16 }; /*!< arrays of this rank's checkpoint id block (sim_state) */
 
 /** Everything a running simulation holds. */
 struct sim {
@@ -39,7 +39,7 @@ struct sim {
                                  force pass (NaN if not sampled) [N, N/m in 2-D] */
   char violation[320];      /*!< a fixed dt broke a stability limit: what, where (else empty) */
   int distributed;          /*!< 1 after the particles were split over the ranks */
-  void *gather[SIM_GATHER]; /*!< rank 0: the whole state gathered for a checkpoint */
+  void *gather[SIM_GATHER]; /*!< this rank's id block of the state, for a checkpoint */
 };
 
 /** Global diagnostics of the current state (all fluid particles). */
@@ -83,16 +83,20 @@ void sim_free(struct sim *S);
 void sim_step(struct sim *S);
 
 /**
- * @brief Append the state a continuation needs to a list (particles in memory order with their
- *        ids, wall values, step, time, last dt and force, flux-controller history).
- * @param[in] S simulation (after sim_init; the fields point into its memory)
+ * @brief Append the state a continuation needs to a list (particles by id with their ids, wall
+ *        values, step, time, last dt and force, flux-controller history). The particle and
+ *        wall fields are distributed (state.h): rank r of P names the ids [r N / P, (r+1) N / P).
+ *        After sim_init the particles are first sent to the ranks of their blocks (collective);
+ *        after sim_create the fields are those slots of the full arrays, to read a block into.
+ * @param[in] S simulation (the fields point into its memory)
  * @param[in,out] L list
  */
 void sim_state(struct sim *S, struct state_list *L);
 
 /**
  * @brief After the fields of sim_state() were filled from a checkpoint (into sim_create()'s
- *        full state): split the particles over the ranks, re-sort them
+ *        full state): split the particles over the ranks (each rank's id block migrates to
+ *        the owners of its columns), re-sort them
  *        (order by cell, then id), rebuild the neighbour list and the quantities derived from
  *        the stored state (pressure, sound speed, volumes, wall values), bitwise as the step
  *        that produced them.

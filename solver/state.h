@@ -9,6 +9,10 @@
  * the reader fills the same memory back. A module adds state by adding fields, without
  * touching the checkpoint code (docs/checkpoint-format.md).
  *
+ * Particle arrays of a run on several MPI ranks are distributed: each rank names its block
+ * of rows (offset, total), and the collective writer and the block reader (restart/ckpt.h)
+ * touch only those rows of the dataset.
+ *
  * Arrays whose length is only known when reading (time series that grow during the run)
  * give a reserve() callback: the reader calls it with the stored shape and reads into the
  * memory it returns (NULL means "cannot", and the reader reports the field).
@@ -39,6 +43,10 @@ struct state_field {
   /** For fields sized on reading: return memory for the stored shape (or NULL). */
   void *(*reserve)(void *owner, int rank, const size_t *dims);
   void *owner; /*!< first argument of reserve */
+  /** Distributed fields (total > 0): this rank holds rows offset .. offset+dims[0]-1 of a
+      dataset of total rows (the other dimensions whole); each rank reads and writes its own
+      rows. total = 0: the whole field, the same on every rank. */
+  size_t offset, total;
 };
 
 struct state_list {
