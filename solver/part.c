@@ -113,8 +113,12 @@ static void grow(void *pp, const char *label, size_t elem, size_t used, size_t c
 }
 
 void part_reserve(struct particles *P, size_t n) {
-  if (n <= P->cap) return;
-  const size_t cap = n + n / 2, used = P->n + P->n_ghost, d = sizeof(double);
+  if (n > P->cap) part_resize(P, n + n / 2);
+}
+
+void part_resize(struct particles *P, size_t cap) {
+  const size_t used = P->n + P->n_ghost, d = sizeof(double);
+  if (cap < used) cap = used;
   struct {
     double **a;
     const char *label;

@@ -93,6 +93,12 @@ void part_create(struct particles *P, struct walls *W, const struct scene *s);
  */
 void part_reserve(struct particles *P, size_t n);
 
+/**
+ * @brief Make every per-particle array hold exactly cap slots (at least the ones in use),
+ *        e.g. to give back the memory of the full initial lattice once a rank kept its part.
+ */
+void part_resize(struct particles *P, size_t cap);
+
 /** @brief Free everything part_create() allocated. */
 void part_destroy(struct particles *P, struct walls *W);
 

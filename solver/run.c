@@ -58,13 +58,15 @@ static void sim_reserve(void *ctx, size_t n) {
 
 /* Neighbours, density, wall values and model terms of the current positions: sort the owned
    particles, build the ghosts, and refresh the ghosts' copies after each pass whose results
-   the next pass reads at neighbours. dt = 0: density from the stored state. */
-static void update_state(struct sim *S, const double *ksum_old_or_null, double dt) {
+   the next pass reads at neighbours. restored: after a checkpoint was read, density from the
+   stored state and kernel sums (dt = 0). */
+static void update_state(struct sim *S, int restored, double dt) {
   struct particles *P = &S->P;
   nbr_sort(&S->nb, P);
   dd_halo(&S->dd, P, &S->nb);
   nbr_build(&S->nb, P, &S->M.k, S->ksum_new);
-  sph_density(&S->M, P, ksum_old_or_null ? ksum_old_or_null : S->ksum_new, dt);
+  /* the arrays may have moved (grown for the ghosts): take the pointers only now */
+  sph_density(&S->M, P, restored ? P->ksum : S->ksum_new, dt);
   double *const dens[5] = {P->rho, P->p, P->c, P->pr2, P->vol};
   dd_update(&S->dd, P, 5, dens); /* fluid ghosts: what sph_walls reads */
   sph_walls(&S->M, P, &S->nb, &S->W);
@@ -99,7 +101,7 @@ int sim_create(struct sim *S, const struct scene *sc) {
 static int sim_distribute(struct sim *S, int block) {
   if (dd_init(&S->dd, S->sc, sim_reserve, S)) return CHANSPH_ERR;
   const int ix0 = S->dd.first[S->dd.rank], nxo = S->dd.first[S->dd.rank + 1] - ix0;
-  nbr_init(&S->nb, S->sc, S->P.n, ix0, nxo, S->dd.halo);
+  nbr_init(&S->nb, S->sc, 0, ix0, nxo, S->dd.halo); /* sized below, for this rank's part */
   if (block && S->dd.size > 1) {
     size_t lo, hi;
     id_block(S->dd.rank, S->dd.size, S->P.n_fluid + S->P.n_vertex, &lo, &hi);
@@ -107,6 +109,9 @@ static int sim_distribute(struct sim *S, int block) {
   } else {
     dd_keep_owned(&S->dd, &S->P, &S->nb);
   }
+  /* several ranks: give back the full lattice's memory, keeping room for the ghosts and the
+     particles that arrive (the arrays grow by half again when needed) */
+  if (S->dd.size > 1) part_resize(&S->P, S->P.n + S->P.n / 2);
   sim_reserve(S, S->P.n);
   S->distributed = 1;
   return CHANSPH_OK;
@@ -118,7 +123,7 @@ int sim_init(struct sim *S, const struct scene *sc) {
     sim_free(S);
     return CHANSPH_ERR;
   }
-  update_state(S, NULL, 0.0);
+  update_state(S, 0, 0.0);
   return CHANSPH_OK;
 }
 
@@ -245,7 +250,7 @@ void sim_step(struct sim *S) {
   if (S->dd.size > 1 && S->sc->balance_every > 0 && S->step % S->sc->balance_every == 0)
     dd_balance(&S->dd, &S->nb, S->sc->balance_threshold);
   dd_migrate(&S->dd, P, &S->nb);
-  update_state(S, NULL, dt);
+  update_state(S, 0, dt);
   if (S->sc->check_ids) dd_check_ids(&S->dd, P, P->n_fluid + P->n_vertex, S->step);
 }
 
@@ -417,7 +422,7 @@ size_t sim_restored(struct sim *S) {
   memcpy(old + nv, S->W.p, nv * sizeof(double));
   /* dt = 0: pressure, sound speed, p/rho^2 and volume from the stored density; the kernel sum
      and gamma are set to the values they already hold */
-  update_state(S, P->ksum, 0.0);
+  update_state(S, 1, 0.0);
   size_t differ = 0;
   for (size_t i = 0; i < nv; i++)
     differ += memcmp(&old[i], &S->W.rho[i], sizeof(double)) != 0 ||
