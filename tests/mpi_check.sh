@@ -4,7 +4,6 @@
 #   bitwise2d  2-D channel, 200 steps, every statistics engine, ranks 1-4
 #   bitwise3d  3-D LES (Smagorinsky, Reichardt wall law), 200 steps, every engine, ranks 1-4,
 #              and 2 ranks x 2 threads
-#   resume     3-D LES: 100 steps on 2 ranks, resumed on 3 to step 200; equals the 1-rank run
 #   migration  fast 2-D flow (Mach 0.5) on 3 and 4 ranks, ids checked after every step,
 #              load checks every 7 steps (4 ranks start from a skewed partition); equals 1 rank
 #   too_many   more ranks than the slabs allow: a message naming domain.lx, exit 1
@@ -110,17 +109,6 @@ case $case in
       cmp -s r2/checkpoints/ckpt_0000000200.h5 r$np/checkpoints/ckpt_0000000200.h5 ||
         { echo "FAIL: the checkpoints of 2 and $np ranks differ in bytes"; fail=1; }
     done
-    ;;
-  resume)
-    scene=$scenes/les395_smoke.ini
-    args=(--set domain.lx=2.4 --set time.max_steps=200 --set output.stats_every=5 "${all_engines[@]}")
-    mpi 1 run "$scene" --out r1 --overwrite "${args[@]}" > r1.txt 2>&1 || { echo "FAIL: 1 rank"; exit 1; }
-    mpi 2 run "$scene" --out r23 --overwrite "${args[@]}" --max-steps 100 > r23a.txt 2>&1
-    rc=$?
-    [ $rc -eq 75 ] || { tail r23a.txt; echo "FAIL: the 2-rank job exited with $rc, not 75"; exit 1; }
-    mpi 3 resume r23 > r23b.txt 2>&1 || { tail r23b.txt; echo "FAIL: resume on 3 ranks"; exit 1; }
-    grep -h "resumed at step\|^decomposition" r23b.txt
-    compare r1 r23 200
     ;;
   migration)
     scene=$scenes/poiseuille2d.ini
