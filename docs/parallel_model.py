@@ -33,7 +33,7 @@ T_C_BENCH = 194.3e-3 / 99840  # s per particle-step per core, bench scene (1 x 1
 T_C_LES = 107e-3 * 2 / 41250  # s per particle-step per core, les395_small LES (1 x 2 threads)
 GHOSTS_BENCH = 2 * 2 * (1.6 / 49) * 1.0 * 1.0 / 0.025 ** 3  # 2 sides x 2 cols x ly x lz x n
 T_G = 4.07e-3 / GHOSTS_BENCH  # s per ghost per step (mean over the 2 ranks)
-B_GHOST = 1973.1e3 / GHOSTS_BENCH  # bytes per ghost per step
+B_GHOST = 1479.8e3 / GHOSTS_BENCH  # bytes per ghost per step (9 doubles built, 12 refreshed)
 MSG_SLAB = 8  # point-to-point messages per step and rank (bench, 2 ranks)
 # assumed cluster network
 BW = 10e9

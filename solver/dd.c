@@ -248,8 +248,25 @@ static void exchange(struct dd *d, int nf, void (*pack_fn)(const void *, size_t,
   d->bytes += (double)ns * nf * sizeof(double);
 }
 
-static void pack_particle(const void *arg, size_t a, double *r) {
-  pack(arg, a, r);
+/* A ghost on the wire: what the passes read at a neighbour before the first refresh (positions,
+   velocities, mass for the neighbour search and kernel sums, id and kind). Density, pressure and
+   the model terms follow in the refreshes (dd_update); nothing reads a ghost's gamma, kernel sum
+   or acceleration. */
+enum { H_X, H_Y, H_Z, H_U, H_V, H_W, H_M, H_ID, H_KIND, H_LEN };
+
+static void pack_ghost(const void *arg, size_t a, double *r) {
+  const struct particles *P = arg;
+  r[H_X] = P->x[a], r[H_Y] = P->y[a], r[H_Z] = P->z[a];
+  r[H_U] = P->u[a], r[H_V] = P->v[a], r[H_W] = P->w[a], r[H_M] = P->m[a];
+  memcpy(&r[H_ID], &P->id[a], sizeof(double));
+  r[H_KIND] = P->kind[a];
+}
+
+static void unpack_ghost(struct particles *P, size_t a, const double *r) {
+  P->x[a] = r[H_X], P->y[a] = r[H_Y], P->z[a] = r[H_Z];
+  P->u[a] = r[H_U], P->v[a] = r[H_V], P->w[a] = r[H_W], P->m[a] = r[H_M];
+  memcpy(&P->id[a], &r[H_ID], sizeof(double));
+  P->kind[a] = (uint8_t)r[H_KIND];
 }
 
 void dd_halo(struct dd *d, struct particles *P, struct nbr *nb) {
@@ -269,10 +286,10 @@ void dd_halo(struct dd *d, struct particles *P, struct nbr *nb) {
   MPI_Isend(&sc[1], 1, MPI_UNSIGNED_LONG, d->right, TAG_RIGHT, MPI_COMM_WORLD, &req[3]);
   MPI_Waitall(4, req, MPI_STATUSES_IGNORE);
   d->nrecv[0] = rc[0], d->nrecv[1] = rc[1];
-  exchange(d, F_LEN, pack_particle, P);
+  exchange(d, H_LEN, pack_ghost, P);
   const size_t ng = d->nrecv[0] + d->nrecv[1];
   d->reserve(d->ctx, P->n + ng);
-  for (size_t g = 0; g < ng; g++) unpack(P, P->n + g, d->rbuf + g * F_LEN);
+  for (size_t g = 0; g < ng; g++) unpack_ghost(P, P->n + g, d->rbuf + g * H_LEN);
   P->n_ghost = ng;
   nbr_sort_ghosts(nb, P, d->nrecv[0]);
   if (ng > d->cap_ghost) d->cap_ghost = ng + ng / 2;
