@@ -49,6 +49,50 @@ void part_memory_report(FILE *f) {
   fprintf(f, "  %-12s %10.2f MB\n", "total", total / 1048576.0);
 }
 
+/* Every per-particle array of part.h with its label and element size; `core` arrays exist in
+   every run, the others (turbulence model) only when turb_init allocated them. */
+struct array {
+  void **p;
+  const char *label;
+  size_t elem;
+  int core;
+};
+
+static size_t arrays(struct particles *P, struct array *t) {
+  const size_t d = sizeof(double);
+  const struct array all[] = {{(void **)&P->x, "x", d, 1},
+                              {(void **)&P->y, "y", d, 1},
+                              {(void **)&P->z, "z", d, 1},
+                              {(void **)&P->u, "u", d, 1},
+                              {(void **)&P->v, "v", d, 1},
+                              {(void **)&P->w, "w", d, 1},
+                              {(void **)&P->rho, "rho", d, 1},
+                              {(void **)&P->m, "mass", d, 1},
+                              {(void **)&P->gam, "gamma", d, 1},
+                              {(void **)&P->ksum, "kernel_sum", d, 1},
+                              {(void **)&P->ddiff, "diffusion", d, 1},
+                              {(void **)&P->p, "pressure", d, 1},
+                              {(void **)&P->c, "sound", d, 1},
+                              {(void **)&P->pr2, "p_over_rho2", d, 1},
+                              {(void **)&P->vol, "volume", d, 1},
+                              {(void **)&P->ax, "ax", d, 1},
+                              {(void **)&P->ay, "ay", d, 1},
+                              {(void **)&P->az, "az", d, 1},
+                              {(void **)&P->tmp, "sort_scratch", d, 1},
+                              {(void **)&P->id, "id", sizeof(int64_t), 1},
+                              {(void **)&P->tmp_i, "sort_scratch_i", sizeof(int64_t), 1},
+                              {(void **)&P->kind, "kind", 1, 1},
+                              {(void **)&P->nur, "nu_r", d, 0},
+                              {(void **)&P->kr, "k_r", d, 0},
+                              {(void **)&P->twx, "wall_law_tx", d, 0},
+                              {(void **)&P->twz, "wall_law_tz", d, 0}};
+  const size_t n = sizeof all / sizeof all[0];
+  memcpy(t, all, sizeof all);
+  return n;
+}
+
+enum { N_ARRAYS_MAX = 32 };
+
 void part_create(struct particles *P, struct walls *W, const struct scene *s) {
   const int nx = (int)floor(s->lx / s->dr + 0.5);
   const int ny = (int)floor(2.0 * s->delta / s->dr + 0.5);
@@ -58,18 +102,9 @@ void part_create(struct particles *P, struct walls *W, const struct scene *s) {
   P->n_vertex = 2 * (size_t)nx * (size_t)nz;
   P->n = P->n_fluid + P->n_vertex;
   P->cap = P->n;
-  const size_t nd = P->n * sizeof(double);
-  P->x = part_alloc("x", nd), P->y = part_alloc("y", nd), P->z = part_alloc("z", nd);
-  P->u = part_alloc("u", nd), P->v = part_alloc("v", nd), P->w = part_alloc("w", nd);
-  P->rho = part_alloc("rho", nd), P->m = part_alloc("mass", nd), P->gam = part_alloc("gamma", nd);
-  P->ksum = part_alloc("kernel_sum", nd), P->ddiff = part_alloc("diffusion", nd);
-  P->p = part_alloc("pressure", nd), P->c = part_alloc("sound", nd);
-  P->pr2 = part_alloc("p_over_rho2", nd), P->vol = part_alloc("volume", nd);
-  P->ax = part_alloc("ax", nd), P->ay = part_alloc("ay", nd), P->az = part_alloc("az", nd);
-  P->id = part_alloc("id", P->n * sizeof(int64_t));
-  P->kind = part_alloc("kind", P->n);
-  P->tmp = part_alloc("sort_scratch", nd);
-  P->tmp_i = part_alloc("sort_scratch_i", P->n * sizeof(int64_t));
+  struct array t[N_ARRAYS_MAX];
+  for (size_t i = 0, na = arrays(P, t); i < na; i++)
+    if (t[i].core) *t[i].p = part_alloc(t[i].label, P->n * t[i].elem);
 
   const double dr = s->dr, mass = s->rho0 * pow(dr, s->dim);
   const double zc = s->dim == 3 ? 0.5 * dr : 0.0;
@@ -95,12 +130,11 @@ void part_create(struct particles *P, struct walls *W, const struct scene *s) {
 }
 
 void part_destroy(struct particles *P, struct walls *W) {
-  double **d[] = {&P->x,   &P->y,   &P->z,    &P->u,     &P->v,   &P->w,   &P->rho,
-                  &P->m,   &P->gam, &P->ksum, &P->ddiff, &P->p,   &P->c,   &P->pr2,
-                  &P->vol, &P->ax,  &P->ay,   &P->az,    &P->tmp, &W->rho, &W->p};
-  for (size_t i = 0; i < sizeof d / sizeof d[0]; i++) part_free(*d[i]), *d[i] = NULL;
-  part_free(P->id), part_free(P->kind), part_free(P->tmp_i);
-  P->id = NULL, P->kind = NULL, P->tmp_i = NULL;
+  struct array t[N_ARRAYS_MAX];
+  for (size_t i = 0, na = arrays(P, t); i < na; i++)
+    if (t[i].core) part_free(*t[i].p), *t[i].p = NULL; /* the others are turb_free's */
+  part_free(W->rho), part_free(W->p);
+  W->rho = W->p = NULL;
 }
 
 static void grow(void *pp, const char *label, size_t elem, size_t used, size_t cap) {
@@ -117,38 +151,10 @@ void part_reserve(struct particles *P, size_t n) {
 }
 
 void part_resize(struct particles *P, size_t cap) {
-  const size_t used = P->n + P->n_ghost, d = sizeof(double);
+  const size_t used = P->n + P->n_ghost;
   if (cap < used) cap = used;
-  struct {
-    double **a;
-    const char *label;
-  } const f[] = {{&P->x, "x"},
-                 {&P->y, "y"},
-                 {&P->z, "z"},
-                 {&P->u, "u"},
-                 {&P->v, "v"},
-                 {&P->w, "w"},
-                 {&P->rho, "rho"},
-                 {&P->m, "mass"},
-                 {&P->gam, "gamma"},
-                 {&P->ksum, "kernel_sum"},
-                 {&P->ddiff, "diffusion"},
-                 {&P->p, "pressure"},
-                 {&P->c, "sound"},
-                 {&P->pr2, "p_over_rho2"},
-                 {&P->vol, "volume"},
-                 {&P->ax, "ax"},
-                 {&P->ay, "ay"},
-                 {&P->az, "az"},
-                 {&P->nur, "nu_r"},
-                 {&P->kr, "k_r"},
-                 {&P->twx, "wall_law_tx"},
-                 {&P->twz, "wall_law_tz"},
-                 {&P->tmp, "sort_scratch"}};
-  for (size_t i = 0; i < sizeof f / sizeof f[0]; i++) grow(f[i].a, f[i].label, d, used, cap);
-  grow(&P->id, "id", sizeof(int64_t), used, cap);
-  grow(&P->tmp_i, "sort_scratch_i", sizeof(int64_t), used, cap);
-  grow(&P->kind, "kind", 1, used, cap);
+  struct array t[N_ARRAYS_MAX];
+  for (size_t i = 0, na = arrays(P, t); i < na; i++) grow(t[i].p, t[i].label, t[i].elem, used, cap);
   P->cap = cap;
 }
 
