@@ -113,8 +113,7 @@ int main(int argc, char **argv) {
   if (argc > 1 && !strcmp(argv[1], "compare"))
     return compare_main(argc - 2, argv + 2, CHANSPH_STATS_DIR);
   MPI_Init(&argc, &argv);
-  int size = 1, rc = 0;
-  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  int rc = 0;
   struct cli c;
   struct scene sc;
   if (cli_parse(argc, argv, &c)) {
