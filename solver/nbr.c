@@ -7,11 +7,17 @@
 
 #include "error.h"
 #include "kernel.h"
+#include "pair.h"
 #include "timers.h"
 
 int nbr_columns(const struct scene *s) {
   const double cell = 2.0 * scene_h(s) / NBR_REACH;
   return (int)floor(s->lx / cell * (1.0 + 1e-12));
+}
+
+/* List slots per particle: at least n, a multiple of NBR_ALIGN. */
+static int nbr_round_stride(int n) {
+  return (n + NBR_ALIGN - 1) / NBR_ALIGN * NBR_ALIGN;
 }
 
 void nbr_init(struct nbr *nb, const struct scene *s, size_t n, int ix0, int nxo, int halo) {
@@ -32,7 +38,7 @@ void nbr_init(struct nbr *nb, const struct scene *s, size_t n, int ix0, int nxo,
   /* expected neighbours in the support, with head room; nbr_build grows it if needed */
   const double per = s->dim == 3 ? 4.0 / 3.0 * M_PI * pow(2.0 * s->h_over_dr, 3)
                                  : M_PI * pow(2.0 * s->h_over_dr, 2);
-  nb->stride = (int)(1.5 * per) + 8;
+  nb->stride = nbr_round_stride((int)(1.5 * per) + 8);
   nbr_reserve(nb, n);
 }
 
@@ -50,7 +56,9 @@ void nbr_reserve(struct nbr *nb, size_t n) {
   if (n <= nb->cap) return;
   const size_t cap = nb->cap ? n + n / 2 : n;
   part_free(nb->perm), part_free(nb->cell), part_free(nb->count), part_free(nb->list);
+  part_free(nb->nfluid);
   nb->cap = cap;
+  nb->nfluid = part_alloc("nbr_nfluid", cap * sizeof(int));
   nb->perm = part_alloc("sort_perm", cap * sizeof(size_t));
   nb->cell = part_alloc("cell_of", cap * sizeof(int));
   nb->count = part_alloc("nbr_count", cap * sizeof(int));
@@ -59,7 +67,7 @@ void nbr_reserve(struct nbr *nb, size_t n) {
 
 void nbr_free(struct nbr *nb) {
   part_free(nb->start), part_free(nb->pos), part_free(nb->perm), part_free(nb->cell);
-  part_free(nb->count), part_free(nb->list);
+  part_free(nb->count), part_free(nb->list), part_free(nb->nfluid);
   memset(nb, 0, sizeof *nb);
 }
 
@@ -140,23 +148,58 @@ void nbr_sort_ghosts(struct nbr *nb, struct particles *P, size_t n_left) {
 }
 
 /* Append the neighbours of a found in particles [b0, b1) shifted by (sx, 0, sz), and add
-   their m_b w_ab to *sum. */
-static inline int scan(const struct particles *restrict P, const struct kernel *K, size_t a,
+   their m_b w_ab to *sum in that order. The distances and kernel values of a block of
+   candidates are computed first (a loop that vectorises), then the block is appended without
+   branches; the sum is formed in the candidate order, so it does not depend on the vector
+   width nor on where the block starts in memory. */
+static inline __attribute__((always_inline)) int scan(const struct particles *restrict P, const struct kernel *K, size_t a,
                        size_t b0, size_t b1, double sx, double sz, double support2,
                        int32_t *restrict out, int cnt, int stride, double *sum) {
-  const double xa = P->x[a] - sx, ya = P->y[a], za = P->z[a] - sz;
+  enum { BLOCK = 32 };
+  const double *restrict x = P->x, *restrict y = P->y, *restrict z = P->z, *restrict m = P->m;
+  const double xa = x[a] - sx, ya = y[a], za = z[a] - sz;
   double s = *sum;
-  for (size_t b = b0; b < b1; b++) {
-    const double dx = xa - P->x[b], dy = ya - P->y[b], dz = za - P->z[b];
-    const double r2 = dx * dx + dy * dy + dz * dz;
-    if (r2 < support2 && b != a) {
-      if (cnt < stride) out[cnt] = (int32_t)b;
-      cnt++;
-      s += P->m[b] * kernel_w(K, sqrt(r2));
+  for (size_t c0 = b0; c0 < b1; c0 += BLOCK) {
+    const int nblk = b1 - c0 < BLOCK ? (int)(b1 - c0) : BLOCK;
+    double mw[BLOCK];
+    int in[BLOCK];
+#pragma omp simd
+    for (int j = 0; j < nblk; j++) {
+      const size_t b = c0 + (size_t)j;
+      const double dx = xa - x[b], dy = ya - y[b], dz = za - z[b];
+      const double r2 = dx * dx + dy * dy + dz * dz;
+      /* computed for every candidate and masked by a product: no branch, so it vectorises */
+      const double hit = (r2 < support2 ? 1.0 : 0.0) * (b != a ? 1.0 : 0.0);
+      in[j] = (int)hit;
+      mw[j] = hit * m[b] * pair_w(K, sqrt(r2));
+    }
+    for (int j = 0; j < nblk; j++) {
+      s += mw[j]; /* zero for a candidate outside the support: the sum is unchanged */
+      if (cnt < stride) out[cnt] = (int32_t)(c0 + (size_t)j); /* kept if it is a hit */
+      cnt += in[j];
     }
   }
   *sum = s;
   return cnt;
+}
+
+/* Stable partition of the list out[0 .. cnt-1]: fluid particles first, then the vertices, each
+   in the order found; returns the number of fluid neighbours. */
+static int fluid_first(const uint8_t *restrict kind, int32_t *restrict out, int cnt) {
+  int nf = 0, nv = 0;
+  for (int j = 0; j < cnt; j++) nv += kind[out[j]] != KIND_FLUID;
+  if (!nv) return cnt;
+  int32_t vtx[nv];
+  nv = 0;
+  for (int j = 0; j < cnt; j++) {
+    const int32_t b = out[j];
+    if (kind[b] == KIND_FLUID)
+      out[nf++] = b;
+    else
+      vtx[nv++] = b;
+  }
+  for (int j = 0; j < nv; j++) out[nf + j] = vtx[j];
+  return nf;
 }
 
 /* Column slot of the stencil column lc + dx of an owned column lc, and the periodic shift of
@@ -176,60 +219,85 @@ static inline int stencil_column(const struct nbr *nb, int lc, int dx, double *s
   return jl;
 }
 
+/* Gap between a coordinate and the cell interval [j, j + 1) / c: a lower bound of the distance
+   to any particle of the cell (particles outside the grid are clamped into the edge cells, on
+   the far side from the interior, so the bound still holds). */
+static inline double cell_gap(double p, int j, double c) {
+  const double lo = j / c, hi = (j + 1) / c;
+  return p < lo ? lo - p : p > hi ? p - hi : 0.0;
+}
+
+/* Neighbour lists and kernel sums of the particles of owned cell c; returns the largest count
+   that did not fit the stride (0 if all fitted). */
+static CHANSPH_CLONES int build_cell(struct nbr *nb, const struct particles *P,
+                                     const struct kernel *K, size_t c, double *ksum) {
+  const double w0 = pair_w(K, 0.0);
+  const int stride = nb->stride, R = NBR_REACH;
+  const int dz_lo = nb->dim == 3 ? -R : 0, dz_hi = nb->dim == 3 ? R : 0;
+  /* rows of the stencil farther than 2h in y and z are skipped (with a margin: the skipped
+     candidates are outside the support by far more than the rounding of the cell index) */
+  const double prune2 = nb->support2 * (1.0 + 1e-9);
+  const int lc = (int)(c % (size_t)nb->nxo);
+  const int iy = (int)(c / (size_t)nb->nxo % (size_t)nb->ny);
+  const int iz = (int)(c / ((size_t)nb->nxo * nb->ny));
+  int overflow = 0;
+  for (size_t a = nb->start[c]; a < nb->start[c + 1]; a++) {
+    int32_t *out = nb->list + a * (size_t)stride;
+    int cnt = 0;
+    double sum = P->m[a] * w0;
+    for (int dz = dz_lo; dz <= dz_hi; dz++) {
+      int jz = iz + dz;
+      double sz = 0.0;
+      if (jz < 0)
+        jz += nb->nz, sz = -nb->lz;
+      else if (jz >= nb->nz)
+        jz -= nb->nz, sz = nb->lz;
+      const double gz = nb->dim == 3 ? cell_gap(P->z[a] - sz, jz, nb->cz) : 0.0;
+      for (int dy = -R; dy <= R; dy++) {
+        const int jy = iy + dy;
+        if (jy < 0 || jy >= nb->ny) continue;
+        const double gy = cell_gap(P->y[a], jy, nb->cy);
+        if (gy * gy + gz * gz >= prune2) continue;
+        const size_t row = (size_t)jz * nb->ny + jy;
+        const int gx = nb->ix0 + lc;
+        if (lc >= R && lc < nb->nxo - R && gx >= R && gx < nb->nx - R) {
+          /* the x cells of the stencil are contiguous and unshifted */
+          const size_t c0 = row * nb->nxo + lc;
+          cnt = scan(P, K, a, nb->start[c0 - R], nb->start[c0 + R + 1], 0.0, sz, nb->support2, out,
+                     cnt, stride, &sum);
+          continue;
+        }
+        for (int dx = -R; dx <= R; dx++) {
+          double sx;
+          const int col = stencil_column(nb, lc, dx, &sx);
+          const size_t cc =
+              col >= 0 ? row * nb->nxo + col : nb->ncell_own + row * 2 * nb->halo + (-1 - col);
+          cnt = scan(P, K, a, nb->start[cc], nb->start[cc + 1], sx, sz, nb->support2, out, cnt,
+                     stride, &sum);
+        }
+      }
+    }
+    nb->count[a] = cnt;
+    nb->nfluid[a] = cnt <= stride ? fluid_first(P->kind, out, cnt) : 0;
+    ksum[a] = sum;
+    if (cnt > stride && cnt > overflow) overflow = cnt;
+  }
+  return overflow;
+}
+
 void nbr_build(struct nbr *nb, const struct particles *P, const struct kernel *K, double *ksum) {
-  const double w0 = kernel_w(K, 0.0);
   timer_push("neighbours");
   if (P->n + P->n_ghost > (size_t)INT32_MAX) die("more than 2^31 particles on one rank");
   for (;;) {
     int overflow = 0;
-    const int stride = nb->stride;
-    const int R = NBR_REACH, dz_lo = nb->dim == 3 ? -R : 0, dz_hi = nb->dim == 3 ? R : 0;
 #pragma omp parallel for schedule(static) reduction(max : overflow)
     for (size_t c = 0; c < nb->ncell_own; c++) {
-      const int lc = (int)(c % (size_t)nb->nxo);
-      const int iy = (int)(c / (size_t)nb->nxo % (size_t)nb->ny);
-      const int iz = (int)(c / ((size_t)nb->nxo * nb->ny));
-      for (size_t a = nb->start[c]; a < nb->start[c + 1]; a++) {
-        int32_t *out = nb->list + a * (size_t)stride;
-        int cnt = 0;
-        double sum = P->m[a] * w0;
-        for (int dz = dz_lo; dz <= dz_hi; dz++) {
-          int jz = iz + dz;
-          double sz = 0.0;
-          if (jz < 0)
-            jz += nb->nz, sz = -nb->lz;
-          else if (jz >= nb->nz)
-            jz -= nb->nz, sz = nb->lz;
-          for (int dy = -R; dy <= R; dy++) {
-            const int jy = iy + dy;
-            if (jy < 0 || jy >= nb->ny) continue;
-            const size_t row = (size_t)jz * nb->ny + jy;
-            const int gx = nb->ix0 + lc;
-            if (lc >= R && lc < nb->nxo - R && gx >= R && gx < nb->nx - R) {
-              /* the x cells of the stencil are contiguous and unshifted */
-              const size_t c0 = row * nb->nxo + lc;
-              cnt = scan(P, K, a, nb->start[c0 - R], nb->start[c0 + R + 1], 0.0, sz, nb->support2,
-                         out, cnt, stride, &sum);
-              continue;
-            }
-            for (int dx = -R; dx <= R; dx++) {
-              double sx;
-              const int col = stencil_column(nb, lc, dx, &sx);
-              const size_t cc =
-                  col >= 0 ? row * nb->nxo + col : nb->ncell_own + row * 2 * nb->halo + (-1 - col);
-              cnt = scan(P, K, a, nb->start[cc], nb->start[cc + 1], sx, sz, nb->support2, out, cnt,
-                         stride, &sum);
-            }
-          }
-        }
-        nb->count[a] = cnt;
-        ksum[a] = sum;
-        if (cnt > stride && cnt > overflow) overflow = cnt;
-      }
+      const int o = build_cell(nb, P, K, c, ksum);
+      if (o > overflow) overflow = o;
     }
     if (!overflow) break;
     part_free(nb->list);
-    nb->stride = overflow + overflow / 4 + 8;
+    nb->stride = nbr_round_stride(overflow + overflow / 4 + 8);
     nb->list = part_alloc("nbr_list", nb->cap * (size_t)nb->stride * sizeof(int32_t));
   }
   timer_pop();

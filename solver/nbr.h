@@ -22,6 +22,10 @@
     (fewer distance checks than 3 cells of size 2h: 125 h^3 instead of 216 h^3 in 3-D). */
 enum { NBR_REACH = 2 };
 
+/** Every particle's list starts at a multiple of NBR_ALIGN entries (64 bytes), so vectorised
+    sums over it split the same way into lanes on any decomposition (bitwise rank-independent). */
+enum { NBR_ALIGN = 16 };
+
 /**
  * Cell grid and neighbour list. The grid is global (cells of the whole channel, column ix
  * along x, row iy, plane iz); a rank owns the columns ix0 .. ix0+nxo-1 and, with several ranks,
@@ -47,9 +51,11 @@ struct nbr {
   int *cell;         /*!< cell of each particle (sort scratch) */
   size_t cap;        /*!< particles the arrays hold */
   /* neighbour list */
-  int stride;    /*!< list slots per particle */
+  int stride;    /*!< list slots per particle, a multiple of NBR_ALIGN */
   int *count;    /*!< neighbours of each particle (excluding itself) */
-  int32_t *list; /*!< neighbours of a: list[a*stride .. a*stride+count[a]-1] */
+  int *nfluid;   /*!< of which fluid particles: they come first in the list, then the vertices */
+  int32_t *list; /*!< neighbours of a: list[a*stride .. a*stride+count[a]-1], each part in
+                      stencil order (cells, then id) */
 };
 
 /** @brief Columns of the global cell grid along x for a scene (what nbr_init uses). */
@@ -113,8 +119,9 @@ static inline size_t nbr_owned_cell(const struct nbr *nb, int lc, int iy, int iz
 }
 
 /**
- * @brief Build the neighbour list of every particle (pairs closer than 2h, self excluded) and,
- *        in the same pass, the kernel sums S_a = sum_b m_b w_ab (self included).
+ * @brief Build the neighbour list of every particle (pairs closer than 2h, self excluded; fluid
+ *        neighbours first, then wall vertices) and, in the same pass, the kernel sums
+ *        S_a = sum_b m_b w_ab (self included).
  * @param[in,out] nb grid and list; the stride grows if a particle has more neighbours
  * @param[in] P particles, sorted by nbr_sort()
  * @param[in] K kernel

@@ -116,6 +116,41 @@ void sph_walls(const struct model *M, struct particles *P, const struct nbr *nb,
 void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb,
                 const struct walls *W, double fx, struct force_info *info);
 
+/** Foot of a particle on the wall lattice: corner indices and weights of the (bi)linear
+    interpolation (the vertices sit at x = (i + 1/2) dr, z = (k + 1/2) dr). */
+struct foot {
+  size_t c00, c01, c10, c11;
+  double tx, tz;
+};
+
+static inline struct foot sph_foot(const struct model *M, const struct walls *W, int wall, double x,
+                                   double z) {
+  const double fx = x / M->dr - 0.5;
+  const double ix = floor(fx), tx = fx - ix;
+  int i0 = (int)ix % W->nx;
+  if (i0 < 0) i0 += W->nx;
+  const int i1 = (i0 + 1) % W->nx;
+  const size_t off = (size_t)wall * W->nx * W->nz;
+  struct foot f = {off + i0, off + i0, off + i1, off + i1, tx, 0.0};
+  if (M->dim == 2) return f;
+  const double fz = z / M->dr - 0.5;
+  const double iz = floor(fz), tz = fz - iz;
+  int k0 = (int)iz % W->nz;
+  if (k0 < 0) k0 += W->nz;
+  const int k1 = (k0 + 1) % W->nz;
+  const size_t nz = (size_t)W->nz;
+  f.c00 = off + i0 * nz + k0, f.c01 = off + i0 * nz + k1;
+  f.c10 = off + i1 * nz + k0, f.c11 = off + i1 * nz + k1;
+  f.tz = tz;
+  return f;
+}
+
+static inline double sph_foot_value(const struct model *M, const struct foot *f, const double *v) {
+  if (M->dim == 2) return (1.0 - f->tx) * v[f->c00] + f->tx * v[f->c10];
+  return (1.0 - f->tx) * ((1.0 - f->tz) * v[f->c00] + f->tz * v[f->c01]) +
+         f->tx * ((1.0 - f->tz) * v[f->c10] + f->tz * v[f->c11]);
+}
+
 /**
  * @brief Wall density and pressure at the foot of a particle on a wall: bilinear (3-D) or
  *        linear (2-D) interpolation of the vertex values, the generalisation of thesis

@@ -4,6 +4,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "pair.h"
 #include "timers.h"
 #include "wall.h"
 
@@ -61,24 +62,85 @@ static inline double nearest_wall(const struct model *M, double y, int *wall) {
   return *wall ? top : y;
 }
 
-/** Shepard sums at vertex s over its fluid neighbours: returns alpha = sum_b V_b w_bs and sets
-    out[k] = sum_b V_b w_bs f_k,b for the nf fields f (Ferrand Eq. 38 without the 1/alpha). */
-static double vertex_sums(const struct model *M, const struct particles *P, const struct nbr *nb,
-                          size_t s, int nf, const double *const *f, double *out) {
+/** Shepard sums at vertex s over its fluid neighbours (the first nfluid of its list): returns
+    alpha = sum_b V_b w_bs and sets out[k] = sum_b V_b w_bs f_k,b for the nf <= 2 fields f
+    (Ferrand Eq. 38 without the 1/alpha). */
+static CHANSPH_CLONES double vertex_sums(const struct model *M, const struct particles *P,
+                                         const struct nbr *nb, size_t s, int nf,
+                                         const double *const *f, double *out) {
+  const struct kernel K = M->k;
   const double *restrict x = P->x, *restrict y = P->y, *restrict z = P->z;
-  const int32_t *nl = nb->list + s * (size_t)nb->stride;
-  double alpha = 0.0;
-  for (int k = 0; k < nf; k++) out[k] = 0.0;
-  for (int j = 0; j < nb->count[s]; j++) {
+  const double *restrict vol = P->vol, *restrict f0 = f[0], *restrict f1 = nf > 1 ? f[1] : f[0];
+  const int32_t *restrict nl = nb->list + s * (size_t)nb->stride;
+  const double xs = x[s], ys = y[s], zs = z[s], lx = M->lx, lz = M->lz;
+  const int d3 = M->dim == 3;
+  double alpha = 0.0, s0 = 0.0, s1 = 0.0;
+#pragma omp simd reduction(+ : alpha, s0, s1)
+  for (int j = 0; j < nb->nfluid[s]; j++) {
     const int32_t b = nl[j];
-    if (P->kind[b] != KIND_FLUID) continue;
-    const double dx = nbr_wrap(x[s] - x[b], M->lx), dy = y[s] - y[b];
-    const double dz = M->dim == 3 ? nbr_wrap(z[s] - z[b], M->lz) : 0.0;
-    const double vw = P->vol[b] * kernel_w(&M->k, sqrt(dx * dx + dy * dy + dz * dz));
-    alpha += vw;
-    for (int k = 0; k < nf; k++) out[k] += vw * f[k][b];
+    const struct pair g = pair_geom(&K, lx, lz, d3, xs - x[b], ys - y[b], zs - z[b]);
+    const double vw = vol[b] * pair_w(&K, g.r);
+    alpha += vw, s0 += vw * f0[b], s1 += vw * f1[b];
   }
+  out[0] = s0;
+  if (nf > 1) out[1] = s1;
   return alpha;
+}
+
+/** Corrected velocity-gradient sums of particle a over its whole list (fluid and vertices):
+    A = -sum_b V_b F_ab r_ab (x) r_ab and B = sum_b V_b (v_b - v_a) (x) F_ab r_ab (thesis
+    Eq. 2.88-2.90, k = 0), as turb_strain_gradient takes them. */
+static CHANSPH_CLONES void gradient_sums(const struct model *M, const struct particles *P,
+                                         const struct nbr *nb, size_t a, double A[6], double B[9]) {
+  const struct kernel K = M->k;
+  const double *restrict x = P->x, *restrict y = P->y, *restrict z = P->z;
+  const double *restrict u = P->u, *restrict v = P->v, *restrict w = P->w;
+  const double *restrict vol = P->vol;
+  const int32_t *restrict nl = nb->list + a * (size_t)nb->stride;
+  const double xa = x[a], ya = y[a], za = z[a], ua = u[a], va = v[a], wa = w[a];
+  const double lx = M->lx, lz = M->lz;
+  const int d3 = M->dim == 3;
+  double axx = 0, axy = 0, axz = 0, ayy = 0, ayz = 0, azz = 0;
+  double bxx = 0, bxy = 0, bxz = 0, byx = 0, byy = 0, byz = 0, bzx = 0, bzy = 0, bzz = 0;
+#pragma omp simd reduction(+ : axx, axy, axz, ayy, ayz, azz, bxx, bxy, bxz, byx, byy, byz, bzx, \
+                               bzy, bzz)
+  for (int j = 0; j < nb->count[a]; j++) {
+    const int32_t b = nl[j];
+    const struct pair g = pair_geom(&K, lx, lz, d3, xa - x[b], ya - y[b], za - z[b]);
+    const struct sym3 t = term_moment(&g, vol[b]);
+    axx += t.xx, axy += t.xy, axz += t.xz, ayy += t.yy, ayz += t.yz, azz += t.zz;
+    const struct v3 gu = term_difference(&g, vol[b], u[b] - ua);
+    const struct v3 gv = term_difference(&g, vol[b], v[b] - va);
+    const struct v3 gw = term_difference(&g, vol[b], w[b] - wa);
+    bxx += gu.x, bxy += gu.y, bxz += gu.z, byx += gv.x, byy += gv.y, byz += gv.z;
+    bzx += gw.x, bzy += gw.y, bzz += gw.z;
+  }
+  A[0] = axx, A[1] = axy, A[2] = axz, A[3] = ayy, A[4] = ayz, A[5] = azz;
+  B[0] = bxx, B[1] = bxy, B[2] = bxz, B[3] = byx, B[4] = byy, B[5] = byz;
+  B[6] = bzx, B[7] = bzy, B[8] = bzz;
+}
+
+/** Violeau-Issa sum of particle a (thesis Eq. 5.48 without its factor 1 / (gamma_a rho_a)):
+    -sum_b V_b (rho_a + rho_b)/2 |u_ab|^2 F_ab over its whole list. */
+static CHANSPH_CLONES double violeau_issa_sum(const struct model *M, const struct particles *P,
+                                              const struct nbr *nb, size_t a) {
+  const struct kernel K = M->k;
+  const double *restrict x = P->x, *restrict y = P->y, *restrict z = P->z;
+  const double *restrict u = P->u, *restrict v = P->v, *restrict w = P->w;
+  const double *restrict vol = P->vol, *restrict rho = P->rho;
+  const int32_t *restrict nl = nb->list + a * (size_t)nb->stride;
+  const double xa = x[a], ya = y[a], za = z[a], ua = u[a], va = v[a], wa = w[a], ra = rho[a];
+  const double lx = M->lx, lz = M->lz;
+  const int d3 = M->dim == 3;
+  double sum = 0.0;
+#pragma omp simd reduction(+ : sum)
+  for (int j = 0; j < nb->count[a]; j++) {
+    const int32_t b = nl[j];
+    const struct pair g = pair_geom(&K, lx, lz, d3, xa - x[b], ya - y[b], za - z[b]);
+    const double ux = ua - u[b], uy = va - v[b], uz = wa - w[b];
+    sum -= vol[b] * 0.5 * (ra + rho[b]) * (ux * ux + uy * uy + uz * uz) * g.f;
+  }
+  return sum;
 }
 
 double turb_update(const struct model *M, struct particles *P, const struct nbr *nb,
@@ -88,8 +150,7 @@ double turb_update(const struct model *M, struct particles *P, const struct nbr 
   const struct kernel *K = &M->k;
   const double two_h = 2.0 * M->h, nu = M->nu;
   const double *restrict x = P->x, *restrict y = P->y, *restrict z = P->z;
-  const double *restrict u = P->u, *restrict v = P->v, *restrict w = P->w;
-  const double *restrict vol = P->vol, *restrict rho = P->rho;
+  const double *restrict u = P->u, *restrict w = P->w, *restrict rho = P->rho;
   const uint8_t *restrict kind = P->kind;
   double *restrict twx = P->twx, *restrict twz = P->twz;
   /* 1. wall-law stress of the near-wall particles: rho u_tau^2 along their tangential velocity
@@ -141,35 +202,14 @@ double turb_update(const struct model *M, struct particles *P, const struct nbr 
     const double utau2 = sqrt(tsx * tsx + tsz * tsz) / rs;
     if (M->van_driest) damp = turb_van_driest(d * sqrt(utau2) / nu, M->a_plus);
     const double ls2 = M->cs * M->cs * dg2 * damp * damp; /* l_S^2 */
-    const int32_t *nl = nb->list + a * (size_t)nb->stride;
     double S;
     if (M->strain == STRAIN_GRADIENT) {
-      double A[6] = {0, 0, 0, 0, 0, 0}, B[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
-      for (int j = 0; j < nb->count[a]; j++) {
-        const int32_t b = nl[j];
-        const double dx = nbr_wrap(x[a] - x[b], M->lx), dy = y[a] - y[b];
-        const double dz = M->dim == 3 ? nbr_wrap(z[a] - z[b], M->lz) : 0.0;
-        const double r = sqrt(dx * dx + dy * dy + dz * dz);
-        const double vf = vol[b] * kernel_f(K, r);
-        const double du[3] = {u[b] - u[a], v[b] - v[a], w[b] - w[a]}, rr[3] = {dx, dy, dz};
-        A[0] -= vf * dx * dx, A[1] -= vf * dx * dy, A[2] -= vf * dx * dz;
-        A[3] -= vf * dy * dy, A[4] -= vf * dy * dz, A[5] -= vf * dz * dz;
-        for (int i = 0; i < 3; i++)
-          for (int k = 0; k < 3; k++) B[3 * i + k] += vf * du[i] * rr[k];
-      }
+      double A[6], B[9];
+      gradient_sums(M, P, nb, a, A, B);
       S = turb_strain_gradient(M->dim, A, B);
     } else { /* Violeau-Issa, Eq. 5.48 with nu_r,b = nu_r,a: S^3 - sum S - W / l_S^2 = 0 */
-      double sum = 0.0;
-      for (int j = 0; j < nb->count[a]; j++) {
-        const int32_t b = nl[j];
-        const double dx = nbr_wrap(x[a] - x[b], M->lx), dy = y[a] - y[b];
-        const double dz = M->dim == 3 ? nbr_wrap(z[a] - z[b], M->lz) : 0.0;
-        const double r = sqrt(dx * dx + dy * dy + dz * dz);
-        const double ux = u[a] - u[b], uy = v[a] - v[b], uz = w[a] - w[b];
-        sum -= vol[b] * 0.5 * (rho[a] + rho[b]) * (ux * ux + uy * uy + uz * uz) * kernel_f(K, r);
-      }
       const double ig = 1.0 / P->gam[a];
-      sum *= ig / rho[a];
+      const double sum = violeau_issa_sum(M, P, nb, a) * ig / rho[a];
       double wterm = 0.0; /* power of the wall shear: 2/gamma sum_s u_tau,s^2 |v_t| |grad gamma| */
       if (d < two_h)
         wterm =

@@ -1,0 +1,289 @@
+/**
+ * @file forces.c
+ * @brief sph_forces (sph.h): the accelerations of the fluid particles and the volume-diffusion
+ *        sum, assembled from the pair terms of pair.h.
+ *
+ * The terms a scene needs are fixed for the whole run, so the pair loop is specialised once per
+ * combination (viscous operator x pressure-gradient form: the table `loops` below) and chosen
+ * before the particle loop; the loops have no branches per pair and vectorise. Each particle's
+ * neighbour list holds its fluid neighbours first, then the wall vertices (nbr.h): the fluid
+ * part adds the volume diffusion, the vertex part gives the viscous pull of the wall for the
+ * wall shear stress of the statistics. The per-particle part (normalisation, wall terms,
+ * time-step maxima) follows the sums in force_finish().
+ *
+ * Determinism: a particle's sums depend only on its own neighbour list, whose order is the same
+ * on any number of threads and ranks (nbr.h), and every list starts at the same alignment, so
+ * the vectorised partial sums are formed in the same order everywhere.
+ */
+#include <math.h>
+
+#include "pair.h"
+#include "sph.h"
+#include "timers.h"
+#include "wall.h"
+
+/** The viscous operator of a loop. */
+enum visc_kind { VK_MORRIS, VK_VIOLEAU, VK_LES, VK_N };
+
+/** What every loop reads. */
+struct fctx {
+  const struct model *M;
+  const struct particles *P;
+  const struct nbr *nb;
+  const struct walls *W;
+  double fx;       /*!< driving acceleration (time-step limit only) [m/s^2] */
+  double *wall_ax; /*!< x-acceleration from the walls, or NULL */
+};
+
+/** Pair sums of one particle over one part of its neighbour list. */
+struct fsums {
+  struct v3 gp;    /*!< pressure, symmetric form */
+  struct v3 vis;   /*!< viscous operator */
+  struct v3 mom;   /*!< moments: r^2, y^2, y (term_moments) */
+  double diff;     /*!< volume diffusion (fluid part only) */
+  double m1x, m2x; /*!< Violeau's wall moments, x part */
+  double m1z, m2z; /*!< and z part */
+  struct sym3 A;   /*!< moment matrix of the corrected gradient */
+  struct v3 gc;    /*!< corrected pressure difference gradient */
+};
+
+/** Sums over the neighbours nl[j0 .. j1-1] of particle a, for the operator `visc`, the
+    corrected (`corr`) or symmetric pressure gradient, with (`fluid`) or without the volume
+    diffusion. Always inlined with constant flags: one specialised loop per combination. */
+static inline __attribute__((always_inline)) void pair_sums(const struct fctx *C, size_t a,
+                                                            const int32_t *restrict nl, int j0,
+                                                            int j1, const int fluid, const int visc,
+                                                            const int corr, struct fsums *out) {
+  const struct model *M = C->M;
+  const struct particles *P = C->P;
+  const struct kernel K = M->k;
+  const double *restrict x = P->x, *restrict y = P->y, *restrict z = P->z;
+  const double *restrict u = P->u, *restrict v = P->v, *restrict w = P->w;
+  const double *restrict m = P->m, *restrict rho = P->rho, *restrict c = P->c;
+  const double *restrict pr2 = P->pr2, *restrict vol = P->vol, *restrict nur = P->nur;
+  const double lx = M->lx, lz = M->lz, eta2 = M->eta2, nu = M->nu, np2 = M->dim + 2.0;
+  const int d3 = M->dim == 3;
+  const double dgrav = M->e.rho0 / (M->e.c0 * M->e.c0) * M->gy; /* Eq. 3.61 */
+  const double xa = x[a], ya = y[a], za = z[a], ua = u[a], va = v[a], wa = w[a];
+  const double ra = rho[a], pa = pr2[a], ca = c[a], ira = 1.0 / ra;
+  const double pm_a = corr ? pa * ra * ra : 0.0;
+  const double mu_a = visc == VK_LES ? ra * (nu + nur[a]) : 0.0;
+  double gpx = 0, gpy = 0, gpz = 0, vx = 0, vy = 0, vz = 0, mo2 = 0, moyy = 0, mo1 = 0;
+  double diff = 0, m1x = 0, m2x = 0, m1z = 0, m2z = 0;
+  double axx = 0, axy = 0, axz = 0, ayy = 0, ayz = 0, azz = 0, gcx = 0, gcy = 0, gcz = 0;
+#pragma omp simd reduction(+ : gpx, gpy, gpz, vx, vy, vz, mo2, moyy, mo1, diff, m1x, m2x, m1z, \
+                               m2z, axx, axy, axz, ayy, ayz, azz, gcx, gcy, gcz)
+  for (int j = j0; j < j1; j++) {
+    const int32_t b = nl[j];
+    const struct pair g = pair_geom(&K, lx, lz, d3, xa - x[b], ya - y[b], za - z[b]);
+    const double vb = vol[b], rb = rho[b];
+    if (corr) {
+      const struct sym3 t = term_moment(&g, vb);
+      axx += t.xx, axy += t.xy, axz += t.xz, ayy += t.yy, ayz += t.yz, azz += t.zz;
+      const struct v3 d = term_difference(&g, vb, pr2[b] * rb * rb - pm_a);
+      gcx += d.x, gcy += d.y, gcz += d.z;
+    } else {
+      const struct v3 t = term_pressure(&g, m[b], pa, pr2[b]);
+      gpx += t.x, gpy += t.y, gpz += t.z;
+    }
+    const struct v3 uab = {ua - u[b], va - v[b], wa - w[b]};
+    struct v3 t;
+    if (visc == VK_MORRIS)
+      t = term_morris(&g, m[b], ira, vb, eta2, uab);
+    else if (visc == VK_VIOLEAU)
+      t = term_violeau(&g, vb, 0.5 * (ra + rb), np2, eta2, uab);
+    else /* Eq. 2.100 with mu = rho (nu + nu_r) */
+      t = term_violeau(&g, vb, 0.5 * (mu_a + rb * (nu + nur[b])), np2, eta2, uab);
+    vx += t.x, vy += t.y, vz += t.z;
+    const struct v3 mo = term_moments(&g, vb);
+    mo2 += mo.x, moyy += mo.y, mo1 += mo.z;
+    if (visc != VK_MORRIS) {
+      const struct v3 vm = term_violeau_moments(&g, vb, np2, eta2);
+      m1x += vm.x, m2x += vm.x * g.dy, m1z += vm.y, m2z += vm.y * g.dy;
+    }
+    if (fluid) diff += term_diffusion(&g, vb, ca, c[b], ra, rb, dgrav);
+  }
+  *out = (struct fsums){{gpx, gpy, gpz},
+                        {vx, vy, vz},
+                        {mo2, moyy, mo1},
+                        diff,
+                        m1x,
+                        m2x,
+                        m1z,
+                        m2z,
+                        {axx, axy, axz, ayy, ayz, azz},
+                        {gcx, gcy, gcz}};
+}
+
+/** Lattice excess of the pressure wall weight at q = d/h: linear between the layers of the
+    lattice, constant below the first layer, zero at q = 2. */
+static double lattice_excess(const struct model *M, double q) {
+  if (q >= 2.0) return 0.0;
+  if (q <= M->lat_q[0]) return M->lat_e[0];
+  int k = 1;
+  while (k < M->n_lat - 1 && M->lat_q[k] < q) k++;
+  const double t = (q - M->lat_q[k - 1]) / (M->lat_q[k] - M->lat_q[k - 1]);
+  return (1.0 - t) * M->lat_e[k - 1] + t * M->lat_e[k];
+}
+
+/** Acceleration of fluid particle a from its pair sums (fluid part s, vertex part sv): the
+    normalisation of the viscous sum, the wall terms, the body force; the time-step maxima go to
+    mx[0] (max |a|^2) and mx[1] (max |grad gamma . v|). */
+static void force_finish(const struct fctx *C, size_t a, const struct fsums *s,
+                         const struct fsums *sv, double mx[2]) {
+  const struct model *M = C->M;
+  const struct particles *P = C->P;
+  const struct walls *W = C->W;
+  const double ih = M->k.inv_h, nu = M->nu, ra = P->rho[a], ira = 1.0 / ra, pa = P->pr2[a];
+  const double ya = P->y[a], ua = P->u[a], va = P->v[a], wa = P->w[a];
+  const int violeau = M->viscous == VISCOUS_VIOLEAU, les = M->les;
+  const int corrected = M->pgrad == PGRAD_CORRECTED;
+  const int discrete = M->wall_weight == WALL_WEIGHT_DISCRETE;
+  const double ig = 1.0 / P->gam[a];
+  const double mom2 = s->mom.x + sv->mom.x, momyy = s->mom.y + sv->mom.y;
+  const double mom1 = s->mom.z + sv->mom.z;
+  const double m1x = s->m1x + sv->m1x, m2x = s->m2x + sv->m2x;
+  const double m1z = s->m1z + sv->m1z, m2z = s->m2z + sv->m2z;
+  const double vx = s->vis.x + sv->vis.x, vy = s->vis.y + sv->vis.y, vz = s->vis.z + sv->vis.z;
+  double axa, aya, aza;
+  if (corrected) { /* -(1/rho_a) L_a g, L_a = A^-1 (Eq. 2.88, 2.90 with k = 0) */
+    const double A[6] = {s->A.xx + sv->A.xx, s->A.xy + sv->A.xy, s->A.xz + sv->A.xz,
+                         s->A.yy + sv->A.yy, s->A.yz + sv->A.yz, s->A.zz + sv->A.zz};
+    const double gc[3] = {s->gc.x + sv->gc.x, s->gc.y + sv->gc.y, s->gc.z + sv->gc.z};
+    double gr[3];
+    sph_solve_sym(M->dim, A, gc, gr);
+    axa = -gr[0] * ira, aya = -gr[1] * ira, aza = -gr[2] * ira;
+  } else {
+    axa = -ig * (s->gp.x + sv->gp.x), aya = -ig * (s->gp.y + sv->gp.y);
+    aza = -ig * (s->gp.z + sv->gp.z);
+  }
+  double kappa = 1.0, kx = 1.0, kz = 1.0; /* normalisation; Violeau: of the x and z parts */
+  if (M->lap_norm != LAPNORM_NONE) {      /* discrete + analytic part behind the walls */
+    const double qb = ya * ih, qt = (M->ly - ya) * ih;
+    if (M->lap_norm == LAPNORM_TRACE) {
+      kappa = -M->dim / (mom2 + wall_moment2(M->dim, qb) + wall_moment2(M->dim, qt));
+      kx = kz = kappa;
+    } else if (violeau) { /* its own y-y moments: -2 in the full space */
+      const double wm = sph_violeau_moment(M, qb) + sph_violeau_moment(M, qt);
+      kx = -2.0 / (m2x + wm);
+      kz = M->dim == 3 ? -2.0 / (m2z + wm) : kx;
+      kappa = 0.5 * (kx + kz);
+    } else {
+      kappa = -1.0 / (momyy + wall_moment_yy(M->dim, qb) + wall_moment_yy(M->dim, qt));
+      kx = kz = kappa;
+    }
+  }
+  const double lap = nu * ig * kappa; /* nu / gamma_a, normalised */
+  const double vis = les ? ig / ra : violeau ? nu * ig / ra : nu * ig;
+  axa += vis * kx * vx, aya += vis * kappa * vy, aza += vis * kz * vz;
+  double awall = vis * kx * sv->vis.x; /* x-acceleration from the walls, for the statistics */
+  /* wall terms: pressure (Eq. 3.17, k = 1) and wall shear (Eq. 2.147-2.148) */
+  double gv = 0.0;
+  for (int wall = 0; wall < 2; wall++) {
+    const double d = wall ? M->ly - ya : ya;
+    const double q = d * ih;
+    if (q >= 2.0) continue;
+    const double dg = wall_dgamma(M->dim, q) * ih; /* |grad gamma_as| */
+    const double ny = wall ? -1.0 : 1.0;           /* inward normal */
+    const struct foot ft = sph_foot(M, W, wall, P->x[a], P->z[a]);
+    const double rs = sph_foot_value(M, &ft, W->rho), ps = sph_foot_value(M, &ft, W->p);
+    /* pressure wall term: |grad gamma_as| plus the excess of the discrete first moment on
+       the particle lattice (so that a uniform pressure leaves the lattice in equilibrium yet
+       pushes a displaced particle back), or of the current particles, or nothing
+       (docs/theory.md) */
+    const double pw = M->wall_pressure == WALL_PRESSURE_LATTICE      ? dg + lattice_excess(M, q)
+                      : M->wall_pressure == WALL_PRESSURE_CONSISTENT ? fmax(dg, ny * mom1)
+                                                                     : dg;
+    if (!corrected) aya += ig * rs * (pa + ps / (rs * rs)) * pw * ny;
+    if (M->law.law != WALL_LAW_LAMINAR) {
+      /* -(2 / gamma_a) rho_s u_tau,s u_tau,s |grad gamma_as| / rho_a (Eq. 2.144-2.145) with
+         the vertex values of Ferrand Eq. 38 at the foot */
+      const double sw = 2.0 * ig * dg * ira;
+      const double tx = sw * sph_foot_value(M, &ft, W->tx);
+      axa -= tx, aza -= sw * sph_foot_value(M, &ft, W->tz);
+      awall -= tx;
+    } else {
+      /* |grad gamma_as|, or the discrete first moment that makes the Morris operator exact
+         for a velocity varying linearly with the wall distance (docs/theory.md) */
+      const double dist = d > M->wall_dmin ? d : M->wall_dmin;
+      if (violeau) { /* half the first moment of its x and z parts */
+        const double dw = 2.0 * nu * ig / dist;
+        const double wx = discrete ? 0.5 * fmax(0.0, ny * m1x) : dg;
+        const double wz = discrete ? 0.5 * fmax(0.0, ny * m1z) : dg;
+        axa -= dw * kx * wx * ua, aza -= dw * kz * wz * wa;
+        awall -= dw * kx * wx * ua;
+      } else {
+        const double weight = discrete ? fmax(0.0, ny * mom1) : dg;
+        const double shear = 2.0 * lap * weight / dist;
+        axa -= shear * ua, aza -= shear * wa;
+        awall -= shear * ua;
+      }
+    }
+    const double g = fabs(dg * va);
+    if (g > gv) gv = g;
+  }
+  aya += M->gy;
+  P->ax[a] = axa, P->ay[a] = aya, P->az[a] = aza;
+  if (C->wall_ax) C->wall_ax[a] = awall;
+  P->ddiff[a] = s->diff * M->inv_xi; /* enters gamma rho directly (Eq. 3.64): no 1/gamma */
+  const double ax2 = (axa + C->fx) * (axa + C->fx) + aya * aya + aza * aza;
+  if (ax2 > mx[0]) mx[0] = ax2;
+  if (gv > mx[1]) mx[1] = gv;
+}
+
+/** One specialised loop over the fluid particles a0 .. a1-1. */
+typedef void (*force_loop)(const struct fctx *C, size_t a0, size_t a1, double mx[2]);
+
+static inline __attribute__((always_inline)) void force_range(const struct fctx *C, size_t a0,
+                                                              size_t a1, double mx[2],
+                                                              const int visc, const int corr) {
+  const struct nbr *nb = C->nb;
+  for (size_t a = a0; a < a1; a++) {
+    if (C->P->kind[a] != KIND_FLUID) continue;
+    const int32_t *nl = nb->list + a * (size_t)nb->stride;
+    struct fsums s, sv;
+    pair_sums(C, a, nl, 0, nb->nfluid[a], 1, visc, corr, &s);
+    pair_sums(C, a, nl, nb->nfluid[a], nb->count[a], 0, visc, corr, &sv);
+    force_finish(C, a, &s, &sv, mx);
+  }
+}
+
+#define FORCE_LOOP(name, visc, corr)                                                          \
+  static CHANSPH_CLONES void name(const struct fctx *C, size_t a0, size_t a1, double mx[2]) { \
+    force_range(C, a0, a1, mx, visc, corr);                                                   \
+  }
+FORCE_LOOP(forces_morris, VK_MORRIS, 0)
+FORCE_LOOP(forces_morris_corrected, VK_MORRIS, 1)
+FORCE_LOOP(forces_violeau, VK_VIOLEAU, 0)
+FORCE_LOOP(forces_violeau_corrected, VK_VIOLEAU, 1)
+FORCE_LOOP(forces_les, VK_LES, 0)
+FORCE_LOOP(forces_les_corrected, VK_LES, 1)
+
+/** The loops by viscous operator and pressure-gradient form (standard, corrected). */
+static const force_loop loops[VK_N][2] = {{forces_morris, forces_morris_corrected},
+                                          {forces_violeau, forces_violeau_corrected},
+                                          {forces_les, forces_les_corrected}};
+
+/** Particles per task of the force loop. */
+enum { FORCE_CHUNK = 128 };
+
+void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb,
+                const struct walls *W, double fx, struct force_info *info) {
+  timer_push("forces");
+  const int visc = M->les ? VK_LES : M->viscous == VISCOUS_VIOLEAU ? VK_VIOLEAU : VK_MORRIS;
+  const force_loop loop = loops[visc][M->pgrad == PGRAD_CORRECTED];
+  const struct fctx C = {M, P, nb, W, fx, info->wall_ax};
+  const size_t n = P->n, nchunk = (n + FORCE_CHUNK - 1) / FORCE_CHUNK;
+  double amax2 = 0.0, gvmax = 0.0;
+#pragma omp parallel for schedule(static) reduction(max : amax2, gvmax)
+  for (size_t k = 0; k < nchunk; k++) {
+    double mx[2] = {0.0, 0.0};
+    const size_t a0 = k * FORCE_CHUNK, a1 = a0 + FORCE_CHUNK < n ? a0 + FORCE_CHUNK : n;
+    loop(&C, a0, a1, mx);
+    if (mx[0] > amax2) amax2 = mx[0];
+    if (mx[1] > gvmax) gvmax = mx[1];
+  }
+  info->amax = sqrt(amax2);
+  info->gvmax = gvmax;
+  timer_pop();
+}
