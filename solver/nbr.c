@@ -2,6 +2,7 @@
 #include "nbr.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -9,6 +10,27 @@
 #include "kernel.h"
 #include "pair.h"
 #include "timers.h"
+
+/* The candidate scan has an AVX-512 version (compress stores) for GCC on x86-64, chosen at run
+   time; elsewhere, or on a processor without it, the portable scalar scan. */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#define NBR_AVX512 1
+#include <immintrin.h>
+#else
+#define NBR_AVX512 0
+#endif
+
+/* Whether this processor runs the AVX-512 scan (CHANSPH_SCALAR_SCAN=1 in the environment turns
+   it off, for comparisons); asked once, in nbr_init. */
+static int nbr_cpu_avx512(void) {
+  const char *e = getenv("CHANSPH_SCALAR_SCAN");
+  if (e && *e == '1') return 0;
+#if NBR_AVX512
+  return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl");
+#else
+  return 0;
+#endif
+}
 
 int nbr_columns(const struct scene *s) {
   const double cell = 2.0 * scene_h(s) / NBR_REACH;
@@ -34,6 +56,7 @@ void nbr_init(struct nbr *nb, const struct scene *s, size_t n, int ix0, int nxo,
         2 * NBR_REACH + 1, NBR_REACH);
   nb->cx = nb->nx / nb->lx, nb->cy = nb->ny / nb->ly, nb->cz = nb->nz / nb->lz;
   nb->support2 = two_h * two_h;
+  nb->avx512 = nbr_cpu_avx512();
   nbr_set_range(nb, ix0, nxo, halo);
   /* expected neighbours in the support, with head room; nbr_build grows it if needed */
   const double per = s->dim == 3 ? 4.0 / 3.0 * M_PI * pow(2.0 * s->h_over_dr, 3)
@@ -68,6 +91,8 @@ void nbr_reserve(struct nbr *nb, size_t n) {
 void nbr_free(struct nbr *nb) {
   part_free(nb->start), part_free(nb->pos), part_free(nb->perm), part_free(nb->cell);
   part_free(nb->count), part_free(nb->list), part_free(nb->nfluid);
+  for (int t = 0; t < nb->scratch_threads; t++) part_free(nb->scratch[t]);
+  free(nb->scratch);
   memset(nb, 0, sizeof *nb);
 }
 
@@ -147,58 +172,97 @@ void nbr_sort_ghosts(struct nbr *nb, struct particles *P, size_t n_left) {
   timer_pop();
 }
 
-/* Append the neighbours of a found in particles [b0, b1) shifted by (sx, 0, sz), and add
-   their m_b w_ab to *sum in that order. The distances and kernel values of a block of
-   candidates are computed first (a loop that vectorises), then the block is appended without
-   branches; the sum is formed in the candidate order, so it does not depend on the vector
-   width nor on where the block starts in memory. */
-static inline __attribute__((always_inline)) int scan(const struct particles *restrict P, const struct kernel *K, size_t a,
-                       size_t b0, size_t b1, double sx, double sz, double support2,
-                       int32_t *restrict out, int cnt, int stride, double *sum) {
-  enum { BLOCK = 32 };
-  const double *restrict x = P->x, *restrict y = P->y, *restrict z = P->z, *restrict m = P->m;
+/* Append the particles of [b0, b1), shifted by (sx, 0, sz), that lie within the support of a
+   to the scratch list (lb, r2b), without branches: every candidate is written, and the count
+   advances only for a neighbour (slot `stride` takes the writes of a list that overflows). */
+static inline __attribute__((always_inline)) int scan_scalar(
+    const struct particles *restrict P, size_t a, size_t b0, size_t b1, double sx, double sz,
+    double support2, int32_t *restrict lb, double *restrict r2b, int cnt, int stride) {
+  const double *restrict x = P->x, *restrict y = P->y, *restrict z = P->z;
   const double xa = x[a] - sx, ya = y[a], za = z[a] - sz;
-  double s = *sum;
-  for (size_t c0 = b0; c0 < b1; c0 += BLOCK) {
-    const int nblk = b1 - c0 < BLOCK ? (int)(b1 - c0) : BLOCK;
-    double mw[BLOCK];
-    int in[BLOCK];
-#pragma omp simd
-    for (int j = 0; j < nblk; j++) {
-      const size_t b = c0 + (size_t)j;
-      const double dx = xa - x[b], dy = ya - y[b], dz = za - z[b];
-      const double r2 = dx * dx + dy * dy + dz * dz;
-      /* computed for every candidate and masked by a product: no branch, so it vectorises */
-      const double hit = (r2 < support2 ? 1.0 : 0.0) * (b != a ? 1.0 : 0.0);
-      in[j] = (int)hit;
-      mw[j] = hit * m[b] * pair_w(K, sqrt(r2));
-    }
-    for (int j = 0; j < nblk; j++) {
-      s += mw[j]; /* zero for a candidate outside the support: the sum is unchanged */
-      if (cnt < stride) out[cnt] = (int32_t)(c0 + (size_t)j); /* kept if it is a hit */
-      cnt += in[j];
-    }
+  for (size_t b = b0; b < b1; b++) {
+    const double dx = xa - x[b], dy = ya - y[b], dz = za - z[b];
+    const double r2 = dx * dx + dy * dy + dz * dz;
+    const int k = cnt < stride ? cnt : stride;
+    lb[k] = (int32_t)b, r2b[k] = r2;
+    cnt += (r2 < support2) & (b != a);
   }
-  *sum = s;
   return cnt;
 }
 
-/* Stable partition of the list out[0 .. cnt-1]: fluid particles first, then the vertices, each
-   in the order found; returns the number of fluid neighbours. */
-static int fluid_first(const uint8_t *restrict kind, int32_t *restrict out, int cnt) {
-  int nf = 0, nv = 0;
-  for (int j = 0; j < cnt; j++) nv += kind[out[j]] != KIND_FLUID;
-  if (!nv) return cnt;
-  int32_t vtx[nv];
-  nv = 0;
-  for (int j = 0; j < cnt; j++) {
-    const int32_t b = out[j];
-    if (kind[b] == KIND_FLUID)
-      out[nf++] = b;
-    else
-      vtx[nv++] = b;
+#if NBR_AVX512
+/* The same with AVX-512: 8 candidates at a time, the neighbours appended by compress stores (in
+   the order of the candidates, so the list is the same as scan_scalar's; the distances are
+   computed with the same operations in the same order). cap: scratch slots (stride + 16). */
+__attribute__((target("avx512f,avx512vl"))) static int scan_avx512(
+    const struct particles *restrict P, size_t a, size_t b0, size_t b1, double sx, double sz,
+    double support2, int32_t *restrict lb, double *restrict r2b, int cnt, int cap) {
+  const double *restrict x = P->x, *restrict y = P->y, *restrict z = P->z;
+  const __m512d xa = _mm512_set1_pd(x[a] - sx), ya = _mm512_set1_pd(y[a]);
+  const __m512d za = _mm512_set1_pd(z[a] - sz), s2 = _mm512_set1_pd(support2);
+  __m256i idx =
+      _mm256_add_epi32(_mm256_set1_epi32((int)b0), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+  for (size_t b = b0; b < b1; b += 8) {
+    const __mmask8 live = b1 - b >= 8 ? 0xff : (__mmask8)((1u << (b1 - b)) - 1u);
+    const __m512d dx = _mm512_sub_pd(xa, _mm512_maskz_loadu_pd(live, x + b));
+    const __m512d dy = _mm512_sub_pd(ya, _mm512_maskz_loadu_pd(live, y + b));
+    const __m512d dz = _mm512_sub_pd(za, _mm512_maskz_loadu_pd(live, z + b));
+    const __m512d r2 = _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy)),
+                                     _mm512_mul_pd(dz, dz));
+    __mmask8 hit = _mm512_mask_cmp_pd_mask(live, r2, s2, _CMP_LT_OQ);
+    if (a >= b && a - b < 8) hit &= (__mmask8) ~(1u << (a - b));
+    if (cnt + 8 <= cap) {
+      _mm256_mask_compressstoreu_epi32(lb + cnt, hit, idx);
+      _mm512_mask_compressstoreu_pd(r2b + cnt, hit, r2);
+    }
+    cnt += __builtin_popcount(hit);
+    idx = _mm256_add_epi32(idx, _mm256_set1_epi32(8));
   }
-  for (int j = 0; j < nv; j++) out[nf + j] = vtx[j];
+  return cnt;
+}
+#endif
+
+/* Candidates [b0, b1) of particle a: the AVX-512 scan where the processor has it. */
+static inline __attribute__((always_inline)) int scan(const struct particles *restrict P, size_t a,
+                                                      size_t b0, size_t b1, double sx, double sz,
+                                                      double support2, int32_t *restrict lb,
+                                                      double *restrict r2b, int cnt, int stride,
+                                                      int avx512) {
+#if NBR_AVX512
+  if (avx512) return scan_avx512(P, a, b0, b1, sx, sz, support2, lb, r2b, cnt, stride + NBR_ALIGN);
+#else
+  (void)avx512;
+#endif
+  return scan_scalar(P, a, b0, b1, sx, sz, support2, lb, r2b, cnt, stride);
+}
+
+/* Kernel sum S_a = m_a w(0) + sum_b m_b w_ab over the list found (vectorised; the order of the
+   list is the same on any decomposition and the scratch list is aligned, so the sum is too). */
+static inline __attribute__((always_inline)) double kernel_sum(const struct kernel *K,
+                                                               const double *restrict m, size_t a,
+                                                               const int32_t *restrict lb,
+                                                               const double *restrict r2b,
+                                                               int cnt) {
+  double s = 0.0;
+#pragma omp simd reduction(+ : s)
+  for (int j = 0; j < cnt; j++) s += m[lb[j]] * pair_w(K, sqrt(r2b[j]));
+  return m[a] * pair_w(K, 0.0) + s;
+}
+
+/* Copy the list lb[0 .. cnt-1] to out, fluid particles first, then the vertices, each in the
+   order found; returns the number of fluid neighbours. */
+static int fluid_first(const uint8_t *restrict kind, const int32_t *restrict lb,
+                       int32_t *restrict out, int cnt) {
+  int nf = 0;
+  for (int j = 0; j < cnt; j++) nf += kind[lb[j]] == KIND_FLUID;
+  int f = 0, v = nf;
+  for (int j = 0; j < cnt; j++) {
+    const int32_t b = lb[j];
+    if (kind[b] == KIND_FLUID)
+      out[f++] = b;
+    else
+      out[v++] = b;
+  }
   return nf;
 }
 
@@ -231,7 +295,6 @@ static inline double cell_gap(double p, int j, double c) {
    that did not fit the stride (0 if all fitted). */
 static CHANSPH_CLONES int build_cell(struct nbr *nb, const struct particles *P,
                                      const struct kernel *K, size_t c, double *ksum) {
-  const double w0 = pair_w(K, 0.0);
   const int stride = nb->stride, R = NBR_REACH;
   const int dz_lo = nb->dim == 3 ? -R : 0, dz_hi = nb->dim == 3 ? R : 0;
   /* rows of the stencil farther than 2h in y and z are skipped (with a margin: the skipped
@@ -241,10 +304,11 @@ static CHANSPH_CLONES int build_cell(struct nbr *nb, const struct particles *P,
   const int iy = (int)(c / (size_t)nb->nxo % (size_t)nb->ny);
   const int iz = (int)(c / ((size_t)nb->nxo * nb->ny));
   int overflow = 0;
+  int32_t *lb = nb->scratch[omp_get_thread_num()];
+  const int avx512 = nb->avx512;
+  double *r2b = (double *)(lb + stride + NBR_ALIGN);
   for (size_t a = nb->start[c]; a < nb->start[c + 1]; a++) {
-    int32_t *out = nb->list + a * (size_t)stride;
     int cnt = 0;
-    double sum = P->m[a] * w0;
     for (int dz = dz_lo; dz <= dz_hi; dz++) {
       int jz = iz + dz;
       double sz = 0.0;
@@ -263,8 +327,8 @@ static CHANSPH_CLONES int build_cell(struct nbr *nb, const struct particles *P,
         if (lc >= R && lc < nb->nxo - R && gx >= R && gx < nb->nx - R) {
           /* the x cells of the stencil are contiguous and unshifted */
           const size_t c0 = row * nb->nxo + lc;
-          cnt = scan(P, K, a, nb->start[c0 - R], nb->start[c0 + R + 1], 0.0, sz, nb->support2, out,
-                     cnt, stride, &sum);
+          cnt = scan(P, a, nb->start[c0 - R], nb->start[c0 + R + 1], 0.0, sz, nb->support2, lb, r2b,
+                     cnt, stride, avx512);
           continue;
         }
         for (int dx = -R; dx <= R; dx++) {
@@ -272,17 +336,33 @@ static CHANSPH_CLONES int build_cell(struct nbr *nb, const struct particles *P,
           const int col = stencil_column(nb, lc, dx, &sx);
           const size_t cc =
               col >= 0 ? row * nb->nxo + col : nb->ncell_own + row * 2 * nb->halo + (-1 - col);
-          cnt = scan(P, K, a, nb->start[cc], nb->start[cc + 1], sx, sz, nb->support2, out, cnt,
-                     stride, &sum);
+          cnt = scan(P, a, nb->start[cc], nb->start[cc + 1], sx, sz, nb->support2, lb, r2b, cnt,
+                     stride, avx512);
         }
       }
     }
     nb->count[a] = cnt;
-    nb->nfluid[a] = cnt <= stride ? fluid_first(P->kind, out, cnt) : 0;
-    ksum[a] = sum;
-    if (cnt > stride && cnt > overflow) overflow = cnt;
+    if (cnt > stride) {
+      if (cnt > overflow) overflow = cnt;
+      continue;
+    }
+    ksum[a] = kernel_sum(K, P->m, a, lb, r2b, cnt);
+    nb->nfluid[a] = fluid_first(P->kind, lb, nb->list + a * (size_t)stride, cnt);
   }
   return overflow;
+}
+
+/* Per-thread scratch lists of stride + 1 entries and their squared distances. */
+static void nbr_scratch(struct nbr *nb) {
+  const int nt = omp_get_max_threads();
+  if (nb->scratch && nb->scratch_stride == nb->stride && nb->scratch_threads >= nt) return;
+  for (int t = 0; t < nb->scratch_threads; t++) part_free(nb->scratch[t]);
+  free(nb->scratch);
+  nb->scratch = calloc((size_t)nt, sizeof *nb->scratch);
+  if (!nb->scratch) die("out of memory for the neighbour scratch lists");
+  const size_t bytes = (size_t)(nb->stride + NBR_ALIGN) * (sizeof(int32_t) + sizeof(double));
+  for (int t = 0; t < nt; t++) nb->scratch[t] = part_alloc("nbr_scratch", bytes);
+  nb->scratch_threads = nt, nb->scratch_stride = nb->stride;
 }
 
 void nbr_build(struct nbr *nb, const struct particles *P, const struct kernel *K, double *ksum) {
@@ -290,6 +370,7 @@ void nbr_build(struct nbr *nb, const struct particles *P, const struct kernel *K
   if (P->n + P->n_ghost > (size_t)INT32_MAX) die("more than 2^31 particles on one rank");
   for (;;) {
     int overflow = 0;
+    nbr_scratch(nb);
 #pragma omp parallel for schedule(static) reduction(max : overflow)
     for (size_t c = 0; c < nb->ncell_own; c++) {
       const int o = build_cell(nb, P, K, c, ksum);
