@@ -194,9 +194,10 @@ static inline __attribute__((always_inline)) int scan_scalar(
 /* The same with AVX-512: 8 candidates at a time, the neighbours appended by compress stores (in
    the order of the candidates, so the list is the same as scan_scalar's; the distances are
    computed with the same operations in the same order). cap: scratch slots (stride + 16). */
-__attribute__((target("avx512f,avx512vl"))) static int scan_avx512(
-    const struct particles *restrict P, size_t a, size_t b0, size_t b1, double sx, double sz,
-    double support2, int32_t *restrict lb, double *restrict r2b, int cnt, int cap) {
+__attribute__((target("avx512f,avx512vl,avx512bw,avx512dq,avx512cd"))) static inline int
+scan_avx512(const struct particles *restrict P, size_t a, size_t b0, size_t b1, double sx,
+            double sz, double support2, int32_t *restrict lb, double *restrict r2b, int cnt,
+            int cap) {
   const double *restrict x = P->x, *restrict y = P->y, *restrict z = P->z;
   const __m512d xa = _mm512_set1_pd(x[a] - sx), ya = _mm512_set1_pd(y[a]);
   const __m512d za = _mm512_set1_pd(z[a] - sz), s2 = _mm512_set1_pd(support2);
@@ -292,9 +293,12 @@ static inline double cell_gap(double p, int j, double c) {
 }
 
 /* Neighbour lists and kernel sums of the particles of owned cell c; returns the largest count
-   that did not fit the stride (0 if all fitted). */
-static CHANSPH_CLONES int build_cell(struct nbr *nb, const struct particles *P,
-                                     const struct kernel *K, size_t c, double *ksum) {
+   that did not fit the stride (0 if all fitted). Instantiated for the AVX-512 scan (avx512 = 1,
+   build_cell_avx512) and for the portable one (build_cell). */
+static inline __attribute__((always_inline)) int build_cell_t(struct nbr *nb,
+                                                              const struct particles *P,
+                                                              const struct kernel *K, size_t c,
+                                                              double *ksum, const int avx512) {
   const int stride = nb->stride, R = NBR_REACH;
   const int dz_lo = nb->dim == 3 ? -R : 0, dz_hi = nb->dim == 3 ? R : 0;
   /* rows of the stencil farther than 2h in y and z are skipped (with a margin: the skipped
@@ -305,7 +309,8 @@ static CHANSPH_CLONES int build_cell(struct nbr *nb, const struct particles *P,
   const int iz = (int)(c / ((size_t)nb->nxo * nb->ny));
   int overflow = 0;
   int32_t *lb = nb->scratch[omp_get_thread_num()];
-  const int avx512 = nb->avx512;
+  /* only lists that reach the first or last row of cells can hold wall vertices */
+  const int wall_rows = iy - R <= 0 || iy + R >= nb->ny - 1;
   double *r2b = (double *)(lb + stride + NBR_ALIGN);
   for (size_t a = nb->start[c]; a < nb->start[c + 1]; a++) {
     int cnt = 0;
@@ -347,10 +352,28 @@ static CHANSPH_CLONES int build_cell(struct nbr *nb, const struct particles *P,
       continue;
     }
     ksum[a] = kernel_sum(K, P->m, a, lb, r2b, cnt);
-    nb->nfluid[a] = fluid_first(P->kind, lb, nb->list + a * (size_t)stride, cnt);
+    int32_t *out = nb->list + a * (size_t)stride;
+    if (wall_rows) {
+      nb->nfluid[a] = fluid_first(P->kind, lb, out, cnt);
+    } else {
+      memcpy(out, lb, (size_t)cnt * sizeof *out);
+      nb->nfluid[a] = cnt;
+    }
   }
   return overflow;
 }
+
+static CHANSPH_CLONES int build_cell(struct nbr *nb, const struct particles *P,
+                                     const struct kernel *K, size_t c, double *ksum) {
+  return build_cell_t(nb, P, K, c, ksum, 0);
+}
+
+#if NBR_AVX512
+__attribute__((target("avx512f,avx512vl,avx512bw,avx512dq,avx512cd"))) static int build_cell_avx512(
+    struct nbr *nb, const struct particles *P, const struct kernel *K, size_t c, double *ksum) {
+  return build_cell_t(nb, P, K, c, ksum, 1);
+}
+#endif
 
 /* Per-thread scratch lists of stride + 1 entries and their squared distances. */
 static void nbr_scratch(struct nbr *nb) {
@@ -373,7 +396,12 @@ void nbr_build(struct nbr *nb, const struct particles *P, const struct kernel *K
     nbr_scratch(nb);
 #pragma omp parallel for schedule(static) reduction(max : overflow)
     for (size_t c = 0; c < nb->ncell_own; c++) {
+#if NBR_AVX512
+      const int o =
+          nb->avx512 ? build_cell_avx512(nb, P, K, c, ksum) : build_cell(nb, P, K, c, ksum);
+#else
       const int o = build_cell(nb, P, K, c, ksum);
+#endif
       if (o > overflow) overflow = o;
     }
     if (!overflow) break;
