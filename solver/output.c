@@ -286,9 +286,19 @@ void output_resume(struct output *o, struct sim *S) {
              CHANSPH_VERSION, S->step, S->t, S->P.n_fluid, S->P.n_vertex);
 }
 
+/* The statistics engines sample the state of this step. */
+static int sample_due(const struct output *o, const struct sim *S) {
+  const struct scene *sc = S->sc;
+  return stats_wanted(&o->st) && S->t >= sc->t_average_start && S->step % sc->stats_every == 0;
+}
+
+int output_takes_state(const struct output *o, const struct sim *S) {
+  return sample_due(o, S) || S->step % S->sc->series_every == 0 || S->t >= o->next_write;
+}
+
 int output_step(struct output *o, struct sim *S) {
   const struct scene *sc = S->sc;
-  if (stats_wanted(&o->st) && S->t >= sc->t_average_start && S->step % sc->stats_every == 0) {
+  if (sample_due(o, S)) {
     timer_push("stats");
     const struct particles *P = &S->P;
     /* the engine merges per global column in a fixed order: rank-independent results */

@@ -74,6 +74,12 @@ int output_stop(struct output *o, struct sim *S, const char *why);
 void output_begin(struct output *o, struct sim *S);
 
 /**
+ * @brief Does output_step() take anything from the state of this step (a statistics sample, a
+ *        time-series row, a stats.nc rewrite)? The caller checks such a state first.
+ */
+int output_takes_state(const struct output *o, const struct sim *S);
+
+/**
  * @brief After each step: sample statistics, record the series, log, rewrite stats.nc.
  * @return CHANSPH_OK, or CHANSPH_ERR after a message when stats.nc cannot be written (the
  *         previous stats.nc and the checkpoints are kept)

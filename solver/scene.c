@@ -300,7 +300,9 @@ static const struct key keys[] = {
     {"lagrangian", "pdf_bins", T_INT, "50", 2, 1e5, 0, NULL, "-",
      "Bins of the PDFs P(y; x) across the channel.", OFF(lagr_pdf_bins)},
     {"health", "every", T_INT, "1", 1, 1e9, 0, NULL, "steps",
-     "Steps between full health checks (NaN, wall crossing, CFL); 1 checks every step.",
+     "Steps between full health checks (NaN, wall crossing, CFL); 1 checks every step. "
+     "Whatever the interval, a state is checked before it is written or sampled (checkpoint, "
+     "snapshot, stats.nc, particles.nc, statistics sample, time-series row).",
      OFF(health_every)},
     {"run", "threads", T_INT, "0", 0, 4096, 0, NULL, "-",
      "OpenMP threads; 0 keeps OMP_NUM_THREADS (or all cores).", OFF(threads)},
