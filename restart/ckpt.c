@@ -13,6 +13,13 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+/** Identity of the run (ckpt_set_run_id), written into every file; "" = none. */
+static char run_id[CKPT_RUN_ID_MAX];
+
+void ckpt_set_run_id(const char *id) {
+  snprintf(run_id, sizeof run_id, "%s", id ? id : "");
+}
+
 /** Largest chunk [bytes]: Fletcher32 covers each chunk; HDF5 needs chunks below 4 GB. */
 enum { CHUNK_BYTES = 1 << 22 };
 
@@ -323,7 +330,8 @@ static int write_file(const char *path, const char *format, const struct state_l
       put_attr_num(file, "format_version_minor", H5T_STD_I32LE, H5T_NATIVE_INT32, &minor) ||
       put_attr_text(file, "code_version", CHANSPH_VERSION) ||
       put_attr_num(file, "step", H5T_STD_I64LE, H5T_NATIVE_INT64, &step64) ||
-      put_attr_num(file, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &time)) {
+      put_attr_num(file, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &time) ||
+      (run_id[0] && put_attr_text(file, "run_id", run_id))) {
     fail(err, errlen, "cannot write the root attributes of checkpoint %s", tmp);
     rc = 1;
   }
@@ -507,6 +515,9 @@ int ckpt_info(const char *path, struct ckpt_info *info, char *err, size_t errlen
   else if (get_attr_int(file, "step", H5T_NATIVE_INT64, &step) ||
            get_attr_int(file, "time", H5T_NATIVE_DOUBLE, &info->time))
     snprintf(err, errlen, "%s: root attributes 'step' or 'time' missing", path);
+  else if (H5Aexists(file, "run_id") > 0 &&
+           get_attr_text(file, "run_id", info->run_id, sizeof info->run_id))
+    snprintf(err, errlen, "%s: root attribute 'run_id' cannot be read", path);
   else if ((info->scene = read_text(file, "scene", path, err, errlen)))
     rc = 0;
   info->step = (long)step, info->major = major, info->minor = minor;

@@ -57,11 +57,19 @@ static int run(struct scene *sc, const struct cli *c) {
   struct output out;
   struct sim S;
   if (c->cmd == CMD_RESUME) {
-    if (restart_resume(c->out, c->n_set, c->set, sc, &S, &out)) return EXIT_INPUT;
+    /* the directory is locked for the life of the process (DIR/.lock) */
+    if (rundir_lock(c->out, 0) || restart_resume(c->out, c->n_set, c->set, sc, &S, &out))
+      return EXIT_INPUT;
     output_resume(&out, &S);
   } else {
     if (sim_init(&S, sc)) return EXIT_INPUT; /* before the run directory exists */
-    if (restart_prepare_new(c->out, c->overwrite) || output_open(&out, c->out, sc, c->overwrite)) {
+    if (rundir_lock(c->out, 1) || restart_prepare_new(c->out, c->overwrite) ||
+        output_open(&out, c->out, sc, c->overwrite)) {
+      sim_free(&S);
+      return EXIT_INPUT;
+    }
+    if (rundir_new_id(c->out, out.run_id)) {
+      output_close(&out);
       sim_free(&S);
       return EXIT_INPUT;
     }

@@ -250,6 +250,7 @@ static int write_stats(struct output *o, const struct sim *S) {
       {"n_fluid", NULL, (double)S->P.n_fluid},
       {"n_snapshots", NULL, (double)o->st.samples},
       {"code_version", CHANSPH_VERSION, 0},
+      {"run_id", o->run_id, 0},
       {"scene", o->scene_text, 0},
   };
   int rc = CHANSPH_OK;
@@ -392,11 +393,14 @@ static int write_particles(struct output *o, const struct sim *S) {
                                           "m/s", "kg/m^3", "Pa", "1",   "kg"};
     const double *cols[NC];
     for (int c = 0; c < NC; c++) cols[c] = buf + (size_t)c * n;
-    const struct nc_attr attrs[] = {
-        {"time", NULL, S->t}, {"step", NULL, (double)S->step}, {"scene", o->scene_text, 0}};
+    const struct nc_attr attrs[] = {{"time", NULL, S->t},
+                                    {"step", NULL, (double)S->step},
+                                    {"run_id", o->run_id, 0},
+                                    {"scene", o->scene_text, 0}};
     char path[4096], err[4096];
     snprintf(path, sizeof path, "%s/particles.nc", o->dir);
-    rc = ncout_columns(path, "particle", n, NC, names, units, cols, ids, attrs, 3, err, sizeof err);
+    rc = ncout_columns(path, "particle", n, NC, names, units, cols, ids, attrs,
+                       sizeof attrs / sizeof attrs[0], err, sizeof err);
     free(ids);
     if (rc) error_input("%s", err);
   }

@@ -30,6 +30,7 @@ struct output {
   int *col;          /*!< global cell column of each owned particle (statistics snapshots) */
   size_t col_cap;    /*!< entries col holds */
   long rebalances;   /*!< re-partitions already reported in the log */
+  char run_id[64];   /*!< identity of the run (DIR/run_id), attribute of stats.nc, particles.nc */
 };
 
 /**

@@ -5,6 +5,8 @@
 # so only the innermost one ends the run.)
 # usage: batch_chain.sh CHANSPH SCENE RUNS
 set -u
+# the runs compared here share one identity (issue 13: DIR/run_id, stored in every file)
+export CHANSPH_RUN_ID=compare-test
 chansph=$1 scene=$2 runs=$3
 here=$(cd "$(dirname "$0")/.." && pwd)
 export OMP_NUM_THREADS=${OMP_NUM_THREADS:-1}

@@ -21,6 +21,8 @@
 # the core driver, one of several ranks by the MPI-IO driver, so their bytes differ; files of
 # 2, 3 or 4 ranks are byte-identical among themselves).
 set -uo pipefail
+# the runs compared here share one identity (issue 13: DIR/run_id, stored in every file)
+export CHANSPH_RUN_ID=compare-test
 chansph=$1 scenes=$2 runs=$3 case=$4
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMP_NUM_THREADS=1
 work=$runs/mpi_$case

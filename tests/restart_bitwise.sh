@@ -4,6 +4,8 @@
 # stats.nc and particles.nc data and identical final checkpoints (h5diff, and cmp of the files).
 # usage: restart_bitwise.sh CHANSPH SCENE RUNS NAME N1 N2 [--set k=v ...]
 set -u
+# the runs compared here share one identity (issue 13: DIR/run_id, stored in every file)
+export CHANSPH_RUN_ID=compare-test
 chansph=$1 scene=$2 runs=$3 name=$4 n1=$5 n2=$6
 shift 6
 full=$runs/bitwise_${name}_full part=$runs/bitwise_${name}_part

@@ -5,6 +5,8 @@
 # (skipped files are renamed *.skipped). Also: forbidden and accepted scene changes on resume.
 # usage: restart_corrupt.sh CHANSPH H5_SET_ATTR SCENE RUNS
 set -u
+# the runs compared here share one identity (issue 13: DIR/run_id, stored in every file)
+export CHANSPH_RUN_ID=compare-test
 chansph=$1 setattr=$2 scene=$3 runs=$4
 base=$runs/corrupt_base
 opts=(--set time.t_end=1 --set output.t_average_start=0.5 --set checkpoint.every_steps=50
@@ -52,7 +54,7 @@ for k in range(o + 200, o + 204): b[k] ^= 0x5a
 open('$newest', 'wb').write(b)\" && rm x.bin"
 case_ missing 0 "ckpt_0000000194.h5: cannot open checkpoint: No such file or directory" \
   "ln -s gone.h5 ckpt_0000000194.h5 && mv $newest ../moved_away.h5"
-case_ future_version 0 "$newest: written in checkpoint format 2.0 by a newer chansph; this build \(.*\) reads format 1.x only" \
+case_ future_version 0 "$newest: written in checkpoint format 2\.[0-9]+ by a newer chansph; this build \(.*\) reads format 1.x only" \
   "$setattr $newest format_version_major 2 > /dev/null"
 case_ incomplete 0 "$newest: incomplete checkpoint \(no completion mark 'complete' = 1\)" \
   "$setattr $newest complete 0 > /dev/null"

@@ -6,6 +6,8 @@
 # tests/CMakeLists.txt (KILL_SCENE).
 # usage: restart_kill.sh CHANSPH SCENE RUNS KILLS SEED [--set k=v ...]
 set -u
+# the runs compared here share one identity (issue 13: DIR/run_id, stored in every file)
+export CHANSPH_RUN_ID=compare-test
 chansph=$1 scene=$2 runs=$3 kills=$4 seed=$5
 shift 5
 here=$(cd "$(dirname "$0")/.." && pwd)

@@ -4,6 +4,8 @@
 # every statistics engine on (Eulerian, correlations and spectra, Lagrangian); the LES smoke
 # scene covers the model terms (wall law, strain, eddy viscosity, k_r).
 set -eu
+# the runs compared here share one identity (issue 13: DIR/run_id, stored in every file)
+export CHANSPH_RUN_ID=compare-test
 chansph=$1 scenes=$2 runs=$3
 status=0
 for scene in poiseuille2d poiseuille3d poiseuille2d_flux les395_smoke; do
