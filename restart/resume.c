@@ -62,6 +62,32 @@ static int check_changes(const struct scene *old, const struct scene *now, const
   return bad ? CHANSPH_ERR : CHANSPH_OK;
 }
 
+/* output.t_average_start may change only before averaging has begun, and not into the past of
+   the checkpoint: otherwise the windows would differ in length and the standard errors would
+   mix them (issue 13). t: time of the checkpoint. */
+static int check_average_start(const struct scene *old, const struct scene *now, double t,
+                               const char *path) {
+  const double a = old->t_average_start, b = now->t_average_start;
+  if (a == b) return CHANSPH_OK;
+  if (t >= a) {
+    error_input(
+        "--set output.t_average_start=%g: key 'output.t_average_start' cannot change on resume "
+        "once averaging has begun (the checkpoint %s is at t = %.9g s, averaging began at "
+        "%g s): the averaging windows would differ in length; keep %g, or start a new run",
+        b, path, t, a, a);
+    return CHANSPH_ERR;
+  }
+  if (b < t) {
+    error_input(
+        "--set output.t_average_start=%g: key 'output.t_average_start' is before the time of "
+        "the checkpoint %s (t = %.9g s): the samples since %g s were not taken; choose a start "
+        "at or after %.9g s",
+        b, path, t, b, t);
+    return CHANSPH_ERR;
+  }
+  return CHANSPH_OK;
+}
+
 /* Log the accepted changes. */
 static void log_changes(struct output *o, const struct scene *old, const struct scene *now) {
   for (int k = 0; k < scene_key_count(); k++) {
@@ -141,7 +167,8 @@ static int try_one(const char *dir, struct candidate *cd, int n_set, char *const
     free(info.scene);
     return CHANSPH_ERR;
   }
-  const int bad = scene_load_text(sc, name, info.scene, n_set, set) || check_changes(old, sc, path);
+  const int bad = scene_load_text(sc, name, info.scene, n_set, set) ||
+                  check_changes(old, sc, path) || check_average_start(old, sc, info.time, path);
   free(info.scene);
   if (bad) {
     *fatal = 1;
