@@ -170,7 +170,11 @@ static int try_one(const char *dir, struct candidate *cd, int n_set, char *const
   const int bad = scene_load_text(sc, name, info.scene, n_set, set) ||
                   check_changes(old, sc, path) || check_average_start(old, sc, info.time, path);
   free(info.scene);
-  if (bad) {
+  /* the ranks must fit the slabs before anything is read (an input error, exit 1) */
+  struct dd probe;
+  const int fits = !bad && dd_init(&probe, sc, NULL, NULL) == CHANSPH_OK;
+  if (!bad) dd_free(&probe);
+  if (bad || !fits) {
     *fatal = 1;
     return CHANSPH_ERR;
   }

@@ -346,10 +346,11 @@ enum { N_KEYS = sizeof keys / sizeof keys[0] };
 struct parse_state {
   struct scene *s;
   const char *file;
-  int line;             /*!< current line, counted by the reader */
-  int where[N_KEYS];    /*!< 0 = default, >0 = file line, -1 = --set */
-  int seen[N_KEYS];     /*!< given with an invalid value */
-  const char *set_text; /*!< the --set argument being applied */
+  int line;                    /*!< current line, counted by the reader */
+  int where[N_KEYS];           /*!< 0 = default, >0 = file line, -1 = --set */
+  int seen[N_KEYS];            /*!< given with an invalid value */
+  const char *set_text;        /*!< the --set argument being applied */
+  const char *set_arg[N_KEYS]; /*!< the --set argument that gave each key */
   int errors;
   FILE *fp;
   char section[64]; /*!< section of the last header line of the file */
@@ -492,6 +493,7 @@ static int apply(struct parse_state *ps, const char *section, const char *name, 
     return 0;
   }
   ps->where[k] = where;
+  if (where < 0) ps->set_arg[k] = ps->set_text;
   return 1;
 }
 
@@ -555,7 +557,9 @@ static void inconsistent(struct parse_state *ps, const char *key, const char *fm
   snprintf(sec, sizeof sec, "%.*s", (int)(dot - key), key);
   const int k = find_key(sec, dot + 1);
   char loc[600], text[400];
+  ps->set_text = k >= 0 ? ps->set_arg[k] : NULL; /* a key given with --set: name the argument */
   location(ps, k >= 0 ? ps->where[k] : 0, loc, sizeof loc);
+  ps->set_text = NULL;
   snprintf(text, sizeof text, fmt, a, b);
   error_input("%s: key '%s': %s", loc, key, text);
   ps->errors++;
@@ -566,8 +570,34 @@ static int is_multiple(double len, double dr) {
   return n >= 1.0 && fabs(n - floor(n + 0.5)) < 1e-9 * n;
 }
 
+/* The lattice: particles along x, y (layers plus one) and z fit an int index, and the particle
+   count is exact in a double and an int64 id (larger counts would overflow before any
+   allocation; part_check_memory() then compares the memory with the machine's). */
+static void check_counts(struct parse_state *ps) {
+  const struct scene *s = ps->s;
+  const double nmax = 0x1p30, nx = s->lx / s->dr, ny = 2.0 * s->delta / s->dr;
+  const double nz = s->dim == 3 ? s->lz / s->dr : 1.0;
+  if (nx > nmax)
+    inconsistent(ps, "domain.lx", "lx / dr = %g / %g: more than 2^30 particles along x", s->lx,
+                 s->dr);
+  if (ny > nmax)
+    inconsistent(ps, "domain.delta", "2 delta / dr = %g / %g: more than 2^30 particle layers",
+                 2.0 * s->delta, s->dr);
+  if (nz > nmax)
+    inconsistent(ps, "domain.lz", "lz / dr = %g / %g: more than 2^30 particles along z", s->lz,
+                 s->dr);
+  const double n = nx * (ny + 1.0) * nz;
+  if (nx <= nmax && ny <= nmax && nz <= nmax && n > 0x1p53)
+    inconsistent(ps, "domain.dr",
+                 "the domain holds %g particles with this dr, more than %g (keys domain.lx, "
+                 "domain.delta, domain.lz, domain.dr)",
+                 n, 0x1p53);
+}
+
 static void validate(struct parse_state *ps) {
   const struct scene *s = ps->s;
+  check_counts(ps);
+  if (ps->errors) return; /* the other checks divide by the same numbers */
   const double h = scene_h(s), two_delta = 2.0 * s->delta;
   if (!is_multiple(two_delta, s->dr))
     inconsistent(ps, "domain.delta", "2 delta = %g is not a multiple of dr = %g", two_delta, s->dr);
@@ -820,7 +850,9 @@ void scene_write_doc(FILE *f) {
           "Unknown keys and sections (also an empty `[]` or a section without keys), text "
           "after a section header (`[wall] law = x`: a key goes on a line of its own), keys "
           "set twice, values out of range and inconsistent geometry are errors that name the "
-          "file, line and key.\n"
+          "file, line and key; so is a domain of more than 2^30 particles along a direction, "
+          "or whose particles would need more memory than the machine has (the estimate, a "
+          "lower bound, is checked before anything is allocated).\n"
           "The fully resolved scene (defaults included) is written to `DIR/scene.used.ini` "
           "and into the `scene` attribute of `stats.nc`.\n");
   const char *section = "";
