@@ -221,7 +221,7 @@ static const struct key keys[] = {
      "start a finer "
      "run. A relative path in a scene file is relative to the scene file's directory (on the "
      "command line, to the working directory). Overrides profile; streaks, modes and noise are "
-     "added on top.",
+     "added on top. A source holding a NaN or Inf is refused (exit 1).",
      OFF(init_from)},
     {"output", "log_every", T_INT, "100", 1, 1e9, 0, NULL, "steps",
      "Steps between progress lines (stdout and DIR/log.txt).", OFF(log_every)},

@@ -58,6 +58,11 @@ case_ future_version 0 "$newest: written in checkpoint format 2\.[0-9]+ by a new
   "$setattr $newest format_version_major 2 > /dev/null"
 case_ incomplete 0 "$newest: incomplete checkpoint \(no completion mark 'complete' = 1\)" \
   "$setattr $newest complete 0 > /dev/null"
+# issue 13, point 8: a metadata checksum failure is named as such, not "not a chansph checkpoint"
+case_ metadata 0 "$newest: cannot read the root group's attributes \(metadata checksum mismatch or corrupt file\) \(HDF5: incorrect metadata checksum" \
+  "python3 -c \"
+b = bytearray(open('$newest', 'rb').read()); o = b.find(b'chansph-checkpoint'); assert o > 0
+b[o + 3] ^= 0x20; open('$newest', 'wb').write(b)\""
 case_ none_valid 1 "none of the 1 checkpoint\(s\) is valid \(see above\); nothing was deleted" \
   "rm ckpt_0000000050.h5 ckpt_0000000100.h5 $prev && truncate -s 1000 $newest"
 case_ no_checkpoint 1 "checkpoints: no checkpoint to resume from" "rm ckpt_*.h5"
