@@ -23,7 +23,7 @@ void cli_usage(void) {
       "  chansph extract STATS.nc [--var a,b] [--units wall|outer] [--format csv|tsv]\n"
       "                  [--window T0:T1]   print profiles (docs/stats-format.md)\n"
       "  chansph compare STATS.nc --dns FILE [--out DIR]   errors against DNS, PNG plots\n"
-      "  chansph --version | --help\n"
+      "  chansph --version | --help   (also: chansph run|resume|bench|extract --help)\n"
       "run writes DIR/log.txt, scene.used.ini, stats.nc, particles.nc (default DIR:\n"
       "runs/<scene name>) and DIR/checkpoints/ckpt_<step>.h5; resume continues a run from\n"
       "its newest valid checkpoint. Threads: OMP_NUM_THREADS or run.threads. Exit codes: 0 done,\n"
@@ -62,6 +62,10 @@ int cli_parse(int argc, char **argv, struct cli *c) {
   for (int i = 2; i < argc; i++) {
     const char *a = argv[i];
     const int has_next = i + 1 < argc;
+    if (!strcmp(a, "--help") || !strcmp(a, "-h")) { /* chansph run --help: the usage, exit 0 */
+      c->cmd = CMD_HELP;
+      return CHANSPH_OK;
+    }
     if (!strcmp(a, "--set") && has_next)
       c->set[c->n_set++] = argv[++i];
     else if (!strncmp(a, "--set=", 6))

@@ -211,7 +211,13 @@ static void log_progress(struct output *o, struct sim *S, const struct diag *d) 
                           ? (double)S->P.n_fluid * (S->step - o->last_step) / (now - o->last_wall)
                           : 0.0;
   const double done = S->t - o->t0, left = S->sc->t_end - S->t;
-  const double eta = done > 0.0 ? (now - o->wall0) * left / done : 0.0;
+  double eta = done > 0.0 ? (now - o->wall0) * left / done : 0.0;
+  /* the run ends at t_end or at time.max_steps, whichever comes first */
+  const long steps = S->step - o->step0;
+  if (S->sc->max_steps > 0 && steps > 0) {
+    const double by_steps = (now - o->wall0) * (double)(S->sc->max_steps - S->step) / steps;
+    if (!(done > 0.0) || by_steps < eta) eta = by_steps;
+  }
   const long es = (long)fmax(0.0, eta);
   output_log(o,
              "step %8ld  t %.6e  dt %.3e  u_bulk %.6e  force %.6e  max|v| %.4e  rho [%.6g, %.6g]"
@@ -219,6 +225,17 @@ static void log_progress(struct output *o, struct sim *S, const struct diag *d) 
              S->step, S->t, S->dt, d->u_bulk, S->fx, d->max_speed, d->rho_min, d->rho_max,
              d->min_gamma, rate, es / 3600, es / 60 % 60, es % 60);
   o->last_wall = now, o->last_step = S->step;
+}
+
+/* Settings that would silently give nothing: say so at the start. */
+static void warn_settings(struct output *o, const struct sim *S) {
+  const struct scene *sc = S->sc;
+  const double every = sc->snap_every;
+  if (every > 0.0 && floor(sc->t_end / every) == floor(S->t / every))
+    output_log(o,
+               "warning: snapshots.every = %g s is longer than the rest of the run (t = %.6g .. "
+               "t_end = %g s): no snapshot will be written\n",
+               every, S->t, sc->t_end);
 }
 
 static int write_stats(struct output *o, const struct sim *S) {
@@ -254,6 +271,7 @@ static int write_stats(struct output *o, const struct sim *S) {
       {"scene", o->scene_text, 0},
   };
   int rc = CHANSPH_OK;
+  o->st.t_reached = S->t; /* an incomplete last window ends here, not at its nominal end */
   if (rank0() &&
       ncout_stats(path, &o->st, &o->ts, attrs, sizeof attrs / sizeof attrs[0], err, sizeof err)) {
     error_input("%s", err);
@@ -276,6 +294,7 @@ void output_begin(struct output *o, struct sim *S) {
     output_log(o, "decomposition: %d MPI ranks, slabs of %d-%d of the %d cell columns along x\n",
                S->dd.size, S->dd.ncol / S->dd.size, (S->dd.ncol + S->dd.size - 1) / S->dd.size,
                S->dd.ncol);
+  warn_settings(o, S);
   log_progress(o, S, &d);
 }
 
@@ -285,6 +304,7 @@ void output_resume(struct output *o, struct sim *S) {
   o->t0 = S->t, o->last_step = o->step0 = S->step;
   output_log(o, "chansph %s: resumed at step %ld, t = %.9g s: %zu fluid + %zu vertex particles\n",
              CHANSPH_VERSION, S->step, S->t, S->P.n_fluid, S->P.n_vertex);
+  warn_settings(o, S);
 }
 
 /* The statistics engines sample the state of this step. */
@@ -436,6 +456,9 @@ int output_finish(struct output *o, struct sim *S) {
   output_log(o, "%s", line);
   output_log(o, "statistics engine: %.3f MB (%lld snapshots)\n", stats_memory(&o->st) / 1048576.0,
              (long long)o->st.samples);
+  char warnings[4096];
+  if (rank0() && stats_warnings(&o->st, warnings, sizeof warnings))
+    for (char *l = strtok(warnings, "\n"); l; l = strtok(NULL, "\n")) output_log(o, "%s\n", l);
   TRY(write_stats(o, S));
   if (S->sc->particles) TRY(write_particles(o, S));
   log_decomposition(o, S, wall);

@@ -53,6 +53,7 @@ struct stored {
   size_t rows;
   double *win, *mom, *snp;
   int *complete;
+  double t_reached; /* the run's reached time (global attribute t_reached; NaN if absent) */
 };
 
 static int get_att(int ncid, const char *name, double *v, const char *path) {
@@ -80,6 +81,8 @@ static int read_stored(const char *path, struct stored *s) {
   double les = 0.0; /* optional: eddy-viscosity profiles present */
   if (!bad && nc_get_att_double(ncid, NC_GLOBAL, "les", &les) != NC_NOERR) les = 0.0;
   s->cfg.les = les != 0.0;
+  if (nc_get_att_double(ncid, NC_GLOBAL, "t_reached", &s->t_reached) != NC_NOERR)
+    s->t_reached = NAN;
   int dy, dw, vw, vm, vs, vc;
   size_t nb = 0;
   if (!bad && (nc_inq_ncid(ncid, "eulerian", &g) || nc_inq_dimid(ncid, "y", &dy) ||
@@ -210,10 +213,12 @@ int extract_main(int argc, char **argv) {
   }
   free(list);
   const double ut = res.u_tau, delta = s.cfg.delta;
+  /* a run that stopped inside its last window reached t_reached, not the window's end */
+  const double t_last = isnan(s.t_reached) ? res.t1 : fmin(res.t1, s.t_reached);
   printf(
       "# chansph extract %s: windows %zu..%zu, t = %.9g .. %.9g s, %.0f snapshots, %d "
       "batches\n",
-      path, r0, r1 - 1, res.t0, res.t1, res.snapshots, res.n_batches);
+      path, r0, r1 - 1, res.t0, t_last, res.snapshots, res.n_batches);
   printf(
       "# u_tau = %.9g m/s (wall shear %.9g, force balance %.9g, stderr %.3g), Re_tau = %.6g, "
       "correlation time %.4g s, stress balance error %.4g\n",

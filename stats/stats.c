@@ -15,6 +15,7 @@
 void stats_init(struct stats *st, const struct stats_config *cfg) {
   memset(st, 0, sizeof *st);
   st->cfg = *cfg;
+  st->t_reached = NAN;
   if (cfg->eulerian) euler_init(&st->eu, &cfg->eul);
   if (cfg->corr.n_levels) corr_init(&st->co, &cfg->corr);
   if (cfg->lagr.n_levels) lagr_init(&st->la, &cfg->lagr);
@@ -108,7 +109,14 @@ static int put_att_d(int ncid, int var, const char *name, double v) {
   return nc_put_att_double(ncid, var, name, NC_DOUBLE, 1, &v);
 }
 
-static int write_eulerian(const struct euler *e, int ncid, char *err, size_t errlen) {
+int stats_warnings(const struct stats *st, char *buf, size_t len) {
+  buf[0] = '\0';
+  return st->cfg.lagr.n_levels ? lagr_warnings(&st->la, buf, len) : 0;
+}
+
+/* t_reached: the time the run reached (NaN: not known); an incomplete last window ends there. */
+static int write_eulerian(const struct euler *e, double t_reached, int ncid, char *err,
+                          size_t errlen) {
   int rc = NC_NOERR, dy, vid;
   struct euler_result r;
   eulerian_result(e, &r);
@@ -139,7 +147,7 @@ static int write_eulerian(const struct euler *e, int ncid, char *err, size_t err
               {"correlation_time", r.corr_time},
               {"stress_balance_error", r.balance_error},
               {"average_start", r.t0},
-              {"average_end", r.t1},
+              {"average_end", isnan(t_reached) ? r.t1 : fmin(r.t1, t_reached)},
               {"n_windows", (double)r.n_batches},
               {"window_length", e->cfg.window},
               {"bin_lower", e->cfg.y0},
@@ -195,7 +203,7 @@ fail:
 
 int stats_nc_write(const struct stats *st, int ncid, char *err, size_t errlen) {
   if (st->cfg.eulerian) {
-    const int rc = write_eulerian(&st->eu, ncid, err, errlen);
+    const int rc = write_eulerian(&st->eu, st->t_reached, ncid, err, errlen);
     if (rc) return rc;
   }
   if (st->cfg.corr.n_levels) {

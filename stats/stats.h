@@ -30,14 +30,23 @@ struct stats_config {
 /** The engine. */
 struct stats {
   struct stats_config cfg;
-  struct euler eu; /*!< Eulerian profiles (if cfg.eulerian) */
-  struct corr co;  /*!< correlations and spectra (if cfg.corr.n_levels) */
-  struct lagr la;  /*!< Lagrangian statistics (if cfg.lagr.n_levels) */
-  int64_t samples; /*!< snapshots handed to the engine */
+  struct euler eu;  /*!< Eulerian profiles (if cfg.eulerian) */
+  struct corr co;   /*!< correlations and spectra (if cfg.corr.n_levels) */
+  struct lagr la;   /*!< Lagrangian statistics (if cfg.lagr.n_levels) */
+  int64_t samples;  /*!< snapshots handed to the engine */
+  double t_reached; /*!< simulated time reached, set before a write (NaN: not known); the
+                         average_end written is at most this */
 };
 
 /** @brief Set up the requested engines. */
 void stats_init(struct stats *st, const struct stats_config *cfg);
+
+/**
+ * @brief Warnings about what the statistics could not give (Lagrangian lags without samples,
+ *        T_L = NaN, no completed release): lines starting "warning: ".
+ * @return the number of warnings (buf "" if none)
+ */
+int stats_warnings(const struct stats *st, char *buf, size_t len);
 
 /** @brief Free them. */
 void stats_free(struct stats *st);
