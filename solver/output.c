@@ -16,8 +16,23 @@
 static const char *const series_names[] = {"time",    "u_bulk",    "body_force", "kinetic_energy",
                                            "mass",    "max_speed", "min_gamma",  "volume",
                                            "rho_min", "rho_max",   "dt"};
-static const char *const series_units[] = {"s", "m/s",   "m/s^2",  "J",      "kg", "m/s",
-                                           "1", "m^dim", "kg/m^3", "kg/m^3", "s"};
+/* udunits strings; in 2-D the volume is an area, mass and energy are per metre of span */
+static const char *const series_units_2d[] = {"s", "m/s", "m/s^2",  "J/m",    "kg/m", "m/s",
+                                              "1", "m^2", "kg/m^3", "kg/m^3", "s"};
+static const char *const series_units_3d[] = {"s", "m/s", "m/s^2",  "J",      "kg", "m/s",
+                                              "1", "m^3", "kg/m^3", "kg/m^3", "s"};
+static const char *const series_long_names[] = {
+    "simulated time",
+    "bulk velocity (volume-weighted mean u of the fluid)",
+    "streamwise body acceleration (driving force per unit mass)",
+    "kinetic energy of the fluid (per metre of span in 2-D)",
+    "mass of the fluid (per metre of span in 2-D)",
+    "largest particle speed",
+    "smallest wall renormalisation factor gamma",
+    "volume of the fluid (sum of m/rho; an area in 2-D)",
+    "smallest particle density",
+    "largest particle density",
+    "time step"};
 enum { N_SERIES = sizeof series_names / sizeof series_names[0] };
 
 static int rank0(void) {
@@ -83,7 +98,8 @@ static int open_common(struct output *o, const char *dir, const struct scene *sc
   struct stats_config cfg;
   output_stats_config(sc, &cfg);
   stats_init(&o->st, &cfg);
-  series_init(&o->ts, N_SERIES, series_names, series_units);
+  series_init(&o->ts, N_SERIES, series_names, sc->dim == 2 ? series_units_2d : series_units_3d,
+              series_long_names);
   o->next_write = sc->write_every > 0.0 ? sc->write_every : INFINITY;
   return CHANSPH_OK;
 }
@@ -246,29 +262,29 @@ static int write_stats(struct output *o, const struct sim *S) {
   snprintf(drive, sizeof drive, "%s", scene_choice("drive.mode", sc->drive_mode));
   snprintf(visc, sizeof visc, "%s", scene_choice("sph.viscous", sc->viscous));
   const struct nc_attr attrs[] = {
-      {"dimension", NULL, sc->dim},
-      {"delta", NULL, sc->delta},
-      {"lx", NULL, sc->lx},
-      {"lz", NULL, sc->lz},
-      {"dr", NULL, sc->dr},
-      {"h", NULL, scene_h(sc)},
-      {"nu", NULL, sc->nu},
-      {"rho0", NULL, sc->rho0},
-      {"c0", NULL, sc->c0},
-      {"xi", NULL, scene_xi(sc)},
-      {"drive_mode", drive, 0},
-      {"viscous", visc, 0},
-      {"u_bulk_target", NULL, sc->drive_mode == DRIVE_FLUX ? sc->u_bulk : NAN},
-      {"body_force", NULL, S->fx},
-      {"t_average_start", NULL, sc->t_average_start},
-      {"t_end", NULL, sc->t_end},
-      {"t_reached", NULL, S->t},
-      {"steps", NULL, (double)S->step},
-      {"n_fluid", NULL, (double)S->P.n_fluid},
-      {"n_snapshots", NULL, (double)o->st.samples},
-      {"code_version", CHANSPH_VERSION, 0},
-      {"run_id", o->run_id, 0},
-      {"scene", o->scene_text, 0},
+      {"dimension", NULL, sc->dim, 1},
+      {"delta", NULL, sc->delta, 0},
+      {"lx", NULL, sc->lx, 0},
+      {"lz", NULL, sc->lz, 0},
+      {"dr", NULL, sc->dr, 0},
+      {"h", NULL, scene_h(sc), 0},
+      {"nu", NULL, sc->nu, 0},
+      {"rho0", NULL, sc->rho0, 0},
+      {"c0", NULL, sc->c0, 0},
+      {"xi", NULL, scene_xi(sc), 0},
+      {"drive_mode", drive, 0, 0},
+      {"viscous", visc, 0, 0},
+      {"u_bulk_target", NULL, sc->drive_mode == DRIVE_FLUX ? sc->u_bulk : NAN, 0},
+      {"body_force", NULL, S->fx, 0},
+      {"t_average_start", NULL, sc->t_average_start, 0},
+      {"t_end", NULL, sc->t_end, 0},
+      {"t_reached", NULL, S->t, 0},
+      {"steps", NULL, (double)S->step, 1},
+      {"n_fluid", NULL, (double)S->P.n_fluid, 1},
+      {"n_snapshots", NULL, (double)o->st.samples, 1},
+      {"code_version", CHANSPH_VERSION, 0, 0},
+      {"run_id", o->run_id, 0, 0},
+      {"scene", o->scene_text, 0, 0},
   };
   int rc = CHANSPH_OK;
   o->st.t_reached = S->t; /* an incomplete last window ends here, not at its nominal end */
@@ -409,18 +425,28 @@ static int write_particles(struct output *o, const struct sim *S) {
     for (size_t r = 0; r < n; r++) ids[r] = (long long)r;
     static const char *const names[NC] = {"x", "y",   "z", "u",     "v",
                                           "w", "rho", "p", "gamma", "mass"};
-    static const char *const units[NC] = {"m",   "m",      "m",  "m/s", "m/s",
-                                          "m/s", "kg/m^3", "Pa", "1",   "kg"};
+    const char *const units[NC] = {"m",   "m",      "m",  "m/s", "m/s",
+                                   "m/s", "kg/m^3", "Pa", "1",   S->sc->dim == 2 ? "kg/m" : "kg"};
     const double *cols[NC];
     for (int c = 0; c < NC; c++) cols[c] = buf + (size_t)c * n;
-    const struct nc_attr attrs[] = {{"time", NULL, S->t},
-                                    {"step", NULL, (double)S->step},
-                                    {"run_id", o->run_id, 0},
-                                    {"scene", o->scene_text, 0}};
+    static const char *const long_names[NC] = {"position x (streamwise)",
+                                               "position y (wall-normal)",
+                                               "position z (spanwise)",
+                                               "velocity u (streamwise)",
+                                               "velocity v (wall-normal)",
+                                               "velocity w (spanwise)",
+                                               "density",
+                                               "pressure",
+                                               "wall renormalisation factor",
+                                               "mass (per metre of span in 2-D)"};
+    const struct nc_attr attrs[] = {{"time", NULL, S->t, 0},
+                                    {"step", NULL, (double)S->step, 1},
+                                    {"run_id", o->run_id, 0, 0},
+                                    {"scene", o->scene_text, 0, 0}};
     char path[4096], err[4096];
     snprintf(path, sizeof path, "%s/particles.nc", o->dir);
-    rc = ncout_columns(path, "particle", n, NC, names, units, cols, ids, attrs,
-                       sizeof attrs / sizeof attrs[0], err, sizeof err);
+    rc = ncout_columns(path, "chansph particle state", "particle", n, NC, names, long_names, units,
+                       cols, ids, attrs, sizeof attrs / sizeof attrs[0], err, sizeof err);
     free(ids);
     if (rc) error_input("%s", err);
   }

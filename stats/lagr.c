@@ -445,7 +445,8 @@ int lagr_nc_write(const struct lagr *g, int ncid, char *err, size_t errlen) {
       "Lagrangian statistics of particles released at x0 and y+ levels (thesis Eq. 5.60-5.68), "
       "ensemble averages over the completed releases";
   CK(nc_put_att_text(gr, NC_GLOBAL, "description", strlen(desc), desc));
-  CK(nc_put_att_double(gr, NC_GLOBAL, "releases", NC_DOUBLE, 1, &g->releases));
+  const long long releases = (long long)g->releases; /* a count */
+  CK(nc_put_att_longlong(gr, NC_GLOBAL, "releases", NC_INT64, 1, &releases));
   CK(nc_put_att_double(gr, NC_GLOBAL, "x0", NC_DOUBLE, 1, &c->x0));
   CK(nc_put_att_double(gr, NC_GLOBAL, "horizon", NC_DOUBLE, 1, &c->horizon));
   CK(nc_put_att_double(gr, NC_GLOBAL, "release_every", NC_DOUBLE, 1, &c->release_every));

@@ -139,24 +139,30 @@ static int write_eulerian(const struct euler *e, double t_reached, int ncid, cha
   const struct {
     const char *name;
     double v;
-  } scal[] = {{"u_tau", r.u_tau},
-              {"u_tau_stderr", r.u_tau_stderr},
-              {"u_tau_wall", r.u_tau_wall},
-              {"u_tau_force", r.u_tau_force},
-              {"re_tau", r.re_tau},
-              {"correlation_time", r.corr_time},
-              {"stress_balance_error", r.balance_error},
-              {"average_start", r.t0},
-              {"average_end", isnan(t_reached) ? r.t1 : fmin(r.t1, t_reached)},
-              {"n_windows", (double)r.n_batches},
-              {"window_length", e->cfg.window},
-              {"bin_lower", e->cfg.y0},
-              {"bin_upper", e->cfg.y1},
-              {"wall_area", e->cfg.area},
-              {"fold", (double)e->cfg.fold},
-              {"les", (double)e->cfg.les}};
+    int integer; /* a count or flag: int64 */
+  } scal[] = {{"u_tau", r.u_tau, 0},
+              {"u_tau_stderr", r.u_tau_stderr, 0},
+              {"u_tau_wall", r.u_tau_wall, 0},
+              {"u_tau_force", r.u_tau_force, 0},
+              {"re_tau", r.re_tau, 0},
+              {"correlation_time", r.corr_time, 0},
+              {"stress_balance_error", r.balance_error, 0},
+              {"average_start", r.t0, 0},
+              {"average_end", isnan(t_reached) ? r.t1 : fmin(r.t1, t_reached), 0},
+              {"n_windows", (double)r.n_batches, 1},
+              {"window_length", e->cfg.window, 0},
+              {"bin_lower", e->cfg.y0, 0},
+              {"bin_upper", e->cfg.y1, 0},
+              {"wall_area", e->cfg.area, 0},
+              {"fold", (double)e->cfg.fold, 1},
+              {"les", (double)e->cfg.les, 1}};
   for (size_t i = 0; i < sizeof scal / sizeof scal[0]; i++)
-    CK(put_att_d(ncid, NC_GLOBAL, scal[i].name, scal[i].v));
+    if (scal[i].integer) {
+      const long long v = (long long)scal[i].v;
+      CK(nc_put_att_longlong(ncid, NC_GLOBAL, scal[i].name, NC_INT64, 1, &v));
+    } else {
+      CK(put_att_d(ncid, NC_GLOBAL, scal[i].name, scal[i].v));
+    }
   /* the raw windows: the complete accumulator state, re-averaged by chansph extract */
   int g, dw, dwf, dm, ds, vw, vm, vs, vc, v0, v1;
   CK(nc_def_grp(ncid, "eulerian", &g));
@@ -172,15 +178,15 @@ static int write_eulerian(const struct euler *e, double t_reached, int ncid, cha
   CK(ncout_def(g, "window_end", NC_DOUBLE, 1, &dw, "s", "end of the averaging window", &v1));
   CK(ncout_def(g, "window_complete", NC_INT, 1, &dw, "1", "1: closed window, 0: still open", &vc));
   const int d2[2] = {dw, dwf}, d3m[3] = {dw, dy, dm}, d3s[3] = {dw, dy, ds};
-  CK(ncout_def(g, "windows", NC_DOUBLE, 2, d2, "1",
+  CK(ncout_def(g, "windows", NC_DOUBLE, 2, d2, NULL,
                "per window: t_start [s], t_end [s], snapshots, sum of body force [m/s^2], sums "
                "of tau_w/rho at y=0 and y=2delta [m^2/s^2]",
                &vw));
-  CK(ncout_def(g, "moments", NC_DOUBLE, 3, d3m, "1",
+  CK(ncout_def(g, "moments", NC_DOUBLE, 3, d3m, NULL,
                "per window and bin: count, means of u v w p rho y nu_t k_r, co-moments uu vv ww "
                "uv uw vw, third and fourth central moments of u v w (sums, not divided by count)",
                &vm));
-  CK(ncout_def(g, "snapshot_u", NC_DOUBLE, 3, d3s, "1",
+  CK(ncout_def(g, "snapshot_u", NC_DOUBLE, 3, d3s, NULL,
                "per window and bin: count, mean and M2 of the per-snapshot bin means of u", &vs));
   for (size_t w = 0; w < rows; w++) {
     const size_t st[1] = {w}, ct[1] = {1};
