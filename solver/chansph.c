@@ -108,6 +108,7 @@ static int run(struct scene *sc, const struct cli *c) {
       rc = EXIT_IOERR;
       break;
     }
+    if (out.converged) break; /* stats.target_stderr met: final checkpoint and files, exit 0 */
     why = trigger_check(&T, S.step);
     if (why == TRIG_NONE) continue;
     if (unhealthy(&out, &S, &checked)) {

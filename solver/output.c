@@ -243,6 +243,45 @@ static void log_progress(struct output *o, struct sim *S, const struct diag *d) 
   o->last_wall = now, o->last_step = S->step;
 }
 
+/* The scene's convergence target; 0 if there is none. */
+static int target_of(const struct scene *sc, struct stats_target *tg) {
+  if (!(sc->target_stderr > 0.0) || !sc->stats_eulerian) return 0;
+  tg->rel_stderr = sc->target_stderr, tg->profiles = sc->target_profiles;
+  tg->corr_ratio = sc->target_corr_ratio, tg->windows = sc->target_windows;
+  return 1;
+}
+
+/* Where the standard errors stand against the target, and the projected simulated and wall
+   time to reach it (this process's wall time per simulated second). */
+static void log_target(struct output *o, const struct sim *S, const struct stats_progress *p) {
+  const struct scene *sc = S->sc;
+  static const char *const which[3] = {"u_mean and the -u'v' peak", "u_mean", "the -u'v' peak"};
+  char proj[320];
+  const double done = S->t - o->t0, rate = done > 0.0 ? (timer_now() - o->wall0) / done : NAN;
+  if (p->met) {
+    snprintf(proj, sizeof proj, "target met");
+  } else if (sc->target_corr_ratio > 0.0 && !(p->ratio >= sc->target_corr_ratio)) {
+    snprintf(proj, sizeof proj,
+             "windows too short to count: window/correlation time %.3g < %g (increase "
+             "stats.window)",
+             p->ratio, sc->target_corr_ratio);
+  } else if (!isfinite(p->t_reach)) {
+    snprintf(proj, sizeof proj, "projection after 2 complete windows");
+  } else {
+    const double more = fmax(0.0, p->t_reach - S->t), wall = more * rate;
+    const long w = isfinite(wall) ? (long)wall : 0;
+    snprintf(proj, sizeof proj,
+             "projected: %.0f windows, t = %.6g s (%.4g s more simulated, about %02ld:%02ld:%02ld "
+             "wall)%s",
+             p->windows_needed, p->t_reach, more, w / 3600, w / 60 % 60, w % 60,
+             p->t_reach > sc->t_end ? " beyond t_end: raise time.t_end" : "");
+  }
+  output_log(o,
+             "target: relative stderr %g of %s: u_mean %.3g, -u'v' peak %.3g after %d "
+             "windows; %s\n",
+             sc->target_stderr, which[sc->target_profiles], p->rel_u, p->rel_uv, p->windows, proj);
+}
+
 /* Settings that would silently give nothing: say so at the start. */
 static void warn_settings(struct output *o, const struct sim *S) {
   const struct scene *sc = S->sc;
@@ -374,6 +413,23 @@ int output_step(struct output *o, struct sim *S) {
                                         .comm = MPI_COMM_WORLD};
     stats_sample(&o->st, &snap);
     timer_pop();
+    struct stats_target tg;
+    if (target_of(sc, &tg) && o->st.eu.nwin != o->target_nwin) { /* a window closed */
+      o->target_nwin = o->st.eu.nwin;
+      struct stats_progress p;
+      stats_progress(&o->st, &tg, &p);
+      if (agree(p.met)) {
+        char line[1024];
+        stats_convergence_line(&o->st, line, sizeof line);
+        output_log(o, "%s", line);
+        log_target(o, S, &p);
+        output_log(o,
+                   "converged: the statistics meet stats.target_stderr = %g at step %ld, t = "
+                   "%.9g s; the run ends here\n",
+                   sc->target_stderr, S->step, S->t);
+        o->converged = 1;
+      }
+    }
   }
   timer_push("output");
   if (S->dd.rebalances != o->rebalances) {
@@ -395,10 +451,14 @@ int output_step(struct output *o, struct sim *S) {
     if (!have) sim_diag(S, &d);
     log_progress(o, S, &d);
   }
+  struct stats_target tg;
+  struct stats_progress prog;
   if (S->t >= o->next_write) {
     char line[1024];
     stats_convergence_line(&o->st, line, sizeof line);
     output_log(o, "%s", line);
+    if (line[0] && target_of(sc, &tg) && !o->converged)
+      stats_progress(&o->st, &tg, &prog), log_target(o, S, &prog);
     if (write_stats(o, S)) {
       timer_pop();
       return CHANSPH_ERR;
@@ -480,6 +540,10 @@ int output_finish(struct output *o, struct sim *S) {
   char line[1024];
   stats_convergence_line(&o->st, line, sizeof line);
   output_log(o, "%s", line);
+  struct stats_target tg;
+  struct stats_progress prog;
+  if (line[0] && target_of(S->sc, &tg) && !o->converged)
+    stats_progress(&o->st, &tg, &prog), log_target(o, S, &prog);
   output_log(o, "statistics engine: %.3f MB (%lld snapshots)\n", stats_memory(&o->st) / 1048576.0,
              (long long)o->st.samples);
   char warnings[4096];

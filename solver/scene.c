@@ -266,6 +266,25 @@ static const struct key keys[] = {
      "Friction velocity that places the y+ levels of the correlations and Lagrangian releases "
      "(y = y+ nu / u_tau_ref); 0 = sqrt(delta drive.force), the force-balance value.",
      OFF(u_tau_ref)},
+    {"stats", "target_stderr", T_DOUBLE, "0", 0, 1, 0, NULL, "-",
+     "Convergence target: once the standard errors relative to their profile (max "
+     "stderr(u_mean) / max |u_mean|, and stderr of -u'v' at its peak / the peak) are below "
+     "this, with at least target_windows complete windows of at least target_corr_ratio "
+     "correlation times, the run ends itself (checkpoint, stats.nc, exit 0). Checked when a "
+     "window closes; every convergence line of the log gives the projected simulated and wall "
+     "time to reach it. 0 = off.",
+     OFF(target_stderr)},
+    {"stats", "target_profiles", T_CHOICE, "both", 0, 0, 0, "both|u_mean|uv_peak", "-",
+     "Profiles of the convergence target: u_mean and the -u'v' peak, or one of them (a laminar "
+     "flow has no -u'v' to converge).",
+     OFF(target_profiles)},
+    {"stats", "target_corr_ratio", T_DOUBLE, "5", 0, BIG, 0, NULL, "-",
+     "Convergence target: smallest window length / correlation time for the standard errors "
+     "to count (shorter windows make them too small); 0 = no requirement.",
+     OFF(target_corr_ratio)},
+    {"stats", "target_windows", T_INT, "4", 2, 1e9, 0, NULL, "-",
+     "Convergence target: fewest complete windows (batches) for the standard errors to count.",
+     OFF(target_windows)},
     {"correlations", "y_plus", T_LIST, "", 0, BIG, 0, NULL, "-",
      "Comma-separated y+ levels (up to 8) of the two-point correlations and 1-D spectra "
      "(thesis Eq. 5.57-5.59); each level and its mirror 2 delta - y are sampled. Empty = off.",

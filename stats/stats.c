@@ -79,6 +79,41 @@ static void eulerian_result(const struct euler *e, struct euler_result *res) {
   free(complete);
 }
 
+void stats_progress(const struct stats *st, const struct stats_target *tg,
+                    struct stats_progress *p) {
+  memset(p, 0, sizeof *p);
+  p->rel_u = p->rel_uv = p->worst = p->ratio = p->windows_needed = p->t_reach = NAN;
+  if (!st->cfg.eulerian || euler_rows(&st->eu) == 0) return;
+  struct euler_result r;
+  eulerian_result(&st->eu, &r);
+  double se = 0.0, umax = 0.0, uv = 0.0, se_uv = NAN;
+  for (int b = 0; b < r.nb; b++) {
+    if (isfinite(r.prof[EP_SE_U][b])) se = fmax(se, r.prof[EP_SE_U][b]);
+    if (isfinite(r.prof[EP_U][b])) umax = fmax(umax, fabs(r.prof[EP_U][b]));
+    if (isfinite(r.prof[EP_UV][b]) && fabs(r.prof[EP_UV][b]) > uv)
+      uv = fabs(r.prof[EP_UV][b]), se_uv = r.prof[EP_SE_U + 8][b]; /* stderr of uv */
+  }
+  p->windows = r.n_batches;
+  const double win = st->cfg.eul.window;
+  p->ratio = win / r.corr_time;
+  if (r.n_batches >= 2) {
+    p->rel_u = umax > 0.0 ? se / umax : NAN;
+    p->rel_uv = uv > 0.0 ? se_uv / uv : NAN;
+    p->worst = tg->profiles == 1   ? p->rel_u
+               : tg->profiles == 2 ? p->rel_uv
+                                   : fmax(p->rel_u, p->rel_uv);
+    if (tg->profiles == 0 && (isnan(p->rel_u) || isnan(p->rel_uv))) p->worst = NAN;
+  }
+  if (isfinite(p->worst)) {
+    const double q = p->worst / tg->rel_stderr;
+    p->windows_needed = fmax((double)tg->windows, ceil(r.n_batches * q * q));
+    p->t_reach = st->eu.win[WIN_T0] + p->windows_needed * win;
+  }
+  p->met = r.n_batches >= tg->windows && isfinite(p->worst) && p->worst <= tg->rel_stderr &&
+           (tg->corr_ratio <= 0.0 || p->ratio >= tg->corr_ratio);
+  euler_result_free(&r);
+}
+
 void stats_convergence_line(const struct stats *st, char *buf, size_t len) {
   buf[0] = '\0';
   if (!st->cfg.eulerian || euler_rows(&st->eu) == 0) return;

@@ -85,4 +85,31 @@ size_t stats_memory(const struct stats *st);
  */
 void stats_convergence_line(const struct stats *st, char *buf, size_t len);
 
+/** A convergence target (scene keys stats.target_*). */
+struct stats_target {
+  double rel_stderr; /*!< target relative standard error (> 0) */
+  int profiles;      /*!< 0: u_mean and the -u'v' peak, 1: u_mean, 2: the -u'v' peak */
+  double corr_ratio; /*!< smallest window length / correlation time (0: none) */
+  int windows;       /*!< fewest complete windows */
+};
+
+/** Where the statistics stand against a target. */
+struct stats_progress {
+  double rel_u;          /*!< max stderr(u_mean) / max |u_mean| (NaN: not yet) */
+  double rel_uv;         /*!< stderr / value of -u'v' at its peak (NaN: not yet) */
+  double worst;          /*!< the largest of the chosen ones (NaN: not yet) */
+  int windows;           /*!< complete windows */
+  double ratio;          /*!< window length / correlation time (NaN: not measured) */
+  double windows_needed; /*!< projected complete windows at the target (stderr ~ n^-1/2) */
+  double t_reach;        /*!< projected simulated time at which they are complete [s] */
+  int met;               /*!< the target is met */
+};
+
+/**
+ * @brief The standard errors against a target, and the projection to reach it (the batch-means
+ *        standard error falls as one over the square root of the number of windows).
+ */
+void stats_progress(const struct stats *st, const struct stats_target *tg,
+                    struct stats_progress *p);
+
 #endif
