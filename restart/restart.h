@@ -148,6 +148,15 @@ int rundir_read_id(const char *dir, char *id);
 /** @brief Record an identity in DIR/run_id and for the following writes. Collective. */
 int rundir_set_id(const char *dir, const char *id);
 
+/**
+ * @brief Record this process in DIR/history, newest first: "YYYY-MM-DDTHH:MM:SSZ: COMMAND LINE
+ *        (R MPI ranks x T threads)"; a new run (fresh) starts the file again. Rank 0 only (other
+ *        ranks get NULL); a file that cannot be written is a warning, not an error.
+ * @return the history text for the attribute `history` of stats.nc and particles.nc
+ *         (malloc'd, no trailing newline), or NULL on ranks other than 0
+ */
+char *rundir_history(const char *dir, const char *cmdline, int fresh, int ranks, int threads);
+
 /** @brief 1 if id is a valid run identity: 1 to 36 letters, digits, '.', '_', '-'. */
 int rundir_valid_id(const char *id);
 

@@ -124,6 +124,41 @@ int rundir_set_id(const char *dir, const char *id) {
   return rc;
 }
 
+char *rundir_history(const char *dir, const char *cmdline, int fresh, int ranks, int threads) {
+  if (!rank0()) return NULL;
+  char path[4096], tmp[4200], stamp[32], entry[8192];
+  const time_t now = time(NULL);
+  struct tm utc;
+  gmtime_r(&now, &utc);
+  strftime(stamp, sizeof stamp, "%Y-%m-%dT%H:%M:%SZ", &utc);
+  snprintf(entry, sizeof entry, "%s: %s (%d MPI rank%s x %d thread%s)", stamp,
+           cmdline ? cmdline : "chansph", ranks, ranks == 1 ? "" : "s", threads,
+           threads == 1 ? "" : "s");
+  snprintf(path, sizeof path, "%s/history", dir);
+  snprintf(tmp, sizeof tmp, "%s.tmp", path);
+  char *old = NULL;
+  size_t n = 0;
+  FILE *f = fresh ? NULL : fopen(path, "r");
+  if (f) {
+    if (fseek(f, 0, SEEK_END) == 0 && (n = (size_t)ftell(f)) > 0 && fseek(f, 0, SEEK_SET) == 0 &&
+        (old = malloc(n + 1)))
+      n = fread(old, 1, n, f), old[n] = '\0';
+    fclose(f);
+  }
+  while (old && n > 0 && old[n - 1] == '\n') old[--n] = '\0';
+  const size_t len = strlen(entry) + (old ? n + 1 : 0) + 1;
+  char *text = malloc(len);
+  if (!text) die("out of memory recording the history");
+  snprintf(text, len, "%s%s%s", entry, old && n ? "\n" : "", old && n ? old : "");
+  free(old);
+  FILE *w = fopen(tmp, "w");
+  if (!w || fprintf(w, "%s\n", text) < 0 || fclose(w) || rename(tmp, path)) {
+    warn("%s: cannot record the command in the history (%s)", path, strerror(errno));
+    remove(tmp);
+  }
+  return text;
+}
+
 /* The lock: rank 0 holds a write lock (fcntl) on DIR/.lock until the process ends. */
 static int lock_fd = -1;
 

@@ -76,6 +76,8 @@ static int run(struct scene *sc, const struct cli *c) {
     output_begin(&out, &S);
   }
   if (sc->threads > 0) omp_set_num_threads(sc->threads);
+  out.history =
+      rundir_history(c->out, c->cmdline, c->cmd == CMD_RUN, S.dd.size, omp_get_max_threads());
   struct trigger T;
   trigger_init(&T, c->out, sc, walltime, c->max_steps, S.step, restart_state_bytes(&out, &S));
   int rc = EXIT_DONE, why = TRIG_NONE;
@@ -169,6 +171,7 @@ int main(int argc, char **argv) {
     rc = c.cmd == CMD_BENCH ? cli_bench(&sc, c.steps) : run(&sc, &c);
   }
   free(c.set);
+  free(c.cmdline);
   MPI_Finalize();
   return rc;
 }

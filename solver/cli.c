@@ -32,9 +32,31 @@ void cli_usage(void) {
       "--max-steps): resume me (docs/batch-jobs.md).\n");
 }
 
+/* The command line as one string, arguments with blanks or quotes single-quoted. */
+static char *command_line(int argc, char **argv) {
+  size_t n = 1;
+  for (int i = 0; i < argc; i++) n += 4 * strlen(argv[i]) + 3;
+  char *s = calloc(n, 1);
+  if (!s) return NULL;
+  for (int i = 0; i < argc; i++) {
+    const char *a = argv[i];
+    if (i == 0 && strrchr(a, '/')) a = strrchr(a, '/') + 1; /* chansph, not its path */
+    if (i) strcat(s, " ");
+    if (a[0] && !strpbrk(a, " \t\n'\"\\$;&|<>*?()")) {
+      strcat(s, a);
+      continue;
+    }
+    strcat(s, "'");
+    for (const char *p = a; *p; p++) strcat(s, *p == '\'' ? "'\\''" : (char[]){*p, 0});
+    strcat(s, "'");
+  }
+  return s;
+}
+
 int cli_parse(int argc, char **argv, struct cli *c) {
   memset(c, 0, sizeof *c);
   c->set = calloc((size_t)argc + 1, sizeof *c->set);
+  c->cmdline = command_line(argc, argv);
   c->steps = 50;
   c->inject_id = -1;
   if (argc < 2) {

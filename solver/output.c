@@ -9,9 +9,24 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include <omp.h>
+#include <time.h>
+
 #include "error.h"
+#include "git_commit.h"
 #include "ncout.h"
 #include "timers.h"
+
+/** The `source` attribute of the output files: version and git commit of the build. */
+#define CHANSPH_SOURCE "chansph " CHANSPH_VERSION " (git " CHANSPH_GIT_COMMIT ")"
+
+/* The date a file is written, ISO 8601 in UTC (attribute date_created). */
+static void date_now(char *buf, size_t n) {
+  const time_t now = time(NULL);
+  struct tm utc;
+  gmtime_r(&now, &utc);
+  strftime(buf, n, "%Y-%m-%dT%H:%M:%SZ", &utc);
+}
 
 static const char *const series_names[] = {"time",    "u_bulk",    "body_force", "kinetic_energy",
                                            "mass",    "max_speed", "min_gamma",  "volume",
@@ -300,6 +315,8 @@ static int write_stats(struct output *o, const struct sim *S) {
   char drive[16], visc[16];
   snprintf(drive, sizeof drive, "%s", scene_choice("drive.mode", sc->drive_mode));
   snprintf(visc, sizeof visc, "%s", scene_choice("sph.viscous", sc->viscous));
+  char date[32];
+  date_now(date, sizeof date);
   const struct nc_attr attrs[] = {
       {"dimension", NULL, sc->dim, 1},
       {"delta", NULL, sc->delta, 0},
@@ -322,6 +339,11 @@ static int write_stats(struct output *o, const struct sim *S) {
       {"n_fluid", NULL, (double)S->P.n_fluid, 1},
       {"n_snapshots", NULL, (double)o->st.samples, 1},
       {"code_version", CHANSPH_VERSION, 0, 0},
+      {"source", CHANSPH_SOURCE, 0, 0},
+      {"history", o->history ? o->history : "", 0, 0},
+      {"date_created", date, 0, 0},
+      {"ranks", NULL, (double)S->dd.size, 1},
+      {"threads", NULL, (double)omp_get_max_threads(), 1},
       {"run_id", o->run_id, 0, 0},
       {"scene", o->scene_text, 0, 0},
   };
@@ -489,6 +511,8 @@ static int write_particles(struct output *o, const struct sim *S) {
                                    "m/s", "kg/m^3", "Pa", "1",   S->sc->dim == 2 ? "kg/m" : "kg"};
     const double *cols[NC];
     for (int c = 0; c < NC; c++) cols[c] = buf + (size_t)c * n;
+    char date[32];
+    date_now(date, sizeof date);
     static const char *const long_names[NC] = {"position x (streamwise)",
                                                "position y (wall-normal)",
                                                "position z (spanwise)",
@@ -501,6 +525,11 @@ static int write_particles(struct output *o, const struct sim *S) {
                                                "mass (per metre of span in 2-D)"};
     const struct nc_attr attrs[] = {{"time", NULL, S->t, 0},
                                     {"step", NULL, (double)S->step, 1},
+                                    {"source", CHANSPH_SOURCE, 0, 0},
+                                    {"history", o->history ? o->history : "", 0, 0},
+                                    {"date_created", date, 0, 0},
+                                    {"ranks", NULL, (double)S->dd.size, 1},
+                                    {"threads", NULL, (double)omp_get_max_threads(), 1},
                                     {"run_id", o->run_id, 0, 0},
                                     {"scene", o->scene_text, 0, 0}};
     char path[4096], err[4096];
@@ -580,6 +609,7 @@ void output_fail(struct output *o, struct sim *S, const struct health_report *re
 void output_close(struct output *o) {
   if (o->log) fclose(o->log);
   free(o->scene_text);
+  free(o->history);
   free(o->col);
   stats_free(&o->st);
   series_free(&o->ts);

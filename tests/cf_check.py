@@ -3,18 +3,21 @@
 libudunits2 parses (through ctypes: the Debian runtime library and its XML database), every
 variable has a long_name or standard_name, the file declares Conventions, and the attributes
 that count or flag are integers. Records of mixed quantities (eulerian/windows, moments,
-snapshot_u) carry no units.
+snapshot_u) carry no units. Provenance: history (a "DATE: chansph ..." line per run and resume,
+newest first), date_created (ISO 8601), source (version and git commit), ranks and threads.
 
-usage: cf_check.py FILE.nc ...
+usage: cf_check.py [resumed:]FILE.nc ...   (resumed: the history must hold a resume)
 """
 import ctypes
 import ctypes.util
+import re
 import sys
 
 import netCDF4
 
 INTEGER_ATTRS = ("dimension", "steps", "n_fluid", "n_snapshots", "n_windows", "fold", "les",
-                 "step", "releases")
+                 "step", "releases", "ranks", "threads")
+STAMP = r"\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ"
 MIXED = ("windows", "moments", "snapshot_u")
 
 
@@ -42,10 +45,28 @@ def udunits():
 def main():
     parses = udunits()
     problems, units_seen = [], 0
-    for path in sys.argv[1:]:
+    for arg in sys.argv[1:]:
+        resumed = arg.startswith("resumed:")
+        path = arg[len("resumed:"):] if resumed else arg
         with netCDF4.Dataset(path) as d:
             if "Conventions" not in d.ncattrs():
                 problems.append("%s: no global attribute Conventions" % path)
+            a = {k: d.getncattr(k) for k in d.ncattrs()}
+            lines = str(a.get("history", "")).split("\n")
+            if not all(re.match(STAMP + r": chansph (run|resume) .*\(\d+ MPI ranks? x \d+ "
+                                r"threads?\)$", l) for l in lines):
+                problems.append("%s: history is not one 'DATE: chansph run|resume ...' line per "
+                                "process: %r" % (path, a.get("history")))
+            if resumed and not any(" chansph resume " in l for l in lines):
+                problems.append("%s: the history has no resume" % path)
+            if not re.match(STAMP + "$", str(a.get("date_created", ""))):
+                problems.append("%s: date_created %r is not ISO 8601" % (path, a.get("date_created")))
+            if not re.match(r"chansph \S+ \(git ([0-9a-f]+(-dirty)?|unknown)\)$",
+                            str(a.get("source", ""))):
+                problems.append("%s: source %r names no version and commit" % (path, a.get("source")))
+            for k in ("ranks", "threads"):
+                if k not in a or not int(a[k]) >= 1:
+                    problems.append("%s: no attribute %s >= 1" % (path, k))
 
             def walk(g, prefix):
                 nonlocal units_seen

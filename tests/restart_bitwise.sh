@@ -20,7 +20,7 @@ rc=$?
 "$chansph" resume "$part" > /dev/null || { echo "FAIL: final resume"; exit 1; }
 status=0
 for f in stats.nc particles.nc; do
-  if diff <(ncdump -p 9,17 "$full/$f" | tail -n +2) <(ncdump -p 9,17 "$part/$f" | tail -n +2) \
+  if diff <("$(dirname "$0")/nc_content.sh" "$full/$f") <("$(dirname "$0")/nc_content.sh" "$part/$f") \
     > /dev/null; then
     echo "$name $f: data identical"
   else
