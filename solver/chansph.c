@@ -81,7 +81,9 @@ static int run(struct scene *sc, const struct cli *c) {
   struct trigger T;
   trigger_init(&T, c->out, sc, walltime, c->max_steps, S.step, restart_state_bytes(&out, &S));
   int rc = EXIT_DONE, why = TRIG_NONE;
-  long checked = S.step; /* the start state: built and checked, or read from a checkpoint */
+  /* the start state counts as checked: read from a checkpoint (checked when it was written), or
+     built from the scene (analytic profiles; init.from is refused if not finite) */
+  long checked = S.step;
   while (!sim_done(&S)) {
     sim_step(&S);
     if (c->inject_id >= 0 && S.step == c->inject_step)
