@@ -13,6 +13,13 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+/** Identity of the run (ckpt_set_run_id), written into every file; "" = none. */
+static char run_id[CKPT_RUN_ID_MAX];
+
+void ckpt_set_run_id(const char *id) {
+  snprintf(run_id, sizeof run_id, "%s", id ? id : "");
+}
+
 /** Largest chunk [bytes]: Fletcher32 covers each chunk; HDF5 needs chunks below 4 GB. */
 enum { CHUNK_BYTES = 1 << 22 };
 
@@ -282,6 +289,8 @@ static int write_file(const char *path, const char *format, const struct state_l
   H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
   int me = 0;
   if (par) MPI_Comm_rank(MPI_COMM_WORLD, &me);
+  /* what the messages call the file: "checkpoint", "snapshot" (chansph-<noun>) */
+  const char *noun = strncmp(format, "chansph-", 8) ? "file" : format + 8;
   char tmp[4096];
   snprintf(tmp, sizeof tmp, "%s.tmp", path);
   const hid_t fcpl = H5Pcreate(H5P_FILE_CREATE), fapl = H5Pcreate(H5P_FILE_ACCESS);
@@ -308,7 +317,7 @@ static int write_file(const char *path, const char *format, const struct state_l
   const hid_t file = H5Fcreate(tmp, H5F_ACC_TRUNC, fcpl, fapl);
   H5Pclose(fcpl), H5Pclose(fapl);
   int rc = file < 0;
-  if (rc) fail(err, errlen, "cannot write checkpoint %s (%s)", tmp, strerror(errno));
+  if (rc) fail(err, errlen, "cannot write %s %s (%s)", noun, tmp, strerror(errno));
   if (par) rc = ckpt_agree(rc, err, errlen);
   if (rc) {
     H5Pclose(gcpl);
@@ -323,39 +332,40 @@ static int write_file(const char *path, const char *format, const struct state_l
       put_attr_num(file, "format_version_minor", H5T_STD_I32LE, H5T_NATIVE_INT32, &minor) ||
       put_attr_text(file, "code_version", CHANSPH_VERSION) ||
       put_attr_num(file, "step", H5T_STD_I64LE, H5T_NATIVE_INT64, &step64) ||
-      put_attr_num(file, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &time)) {
-    fail(err, errlen, "cannot write the root attributes of checkpoint %s", tmp);
+      put_attr_num(file, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &time) ||
+      (run_id[0] && put_attr_text(file, "run_id", run_id))) {
+    fail(err, errlen, "cannot write the root attributes of %s %s", noun, tmp);
     rc = 1;
   }
   if (par) rc = ckpt_agree(rc, err, errlen);
   char *scene_copy = (char *)scene;
   struct state_field sf = {.name = "scene", .type = STATE_TEXT, .data = &scene_copy};
   if (!rc && scene && write_field(file, &sf, gcpl, par, me)) {
-    fail(err, errlen, "cannot write dataset /scene of checkpoint %s", tmp);
+    fail(err, errlen, "cannot write dataset /scene of %s %s", noun, tmp);
     rc = 1;
   }
   if (par) rc = ckpt_agree(rc, err, errlen);
   for (int i = 0; i < L->n && !rc; i++) {
     if (write_field(file, &L->f[i], gcpl, par, me)) {
-      fail(err, errlen, "cannot write dataset /%s of checkpoint %s", L->f[i].name, tmp);
+      fail(err, errlen, "cannot write dataset /%s of %s %s", L->f[i].name, noun, tmp);
       rc = 1;
     }
     if (par) rc = ckpt_agree(rc, err, errlen);
   }
   const int32_t one = 1; /* written last: a file without it is incomplete */
   if (!rc && put_attr_num(file, "complete", H5T_STD_I32LE, H5T_NATIVE_INT32, &one)) {
-    fail(err, errlen, "cannot write the completion mark of checkpoint %s", tmp);
+    fail(err, errlen, "cannot write the completion mark of %s %s", noun, tmp);
     rc = 1;
   }
   if (par) rc = ckpt_agree(rc, err, errlen);
   H5Pclose(gcpl);
   if (H5Fclose(file) < 0 && !rc) {
-    fail(err, errlen, "cannot write checkpoint %s", tmp);
+    fail(err, errlen, "cannot write %s %s", noun, tmp);
     rc = 1;
   }
   if (par) rc = ckpt_agree(rc, err, errlen);
   if (me == 0 && !rc && sync_path(tmp, 0)) {
-    snprintf(err, errlen, "cannot fsync checkpoint %s: %s", tmp, strerror(errno));
+    snprintf(err, errlen, "cannot fsync %s %s: %s", noun, tmp, strerror(errno));
     rc = 1;
   }
   if (me == 0 && !rc && rename(tmp, path)) {
@@ -487,9 +497,21 @@ int ckpt_info(const char *path, struct ckpt_info *info, char *err, size_t errlen
   int rc = 1;
   int32_t major = 0, minor = 0, complete = 0;
   int64_t step = 0;
-  if (get_attr_text(file, "format", format, sizeof format) || strcmp(format, CKPT_FORMAT))
-    snprintf(err, errlen, "%s: not a chansph checkpoint (root attribute 'format' is not '%s')",
-             path, CKPT_FORMAT);
+  const htri_t has_format = H5Aexists(file, "format");
+  if (has_format < 0) /* the root group's header does not read: its checksum, or damage */
+    fail(err, errlen,
+         "%s: cannot read the root group's attributes (metadata checksum mismatch or corrupt "
+         "file)",
+         path);
+  else if (has_format == 0)
+    snprintf(err, errlen, "%s: not a chansph checkpoint (no root attribute 'format')", path);
+  else if (get_attr_text(file, "format", format, sizeof format))
+    fail(err, errlen, "%s: cannot read root attribute 'format' (checksum mismatch or corrupt file)",
+         path);
+  else if (strcmp(format, CKPT_FORMAT))
+    snprintf(err, errlen,
+             "%s: not a chansph checkpoint (root attribute 'format' is '%.64s', not '%s')", path,
+             format, CKPT_FORMAT);
   else if (get_attr_int(file, "format_version_major", H5T_NATIVE_INT32, &major) ||
            get_attr_int(file, "format_version_minor", H5T_NATIVE_INT32, &minor))
     snprintf(err, errlen, "%s: no readable format version (root attributes format_version_*)",
@@ -507,6 +529,9 @@ int ckpt_info(const char *path, struct ckpt_info *info, char *err, size_t errlen
   else if (get_attr_int(file, "step", H5T_NATIVE_INT64, &step) ||
            get_attr_int(file, "time", H5T_NATIVE_DOUBLE, &info->time))
     snprintf(err, errlen, "%s: root attributes 'step' or 'time' missing", path);
+  else if (H5Aexists(file, "run_id") > 0 &&
+           get_attr_text(file, "run_id", info->run_id, sizeof info->run_id))
+    snprintf(err, errlen, "%s: root attribute 'run_id' cannot be read", path);
   else if ((info->scene = read_text(file, "scene", path, err, errlen)))
     rc = 0;
   info->step = (long)step, info->major = major, info->minor = minor;

@@ -18,18 +18,29 @@
 /** Value of the root attribute "format". */
 #define CKPT_FORMAT "chansph-checkpoint"
 
-/** Format version: a reader refuses a newer major version; minor versions only add. */
-enum { CKPT_VERSION_MAJOR = 1, CKPT_VERSION_MINOR = 0 };
+/** Format version: a reader refuses a newer major version; minor versions only add
+    (1.1: root attribute run_id). */
+enum { CKPT_VERSION_MAJOR = 1, CKPT_VERSION_MINOR = 1 };
+
+/** Room for a run identity (a UUID has 36 characters; restart.h: rundir_*). */
+enum { CKPT_RUN_ID_MAX = 64 };
 
 /** What ckpt_info() reads from a file without reading the state. */
 struct ckpt_info {
-  long step;      /*!< step of the state */
-  double time;    /*!< simulated time of the state [s] */
-  int major;      /*!< format version of the file */
-  int minor;      /*!< format version of the file */
-  char *scene;    /*!< resolved scene text (malloc'd; free it) */
-  size_t n_bytes; /*!< file size [bytes] */
+  long step;                    /*!< step of the state */
+  double time;                  /*!< simulated time of the state [s] */
+  int major;                    /*!< format version of the file */
+  int minor;                    /*!< format version of the file */
+  char *scene;                  /*!< resolved scene text (malloc'd; free it) */
+  size_t n_bytes;               /*!< file size [bytes] */
+  char run_id[CKPT_RUN_ID_MAX]; /*!< identity of the run that wrote it ("" before format 1.1) */
 };
+
+/**
+ * @brief The identity of the run, written as root attribute run_id into every following file
+ *        (checkpoints, snapshots); "" writes none. Call with the same text on every rank.
+ */
+void ckpt_set_run_id(const char *id);
 
 /**
  * @brief Write a checkpoint atomically.
@@ -71,7 +82,7 @@ int ckpt_write_fields(const char *path, const char *format, const struct state_l
 
 /**
  * @brief Open a checkpoint and check it: HDF5 structure, format name, version (a newer major
- *        version is refused), completion mark; read step, time and scene text.
+ *        version is refused), completion mark; read step, time, run identity and scene text.
  * @param[in] path file
  * @param[out] info what was read (info->scene must be freed)
  * @param[out] err,errlen message on failure

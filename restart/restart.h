@@ -106,9 +106,10 @@ int restart_prepare_new(const char *dir, int overwrite);
 
 /**
  * @brief Resume the run in DIR from its newest valid checkpoint: a corrupt, truncated,
- *        incomplete or future-version file is reported and renamed NAME.skipped (nothing is
- *        deleted), and the previous one is tried. Overrides may change only the keys
- *        documented as changeable (end time, output, statistics windows, health, threads,
+ *        incomplete or future-version file, one of another run (its run_id is not DIR/run_id)
+ *        and one whose file name disagrees with the step inside are reported and renamed
+ *        NAME.skipped (nothing is deleted), and the previous one is tried. Overrides may change
+ * only the keys documented as changeable (end time, output, statistics windows, health, threads,
  *        checkpoints); changes are logged.
  * @param[in] dir run directory
  * @param[in] n_set,set --set overrides
@@ -119,6 +120,45 @@ int restart_prepare_new(const char *dir, int overwrite);
  */
 int restart_resume(const char *dir, int n_set, char *const *set, struct scene *sc, struct sim *S,
                    struct output *o);
+
+/**
+ * @brief Lock the run directory for the life of the process (rank 0 holds an fcntl write lock
+ *        on DIR/.lock): a second chansph in the same directory gets a message naming the
+ *        holder's process id. create: make DIR first if it does not exist (run); otherwise a
+ *        missing DIR is not locked (resume then reports it). Collective.
+ * @return CHANSPH_OK, or CHANSPH_ERR after a message
+ */
+int rundir_lock(const char *dir, int create);
+
+/**
+ * @brief A new run's identity: CHANSPH_RUN_ID if set, else a random UUID; written to
+ *        DIR/run_id and into every following checkpoint and snapshot (ckpt_set_run_id).
+ * @param[out] id the identity (CKPT_RUN_ID_MAX bytes), the same on every rank
+ * @return CHANSPH_OK, or CHANSPH_ERR after a message
+ */
+int rundir_new_id(const char *dir, char *id);
+
+/**
+ * @brief Read DIR/run_id. Collective.
+ * @param[out] id the identity, or "" (CKPT_RUN_ID_MAX bytes)
+ * @return 0, or 1 if the directory has none (a run started before run identities existed)
+ */
+int rundir_read_id(const char *dir, char *id);
+
+/** @brief Record an identity in DIR/run_id and for the following writes. Collective. */
+int rundir_set_id(const char *dir, const char *id);
+
+/**
+ * @brief Record this process in DIR/history, newest first: "YYYY-MM-DDTHH:MM:SSZ: COMMAND LINE
+ *        (R MPI ranks x T threads)"; a new run (fresh) starts the file again. Rank 0 only (other
+ *        ranks get NULL); a file that cannot be written is a warning, not an error.
+ * @return the history text for the attribute `history` of stats.nc and particles.nc
+ *         (malloc'd, no trailing newline), or NULL on ranks other than 0
+ */
+char *rundir_history(const char *dir, const char *cmdline, int fresh, int ranks, int threads);
+
+/** @brief 1 if id is a valid run identity: 1 to 36 letters, digits, '.', '_', '-'. */
+int rundir_valid_id(const char *id);
 
 /** @brief State size in bytes of a run (for the write-time estimate and reports). */
 double restart_state_bytes(struct output *o, struct sim *S);

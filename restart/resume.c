@@ -25,6 +25,10 @@ static const char *const changeable[] = {"time.t_end",
                                          "output.write_every",
                                          "output.t_average_start",
                                          "stats.window",
+                                         "stats.target_stderr",
+                                         "stats.target_profiles",
+                                         "stats.target_corr_ratio",
+                                         "stats.target_windows",
                                          "output.particles",
                                          "health.every",
                                          "run.threads",
@@ -62,6 +66,32 @@ static int check_changes(const struct scene *old, const struct scene *now, const
   return bad ? CHANSPH_ERR : CHANSPH_OK;
 }
 
+/* output.t_average_start may change only before averaging has begun, and not into the past of
+   the checkpoint: otherwise the windows would differ in length and the standard errors would
+   mix them (issue 13). t: time of the checkpoint. */
+static int check_average_start(const struct scene *old, const struct scene *now, double t,
+                               const char *path) {
+  const double a = old->t_average_start, b = now->t_average_start;
+  if (a == b) return CHANSPH_OK;
+  if (t >= a) {
+    error_input(
+        "--set output.t_average_start=%g: key 'output.t_average_start' cannot change on resume "
+        "once averaging has begun (the checkpoint %s is at t = %.9g s, averaging began at "
+        "%g s): the averaging windows would differ in length; keep %g, or start a new run",
+        b, path, t, a, a);
+    return CHANSPH_ERR;
+  }
+  if (b < t) {
+    error_input(
+        "--set output.t_average_start=%g: key 'output.t_average_start' is before the time of "
+        "the checkpoint %s (t = %.9g s): the samples since %g s were not taken; choose a start "
+        "at or after %.9g s",
+        b, path, t, b, t);
+    return CHANSPH_ERR;
+  }
+  return CHANSPH_OK;
+}
+
 /* Log the accepted changes. */
 static void log_changes(struct output *o, const struct scene *old, const struct scene *now) {
   for (int k = 0; k < scene_key_count(); k++) {
@@ -90,17 +120,48 @@ static void skip(struct skipped *sk, const char *path, const char *why) {
   }
 }
 
+/* The candidate's identity: the step its name says, and the run of the directory ("": the
+   directory has no run_id). */
+struct candidate {
+  const char *path;
+  long name_step;
+  const char *dir_id;
+  char run_id[CKPT_RUN_ID_MAX]; /* the file's identity, once read */
+};
+
 /* Read one candidate; on failure everything it set up is released. */
-static int try_one(const char *dir, const char *path, int n_set, char *const *set, struct scene *sc,
-                   struct sim *S, struct output *o, struct skipped *sk, struct scene *old,
-                   int *fatal, double seconds[2]) {
+static int try_one(const char *dir, struct candidate *cd, int n_set, char *const *set,
+                   struct scene *sc, struct sim *S, struct output *o, struct skipped *sk,
+                   struct scene *old, int *fatal, double seconds[2]) {
+  const char *path = cd->path;
   char err[2048];
   struct ckpt_info info;
-  if (ckpt_agree(ckpt_info(path, &info, err, sizeof err), err, sizeof err)) {
+  int bad_file = ckpt_agree(ckpt_info(path, &info, err, sizeof err), err, sizeof err);
+  if (!bad_file && info.step != cd->name_step) {
+    snprintf(err, sizeof err,
+             "%.1900s: the file name says step %ld but the checkpoint holds step %ld (a renamed "
+             "or copied file)",
+             path, cd->name_step, info.step);
+    bad_file = 1;
+  } else if (!bad_file && cd->dir_id[0] && strcmp(info.run_id, cd->dir_id)) {
+    if (info.run_id[0])
+      snprintf(err, sizeof err,
+               "%.1900s: a checkpoint of another run (run_id %s; this directory's run is %s, "
+               "see %s/run_id)",
+               path, info.run_id, cd->dir_id, dir);
+    else
+      snprintf(err, sizeof err,
+               "%.1900s: a checkpoint without a run identity (format %d.%d) in the directory "
+               "of run %s",
+               path, info.major, info.minor, cd->dir_id);
+    bad_file = 1;
+  }
+  if (bad_file) {
     free(info.scene);
     skip(sk, path, err);
     return CHANSPH_ERR;
   }
+  snprintf(cd->run_id, sizeof cd->run_id, "%s", info.run_id);
   char name[4200];
   snprintf(name, sizeof name, "%s:/scene", path);
   if (scene_load_text(old, name, info.scene, 0, NULL)) {
@@ -110,15 +171,22 @@ static int try_one(const char *dir, const char *path, int n_set, char *const *se
     free(info.scene);
     return CHANSPH_ERR;
   }
-  const int bad = scene_load_text(sc, name, info.scene, n_set, set) || check_changes(old, sc, path);
+  const int bad = scene_load_text(sc, name, info.scene, n_set, set) ||
+                  check_changes(old, sc, path) || check_average_start(old, sc, info.time, path);
   free(info.scene);
-  if (bad) {
+  /* the ranks must fit the slabs before anything is read (an input error, exit 1) */
+  struct dd probe;
+  const int fits = !bad && dd_init(&probe, sc, NULL, NULL) == CHANSPH_OK;
+  if (!bad) dd_free(&probe);
+  if (bad || !fits) {
     *fatal = 1;
     return CHANSPH_ERR;
   }
-  /* the initial condition is replaced by the checkpoint: do not read init.from again */
+  /* the initial condition is replaced by the checkpoint: do not read init.from again, */
   struct scene bare = *sc;
   bare.init_from[0] = '\0';
+  /* nor build (and announce) an initial profile: the checkpoint holds the velocities */
+  bare.init_profile = INIT_REST, bare.init_noise = bare.init_modes = bare.init_streaks = 0.0;
   if (sim_create(S, &bare)) {
     *fatal = 1;
     return CHANSPH_ERR;
@@ -174,10 +242,13 @@ int restart_resume(const char *dir, int n_set, char *const *set, struct scene *s
   struct scene old;
   int fatal = 0, found = -1;
   double seconds[2] = {0.0, 0.0}; /* read, restore */
-  char path[4096];
+  char path[4096], dir_id[CKPT_RUN_ID_MAX];
+  const int no_id = rundir_read_id(dir, dir_id);
+  struct candidate cd = {.path = path, .dir_id = dir_id};
   for (int i = n - 1; i >= 0 && !fatal && found < 0; i--) {
     rotate_path(path, sizeof path, dir, steps[i]);
-    if (!try_one(dir, path, n_set, set, sc, S, o, &sk, &old, &fatal, seconds)) found = i;
+    cd.name_step = steps[i];
+    if (!try_one(dir, &cd, n_set, set, sc, S, o, &sk, &old, &fatal, seconds)) found = i;
   }
   free(steps);
   if (fatal) return CHANSPH_ERR;
@@ -188,6 +259,22 @@ int restart_resume(const char *dir, int n_set, char *const *set, struct scene *s
         dir, n);
     return CHANSPH_ERR;
   }
+  /* the run's identity: the directory's; a directory without one (a run started before
+     identities existed) takes the checkpoint's, or a new one */
+  if (no_id) {
+    const int had = cd.run_id[0] != '\0';
+    const int rc = had ? rundir_set_id(dir, cd.run_id) : rundir_new_id(dir, cd.run_id);
+    if (rc) {
+      output_close(o);
+      sim_free(S);
+      return CHANSPH_ERR;
+    }
+    output_log(o, "resume: %s/run_id was missing: the run's identity is now %s (%s)\n", dir,
+               cd.run_id, had ? "the checkpoint's" : "new");
+  } else {
+    ckpt_set_run_id(dir_id);
+  }
+  snprintf(o->run_id, sizeof o->run_id, "%s", no_id ? cd.run_id : dir_id);
   output_log(o, "resume: from %s (step %ld, t = %.9g s; read in %.3f s, restored in %.3f s)\n",
              path, S->step, S->t, seconds[0], seconds[1]);
   if (tmp) output_log(o, "resume: removed %d temporary file(s) of interrupted writes\n", tmp);

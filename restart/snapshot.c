@@ -46,8 +46,9 @@ static void item(FILE *x, const char *file, const char *ds, size_t n, int cols, 
           n, cols == 3 ? " 3" : "", type, prec, file, ds);
 }
 
-/* Rewrite DIR/snapshots/particles.xdmf from the snapshot files present. */
-static int write_xdmf(const char *sdir, size_t n) {
+/* Rewrite DIR/snapshots/particles.xdmf from the snapshot files present. les: the files hold
+   the eddy viscosity. */
+static int write_xdmf(const char *sdir, size_t n, int les) {
   DIR *d = opendir(sdir);
   if (!d) return -1;
   char **names = NULL;
@@ -81,17 +82,24 @@ static int write_xdmf(const char *sdir, size_t n) {
       snprintf(file, sizeof file, "%s/%s", sdir, names[i]);
       const double t = snap_time(file);
       if (isnan(t)) continue;
+      /* one vertex cell per particle; the connectivity is the id dataset (0 .. n-1, the
+         rows in order): ParaView's Xdmf3 readers build no cells without it */
       fprintf(x,
               "      <Grid Name=\"%.*s\" GridType=\"Uniform\">\n"
               "        <Time Value=\"%.17g\"/>\n"
               "        <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"%zu\" "
-              "NodesPerElement=\"1\"/>\n        <Geometry GeometryType=\"XYZ\">\n",
+              "NodesPerElement=\"1\">\n",
               (int)(strlen(names[i]) - 3), names[i], t, n);
+      item(x, names[i], "id", n, 1, "Int", 8);
+      fprintf(x, "        </Topology>\n        <Geometry GeometryType=\"XYZ\">\n");
       item(x, names[i], "position", n, 3, "Float", 8);
       fprintf(x, "        </Geometry>\n");
-      static const char *const attr[4][2] = {
-          {"velocity", "Vector"}, {"pressure", "Scalar"}, {"density", "Scalar"}, {"id", "Scalar"}};
-      for (int k = 0; k < 4; k++) {
+      static const char *const attr[5][2] = {{"velocity", "Vector"},
+                                             {"pressure", "Scalar"},
+                                             {"density", "Scalar"},
+                                             {"id", "Scalar"},
+                                             {"eddy_viscosity", "Scalar"}};
+      for (int k = 0; k < (les ? 5 : 4); k++) {
         fprintf(x, "        <Attribute Name=\"%s\" AttributeType=\"%s\" Center=\"Node\">\n",
                 attr[k][0], attr[k][1]);
         item(x, names[i], attr[k][0], n, k == 0 ? 3 : 1, k == 3 ? "Int" : "Float", 8);
@@ -114,9 +122,12 @@ int snapshot_write(const char *dir, const struct sim *S) {
   const size_t n = P->n_fluid;
   const int root = S->dd.rank == 0;
   /* gathered on rank 0 by id, which writes the file */
-  enum { NC = 8 };
-  const double *src[NC] = {P->x, P->y, P->z, P->u, P->v, P->w, P->p, P->rho};
-  double *g = root ? malloc(NC * n * sizeof *g) : NULL;
+  /* with LES the eddy viscosity too (every rank has nu_r, or none has) */
+  const int les = P->nur != NULL;
+  enum { NC_MAX = 9 };
+  const int NC = les ? 9 : 8;
+  const double *src[NC_MAX] = {P->x, P->y, P->z, P->u, P->v, P->w, P->p, P->rho, P->nur};
+  double *g = root ? malloc((size_t)NC * n * sizeof *g) : NULL;
   if (root && !g) die("out of memory writing a snapshot");
   dd_gather_fluid(&S->dd, P, NC, src, g);
   int rc = CHANSPH_OK;
@@ -136,6 +147,7 @@ int snapshot_write(const char *dir, const struct sim *S) {
     state_add(&L, "velocity", STATE_F64, 2, d2, vel, "m/s");
     state_add(&L, "pressure", STATE_F64, 1, d1, g + 6 * n, "Pa");
     state_add(&L, "density", STATE_F64, 1, d1, g + 7 * n, "kg/m^3");
+    if (les) state_add(&L, "eddy_viscosity", STATE_F64, 1, d1, g + 8 * n, "m^2/s");
     char sdir[4096], path[4200], err[2048];
     snprintf(sdir, sizeof sdir, "%s/snapshots", dir);
     snprintf(path, sizeof path, "%s/snap_%010ld.h5", sdir, S->step);
@@ -146,7 +158,7 @@ int snapshot_write(const char *dir, const struct sim *S) {
                                  sizeof err)) {
       error_input("%s", err);
       rc = CHANSPH_ERR;
-    } else if (write_xdmf(sdir, n)) {
+    } else if (write_xdmf(sdir, n, les)) {
       error_input("%s/particles.xdmf: cannot write (%s)", sdir, strerror(errno));
       rc = CHANSPH_ERR;
     }

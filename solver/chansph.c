@@ -34,6 +34,19 @@ static int save(struct output *out, struct sim *S, struct trigger *T) {
   return CHANSPH_OK;
 }
 
+/** Health check of the state before it is written or sampled, once per step (checked: the
+    step last checked); a failure is reported (step, particle id, position) and returns 1. */
+static int unhealthy(struct output *out, struct sim *S, long *checked) {
+  struct health_report rep;
+  if (*checked == S->step) return 0;
+  if (health_check(&S->M, &S->P, S->step, S->t, &rep)) {
+    output_fail(out, S, &rep);
+    return 1;
+  }
+  *checked = S->step;
+  return 0;
+}
+
 /** Run a scene, or resume a run, in a directory; returns the process exit code. */
 static int run(struct scene *sc, const struct cli *c) {
   double walltime = 0.0;
@@ -44,30 +57,48 @@ static int run(struct scene *sc, const struct cli *c) {
   struct output out;
   struct sim S;
   if (c->cmd == CMD_RESUME) {
-    if (restart_resume(c->out, c->n_set, c->set, sc, &S, &out)) return EXIT_INPUT;
+    /* the directory is locked for the life of the process (DIR/.lock) */
+    if (rundir_lock(c->out, 0) || restart_resume(c->out, c->n_set, c->set, sc, &S, &out))
+      return EXIT_INPUT;
     output_resume(&out, &S);
   } else {
     if (sim_init(&S, sc)) return EXIT_INPUT; /* before the run directory exists */
-    if (restart_prepare_new(c->out, c->overwrite) || output_open(&out, c->out, sc, c->overwrite)) {
+    if (rundir_lock(c->out, 1) || restart_prepare_new(c->out, c->overwrite) ||
+        output_open(&out, c->out, sc, c->overwrite)) {
+      sim_free(&S);
+      return EXIT_INPUT;
+    }
+    if (rundir_new_id(c->out, out.run_id)) {
+      output_close(&out);
       sim_free(&S);
       return EXIT_INPUT;
     }
     output_begin(&out, &S);
   }
   if (sc->threads > 0) omp_set_num_threads(sc->threads);
+  out.history =
+      rundir_history(c->out, c->cmdline, c->cmd == CMD_RUN, S.dd.size, omp_get_max_threads());
   struct trigger T;
   trigger_init(&T, c->out, sc, walltime, c->max_steps, S.step, restart_state_bytes(&out, &S));
   int rc = EXIT_DONE, why = TRIG_NONE;
+  /* the start state counts as checked: read from a checkpoint (checked when it was written), or
+     built from the scene (analytic profiles; init.from is refused if not finite) */
+  long checked = S.step;
   while (!sim_done(&S)) {
     sim_step(&S);
     if (c->inject_id >= 0 && S.step == c->inject_step)
       for (size_t a = 0; a < S.P.n; a++)
         if (S.P.id[a] == c->inject_id) S.P.u[a] = NAN; /* fault injection (tests only) */
-    struct health_report rep;
-    if (S.violation[0]) snprintf(rep.what, sizeof rep.what, "%s", S.violation);
-    if (S.violation[0] ||
-        (S.step % sc->health_every == 0 && health_check(&S.M, &S.P, S.step, S.t, &rep))) {
+    if (S.violation[0]) {
+      struct health_report rep;
+      snprintf(rep.what, sizeof rep.what, "%s", S.violation);
       output_fail(&out, &S, &rep);
+      rc = EXIT_NUMERICAL;
+      break;
+    }
+    /* every state that is written or sampled is checked first, whatever health.every */
+    if ((S.step % sc->health_every == 0 || output_takes_state(&out, &S) || snapshot_due(&S)) &&
+        unhealthy(&out, &S, &checked)) {
       rc = EXIT_NUMERICAL;
       break;
     }
@@ -81,8 +112,13 @@ static int run(struct scene *sc, const struct cli *c) {
       rc = EXIT_IOERR;
       break;
     }
+    if (out.converged) break; /* stats.target_stderr met: final checkpoint and files, exit 0 */
     why = trigger_check(&T, S.step);
     if (why == TRIG_NONE) continue;
+    if (unhealthy(&out, &S, &checked)) {
+      rc = EXIT_NUMERICAL;
+      break;
+    }
     if (save(&out, &S, &T)) {
       rc = EXIT_IOERR;
       break;
@@ -92,6 +128,7 @@ static int run(struct scene *sc, const struct cli *c) {
       break;
     }
   }
+  if (rc == EXIT_DONE && unhealthy(&out, &S, &checked)) rc = EXIT_NUMERICAL;
   if (rc == EXIT_DONE && T.last_step != S.step && save(&out, &S, &T)) rc = EXIT_IOERR;
   if (rc == EXIT_DONE && output_finish(&out, &S)) rc = EXIT_IOERR;
   if (rc == EXIT_RESUBMIT) {
@@ -136,6 +173,7 @@ int main(int argc, char **argv) {
     rc = c.cmd == CMD_BENCH ? cli_bench(&sc, c.steps) : run(&sc, &c);
   }
   free(c.set);
+  free(c.cmdline);
   MPI_Finalize();
   return rc;
 }

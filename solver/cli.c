@@ -23,7 +23,7 @@ void cli_usage(void) {
       "  chansph extract STATS.nc [--var a,b] [--units wall|outer] [--format csv|tsv]\n"
       "                  [--window T0:T1]   print profiles (docs/stats-format.md)\n"
       "  chansph compare STATS.nc --dns FILE [--out DIR]   errors against DNS, PNG plots\n"
-      "  chansph --version | --help\n"
+      "  chansph --version | --help   (also: chansph run|resume|bench|extract --help)\n"
       "run writes DIR/log.txt, scene.used.ini, stats.nc, particles.nc (default DIR:\n"
       "runs/<scene name>) and DIR/checkpoints/ckpt_<step>.h5; resume continues a run from\n"
       "its newest valid checkpoint. Threads: OMP_NUM_THREADS or run.threads. Exit codes: 0 done,\n"
@@ -32,9 +32,31 @@ void cli_usage(void) {
       "--max-steps): resume me (docs/batch-jobs.md).\n");
 }
 
+/* The command line as one string, arguments with blanks or quotes single-quoted. */
+static char *command_line(int argc, char **argv) {
+  size_t n = 1;
+  for (int i = 0; i < argc; i++) n += 4 * strlen(argv[i]) + 3;
+  char *s = calloc(n, 1);
+  if (!s) return NULL;
+  for (int i = 0; i < argc; i++) {
+    const char *a = argv[i];
+    if (i == 0 && strrchr(a, '/')) a = strrchr(a, '/') + 1; /* chansph, not its path */
+    if (i) strcat(s, " ");
+    if (a[0] && !strpbrk(a, " \t\n'\"\\$;&|<>*?()")) {
+      strcat(s, a);
+      continue;
+    }
+    strcat(s, "'");
+    for (const char *p = a; *p; p++) strcat(s, *p == '\'' ? "'\\''" : (char[]){*p, 0});
+    strcat(s, "'");
+  }
+  return s;
+}
+
 int cli_parse(int argc, char **argv, struct cli *c) {
   memset(c, 0, sizeof *c);
   c->set = calloc((size_t)argc + 1, sizeof *c->set);
+  c->cmdline = command_line(argc, argv);
   c->steps = 50;
   c->inject_id = -1;
   if (argc < 2) {
@@ -62,6 +84,10 @@ int cli_parse(int argc, char **argv, struct cli *c) {
   for (int i = 2; i < argc; i++) {
     const char *a = argv[i];
     const int has_next = i + 1 < argc;
+    if (!strcmp(a, "--help") || !strcmp(a, "-h")) { /* chansph run --help: the usage, exit 0 */
+      c->cmd = CMD_HELP;
+      return CHANSPH_OK;
+    }
     if (!strcmp(a, "--set") && has_next)
       c->set[c->n_set++] = argv[++i];
     else if (!strncmp(a, "--set=", 6))

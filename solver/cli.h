@@ -23,6 +23,7 @@ struct cli {
   long long inject_id;  /*!< particle whose u becomes NaN after that step; -1 = none */
   long max_steps;       /*!< run/resume: --max-steps, steps of this process (0: no limit) */
   const char *walltime; /*!< run/resume: --walltime HH:MM:SS (NULL: none) */
+  char *cmdline;        /*!< the command line (malloc'd), for the history of the run */
 };
 
 /**

@@ -10,10 +10,24 @@
 
 enum { OK = 0, NOT_FINITE = 1, THROUGH_WALL = 2, SUPERSONIC = 3 };
 
+/* The per-particle arrays a checkpoint, a snapshot, particles.nc or a statistics sample takes
+   from a fluid particle (the model arrays nu_r and k_r only when the model has them). */
+enum { N_FIELDS = 16 };
+static const char *const field_names[N_FIELDS] = {"x",   "y",  "z",    "u",     "v",          "w",
+                                                  "rho", "p",  "mass", "gamma", "kernel_sum", "ax",
+                                                  "ay",  "az", "nu_r", "k_r"};
+
+/* The first non-finite field of particle a, or -1. */
+static int non_finite(const struct particles *P, size_t a) {
+  const double *const f[N_FIELDS] = {P->x, P->y,   P->z,    P->u,  P->v,  P->w,  P->rho, P->p,
+                                     P->m, P->gam, P->ksum, P->ax, P->ay, P->az, P->nur, P->kr};
+  for (int k = 0; k < N_FIELDS; k++)
+    if (f[k] && !isfinite(f[k][a])) return k;
+  return -1;
+}
+
 static int classify(const struct model *M, const struct particles *P, size_t a) {
-  const double vals[] = {P->x[a], P->y[a], P->z[a], P->u[a], P->v[a], P->w[a], P->rho[a]};
-  for (size_t k = 0; k < sizeof vals / sizeof vals[0]; k++)
-    if (!isfinite(vals[k])) return NOT_FINITE;
+  if (non_finite(P, a) >= 0) return NOT_FINITE;
   if (P->y[a] <= 0.0 || P->y[a] >= M->ly) return THROUGH_WALL;
   const double s2 = P->u[a] * P->u[a] + P->v[a] * P->v[a] + P->w[a] * P->w[a];
   if (s2 >= M->e.c0 * M->e.c0) return SUPERSONIC;
@@ -38,11 +52,13 @@ int health_check(const struct model *M, const struct particles *P, long step, do
     rc = classify(M, P, a);
     static const char *names[] = {"", "non-finite value", "particle through a wall",
                                   "particle faster than the speed of sound c0"};
+    char field[32] = "";
+    if (rc == NOT_FINITE) snprintf(field, sizeof field, " (%s)", field_names[non_finite(P, a)]);
     snprintf(rep->what, sizeof rep->what,
              "%s at step %ld (t = %.9g): particle id %lld at (%.9g, %.9g, %.9g), velocity "
-             "(%.6g, %.6g, %.6g), density %.6g",
+             "(%.6g, %.6g, %.6g), density %.6g%s",
              names[rc], step, t, (long long)P->id[a], P->x[a], P->y[a], P->z[a], P->u[a], P->v[a],
-             P->w[a], P->rho[a]);
+             P->w[a], P->rho[a], field);
     break;
   }
   if (worst != LLONG_MAX) { /* share the owner's report */

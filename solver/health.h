@@ -1,7 +1,11 @@
 /**
  * @file health.h
- * @brief Health checks of the particle state: NaN/Inf, particles through a wall, supersonic
- *        particles. A failure names the step, the particle id and its position.
+ * @brief Health checks of the particle state: NaN/Inf in any per-particle array that is written
+ *        or sampled (position, velocity, density, pressure, mass, gamma, kernel sum,
+ *        acceleration, nu_r, k_r), particles through a wall, supersonic particles. A failure
+ *        names the step, the particle id and its position. The run checks every health.every
+ *        steps and, whatever that interval, every state before it is written or sampled
+ *        (checkpoint, snapshot, stats.nc, statistics sample, time-series row, particles.nc).
  */
 #ifndef CHANSPH_HEALTH_H
 #define CHANSPH_HEALTH_H

@@ -129,6 +129,18 @@ static int read_source(const char *path, const struct scene *sc, struct source *
     free(text), source_free(src);
     return CHANSPH_ERR;
   }
+  /* a broken source (NaN or Inf, say from a run that failed) is an input error here, not a
+     numerical failure at step 1 */
+  for (int c = 0; c < 8; c++)
+    for (size_t b = 0; b < n; b++)
+      if (!isfinite(src->col[c][b])) {
+        error_input(
+            "%s (init.from): variable '%s' of particle id %lld is not finite (%g): not a "
+            "usable initial state",
+            path, names[c], src->id[b], src->col[c][b]);
+        free(text), source_free(src);
+        return CHANSPH_ERR;
+      }
   const double dim = scene_text_value(text, "domain", "dimension");
   const double delta = scene_text_value(text, "domain", "delta");
   const double lx = scene_text_value(text, "domain", "lx");

@@ -9,15 +9,45 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include <omp.h>
+#include <time.h>
+
 #include "error.h"
+#include "git_commit.h"
 #include "ncout.h"
 #include "timers.h"
+
+/** The `source` attribute of the output files: version and git commit of the build. */
+#define CHANSPH_SOURCE "chansph " CHANSPH_VERSION " (git " CHANSPH_GIT_COMMIT ")"
+
+/* The date a file is written, ISO 8601 in UTC (attribute date_created). */
+static void date_now(char *buf, size_t n) {
+  const time_t now = time(NULL);
+  struct tm utc;
+  gmtime_r(&now, &utc);
+  strftime(buf, n, "%Y-%m-%dT%H:%M:%SZ", &utc);
+}
 
 static const char *const series_names[] = {"time",    "u_bulk",    "body_force", "kinetic_energy",
                                            "mass",    "max_speed", "min_gamma",  "volume",
                                            "rho_min", "rho_max",   "dt"};
-static const char *const series_units[] = {"s", "m/s",   "m/s^2",  "J",      "kg", "m/s",
-                                           "1", "m^dim", "kg/m^3", "kg/m^3", "s"};
+/* udunits strings; in 2-D the volume is an area, mass and energy are per metre of span */
+static const char *const series_units_2d[] = {"s", "m/s", "m/s^2",  "J/m",    "kg/m", "m/s",
+                                              "1", "m^2", "kg/m^3", "kg/m^3", "s"};
+static const char *const series_units_3d[] = {"s", "m/s", "m/s^2",  "J",      "kg", "m/s",
+                                              "1", "m^3", "kg/m^3", "kg/m^3", "s"};
+static const char *const series_long_names[] = {
+    "simulated time",
+    "bulk velocity (volume-weighted mean u of the fluid)",
+    "streamwise body acceleration (driving force per unit mass)",
+    "kinetic energy of the fluid (per metre of span in 2-D)",
+    "mass of the fluid (per metre of span in 2-D)",
+    "largest particle speed",
+    "smallest wall renormalisation factor gamma",
+    "volume of the fluid (sum of m/rho; an area in 2-D)",
+    "smallest particle density",
+    "largest particle density",
+    "time step"};
 enum { N_SERIES = sizeof series_names / sizeof series_names[0] };
 
 static int rank0(void) {
@@ -83,7 +113,8 @@ static int open_common(struct output *o, const char *dir, const struct scene *sc
   struct stats_config cfg;
   output_stats_config(sc, &cfg);
   stats_init(&o->st, &cfg);
-  series_init(&o->ts, N_SERIES, series_names, series_units);
+  series_init(&o->ts, N_SERIES, series_names, sc->dim == 2 ? series_units_2d : series_units_3d,
+              series_long_names);
   o->next_write = sc->write_every > 0.0 ? sc->write_every : INFINITY;
   return CHANSPH_OK;
 }
@@ -211,7 +242,13 @@ static void log_progress(struct output *o, struct sim *S, const struct diag *d) 
                           ? (double)S->P.n_fluid * (S->step - o->last_step) / (now - o->last_wall)
                           : 0.0;
   const double done = S->t - o->t0, left = S->sc->t_end - S->t;
-  const double eta = done > 0.0 ? (now - o->wall0) * left / done : 0.0;
+  double eta = done > 0.0 ? (now - o->wall0) * left / done : 0.0;
+  /* the run ends at t_end or at time.max_steps, whichever comes first */
+  const long steps = S->step - o->step0;
+  if (S->sc->max_steps > 0 && steps > 0) {
+    const double by_steps = (now - o->wall0) * (double)(S->sc->max_steps - S->step) / steps;
+    if (!(done > 0.0) || by_steps < eta) eta = by_steps;
+  }
   const long es = (long)fmax(0.0, eta);
   output_log(o,
              "step %8ld  t %.6e  dt %.3e  u_bulk %.6e  force %.6e  max|v| %.4e  rho [%.6g, %.6g]"
@@ -221,6 +258,56 @@ static void log_progress(struct output *o, struct sim *S, const struct diag *d) 
   o->last_wall = now, o->last_step = S->step;
 }
 
+/* The scene's convergence target; 0 if there is none. */
+static int target_of(const struct scene *sc, struct stats_target *tg) {
+  if (!(sc->target_stderr > 0.0) || !sc->stats_eulerian) return 0;
+  tg->rel_stderr = sc->target_stderr, tg->profiles = sc->target_profiles;
+  tg->corr_ratio = sc->target_corr_ratio, tg->windows = sc->target_windows;
+  return 1;
+}
+
+/* Where the standard errors stand against the target, and the projected simulated and wall
+   time to reach it (this process's wall time per simulated second). */
+static void log_target(struct output *o, const struct sim *S, const struct stats_progress *p) {
+  const struct scene *sc = S->sc;
+  static const char *const which[3] = {"u_mean and the -u'v' peak", "u_mean", "the -u'v' peak"};
+  char proj[320];
+  const double done = S->t - o->t0, rate = done > 0.0 ? (timer_now() - o->wall0) / done : NAN;
+  if (p->met) {
+    snprintf(proj, sizeof proj, "target met");
+  } else if (sc->target_corr_ratio > 0.0 && !(p->ratio >= sc->target_corr_ratio)) {
+    snprintf(proj, sizeof proj,
+             "windows too short to count: window/correlation time %.3g < %g (increase "
+             "stats.window)",
+             p->ratio, sc->target_corr_ratio);
+  } else if (!isfinite(p->t_reach)) {
+    snprintf(proj, sizeof proj, "projection after 2 complete windows");
+  } else {
+    const double more = fmax(0.0, p->t_reach - S->t), wall = more * rate;
+    const long w = isfinite(wall) ? (long)wall : 0;
+    snprintf(proj, sizeof proj,
+             "projected: %.0f windows, t = %.6g s (%.4g s more simulated, about %02ld:%02ld:%02ld "
+             "wall)%s",
+             p->windows_needed, p->t_reach, more, w / 3600, w / 60 % 60, w % 60,
+             p->t_reach > sc->t_end ? " beyond t_end: raise time.t_end" : "");
+  }
+  output_log(o,
+             "target: relative stderr %g of %s: u_mean %.3g, -u'v' peak %.3g after %d "
+             "windows; %s\n",
+             sc->target_stderr, which[sc->target_profiles], p->rel_u, p->rel_uv, p->windows, proj);
+}
+
+/* Settings that would silently give nothing: say so at the start. */
+static void warn_settings(struct output *o, const struct sim *S) {
+  const struct scene *sc = S->sc;
+  const double every = sc->snap_every;
+  if (every > 0.0 && floor(sc->t_end / every) == floor(S->t / every))
+    output_log(o,
+               "warning: snapshots.every = %g s is longer than the rest of the run (t = %.6g .. "
+               "t_end = %g s): no snapshot will be written\n",
+               every, S->t, sc->t_end);
+}
+
 static int write_stats(struct output *o, const struct sim *S) {
   const struct scene *sc = S->sc;
   char path[4096], err[4096];
@@ -228,31 +315,40 @@ static int write_stats(struct output *o, const struct sim *S) {
   char drive[16], visc[16];
   snprintf(drive, sizeof drive, "%s", scene_choice("drive.mode", sc->drive_mode));
   snprintf(visc, sizeof visc, "%s", scene_choice("sph.viscous", sc->viscous));
+  char date[32];
+  date_now(date, sizeof date);
   const struct nc_attr attrs[] = {
-      {"dimension", NULL, sc->dim},
-      {"delta", NULL, sc->delta},
-      {"lx", NULL, sc->lx},
-      {"lz", NULL, sc->lz},
-      {"dr", NULL, sc->dr},
-      {"h", NULL, scene_h(sc)},
-      {"nu", NULL, sc->nu},
-      {"rho0", NULL, sc->rho0},
-      {"c0", NULL, sc->c0},
-      {"xi", NULL, scene_xi(sc)},
-      {"drive_mode", drive, 0},
-      {"viscous", visc, 0},
-      {"u_bulk_target", NULL, sc->drive_mode == DRIVE_FLUX ? sc->u_bulk : NAN},
-      {"body_force", NULL, S->fx},
-      {"t_average_start", NULL, sc->t_average_start},
-      {"t_end", NULL, sc->t_end},
-      {"t_reached", NULL, S->t},
-      {"steps", NULL, (double)S->step},
-      {"n_fluid", NULL, (double)S->P.n_fluid},
-      {"n_snapshots", NULL, (double)o->st.samples},
-      {"code_version", CHANSPH_VERSION, 0},
-      {"scene", o->scene_text, 0},
+      {"dimension", NULL, sc->dim, 1},
+      {"delta", NULL, sc->delta, 0},
+      {"lx", NULL, sc->lx, 0},
+      {"lz", NULL, sc->lz, 0},
+      {"dr", NULL, sc->dr, 0},
+      {"h", NULL, scene_h(sc), 0},
+      {"nu", NULL, sc->nu, 0},
+      {"rho0", NULL, sc->rho0, 0},
+      {"c0", NULL, sc->c0, 0},
+      {"xi", NULL, scene_xi(sc), 0},
+      {"drive_mode", drive, 0, 0},
+      {"viscous", visc, 0, 0},
+      {"u_bulk_target", NULL, sc->drive_mode == DRIVE_FLUX ? sc->u_bulk : NAN, 0},
+      {"body_force", NULL, S->fx, 0},
+      {"t_average_start", NULL, sc->t_average_start, 0},
+      {"t_end", NULL, sc->t_end, 0},
+      {"t_reached", NULL, S->t, 0},
+      {"steps", NULL, (double)S->step, 1},
+      {"n_fluid", NULL, (double)S->P.n_fluid, 1},
+      {"n_snapshots", NULL, (double)o->st.samples, 1},
+      {"code_version", CHANSPH_VERSION, 0, 0},
+      {"source", CHANSPH_SOURCE, 0, 0},
+      {"history", o->history ? o->history : "", 0, 0},
+      {"date_created", date, 0, 0},
+      {"ranks", NULL, (double)S->dd.size, 1},
+      {"threads", NULL, (double)omp_get_max_threads(), 1},
+      {"run_id", o->run_id, 0, 0},
+      {"scene", o->scene_text, 0, 0},
   };
   int rc = CHANSPH_OK;
+  o->st.t_reached = S->t; /* an incomplete last window ends here, not at its nominal end */
   if (rank0() &&
       ncout_stats(path, &o->st, &o->ts, attrs, sizeof attrs / sizeof attrs[0], err, sizeof err)) {
     error_input("%s", err);
@@ -275,6 +371,7 @@ void output_begin(struct output *o, struct sim *S) {
     output_log(o, "decomposition: %d MPI ranks, slabs of %d-%d of the %d cell columns along x\n",
                S->dd.size, S->dd.ncol / S->dd.size, (S->dd.ncol + S->dd.size - 1) / S->dd.size,
                S->dd.ncol);
+  warn_settings(o, S);
   log_progress(o, S, &d);
 }
 
@@ -284,11 +381,22 @@ void output_resume(struct output *o, struct sim *S) {
   o->t0 = S->t, o->last_step = o->step0 = S->step;
   output_log(o, "chansph %s: resumed at step %ld, t = %.9g s: %zu fluid + %zu vertex particles\n",
              CHANSPH_VERSION, S->step, S->t, S->P.n_fluid, S->P.n_vertex);
+  warn_settings(o, S);
+}
+
+/* The statistics engines sample the state of this step. */
+static int sample_due(const struct output *o, const struct sim *S) {
+  const struct scene *sc = S->sc;
+  return stats_wanted(&o->st) && S->t >= sc->t_average_start && S->step % sc->stats_every == 0;
+}
+
+int output_takes_state(const struct output *o, const struct sim *S) {
+  return sample_due(o, S) || S->step % S->sc->series_every == 0 || S->t >= o->next_write;
 }
 
 int output_step(struct output *o, struct sim *S) {
   const struct scene *sc = S->sc;
-  if (stats_wanted(&o->st) && S->t >= sc->t_average_start && S->step % sc->stats_every == 0) {
+  if (sample_due(o, S)) {
     timer_push("stats");
     const struct particles *P = &S->P;
     /* the engine merges per global column in a fixed order: rank-independent results */
@@ -327,6 +435,23 @@ int output_step(struct output *o, struct sim *S) {
                                         .comm = MPI_COMM_WORLD};
     stats_sample(&o->st, &snap);
     timer_pop();
+    struct stats_target tg;
+    if (target_of(sc, &tg) && o->st.eu.nwin != o->target_nwin) { /* a window closed */
+      o->target_nwin = o->st.eu.nwin;
+      struct stats_progress p;
+      stats_progress(&o->st, &tg, &p);
+      if (agree(p.met)) {
+        char line[1024];
+        stats_convergence_line(&o->st, line, sizeof line);
+        output_log(o, "%s", line);
+        log_target(o, S, &p);
+        output_log(o,
+                   "converged: the statistics meet stats.target_stderr = %g at step %ld, t = "
+                   "%.9g s; the run ends here\n",
+                   sc->target_stderr, S->step, S->t);
+        o->converged = 1;
+      }
+    }
   }
   timer_push("output");
   if (S->dd.rebalances != o->rebalances) {
@@ -348,10 +473,14 @@ int output_step(struct output *o, struct sim *S) {
     if (!have) sim_diag(S, &d);
     log_progress(o, S, &d);
   }
+  struct stats_target tg;
+  struct stats_progress prog;
   if (S->t >= o->next_write) {
     char line[1024];
     stats_convergence_line(&o->st, line, sizeof line);
     output_log(o, "%s", line);
+    if (line[0] && target_of(sc, &tg) && !o->converged)
+      stats_progress(&o->st, &tg, &prog), log_target(o, S, &prog);
     if (write_stats(o, S)) {
       timer_pop();
       return CHANSPH_ERR;
@@ -378,15 +507,35 @@ static int write_particles(struct output *o, const struct sim *S) {
     for (size_t r = 0; r < n; r++) ids[r] = (long long)r;
     static const char *const names[NC] = {"x", "y",   "z", "u",     "v",
                                           "w", "rho", "p", "gamma", "mass"};
-    static const char *const units[NC] = {"m",   "m",      "m",  "m/s", "m/s",
-                                          "m/s", "kg/m^3", "Pa", "1",   "kg"};
+    const char *const units[NC] = {"m",   "m",      "m",  "m/s", "m/s",
+                                   "m/s", "kg/m^3", "Pa", "1",   S->sc->dim == 2 ? "kg/m" : "kg"};
     const double *cols[NC];
     for (int c = 0; c < NC; c++) cols[c] = buf + (size_t)c * n;
-    const struct nc_attr attrs[] = {
-        {"time", NULL, S->t}, {"step", NULL, (double)S->step}, {"scene", o->scene_text, 0}};
+    char date[32];
+    date_now(date, sizeof date);
+    static const char *const long_names[NC] = {"position x (streamwise)",
+                                               "position y (wall-normal)",
+                                               "position z (spanwise)",
+                                               "velocity u (streamwise)",
+                                               "velocity v (wall-normal)",
+                                               "velocity w (spanwise)",
+                                               "density",
+                                               "pressure",
+                                               "wall renormalisation factor",
+                                               "mass (per metre of span in 2-D)"};
+    const struct nc_attr attrs[] = {{"time", NULL, S->t, 0},
+                                    {"step", NULL, (double)S->step, 1},
+                                    {"source", CHANSPH_SOURCE, 0, 0},
+                                    {"history", o->history ? o->history : "", 0, 0},
+                                    {"date_created", date, 0, 0},
+                                    {"ranks", NULL, (double)S->dd.size, 1},
+                                    {"threads", NULL, (double)omp_get_max_threads(), 1},
+                                    {"run_id", o->run_id, 0, 0},
+                                    {"scene", o->scene_text, 0, 0}};
     char path[4096], err[4096];
     snprintf(path, sizeof path, "%s/particles.nc", o->dir);
-    rc = ncout_columns(path, "particle", n, NC, names, units, cols, ids, attrs, 3, err, sizeof err);
+    rc = ncout_columns(path, "chansph particle state", "particle", n, NC, names, long_names, units,
+                       cols, ids, attrs, sizeof attrs / sizeof attrs[0], err, sizeof err);
     free(ids);
     if (rc) error_input("%s", err);
   }
@@ -420,8 +569,15 @@ int output_finish(struct output *o, struct sim *S) {
   char line[1024];
   stats_convergence_line(&o->st, line, sizeof line);
   output_log(o, "%s", line);
+  struct stats_target tg;
+  struct stats_progress prog;
+  if (line[0] && target_of(S->sc, &tg) && !o->converged)
+    stats_progress(&o->st, &tg, &prog), log_target(o, S, &prog);
   output_log(o, "statistics engine: %.3f MB (%lld snapshots)\n", stats_memory(&o->st) / 1048576.0,
              (long long)o->st.samples);
+  char warnings[4096];
+  if (rank0() && stats_warnings(&o->st, warnings, sizeof warnings))
+    for (char *l = strtok(warnings, "\n"); l; l = strtok(NULL, "\n")) output_log(o, "%s\n", l);
   TRY(write_stats(o, S));
   if (S->sc->particles) TRY(write_particles(o, S));
   log_decomposition(o, S, wall);
@@ -453,6 +609,7 @@ void output_fail(struct output *o, struct sim *S, const struct health_report *re
 void output_close(struct output *o) {
   if (o->log) fclose(o->log);
   free(o->scene_text);
+  free(o->history);
   free(o->col);
   stats_free(&o->st);
   series_free(&o->ts);

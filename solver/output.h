@@ -16,20 +16,24 @@
 
 /** Output state of a run. */
 struct output {
-  char dir[2048];    /*!< run directory */
-  FILE *log;         /*!< DIR/log.txt */
-  char *scene_text;  /*!< resolved scene */
-  struct stats st;   /*!< the statistics engine */
-  struct series ts;  /*!< time series */
-  double next_write; /*!< simulated time of the next stats.nc rewrite [s] */
-  double wall0;      /*!< wall clock at the start of the loop [s] */
-  double t0;         /*!< simulated time at the start of the loop [s] */
-  double last_wall;  /*!< wall clock of the last log line [s] */
-  long last_step;    /*!< step of the last log line */
-  long step0;        /*!< step at the start of the loop (0, or where a resume started) */
-  int *col;          /*!< global cell column of each owned particle (statistics snapshots) */
-  size_t col_cap;    /*!< entries col holds */
-  long rebalances;   /*!< re-partitions already reported in the log */
+  char dir[2048];     /*!< run directory */
+  FILE *log;          /*!< DIR/log.txt */
+  char *scene_text;   /*!< resolved scene */
+  struct stats st;    /*!< the statistics engine */
+  struct series ts;   /*!< time series */
+  double next_write;  /*!< simulated time of the next stats.nc rewrite [s] */
+  double wall0;       /*!< wall clock at the start of the loop [s] */
+  double t0;          /*!< simulated time at the start of the loop [s] */
+  double last_wall;   /*!< wall clock of the last log line [s] */
+  long last_step;     /*!< step of the last log line */
+  long step0;         /*!< step at the start of the loop (0, or where a resume started) */
+  int *col;           /*!< global cell column of each owned particle (statistics snapshots) */
+  size_t col_cap;     /*!< entries col holds */
+  long rebalances;    /*!< re-partitions already reported in the log */
+  char run_id[64];    /*!< identity of the run (DIR/run_id), attribute of stats.nc, particles.nc */
+  char *history;      /*!< DIR/history: every run and resume command, newest first (rank 0) */
+  size_t target_nwin; /*!< complete windows when the convergence target was last checked */
+  int converged;      /*!< the convergence target (stats.target_stderr) is met: end the run */
 };
 
 /**
@@ -74,7 +78,15 @@ int output_stop(struct output *o, struct sim *S, const char *why);
 void output_begin(struct output *o, struct sim *S);
 
 /**
- * @brief After each step: sample statistics, record the series, log, rewrite stats.nc.
+ * @brief Does output_step() take anything from the state of this step (a statistics sample, a
+ *        time-series row, a stats.nc rewrite)? The caller checks such a state first.
+ */
+int output_takes_state(const struct output *o, const struct sim *S);
+
+/**
+ * @brief After each step: sample statistics, record the series, log, rewrite stats.nc; when a
+ *        window closes, check the convergence target (stats.target_stderr) and set
+ *        o->converged if it is met (the caller then ends the run).
  * @return CHANSPH_OK, or CHANSPH_ERR after a message when stats.nc cannot be written (the
  *         previous stats.nc and the checkpoints are kept)
  */

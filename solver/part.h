@@ -79,6 +79,14 @@ void part_free(void *ptr);
 void part_memory_report(FILE *f);
 
 /**
+ * @brief Before anything is allocated: refuse a scene whose particles need more memory than
+ *        the machine has (sysconf physical pages), with a message naming the keys and sizes.
+ *        The estimate is a lower bound: per-particle arrays, step scratch, neighbour lists.
+ * @return 0, or nonzero after the message
+ */
+int part_check_memory(const struct scene *s);
+
+/**
  * @brief Create the fluid lattice (x = (i+1/2) dr, y = j dr for j = 1..2delta/dr-1,
  *        z = (k+1/2) dr) and the vertex particles on both walls (volume dr^dim / 2).
  * @param[out] P particles

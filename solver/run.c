@@ -78,6 +78,7 @@ static void update_state(struct sim *S, int restored, double dt) {
 
 int sim_create(struct sim *S, const struct scene *sc) {
   memset(S, 0, sizeof *S);
+  TRY(part_check_memory(sc)); /* before any allocation: a clear refusal, not the OOM killer */
   S->sc = sc;
   sph_model_init(&S->M, sc);
   /* every rank builds the same full initial state; sim_distribute keeps its own columns */

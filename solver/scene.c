@@ -5,6 +5,7 @@
 #define _XOPEN_SOURCE 700 /* realpath */
 #include "scene.h"
 
+#include <ctype.h>
 #include <ini.h>
 #include <limits.h>
 #include <math.h>
@@ -220,7 +221,7 @@ static const struct key keys[] = {
      "start a finer "
      "run. A relative path in a scene file is relative to the scene file's directory (on the "
      "command line, to the working directory). Overrides profile; streaks, modes and noise are "
-     "added on top.",
+     "added on top. A source holding a NaN or Inf is refused (exit 1).",
      OFF(init_from)},
     {"output", "log_every", T_INT, "100", 1, 1e9, 0, NULL, "steps",
      "Steps between progress lines (stdout and DIR/log.txt).", OFF(log_every)},
@@ -265,6 +266,25 @@ static const struct key keys[] = {
      "Friction velocity that places the y+ levels of the correlations and Lagrangian releases "
      "(y = y+ nu / u_tau_ref); 0 = sqrt(delta drive.force), the force-balance value.",
      OFF(u_tau_ref)},
+    {"stats", "target_stderr", T_DOUBLE, "0", 0, 1, 0, NULL, "-",
+     "Convergence target: once the standard errors relative to their profile (max "
+     "stderr(u_mean) / max |u_mean|, and stderr of -u'v' at its peak / the peak) are below "
+     "this, with at least target_windows complete windows of at least target_corr_ratio "
+     "correlation times, the run ends itself (checkpoint, stats.nc, exit 0). Checked when a "
+     "window closes; every convergence line of the log gives the projected simulated and wall "
+     "time to reach it. 0 = off.",
+     OFF(target_stderr)},
+    {"stats", "target_profiles", T_CHOICE, "both", 0, 0, 0, "both|u_mean|uv_peak", "-",
+     "Profiles of the convergence target: u_mean and the -u'v' peak, or one of them (a laminar "
+     "flow has no -u'v' to converge).",
+     OFF(target_profiles)},
+    {"stats", "target_corr_ratio", T_DOUBLE, "5", 0, BIG, 0, NULL, "-",
+     "Convergence target: smallest window length / correlation time for the standard errors "
+     "to count (shorter windows make them too small); 0 = no requirement.",
+     OFF(target_corr_ratio)},
+    {"stats", "target_windows", T_INT, "4", 2, 1e9, 0, NULL, "-",
+     "Convergence target: fewest complete windows (batches) for the standard errors to count.",
+     OFF(target_windows)},
     {"correlations", "y_plus", T_LIST, "", 0, BIG, 0, NULL, "-",
      "Comma-separated y+ levels (up to 8) of the two-point correlations and 1-D spectra "
      "(thesis Eq. 5.57-5.59); each level and its mirror 2 delta - y are sampled. Empty = off.",
@@ -300,7 +320,9 @@ static const struct key keys[] = {
     {"lagrangian", "pdf_bins", T_INT, "50", 2, 1e5, 0, NULL, "-",
      "Bins of the PDFs P(y; x) across the channel.", OFF(lagr_pdf_bins)},
     {"health", "every", T_INT, "1", 1, 1e9, 0, NULL, "steps",
-     "Steps between full health checks (NaN, wall crossing, CFL); 1 checks every step.",
+     "Steps between full health checks (NaN, wall crossing, CFL); 1 checks every step. "
+     "Whatever the interval, a state is checked before it is written or sampled (checkpoint, "
+     "snapshot, stats.nc, particles.nc, statistics sample, time-series row).",
      OFF(health_every)},
     {"run", "threads", T_INT, "0", 0, 4096, 0, NULL, "-",
      "OpenMP threads; 0 keeps OMP_NUM_THREADS (or all cores).", OFF(threads)},
@@ -343,12 +365,16 @@ enum { N_KEYS = sizeof keys / sizeof keys[0] };
 struct parse_state {
   struct scene *s;
   const char *file;
-  int line;             /*!< current line, counted by the reader */
-  int where[N_KEYS];    /*!< 0 = default, >0 = file line, -1 = --set */
-  int seen[N_KEYS];     /*!< given with an invalid value */
-  const char *set_text; /*!< the --set argument being applied */
+  int line;                    /*!< current line, counted by the reader */
+  int where[N_KEYS];           /*!< 0 = default, >0 = file line, -1 = --set */
+  int seen[N_KEYS];            /*!< given with an invalid value */
+  const char *set_text;        /*!< the --set argument being applied */
+  const char *set_arg[N_KEYS]; /*!< the --set argument that gave each key */
   int errors;
   FILE *fp;
+  char section[64]; /*!< section of the last header line of the file */
+  int section_line; /*!< its line (0: none yet) */
+  int section_keys; /*!< keys read in it */
 };
 
 static int find_key(const char *section, const char *name) {
@@ -486,18 +512,59 @@ static int apply(struct parse_state *ps, const char *section, const char *name, 
     return 0;
   }
   ps->where[k] = where;
+  if (where < 0) ps->set_arg[k] = ps->set_text;
   return 1;
 }
 
 static int handler(void *user, const char *section, const char *name, const char *value) {
   struct parse_state *ps = user;
+  ps->section_keys++;
   return apply(ps, section, name, value, ps->line);
+}
+
+/* The section before a new header (or the end of the file) ends: an unknown one without keys
+   is reported here (one with keys is reported at each key). */
+static void end_section(struct parse_state *ps) {
+  if (ps->section_line > 0 && ps->section[0] && !ps->section_keys && !known_section(ps->section)) {
+    error_input("%s:%d: unknown section [%s] (no keys; see docs/scenes.md)", ps->file,
+                ps->section_line, ps->section);
+    ps->errors++;
+  }
+}
+
+/* A section header line ("[name]", optionally followed by a "; comment"): inih ignores what
+   follows the ']', so anything else there ("[wall] law = reichardt", "[fluid]junk") is an
+   error, as is an empty name. */
+static void check_header(struct parse_state *ps, const char *line) {
+  while (isspace((unsigned char)*line)) line++;
+  if (*line != '[') return;
+  const char *close = strchr(line, ']');
+  if (!close) return; /* inih reports the syntax error */
+  end_section(ps);
+  snprintf(ps->section, sizeof ps->section, "%.*s", (int)(close - line - 1), line + 1);
+  ps->section_line = ps->line, ps->section_keys = 0;
+  if (!ps->section[0]) {
+    error_input("%s:%d: empty section name '[]'", ps->file, ps->line);
+    ps->errors++;
+  }
+  const char *rest = close + 1;
+  while (isspace((unsigned char)*rest)) rest++;
+  if (*rest && *rest != ';') {
+    char text[80];
+    snprintf(text, sizeof text, "%s", rest);
+    text[strcspn(text, "\r\n")] = '\0';
+    error_input(
+        "%s:%d: text after the section header [%s]: '%s' (a 'key = value' goes on a line of "
+        "its own; only a '; comment' may follow the header)",
+        ps->file, ps->line, ps->section, text);
+    ps->errors++;
+  }
 }
 
 static char *reader(char *str, int num, void *stream) {
   struct parse_state *ps = stream;
   char *r = fgets(str, num, ps->fp);
-  if (r) ps->line++;
+  if (r) ps->line++, check_header(ps, r);
   return r;
 }
 
@@ -509,7 +576,9 @@ static void inconsistent(struct parse_state *ps, const char *key, const char *fm
   snprintf(sec, sizeof sec, "%.*s", (int)(dot - key), key);
   const int k = find_key(sec, dot + 1);
   char loc[600], text[400];
+  ps->set_text = k >= 0 ? ps->set_arg[k] : NULL; /* a key given with --set: name the argument */
   location(ps, k >= 0 ? ps->where[k] : 0, loc, sizeof loc);
+  ps->set_text = NULL;
   snprintf(text, sizeof text, fmt, a, b);
   error_input("%s: key '%s': %s", loc, key, text);
   ps->errors++;
@@ -520,8 +589,34 @@ static int is_multiple(double len, double dr) {
   return n >= 1.0 && fabs(n - floor(n + 0.5)) < 1e-9 * n;
 }
 
+/* The lattice: particles along x, y (layers plus one) and z fit an int index, and the particle
+   count is exact in a double and an int64 id (larger counts would overflow before any
+   allocation; part_check_memory() then compares the memory with the machine's). */
+static void check_counts(struct parse_state *ps) {
+  const struct scene *s = ps->s;
+  const double nmax = 0x1p30, nx = s->lx / s->dr, ny = 2.0 * s->delta / s->dr;
+  const double nz = s->dim == 3 ? s->lz / s->dr : 1.0;
+  if (nx > nmax)
+    inconsistent(ps, "domain.lx", "lx / dr = %g / %g: more than 2^30 particles along x", s->lx,
+                 s->dr);
+  if (ny > nmax)
+    inconsistent(ps, "domain.delta", "2 delta / dr = %g / %g: more than 2^30 particle layers",
+                 2.0 * s->delta, s->dr);
+  if (nz > nmax)
+    inconsistent(ps, "domain.lz", "lz / dr = %g / %g: more than 2^30 particles along z", s->lz,
+                 s->dr);
+  const double n = nx * (ny + 1.0) * nz;
+  if (nx <= nmax && ny <= nmax && nz <= nmax && n > 0x1p53)
+    inconsistent(ps, "domain.dr",
+                 "the domain holds %g particles with this dr, more than %g (keys domain.lx, "
+                 "domain.delta, domain.lz, domain.dr)",
+                 n, 0x1p53);
+}
+
 static void validate(struct parse_state *ps) {
   const struct scene *s = ps->s;
+  check_counts(ps);
+  if (ps->errors) return; /* the other checks divide by the same numbers */
   const double h = scene_h(s), two_delta = 2.0 * s->delta;
   if (!is_multiple(two_delta, s->dr))
     inconsistent(ps, "domain.delta", "2 delta = %g is not a multiple of dr = %g", two_delta, s->dr);
@@ -618,6 +713,7 @@ static int load(struct scene *s, const char *path, FILE *fp, int file_paths, int
     }
     const int rc = ini_parse_stream(reader, &ps, handler, &ps);
     fclose(ps.fp);
+    end_section(&ps);
     if (rc > 0 && ps.errors == 0) {
       error_input("%s:%d: syntax error (expected '[section]' or 'key = value')", path, rc);
       ps.errors++;
@@ -768,10 +864,14 @@ void scene_write_doc(FILE *f) {
           "# Scene reference\n\n"
           "<!-- generated by `build/chansph scene-doc`; do not edit, edit solver/scene.c -->\n\n"
           "A scene is an INI file (parsed with inih). Comments start with `#` or `;` at the "
-          "start of a line, or `;` after a value.\n"
+          "start of a line, or `;` after a value or a section header.\n"
           "Any key can be overridden on the command line with `--set section.key=value`.\n"
-          "Unknown keys, keys set twice, values out of range and inconsistent geometry are "
-          "errors that name the file, line and key.\n"
+          "Unknown keys and sections (also an empty `[]` or a section without keys), text "
+          "after a section header (`[wall] law = x`: a key goes on a line of its own), keys "
+          "set twice, values out of range and inconsistent geometry are errors that name the "
+          "file, line and key; so is a domain of more than 2^30 particles along a direction, "
+          "or whose particles would need more memory than the machine has (the estimate, a "
+          "lower bound, is checked before anything is allocated).\n"
           "The fully resolved scene (defaults included) is written to `DIR/scene.used.ini` "
           "and into the `scene` attribute of `stats.nc`.\n");
   const char *section = "";

@@ -103,11 +103,15 @@ struct scene {
   int n_bins;             /*!< wall-normal bins; 0 = 2 delta / dr - 1 */
   int particles;          /*!< write the final particle state to particles.nc (1) or not (0) */
   /* [stats] */
-  int stats_eulerian;  /*!< Eulerian profiles on (1) or off (0) */
-  double stats_window; /*!< averaging window (batch) length [s]; 0 = a tenth of the average */
-  int stats_fold;      /*!< fold the upper half of the channel onto the lower one (1) */
-  int stats_method;    /*!< 0: bin sampling (Eq. 5.54-5.55), 1: SPH interpolation (Eq. 5.56) */
-  double u_tau_ref;    /*!< friction velocity placing y+ levels [m/s]; 0 = sqrt(delta force) */
+  int stats_eulerian;       /*!< Eulerian profiles on (1) or off (0) */
+  double stats_window;      /*!< averaging window (batch) length [s]; 0 = a tenth of the average */
+  int stats_fold;           /*!< fold the upper half of the channel onto the lower one (1) */
+  int stats_method;         /*!< 0: bin sampling (Eq. 5.54-5.55), 1: SPH interpolation (Eq. 5.56) */
+  double u_tau_ref;         /*!< friction velocity placing y+ levels [m/s]; 0 = sqrt(delta force) */
+  double target_stderr;     /*!< stop once the relative standard errors are below this (0: off) */
+  int target_profiles;      /*!< 0: u_mean and the -u'v' peak, 1: u_mean, 2: the -u'v' peak */
+  double target_corr_ratio; /*!< minimum window length / correlation time for the target */
+  int target_windows;       /*!< minimum complete windows for the target */
   /* [correlations] */
   struct scene_list corr_y_plus; /*!< y+ levels of the two-point correlations (empty = off) */
   int corr_nx, corr_nz;          /*!< plane grid; 0 = lx/dr, lz/dr */

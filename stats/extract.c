@@ -1,6 +1,7 @@
 /** @file extract.c @brief Implementation of extract.h. */
 #include "extract.h"
 
+#include <errno.h>
 #include <math.h>
 #include <netcdf.h>
 #include <stdio.h>
@@ -52,6 +53,7 @@ struct stored {
   size_t rows;
   double *win, *mom, *snp;
   int *complete;
+  double t_reached; /* the run's reached time (global attribute t_reached; NaN if absent) */
 };
 
 static int get_att(int ncid, const char *name, double *v, const char *path) {
@@ -79,6 +81,8 @@ static int read_stored(const char *path, struct stored *s) {
   double les = 0.0; /* optional: eddy-viscosity profiles present */
   if (!bad && nc_get_att_double(ncid, NC_GLOBAL, "les", &les) != NC_NOERR) les = 0.0;
   s->cfg.les = les != 0.0;
+  if (nc_get_att_double(ncid, NC_GLOBAL, "t_reached", &s->t_reached) != NC_NOERR)
+    s->t_reached = NAN;
   int dy, dw, vw, vm, vs, vc;
   size_t nb = 0;
   if (!bad && (nc_inq_ncid(ncid, "eulerian", &g) || nc_inq_dimid(ncid, "y", &dy) ||
@@ -110,8 +114,21 @@ static void free_stored(struct stored *s) {
   free(s->win), free(s->mom), free(s->snp), free(s->complete);
 }
 
-static void usage(void) {
-  fprintf(stderr,
+/* A time of --window between text and stop: empty gives dflt; anything but one finite number
+   is an error (nonzero). */
+static int parse_time(const char *text, const char *stop, double dflt, double *t) {
+  if (text == stop) {
+    *t = dflt;
+    return 0;
+  }
+  char *end;
+  errno = 0;
+  *t = strtod(text, &end);
+  return end != stop || errno || !isfinite(*t);
+}
+
+static void usage(FILE *f) {
+  fprintf(f,
           "usage: chansph extract STATS.nc [--var a,b,...] [--units wall|outer] "
           "[--format csv|tsv] [--window T0:T1]\n"
           "  variables: u_mean v_mean w_mean p_mean rho_mean uu vv ww uv uw vw u_rms v_rms "
@@ -126,33 +143,36 @@ int extract_main(int argc, char **argv) {
   double t0 = -INFINITY, t1 = INFINITY;
   for (int i = 0; i < argc; i++) {
     const int more = i + 1 < argc;
-    if (!strcmp(argv[i], "--var") && more)
+    if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
+      usage(stdout);
+      return 0;
+    } else if (!strcmp(argv[i], "--var") && more)
       vars = argv[++i];
     else if (!strcmp(argv[i], "--units") && more)
       units = argv[++i];
     else if (!strcmp(argv[i], "--format") && more)
       fmt = argv[++i];
     else if (!strcmp(argv[i], "--window") && more) {
-      char *end;
-      const char *w = argv[++i];
-      t0 = *w == ':' ? -INFINITY : strtod(w, &end);
-      const char *colon = strchr(w, ':');
-      if (!colon) {
-        fprintf(stderr, "error: --window %s: expected T0:T1 (either may be empty)\n", w);
+      const char *w = argv[++i], *colon = strchr(w, ':');
+      if (!colon || parse_time(w, colon, -INFINITY, &t0) ||
+          parse_time(colon + 1, colon + strlen(colon), INFINITY, &t1) || t0 > t1) {
+        fprintf(stderr,
+                "error: --window %s: expected T0:T1, two times in seconds with T0 <= T1 (either "
+                "may be empty: from the first or to the last window)\n",
+                w);
         return 1;
       }
-      t1 = colon[1] ? strtod(colon + 1, &end) : INFINITY;
     } else if (argv[i][0] != '-' && !path)
       path = argv[i];
     else {
       fprintf(stderr, "error: unexpected argument '%s'\n", argv[i]);
-      usage();
+      usage(stderr);
       return 1;
     }
   }
   if (!path || (strcmp(units, "wall") && strcmp(units, "outer")) ||
       (strcmp(fmt, "csv") && strcmp(fmt, "tsv"))) {
-    usage();
+    usage(stderr);
     return 1;
   }
   const int wall = !strcmp(units, "wall");
@@ -185,7 +205,7 @@ int extract_main(int argc, char **argv) {
       k = EP_UU + (tok[0] - 'u'), is_rms = 1;
     if (k < 0) {
       fprintf(stderr, "error: unknown variable '%s'\n", tok);
-      usage();
+      usage(stderr);
       free(list), free_stored(&s), euler_result_free(&res);
       return 1;
     }
@@ -193,10 +213,12 @@ int extract_main(int argc, char **argv) {
   }
   free(list);
   const double ut = res.u_tau, delta = s.cfg.delta;
+  /* a run that stopped inside its last window reached t_reached, not the window's end */
+  const double t_last = isnan(s.t_reached) ? res.t1 : fmin(res.t1, s.t_reached);
   printf(
       "# chansph extract %s: windows %zu..%zu, t = %.9g .. %.9g s, %.0f snapshots, %d "
       "batches\n",
-      path, r0, r1 - 1, res.t0, res.t1, res.snapshots, res.n_batches);
+      path, r0, r1 - 1, res.t0, t_last, res.snapshots, res.n_batches);
   printf(
       "# u_tau = %.9g m/s (wall shear %.9g, force balance %.9g, stderr %.3g), Re_tau = %.6g, "
       "correlation time %.4g s, stress balance error %.4g\n",
@@ -261,11 +283,19 @@ int extract_main(int argc, char **argv) {
 int compare_main(int argc, char **argv, const char *stats_dir) {
   char script[4096];
   snprintf(script, sizeof script, "%s/compare.py", stats_dir);
+  /* CHANSPH_PYTHON: a python3 with numpy, netCDF4 and matplotlib (a path, or a name looked up
+     in PATH); the Debian one by default */
+  const char *env = getenv("CHANSPH_PYTHON");
+  const char *py = env && env[0] ? env : "/usr/bin/python3";
   char **args = calloc((size_t)argc + 3, sizeof *args);
-  args[0] = "python3", args[1] = script;
+  if (!args) return 1;
+  args[0] = (char *)py, args[1] = script;
   for (int i = 0; i < argc; i++) args[2 + i] = argv[i];
-  execv("/usr/bin/python3", args);
-  perror("error: cannot start /usr/bin/python3 for chansph compare");
+  execvp(py, args);
+  fprintf(stderr,
+          "error: cannot start %s for chansph compare (%s); set CHANSPH_PYTHON to a python3 with "
+          "numpy, netCDF4 and matplotlib\n",
+          py, strerror(errno));
   free(args);
   return 1;
 }

@@ -372,6 +372,54 @@ void lagr_functions(const struct lagr *g, int level, double *out, double *tl) {
     tl[i] = lagr_tl(out + (LF_RHO_L + i) * nlag, nlag, g->cfg.horizon / g->cfg.n_lags);
 }
 
+int lagr_warnings(const struct lagr *g, char *buf, size_t len) {
+  const struct lagr_config *c = &g->cfg;
+  const size_t nlag = g->nlag;
+  int n = 0;
+  size_t m = 0;
+  buf[0] = '\0';
+  if (c->n_levels > 0 && g->releases == 0.0) {
+    m += (size_t)snprintf(buf + m, len - m,
+                          "warning: lagrangian: no release completed (horizon %g s): no "
+                          "Lagrangian statistics; run longer than lagrangian.horizon\n",
+                          c->horizon);
+    return 1;
+  }
+  double *fn = malloc(LF_LEN * nlag * sizeof(double));
+  if (!fn) return 0;
+  for (int l = 0; l < c->n_levels && m < len; l++) {
+    double tl[3];
+    lagr_functions(g, l, fn, tl);
+    size_t empty = 0;
+    for (size_t k = 0; k < nlag; k++) empty += !(fn[LF_N * nlag + k] > 0.0);
+    if (empty) {
+      m += (size_t)snprintf(buf + m, len - m,
+                            "warning: lagrangian level y+ = %g: %zu of %zu lags have no samples "
+                            "(lag interval horizon / n_lags = %g s is shorter than the "
+                            "statistics sampling interval, output.stats_every steps): increase "
+                            "lagrangian.horizon or decrease lagrangian.n_lags\n",
+                            c->y_plus[l], empty, nlag, c->horizon / c->n_lags);
+      n++;
+    }
+    static const char *const comp[3] = {"u", "v", "w"};
+    char which[16] = "";
+    for (int i = 0; i < 3; i++)
+      if (!isfinite(tl[i]))
+        snprintf(which + strlen(which), sizeof which - strlen(which), "%s%s", which[0] ? ", " : "",
+                 comp[i]);
+    if (which[0] && m < len) {
+      m += (size_t)snprintf(buf + m, len - m,
+                            "warning: lagrangian level y+ = %g: T_L of %s is NaN (rho_L does not "
+                            "fall to e^-1/2 within the horizon %g s, or too few lags): increase "
+                            "lagrangian.horizon\n",
+                            c->y_plus[l], which, c->horizon);
+      n++;
+    }
+  }
+  free(fn);
+  return n;
+}
+
 #define CK(call) NC_TRY(call, done)
 
 static int put_rows(int g, int v, int level, size_t n, const double *src) {
@@ -397,7 +445,8 @@ int lagr_nc_write(const struct lagr *g, int ncid, char *err, size_t errlen) {
       "Lagrangian statistics of particles released at x0 and y+ levels (thesis Eq. 5.60-5.68), "
       "ensemble averages over the completed releases";
   CK(nc_put_att_text(gr, NC_GLOBAL, "description", strlen(desc), desc));
-  CK(nc_put_att_double(gr, NC_GLOBAL, "releases", NC_DOUBLE, 1, &g->releases));
+  const long long releases = (long long)g->releases; /* a count */
+  CK(nc_put_att_longlong(gr, NC_GLOBAL, "releases", NC_INT64, 1, &releases));
   CK(nc_put_att_double(gr, NC_GLOBAL, "x0", NC_DOUBLE, 1, &c->x0));
   CK(nc_put_att_double(gr, NC_GLOBAL, "horizon", NC_DOUBLE, 1, &c->horizon));
   CK(nc_put_att_double(gr, NC_GLOBAL, "release_every", NC_DOUBLE, 1, &c->release_every));

@@ -130,6 +130,16 @@ void lagr_functions(const struct lagr *g, int level, double *out, double *tl);
 enum { LF_RHO_L = 0, LF_RHO_A = 3, LF_D = 6, LF_S = 9, LF_K = 12, LF_SIG2 = 15, LF_N = 18, LF_LEN };
 
 /**
+ * @brief Warnings about the Lagrangian statistics (issue 13): lags left without samples (the lag
+ *        interval horizon / n_lags is shorter than the statistics sampling interval), T_L that
+ *        is NaN (rho_L never falls to e^{-1/2} within the horizon), no completed release.
+ *        One line per level, each starting "warning: ".
+ * @param[out] buf,len the text ("" if nothing to say)
+ * @return the number of warnings
+ */
+int lagr_warnings(const struct lagr *g, char *buf, size_t len);
+
+/**
  * @brief T_L of Eq. 5.61 from a sampled rho(tau_k), tau_k = k dtau: T_E from the first
  *        crossing of e^{-1/2} (linear interpolation), trapezoidal integral to 4 T_E (or to
  *        the last lag if shorter). NaN if rho never falls to e^{-1/2}.

@@ -26,9 +26,12 @@
 
 static int put_attrs(int ncid, const struct nc_attr *attrs, int nattrs) {
   for (int i = 0; i < nattrs; i++) {
+    const long long v = (long long)attrs[i].value;
     const int rc =
         attrs[i].text
             ? nc_put_att_text(ncid, NC_GLOBAL, attrs[i].name, strlen(attrs[i].text), attrs[i].text)
+        : attrs[i].integer
+            ? nc_put_att_longlong(ncid, NC_GLOBAL, attrs[i].name, NC_INT64, 1, &v)
             : nc_put_att_double(ncid, NC_GLOBAL, attrs[i].name, NC_DOUBLE, 1, &attrs[i].value);
     if (rc != NC_NOERR) return rc;
   }
@@ -114,7 +117,8 @@ int ncout_stats(const char *path, const struct stats *st, const struct series *t
   double *col = malloc((ts->n ? ts->n : 1) * sizeof *col);
   int rc = vts && col ? NC_NOERR : NC_ENOMEM;
   for (int c = 0; c < ts->ncol && rc == NC_NOERR; c++) {
-    rc = def_var(ncid, ts->names[c], NC_DOUBLE, 1, &dt, ts->units[c], NULL, &vts[c]);
+    rc = def_var(ncid, ts->names[c], NC_DOUBLE, 1, &dt, ts->units[c],
+                 ts->long_names ? ts->long_names[c] : NULL, &vts[c]);
     if (rc == NC_NOERR && c == 0) rc = nc_put_att_text(ncid, vts[c], "standard_name", 4, "time");
   }
   for (int c = 0; c < ts->ncol && rc == NC_NOERR && ts->n; c++) {
@@ -127,13 +131,17 @@ int ncout_stats(const char *path, const struct stats *st, const struct series *t
   return commit(ncid, tmp, path, err, errlen);
 }
 
-int ncout_columns(const char *path, const char *dim, size_t n, int ncol, const char *const *names,
-                  const char *const *units, const double *const *cols, const long long *ids,
-                  const struct nc_attr *attrs, int nattrs, char *err, size_t errlen) {
+int ncout_columns(const char *path, const char *title, const char *dim, size_t n, int ncol,
+                  const char *const *names, const char *const *long_names, const char *const *units,
+                  const double *const *cols, const long long *ids, const struct nc_attr *attrs,
+                  int nattrs, char *err, size_t errlen) {
   char tmp[4096];
   snprintf(tmp, sizeof tmp, "%s.tmp", path);
   int ncid = -1, d, vid = -1;
   NC(nc_create_mem(tmp, NC_NETCDF4, 1 << 20, &ncid));
+  NC(nc_put_att_text(ncid, NC_GLOBAL, "Conventions", 6, "CF-1.8"));
+  NC(nc_put_att_text(ncid, NC_GLOBAL, "title", strlen(title), title));
+  NC(nc_put_att_text(ncid, NC_GLOBAL, "source", 7, "chansph"));
   NC(nc_def_dim(ncid, dim, n, &d));
   if (ids) NC(def_var(ncid, "id", NC_INT64, 1, &d, "1", "particle id", &vid));
   int *v = malloc((size_t)ncol * sizeof *v);
@@ -143,7 +151,8 @@ int ncout_columns(const char *path, const char *dim, size_t n, int ncol, const c
     return 1;
   }
   for (int c = 0; c < ncol; c++) {
-    const int rc = def_var(ncid, names[c], NC_DOUBLE, 1, &d, units[c], NULL, &v[c]);
+    const int rc = def_var(ncid, names[c], NC_DOUBLE, 1, &d, units[c],
+                           long_names ? long_names[c] : NULL, &v[c]);
     if (rc != NC_NOERR) free(v);
     NC(rc);
   }

@@ -13,11 +13,12 @@
 
 struct stats;
 
-/** A global attribute: text if text != NULL, else a double. */
+/** A global attribute: text if text != NULL, else a double, or a 64-bit integer if integer. */
 struct nc_attr {
   const char *name;
   const char *text;
   double value;
+  int integer; /*!< 1: a count or flag, written as an int64 */
 };
 
 /**
@@ -36,19 +37,22 @@ int ncout_stats(const char *path, const struct stats *st, const struct series *t
 /**
  * @brief Write named double columns along one dimension atomically (e.g. particles.nc).
  * @param[in] path file name
+ * @param[in] title global attribute title (the file also gets Conventions = CF-1.8, source)
  * @param[in] dim dimension name
  * @param[in] n rows
  * @param[in] ncol columns
- * @param[in] names,units column names and units
+ * @param[in] names,units column names and units (udunits strings)
+ * @param[in] long_names column descriptions (attribute long_name; NULL: none)
  * @param[in] cols column data
  * @param[in] ids optional int64 ids written as variable "id" (may be NULL)
  * @param[in] attrs,nattrs global attributes
  * @param[out] err,errlen message on failure
  * @return 0 on success
  */
-int ncout_columns(const char *path, const char *dim, size_t n, int ncol, const char *const *names,
-                  const char *const *units, const double *const *cols, const long long *ids,
-                  const struct nc_attr *attrs, int nattrs, char *err, size_t errlen);
+int ncout_columns(const char *path, const char *title, const char *dim, size_t n, int ncol,
+                  const char *const *names, const char *const *long_names, const char *const *units,
+                  const double *const *cols, const long long *ids, const struct nc_attr *attrs,
+                  int nattrs, char *err, size_t errlen);
 
 /**
  * @brief Define a variable with units and long_name attributes (CF).

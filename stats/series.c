@@ -6,9 +6,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-void series_init(struct series *s, int ncol, const char *const *names, const char *const *units) {
+void series_init(struct series *s, int ncol, const char *const *names, const char *const *units,
+                 const char *const *long_names) {
   memset(s, 0, sizeof *s);
-  s->ncol = ncol, s->names = names, s->units = units;
+  s->ncol = ncol, s->names = names, s->units = units, s->long_names = long_names;
 }
 
 void series_add(struct series *s, const double *row) {

@@ -11,14 +11,17 @@
 /** A table of named columns growing by rows (the time series of a run). */
 struct series {
   int ncol;
-  const char *const *names; /*!< column names (static strings) */
-  const char *const *units; /*!< column units (static strings) */
-  size_t n, cap;            /*!< rows stored, capacity */
-  double *data;             /*!< row-major values */
+  const char *const *names;      /*!< column names (static strings) */
+  const char *const *units;      /*!< column units (static strings) */
+  const char *const *long_names; /*!< column descriptions (static strings; NULL: none) */
+  size_t n, cap;                 /*!< rows stored, capacity */
+  double *data;                  /*!< row-major values */
 };
 
-/** @brief Initialise an empty series with static column names and units. */
-void series_init(struct series *s, int ncol, const char *const *names, const char *const *units);
+/** @brief Initialise an empty series with static column names, units and long names (may be
+    NULL). */
+void series_init(struct series *s, int ncol, const char *const *names, const char *const *units,
+                 const char *const *long_names);
 
 /** @brief Append one row of ncol values. */
 void series_add(struct series *s, const double *row);

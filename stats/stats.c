@@ -15,6 +15,7 @@
 void stats_init(struct stats *st, const struct stats_config *cfg) {
   memset(st, 0, sizeof *st);
   st->cfg = *cfg;
+  st->t_reached = NAN;
   if (cfg->eulerian) euler_init(&st->eu, &cfg->eul);
   if (cfg->corr.n_levels) corr_init(&st->co, &cfg->corr);
   if (cfg->lagr.n_levels) lagr_init(&st->la, &cfg->lagr);
@@ -78,6 +79,41 @@ static void eulerian_result(const struct euler *e, struct euler_result *res) {
   free(complete);
 }
 
+void stats_progress(const struct stats *st, const struct stats_target *tg,
+                    struct stats_progress *p) {
+  memset(p, 0, sizeof *p);
+  p->rel_u = p->rel_uv = p->worst = p->ratio = p->windows_needed = p->t_reach = NAN;
+  if (!st->cfg.eulerian || euler_rows(&st->eu) == 0) return;
+  struct euler_result r;
+  eulerian_result(&st->eu, &r);
+  double se = 0.0, umax = 0.0, uv = 0.0, se_uv = NAN;
+  for (int b = 0; b < r.nb; b++) {
+    if (isfinite(r.prof[EP_SE_U][b])) se = fmax(se, r.prof[EP_SE_U][b]);
+    if (isfinite(r.prof[EP_U][b])) umax = fmax(umax, fabs(r.prof[EP_U][b]));
+    if (isfinite(r.prof[EP_UV][b]) && fabs(r.prof[EP_UV][b]) > uv)
+      uv = fabs(r.prof[EP_UV][b]), se_uv = r.prof[EP_SE_U + 8][b]; /* stderr of uv */
+  }
+  p->windows = r.n_batches;
+  const double win = st->cfg.eul.window;
+  p->ratio = win / r.corr_time;
+  if (r.n_batches >= 2) {
+    p->rel_u = umax > 0.0 ? se / umax : NAN;
+    p->rel_uv = uv > 0.0 ? se_uv / uv : NAN;
+    p->worst = tg->profiles == 1   ? p->rel_u
+               : tg->profiles == 2 ? p->rel_uv
+                                   : fmax(p->rel_u, p->rel_uv);
+    if (tg->profiles == 0 && (isnan(p->rel_u) || isnan(p->rel_uv))) p->worst = NAN;
+  }
+  if (isfinite(p->worst)) {
+    const double q = p->worst / tg->rel_stderr;
+    p->windows_needed = fmax((double)tg->windows, ceil(r.n_batches * q * q));
+    p->t_reach = st->eu.win[WIN_T0] + p->windows_needed * win;
+  }
+  p->met = r.n_batches >= tg->windows && isfinite(p->worst) && p->worst <= tg->rel_stderr &&
+           (tg->corr_ratio <= 0.0 || p->ratio >= tg->corr_ratio);
+  euler_result_free(&r);
+}
+
 void stats_convergence_line(const struct stats *st, char *buf, size_t len) {
   buf[0] = '\0';
   if (!st->cfg.eulerian || euler_rows(&st->eu) == 0) return;
@@ -108,7 +144,14 @@ static int put_att_d(int ncid, int var, const char *name, double v) {
   return nc_put_att_double(ncid, var, name, NC_DOUBLE, 1, &v);
 }
 
-static int write_eulerian(const struct euler *e, int ncid, char *err, size_t errlen) {
+int stats_warnings(const struct stats *st, char *buf, size_t len) {
+  buf[0] = '\0';
+  return st->cfg.lagr.n_levels ? lagr_warnings(&st->la, buf, len) : 0;
+}
+
+/* t_reached: the time the run reached (NaN: not known); an incomplete last window ends there. */
+static int write_eulerian(const struct euler *e, double t_reached, int ncid, char *err,
+                          size_t errlen) {
   int rc = NC_NOERR, dy, vid;
   struct euler_result r;
   eulerian_result(e, &r);
@@ -131,24 +174,30 @@ static int write_eulerian(const struct euler *e, int ncid, char *err, size_t err
   const struct {
     const char *name;
     double v;
-  } scal[] = {{"u_tau", r.u_tau},
-              {"u_tau_stderr", r.u_tau_stderr},
-              {"u_tau_wall", r.u_tau_wall},
-              {"u_tau_force", r.u_tau_force},
-              {"re_tau", r.re_tau},
-              {"correlation_time", r.corr_time},
-              {"stress_balance_error", r.balance_error},
-              {"average_start", r.t0},
-              {"average_end", r.t1},
-              {"n_windows", (double)r.n_batches},
-              {"window_length", e->cfg.window},
-              {"bin_lower", e->cfg.y0},
-              {"bin_upper", e->cfg.y1},
-              {"wall_area", e->cfg.area},
-              {"fold", (double)e->cfg.fold},
-              {"les", (double)e->cfg.les}};
+    int integer; /* a count or flag: int64 */
+  } scal[] = {{"u_tau", r.u_tau, 0},
+              {"u_tau_stderr", r.u_tau_stderr, 0},
+              {"u_tau_wall", r.u_tau_wall, 0},
+              {"u_tau_force", r.u_tau_force, 0},
+              {"re_tau", r.re_tau, 0},
+              {"correlation_time", r.corr_time, 0},
+              {"stress_balance_error", r.balance_error, 0},
+              {"average_start", r.t0, 0},
+              {"average_end", isnan(t_reached) ? r.t1 : fmin(r.t1, t_reached), 0},
+              {"n_windows", (double)r.n_batches, 1},
+              {"window_length", e->cfg.window, 0},
+              {"bin_lower", e->cfg.y0, 0},
+              {"bin_upper", e->cfg.y1, 0},
+              {"wall_area", e->cfg.area, 0},
+              {"fold", (double)e->cfg.fold, 1},
+              {"les", (double)e->cfg.les, 1}};
   for (size_t i = 0; i < sizeof scal / sizeof scal[0]; i++)
-    CK(put_att_d(ncid, NC_GLOBAL, scal[i].name, scal[i].v));
+    if (scal[i].integer) {
+      const long long v = (long long)scal[i].v;
+      CK(nc_put_att_longlong(ncid, NC_GLOBAL, scal[i].name, NC_INT64, 1, &v));
+    } else {
+      CK(put_att_d(ncid, NC_GLOBAL, scal[i].name, scal[i].v));
+    }
   /* the raw windows: the complete accumulator state, re-averaged by chansph extract */
   int g, dw, dwf, dm, ds, vw, vm, vs, vc, v0, v1;
   CK(nc_def_grp(ncid, "eulerian", &g));
@@ -164,15 +213,15 @@ static int write_eulerian(const struct euler *e, int ncid, char *err, size_t err
   CK(ncout_def(g, "window_end", NC_DOUBLE, 1, &dw, "s", "end of the averaging window", &v1));
   CK(ncout_def(g, "window_complete", NC_INT, 1, &dw, "1", "1: closed window, 0: still open", &vc));
   const int d2[2] = {dw, dwf}, d3m[3] = {dw, dy, dm}, d3s[3] = {dw, dy, ds};
-  CK(ncout_def(g, "windows", NC_DOUBLE, 2, d2, "1",
+  CK(ncout_def(g, "windows", NC_DOUBLE, 2, d2, NULL,
                "per window: t_start [s], t_end [s], snapshots, sum of body force [m/s^2], sums "
                "of tau_w/rho at y=0 and y=2delta [m^2/s^2]",
                &vw));
-  CK(ncout_def(g, "moments", NC_DOUBLE, 3, d3m, "1",
+  CK(ncout_def(g, "moments", NC_DOUBLE, 3, d3m, NULL,
                "per window and bin: count, means of u v w p rho y nu_t k_r, co-moments uu vv ww "
                "uv uw vw, third and fourth central moments of u v w (sums, not divided by count)",
                &vm));
-  CK(ncout_def(g, "snapshot_u", NC_DOUBLE, 3, d3s, "1",
+  CK(ncout_def(g, "snapshot_u", NC_DOUBLE, 3, d3s, NULL,
                "per window and bin: count, mean and M2 of the per-snapshot bin means of u", &vs));
   for (size_t w = 0; w < rows; w++) {
     const size_t st[1] = {w}, ct[1] = {1};
@@ -195,7 +244,7 @@ fail:
 
 int stats_nc_write(const struct stats *st, int ncid, char *err, size_t errlen) {
   if (st->cfg.eulerian) {
-    const int rc = write_eulerian(&st->eu, ncid, err, errlen);
+    const int rc = write_eulerian(&st->eu, st->t_reached, ncid, err, errlen);
     if (rc) return rc;
   }
   if (st->cfg.corr.n_levels) {

@@ -30,14 +30,23 @@ struct stats_config {
 /** The engine. */
 struct stats {
   struct stats_config cfg;
-  struct euler eu; /*!< Eulerian profiles (if cfg.eulerian) */
-  struct corr co;  /*!< correlations and spectra (if cfg.corr.n_levels) */
-  struct lagr la;  /*!< Lagrangian statistics (if cfg.lagr.n_levels) */
-  int64_t samples; /*!< snapshots handed to the engine */
+  struct euler eu;  /*!< Eulerian profiles (if cfg.eulerian) */
+  struct corr co;   /*!< correlations and spectra (if cfg.corr.n_levels) */
+  struct lagr la;   /*!< Lagrangian statistics (if cfg.lagr.n_levels) */
+  int64_t samples;  /*!< snapshots handed to the engine */
+  double t_reached; /*!< simulated time reached, set before a write (NaN: not known); the
+                         average_end written is at most this */
 };
 
 /** @brief Set up the requested engines. */
 void stats_init(struct stats *st, const struct stats_config *cfg);
+
+/**
+ * @brief Warnings about what the statistics could not give (Lagrangian lags without samples,
+ *        T_L = NaN, no completed release): lines starting "warning: ".
+ * @return the number of warnings (buf "" if none)
+ */
+int stats_warnings(const struct stats *st, char *buf, size_t len);
 
 /** @brief Free them. */
 void stats_free(struct stats *st);
@@ -75,5 +84,32 @@ size_t stats_memory(const struct stats *st);
  * @param[out] buf,len the text (ends with a newline; empty if nothing is gathered yet)
  */
 void stats_convergence_line(const struct stats *st, char *buf, size_t len);
+
+/** A convergence target (scene keys stats.target_*). */
+struct stats_target {
+  double rel_stderr; /*!< target relative standard error (> 0) */
+  int profiles;      /*!< 0: u_mean and the -u'v' peak, 1: u_mean, 2: the -u'v' peak */
+  double corr_ratio; /*!< smallest window length / correlation time (0: none) */
+  int windows;       /*!< fewest complete windows */
+};
+
+/** Where the statistics stand against a target. */
+struct stats_progress {
+  double rel_u;          /*!< max stderr(u_mean) / max |u_mean| (NaN: not yet) */
+  double rel_uv;         /*!< stderr / value of -u'v' at its peak (NaN: not yet) */
+  double worst;          /*!< the largest of the chosen ones (NaN: not yet) */
+  int windows;           /*!< complete windows */
+  double ratio;          /*!< window length / correlation time (NaN: not measured) */
+  double windows_needed; /*!< projected complete windows at the target (stderr ~ n^-1/2) */
+  double t_reach;        /*!< projected simulated time at which they are complete [s] */
+  int met;               /*!< the target is met */
+};
+
+/**
+ * @brief The standard errors against a target, and the projection to reach it (the batch-means
+ *        standard error falls as one over the square root of the number of windows).
+ */
+void stats_progress(const struct stats *st, const struct stats_target *tg,
+                    struct stats_progress *p);
 
 #endif

@@ -5,6 +5,8 @@
 # so only the innermost one ends the run.)
 # usage: batch_chain.sh CHANSPH SCENE RUNS
 set -u
+# the runs compared here share one identity (issue 13: DIR/run_id, stored in every file)
+export CHANSPH_RUN_ID=compare-test
 chansph=$1 scene=$2 runs=$3
 here=$(cd "$(dirname "$0")/.." && pwd)
 export OMP_NUM_THREADS=${OMP_NUM_THREADS:-1}
@@ -52,7 +54,7 @@ for kind in slurm pbs; do
   echo "$kind: $jobs jobs; ${done_line:-no 'done' line}"
   [ -n "$done_line" ] && [ $jobs -ge 2 ] || { echo "FAIL: $kind chain"; status=1; }
   for f in stats.nc particles.nc; do
-    diff <(ncdump -p 9,17 "$ref/$f" | tail -n +2) <(ncdump -p 9,17 "$d/$f" | tail -n +2) \
+    diff <("$(dirname "$0")/nc_content.sh" "$ref/$f") <("$(dirname "$0")/nc_content.sh" "$d/$f") \
       > /dev/null || { echo "FAIL: $kind $f differs"; status=1; }
   done
 done

@@ -7,6 +7,8 @@
 #   migration  fast 2-D flow (Mach 0.5) on 3 and 4 ranks, ids checked after every step,
 #              load checks every 7 steps (4 ranks start from a skewed partition); equals 1 rank
 #   too_many   more ranks than the slabs allow: a message naming domain.lx, exit 1
+#   resume_too_many  a 1-rank checkpoint resumed on more ranks than its slabs allow: the same
+#                    message, exit 1, the checkpoints untouched
 #   ckpt_resume      3-D LES: 100 steps on 2 ranks (parallel HDF5 checkpoint), resumed on 3 ranks
 #                    and on 1 rank to step 200; both equal the uninterrupted 1-rank run
 #   ckpt_write_fail  2 ranks under a file-size limit: exit 74, a message, previous checkpoint
@@ -21,6 +23,8 @@
 # the core driver, one of several ranks by the MPI-IO driver, so their bytes differ; files of
 # 2, 3 or 4 ranks are byte-identical among themselves).
 set -uo pipefail
+# the runs compared here share one identity (issue 13: DIR/run_id, stored in every file)
+export CHANSPH_RUN_ID=compare-test
 chansph=$1 scenes=$2 runs=$3 case=$4
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMP_NUM_THREADS=1
 work=$runs/mpi_$case
@@ -144,6 +148,18 @@ case $case in
     grep -q "key 'domain.lx': lx = 1.2 gives 9 cell columns .* 4 MPI ranks need at least 16 .* at most 2 ranks" r4.txt ||
       { cat r4.txt; echo "FAIL: message"; exit 1; }
     [ ! -e r4/stats.nc ] || { echo "FAIL: output written"; exit 1; }
+    echo "ok: $(grep -h "domain.lx" r4.txt | head -1)"
+    ;;
+  resume_too_many) # issue 13 point 6: an input error (exit 1), not an MPI_Abort (exit 2)
+    "$chansph" run "$scenes/poiseuille2d.ini" --out r1 --max-steps 2 > r1.txt 2>&1
+    [ $? -eq 75 ] || { cat r1.txt; echo "FAIL: the 1-rank run did not stop at --max-steps"; exit 1; }
+    before=$(ls r1/checkpoints)
+    mpi 4 resume r1 > r4.txt 2>&1
+    rc=$?
+    [ $rc -eq 1 ] || { cat r4.txt; echo "FAIL: resume on 4 ranks: exit $rc, expected 1"; exit 1; }
+    grep -q "key 'domain.lx': lx = 1 gives 15 cell columns .* 4 MPI ranks need at least 16 .* at most 3 ranks" r4.txt ||
+      { cat r4.txt; echo "FAIL: message"; exit 1; }
+    [ "$before" = "$(ls r1/checkpoints)" ] || { echo "FAIL: the checkpoints changed"; exit 1; }
     echo "ok: $(grep -h "domain.lx" r4.txt | head -1)"
     ;;
   ckpt_resume)

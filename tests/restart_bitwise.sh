@@ -4,6 +4,8 @@
 # stats.nc and particles.nc data and identical final checkpoints (h5diff, and cmp of the files).
 # usage: restart_bitwise.sh CHANSPH SCENE RUNS NAME N1 N2 [--set k=v ...]
 set -u
+# the runs compared here share one identity (issue 13: DIR/run_id, stored in every file)
+export CHANSPH_RUN_ID=compare-test
 chansph=$1 scene=$2 runs=$3 name=$4 n1=$5 n2=$6
 shift 6
 full=$runs/bitwise_${name}_full part=$runs/bitwise_${name}_part
@@ -18,7 +20,7 @@ rc=$?
 "$chansph" resume "$part" > /dev/null || { echo "FAIL: final resume"; exit 1; }
 status=0
 for f in stats.nc particles.nc; do
-  if diff <(ncdump -p 9,17 "$full/$f" | tail -n +2) <(ncdump -p 9,17 "$part/$f" | tail -n +2) \
+  if diff <("$(dirname "$0")/nc_content.sh" "$full/$f") <("$(dirname "$0")/nc_content.sh" "$part/$f") \
     > /dev/null; then
     echo "$name $f: data identical"
   else

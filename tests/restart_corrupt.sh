@@ -5,6 +5,8 @@
 # (skipped files are renamed *.skipped). Also: forbidden and accepted scene changes on resume.
 # usage: restart_corrupt.sh CHANSPH H5_SET_ATTR SCENE RUNS
 set -u
+# the runs compared here share one identity (issue 13: DIR/run_id, stored in every file)
+export CHANSPH_RUN_ID=compare-test
 chansph=$1 setattr=$2 scene=$3 runs=$4
 base=$runs/corrupt_base
 opts=(--set time.t_end=1 --set output.t_average_start=0.5 --set checkpoint.every_steps=50
@@ -35,7 +37,7 @@ case_() {
   if [ "$want" -eq 0 ]; then
     grep -q "resume: from .*$prev" "$d/log.txt" || fail "$name: did not fall back to $prev"
     for f in stats.nc particles.nc; do
-      diff <(ncdump -p 9,17 "$base/$f" | tail -n +2) <(ncdump -p 9,17 "$d/$f" | tail -n +2) \
+      diff <("$(dirname "$0")/nc_content.sh" "$base/$f") <("$(dirname "$0")/nc_content.sh" "$d/$f") \
         > /dev/null || fail "$name: $f differs from the uninterrupted run"
     done
   fi
@@ -52,10 +54,15 @@ for k in range(o + 200, o + 204): b[k] ^= 0x5a
 open('$newest', 'wb').write(b)\" && rm x.bin"
 case_ missing 0 "ckpt_0000000194.h5: cannot open checkpoint: No such file or directory" \
   "ln -s gone.h5 ckpt_0000000194.h5 && mv $newest ../moved_away.h5"
-case_ future_version 0 "$newest: written in checkpoint format 2.0 by a newer chansph; this build \(.*\) reads format 1.x only" \
+case_ future_version 0 "$newest: written in checkpoint format 2\.[0-9]+ by a newer chansph; this build \(.*\) reads format 1.x only" \
   "$setattr $newest format_version_major 2 > /dev/null"
 case_ incomplete 0 "$newest: incomplete checkpoint \(no completion mark 'complete' = 1\)" \
   "$setattr $newest complete 0 > /dev/null"
+# issue 13, point 8: a metadata checksum failure is named as such, not "not a chansph checkpoint"
+case_ metadata 0 "$newest: cannot read the root group's attributes \(metadata checksum mismatch or corrupt file\) \(HDF5: incorrect metadata checksum" \
+  "python3 -c \"
+b = bytearray(open('$newest', 'rb').read()); o = b.find(b'chansph-checkpoint'); assert o > 0
+b[o + 3] ^= 0x20; open('$newest', 'wb').write(b)\""
 case_ none_valid 1 "none of the 1 checkpoint\(s\) is valid \(see above\); nothing was deleted" \
   "rm ckpt_0000000050.h5 ckpt_0000000100.h5 $prev && truncate -s 1000 $newest"
 case_ no_checkpoint 1 "checkpoints: no checkpoint to resume from" "rm ckpt_*.h5"

@@ -1,21 +1,31 @@
 #!/usr/bin/env bash
 # Acceptance 3 of issue 4: SIGTERM, SIGUSR1, SIGINT and a STOP file make a run finish its step,
 # write a checkpoint and exit with 75 ("checkpointed, resubmit me"); --walltime exits in time.
-# usage: restart_signals.sh CHANSPH SCENE RUNS
+# usage: restart_signals.sh CHANSPH SCENE RUNS [DELAY TRIGGERS]
+#   DELAY: seconds each run waits before it starts (a loaded machine; default 0); TRIGGERS:
+#   the triggers to try (default "TERM USR1 INT STOP", then resume and --walltime)
 set -u
-chansph=$1 scene=$2 runs=$3
+chansph=$1 scene=$2 runs=$3 delay=${4:-0} triggers=${5:-}
 export OMP_NUM_THREADS=${OMP_NUM_THREADS:-1} # timing checks: no spinning threads on a busy machine
 status=0
 fail() { echo "FAIL: $*"; status=1; }
 long=(--set time.t_end=1000 --set output.t_average_start=0 --set checkpoint.every_minutes=0)
 
-# a run that would last for hours; the trigger arrives after about 1 s
-for trig in TERM USR1 INT STOP; do
+# a run that would last for hours; the trigger arrives once it is under way
+for trig in ${triggers:-TERM USR1 INT STOP}; do
   d=$runs/signal_$trig
   rm -rf "$d"
-  "$chansph" run "$scene" --out "$d" "${long[@]}" > "$runs/signal_$trig.out" 2>&1 &
+  (sleep "$delay" && exec "$chansph" run "$scene" --out "$d" "${long[@]}") \
+    > "$runs/signal_$trig.out" 2>&1 &
   pid=$!
-  sleep 1
+  # under way: the first progress line is in DIR/log.txt (the directory exists, the loop runs);
+  # a fixed delay lost the race under load (issue 13, point 9)
+  for _ in $(seq 3000); do
+    grep -q "^step" "$d/log.txt" 2> /dev/null && break
+    kill -0 $pid 2> /dev/null || break
+    sleep 0.1
+  done
+  grep -q "^step" "$d/log.txt" 2> /dev/null || fail "$trig: the run did not get under way"
   t0=$(date +%s.%N)
   if [ $trig = STOP ]; then touch "$d/STOP"; else kill -$trig $pid; fi
   wait $pid
@@ -32,6 +42,10 @@ for trig in TERM USR1 INT STOP; do
   [ $trig = STOP ] && [ -e "$d/STOP" ] && fail "STOP file not removed"
   [ -s "$d/stats.nc" ] || fail "$trig: no stats.nc"
 done
+if [ -n "$triggers" ]; then
+  [ $status -eq 0 ] && echo PASS
+  exit $status
+fi
 # the run resumes from there, and stops again by --max-steps
 d=$runs/signal_TERM
 "$chansph" resume "$d" --max-steps 3 > /dev/null

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # stats.nc opens cleanly in ncdump, NCO (ncks -m) and python3-netCDF4 (issue 5, acceptance 7):
-# no error, no warning on stderr, every variable of every group readable.
+# no error, no warning on stderr, every variable of every group readable and with units
+# (except the raw records of mixed quantities, issue 13 point 12).
 set -eu
 f=$1
 status=0
@@ -24,7 +25,8 @@ import sys, netCDF4
 def walk(g):
     for v in g.variables.values():
         v[:]
-        getattr(v, "units")
+        if v.name not in ("windows", "moments", "snapshot_u"):  # mixed quantities: no units
+            getattr(v, "units")
     for c in g.groups.values():
         walk(c)
 with netCDF4.Dataset(sys.argv[1]) as d:

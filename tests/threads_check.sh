@@ -4,6 +4,8 @@
 # every statistics engine on (Eulerian, correlations and spectra, Lagrangian); the LES smoke
 # scene covers the model terms (wall law, strain, eddy viscosity, k_r).
 set -eu
+# the runs compared here share one identity (issue 13: DIR/run_id, stored in every file)
+export CHANSPH_RUN_ID=compare-test
 chansph=$1 scenes=$2 runs=$3
 status=0
 for scene in poiseuille2d poiseuille3d poiseuille2d_flux les395_smoke; do
@@ -15,8 +17,8 @@ for scene in poiseuille2d poiseuille3d poiseuille2d_flux les395_smoke; do
       --set lagrangian.n_lags=10 --set lagrangian.pdf_x=0.01 > /dev/null
   done
   for f in stats.nc particles.nc; do
-    if diff <(ncdump -p 9,17 "$runs/threads_${scene}_1/$f" | tail -n +2) \
-            <(ncdump -p 9,17 "$runs/threads_${scene}_2/$f" | tail -n +2) > /dev/null; then
+    if diff <("$(dirname "$0")/nc_content.sh" "$runs/threads_${scene}_1/$f") \
+            <("$(dirname "$0")/nc_content.sh" "$runs/threads_${scene}_2/$f") > /dev/null; then
       echo "$scene $f: identical for 1 and 2 threads"
     else
       echo "$scene $f: DIFFERENT for 1 and 2 threads"; status=1
