@@ -16,8 +16,10 @@
  * the vectorised partial sums are formed in the same order everywhere.
  */
 #include <math.h>
+#include <omp.h>
 
 #include "pair.h"
+#include "records.h"
 #include "sph.h"
 #include "timers.h"
 #include "wall.h"
@@ -47,53 +49,56 @@ struct fsums {
   struct v3 gc;    /*!< corrected pressure difference gradient */
 };
 
-/** Sums over the neighbours nl[j0 .. j1-1] of particle a, for the operator `visc`, the
-    corrected (`corr`) or symmetric pressure gradient, with (`fluid`) or without the volume
+/** Sums over the neighbours j0 .. j1-1 of particle a, whose records were gathered into the
+    buffers bf (records.h: bf + REC_X * ld holds their x, and so on), for the operator `visc`,
+    the corrected (`corr`) or symmetric pressure gradient, with (`fluid`) or without the volume
     diffusion. Always inlined with constant flags: one specialised loop per combination. */
 static inline __attribute__((always_inline)) void pair_sums(const struct fctx *C, size_t a,
-                                                            const int32_t *restrict nl, int j0,
-                                                            int j1, const int fluid, const int visc,
-                                                            const int corr, struct fsums *out) {
+                                                            const double *restrict bf, int ld,
+                                                            int j0, int j1, const int fluid,
+                                                            const int visc, const int corr,
+                                                            struct fsums *out) {
   const struct model *M = C->M;
   const struct particles *P = C->P;
   const struct kernel K = M->k;
-  const double *restrict x = P->x, *restrict y = P->y, *restrict z = P->z;
-  const double *restrict u = P->u, *restrict v = P->v, *restrict w = P->w;
-  const double *restrict m = P->m, *restrict rho = P->rho, *restrict c = P->c;
-  const double *restrict pr2 = P->pr2, *restrict vol = P->vol, *restrict nur = P->nur;
+  const double *restrict x = bf + REC_X * ld, *restrict y = bf + REC_Y * ld;
+  const double *restrict z = bf + REC_Z * ld, *restrict u = bf + REC_U * ld;
+  const double *restrict v = bf + REC_V * ld, *restrict w = bf + REC_W * ld;
+  const double *restrict vol = bf + REC_VOL * ld, *restrict rho = bf + REC_RHO * ld;
+  const double *restrict m = bf + REC_M * ld, *restrict pr2 = bf + REC_PR2 * ld;
+  const double *restrict c = bf + REC_C * ld, *restrict nur = bf + REC_NUR * ld;
   const double lx = M->lx, lz = M->lz, eta2 = M->eta2, nu = M->nu, np2 = M->dim + 2.0;
   const int d3 = M->dim == 3;
   const double dgrav = M->e.rho0 / (M->e.c0 * M->e.c0) * M->gy; /* Eq. 3.61 */
-  const double xa = x[a], ya = y[a], za = z[a], ua = u[a], va = v[a], wa = w[a];
-  const double ra = rho[a], pa = pr2[a], ca = c[a], ira = 1.0 / ra;
+  const double xa = P->x[a], ya = P->y[a], za = P->z[a], ua = P->u[a], va = P->v[a];
+  const double wa = P->w[a], ra = P->rho[a], pa = P->pr2[a], ca = P->c[a], ira = 1.0 / ra;
   const double pm_a = corr ? pa * ra * ra : 0.0;
-  const double mu_a = visc == VK_LES ? ra * (nu + nur[a]) : 0.0;
+  const double mu_a = visc == VK_LES ? ra * (nu + P->nur[a]) : 0.0;
   double gpx = 0, gpy = 0, gpz = 0, vx = 0, vy = 0, vz = 0, mo2 = 0, moyy = 0, mo1 = 0;
   double diff = 0, m1x = 0, m2x = 0, m1z = 0, m2z = 0;
   double axx = 0, axy = 0, axz = 0, ayy = 0, ayz = 0, azz = 0, gcx = 0, gcy = 0, gcz = 0;
 #pragma omp simd reduction(+ : gpx, gpy, gpz, vx, vy, vz, mo2, moyy, mo1, diff, m1x, m2x, m1z, \
                                m2z, axx, axy, axz, ayy, ayz, azz, gcx, gcy, gcz)
   for (int j = j0; j < j1; j++) {
-    const int32_t b = nl[j];
-    const struct pair g = pair_geom(&K, lx, lz, d3, xa - x[b], ya - y[b], za - z[b]);
-    const double vb = vol[b], rb = rho[b];
+    const struct pair g = pair_geom(&K, lx, lz, d3, xa - x[j], ya - y[j], za - z[j]);
+    const double vb = vol[j], rb = rho[j];
     if (corr) {
       const struct sym3 t = term_moment(&g, vb);
       axx += t.xx, axy += t.xy, axz += t.xz, ayy += t.yy, ayz += t.yz, azz += t.zz;
-      const struct v3 d = term_difference(&g, vb, pr2[b] * rb * rb - pm_a);
+      const struct v3 d = term_difference(&g, vb, pr2[j] * rb * rb - pm_a);
       gcx += d.x, gcy += d.y, gcz += d.z;
     } else {
-      const struct v3 t = term_pressure(&g, m[b], pa, pr2[b]);
+      const struct v3 t = term_pressure(&g, m[j], pa, pr2[j]);
       gpx += t.x, gpy += t.y, gpz += t.z;
     }
-    const struct v3 uab = {ua - u[b], va - v[b], wa - w[b]};
+    const struct v3 uab = {ua - u[j], va - v[j], wa - w[j]};
     struct v3 t;
     if (visc == VK_MORRIS)
-      t = term_morris(&g, m[b], ira, vb, eta2, uab);
+      t = term_morris(&g, m[j], ira, vb, eta2, uab);
     else if (visc == VK_VIOLEAU)
       t = term_violeau(&g, vb, 0.5 * (ra + rb), np2, eta2, uab);
     else /* Eq. 2.100 with mu = rho (nu + nu_r) */
-      t = term_violeau(&g, vb, 0.5 * (mu_a + rb * (nu + nur[b])), np2, eta2, uab);
+      t = term_violeau(&g, vb, 0.5 * (mu_a + rb * (nu + nur[j])), np2, eta2, uab);
     vx += t.x, vy += t.y, vz += t.z;
     const struct v3 mo = term_moments(&g, vb);
     mo2 += mo.x, moyy += mo.y, mo1 += mo.z;
@@ -101,7 +106,7 @@ static inline __attribute__((always_inline)) void pair_sums(const struct fctx *C
       const struct v3 vm = term_violeau_moments(&g, vb, np2, eta2);
       m1x += vm.x, m2x += vm.x * g.dy, m1z += vm.y, m2z += vm.y * g.dy;
     }
-    if (fluid) diff += term_diffusion(&g, vb, ca, c[b], ra, rb, dgrav);
+    if (fluid) diff += term_diffusion(&g, vb, ca, c[j], ra, rb, dgrav);
   }
   *out = (struct fsums){{gpx, gpy, gpz},
                         {vx, vy, vz},
@@ -238,12 +243,16 @@ static inline __attribute__((always_inline)) void force_range(const struct fctx 
                                                               size_t a1, double mx[2],
                                                               const int visc, const int corr) {
   const struct nbr *nb = C->nb;
+  const int ld = nb->stride;
+  double *bf = nb->pairbuf[omp_get_thread_num()];
   for (size_t a = a0; a < a1; a++) {
     if (C->P->kind[a] != KIND_FLUID) continue;
     const int32_t *nl = nb->list + a * (size_t)nb->stride;
+    records_gather(C->P->rec, nl, nb->count[a], 0, bf, ld);
+    records_gather(C->P->rec, nl, nb->count[a], 1, bf + 8 * (size_t)ld, ld);
     struct fsums s, sv;
-    pair_sums(C, a, nl, 0, nb->nfluid[a], 1, visc, corr, &s);
-    pair_sums(C, a, nl, nb->nfluid[a], nb->count[a], 0, visc, corr, &sv);
+    pair_sums(C, a, bf, ld, 0, nb->nfluid[a], 1, visc, corr, &s);
+    pair_sums(C, a, bf, ld, nb->nfluid[a], nb->count[a], 0, visc, corr, &sv);
     force_finish(C, a, &s, &sv, mx);
   }
 }

@@ -91,8 +91,9 @@ void nbr_reserve(struct nbr *nb, size_t n) {
 void nbr_free(struct nbr *nb) {
   part_free(nb->start), part_free(nb->pos), part_free(nb->perm), part_free(nb->cell);
   part_free(nb->count), part_free(nb->list), part_free(nb->nfluid);
-  for (int t = 0; t < nb->scratch_threads; t++) part_free(nb->scratch[t]);
-  free(nb->scratch);
+  for (int t = 0; t < nb->scratch_threads; t++)
+    part_free(nb->scratch[t]), part_free(nb->pairbuf[t]);
+  free(nb->scratch), free(nb->pairbuf);
   memset(nb, 0, sizeof *nb);
 }
 
@@ -379,12 +380,17 @@ __attribute__((target("avx512f,avx512vl,avx512bw,avx512dq,avx512cd"))) static in
 static void nbr_scratch(struct nbr *nb) {
   const int nt = omp_get_max_threads();
   if (nb->scratch && nb->scratch_stride == nb->stride && nb->scratch_threads >= nt) return;
-  for (int t = 0; t < nb->scratch_threads; t++) part_free(nb->scratch[t]);
-  free(nb->scratch);
+  for (int t = 0; t < nb->scratch_threads; t++)
+    part_free(nb->scratch[t]), part_free(nb->pairbuf[t]);
+  free(nb->scratch), free(nb->pairbuf);
   nb->scratch = calloc((size_t)nt, sizeof *nb->scratch);
-  if (!nb->scratch) die("out of memory for the neighbour scratch lists");
+  nb->pairbuf = calloc((size_t)nt, sizeof *nb->pairbuf);
+  if (!nb->scratch || !nb->pairbuf) die("out of memory for the neighbour scratch lists");
   const size_t bytes = (size_t)(nb->stride + NBR_ALIGN) * (sizeof(int32_t) + sizeof(double));
-  for (int t = 0; t < nt; t++) nb->scratch[t] = part_alloc("nbr_scratch", bytes);
+  for (int t = 0; t < nt; t++) {
+    nb->scratch[t] = part_alloc("nbr_scratch", bytes);
+    nb->pairbuf[t] = part_alloc("pair_buffer", 16 * (size_t)nb->stride * sizeof(double));
+  }
   nb->scratch_threads = nt, nb->scratch_stride = nb->stride;
 }
 

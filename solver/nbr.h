@@ -51,10 +51,12 @@ struct nbr {
   int *cell;         /*!< cell of each particle (sort scratch) */
   size_t cap;        /*!< particles the arrays hold */
   /* neighbour list */
-  int stride;  /*!< list slots per particle, a multiple of NBR_ALIGN */
-  int *count;  /*!< neighbours of each particle (excluding itself) */
-  int *nfluid; /*!< of which fluid particles: they come first in the list, then the vertices */
-  int avx512;  /*!< the candidate scan uses AVX-512 */
+  int stride;       /*!< list slots per particle, a multiple of NBR_ALIGN */
+  int *count;       /*!< neighbours of each particle (excluding itself) */
+  int *nfluid;      /*!< of which fluid particles: they come first in the list, then the vertices */
+  int avx512;       /*!< the candidate scan uses AVX-512 */
+  double **pairbuf; /*!< per thread: the gathered records of one list (records.h),
+                         16 fields of stride values */
   int32_t **scratch;   /*!< per thread: a list being built and its squared distances */
   int scratch_threads; /*!< threads the scratch lists were made for */
   int scratch_stride;  /*!< stride they were made for */

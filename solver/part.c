@@ -76,6 +76,7 @@ static size_t arrays(struct particles *P, struct array *t) {
                               {(void **)&P->c, "sound", d, 1},
                               {(void **)&P->pr2, "p_over_rho2", d, 1},
                               {(void **)&P->vol, "volume", d, 1},
+                              {(void **)&P->rec, "pair_records", 16 * d, 1},
                               {(void **)&P->ax, "ax", d, 1},
                               {(void **)&P->ay, "ay", d, 1},
                               {(void **)&P->az, "az", d, 1},

@@ -44,6 +44,7 @@ struct particles {
   double *c;            /*!< local speed of sound [m/s] */
   double *pr2;          /*!< p / rho^2 [m^5/(kg s^2)] */
   double *vol;          /*!< volume m / rho [m^dim] */
+  double *rec;          /*!< pair records, REC_LEN doubles a slot (records.h) */
   double *ax, *ay, *az; /*!< acceleration without the driving force at the start of the last
                              step [m/s^2]; permuted (and migrated) with the particles */
   /* turbulence model (turb.h), allocated only when used, NULL otherwise; recomputed from the

@@ -8,6 +8,7 @@
 
 #include "error.h"
 #include "init.h"
+#include "records.h"
 #include "reduce.h"
 #include "timers.h"
 #include "turb.h"
@@ -74,6 +75,7 @@ static void update_state(struct sim *S, int restored, double dt) {
   double *const wv[2] = {S->W.rho, S->W.p};
   dd_update_walls(&S->dd, P, 2, wv);
   model_update(S);
+  records_pack(P, P->n + P->n_ghost); /* what the force pass reads at neighbours */
 }
 
 int sim_create(struct sim *S, const struct scene *sc) {

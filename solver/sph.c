@@ -13,6 +13,7 @@
 #include <math.h>
 
 #include "pair.h"
+#include "records.h"
 #include "timers.h"
 #include "wall.h"
 
@@ -43,6 +44,7 @@ void sph_model_init(struct model *M, const struct scene *s) {
   M->wall_tau = M->les || s->wall_law != WALL_LAW_LAMINAR;
   sph_lattice_excess_table(M);
   sph_violeau_table(M);
+  records_init();
 }
 
 /** Integral over the half-space y > q (units of h) of y^2 F(r) ((n+2) x_t^2 / r^2 + 1), with

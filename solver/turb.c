@@ -2,9 +2,11 @@
 #include "turb.h"
 
 #include <math.h>
+#include <omp.h>
 #include <string.h>
 
 #include "pair.h"
+#include "records.h"
 #include "timers.h"
 #include "wall.h"
 
@@ -89,29 +91,32 @@ static CHANSPH_CLONES double vertex_sums(const struct model *M, const struct par
 
 /** Corrected velocity-gradient sums of particle a over its whole list (fluid and vertices):
     A = -sum_b V_b F_ab r_ab (x) r_ab and B = sum_b V_b (v_b - v_a) (x) F_ab r_ab (thesis
-    Eq. 2.88-2.90, k = 0), as turb_strain_gradient takes them. */
+    Eq. 2.88-2.90, k = 0), as turb_strain_gradient takes them. The neighbours' positions,
+    velocities and volumes come from their pair records (records.h). */
 static CHANSPH_CLONES void gradient_sums(const struct model *M, const struct particles *P,
                                          const struct nbr *nb, size_t a, double A[6], double B[9]) {
   const struct kernel K = M->k;
-  const double *restrict x = P->x, *restrict y = P->y, *restrict z = P->z;
-  const double *restrict u = P->u, *restrict v = P->v, *restrict w = P->w;
-  const double *restrict vol = P->vol;
-  const int32_t *restrict nl = nb->list + a * (size_t)nb->stride;
-  const double xa = x[a], ya = y[a], za = z[a], ua = u[a], va = v[a], wa = w[a];
-  const double lx = M->lx, lz = M->lz;
+  const int ld = nb->stride, cnt = nb->count[a];
+  double *bf = nb->pairbuf[omp_get_thread_num()];
+  records_gather(P->rec, nb->list + a * (size_t)nb->stride, cnt, 0, bf, ld);
+  const double *restrict x = bf + REC_X * ld, *restrict y = bf + REC_Y * ld;
+  const double *restrict z = bf + REC_Z * ld, *restrict u = bf + REC_U * ld;
+  const double *restrict v = bf + REC_V * ld, *restrict w = bf + REC_W * ld;
+  const double *restrict vol = bf + REC_VOL * ld;
+  const double xa = P->x[a], ya = P->y[a], za = P->z[a], ua = P->u[a], va = P->v[a];
+  const double wa = P->w[a], lx = M->lx, lz = M->lz;
   const int d3 = M->dim == 3;
   double axx = 0, axy = 0, axz = 0, ayy = 0, ayz = 0, azz = 0;
   double bxx = 0, bxy = 0, bxz = 0, byx = 0, byy = 0, byz = 0, bzx = 0, bzy = 0, bzz = 0;
 #pragma omp simd reduction(+ : axx, axy, axz, ayy, ayz, azz, bxx, bxy, bxz, byx, byy, byz, bzx, \
                                bzy, bzz)
-  for (int j = 0; j < nb->count[a]; j++) {
-    const int32_t b = nl[j];
-    const struct pair g = pair_geom(&K, lx, lz, d3, xa - x[b], ya - y[b], za - z[b]);
-    const struct sym3 t = term_moment(&g, vol[b]);
+  for (int j = 0; j < cnt; j++) {
+    const struct pair g = pair_geom(&K, lx, lz, d3, xa - x[j], ya - y[j], za - z[j]);
+    const struct sym3 t = term_moment(&g, vol[j]);
     axx += t.xx, axy += t.xy, axz += t.xz, ayy += t.yy, ayz += t.yz, azz += t.zz;
-    const struct v3 gu = term_difference(&g, vol[b], u[b] - ua);
-    const struct v3 gv = term_difference(&g, vol[b], v[b] - va);
-    const struct v3 gw = term_difference(&g, vol[b], w[b] - wa);
+    const struct v3 gu = term_difference(&g, vol[j], u[j] - ua);
+    const struct v3 gv = term_difference(&g, vol[j], v[j] - va);
+    const struct v3 gw = term_difference(&g, vol[j], w[j] - wa);
     bxx += gu.x, bxy += gu.y, bxz += gu.z, byx += gv.x, byy += gv.y, byz += gv.z;
     bzx += gw.x, bzy += gw.y, bzz += gw.z;
   }
@@ -186,6 +191,7 @@ double turb_update(const struct model *M, struct particles *P, const struct nbr 
   if (dd) dd_update_walls(dd, P, 2, wt);
   if (!M->les) return nu;
   timer_push("les");
+  records_pack(P, P->n + P->n_ghost); /* positions, velocities, volumes for the gradient */
   /* 3. rate of strain, damping, eddy viscosity and residual kinetic energy */
   double *restrict nur = P->nur, *restrict kr = P->kr;
   const double ih = K->inv_h, dg2 = M->delta_g * M->delta_g;

@@ -1,0 +1,93 @@
+/** @file records.c @brief Implementation of records.h. */
+#include "records.h"
+
+#include <stdlib.h>
+
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#define REC_AVX512 1
+#include <immintrin.h>
+#else
+#define REC_AVX512 0
+#endif
+
+static int use_avx512;
+
+void records_init(void) {
+  const char *e = getenv("CHANSPH_SCALAR_SCAN"); /* the portable paths, for comparisons */
+#if REC_AVX512
+  use_avx512 = !(e && *e == '1') && __builtin_cpu_supports("avx512f");
+#else
+  (void)e;
+  use_avx512 = 0;
+#endif
+}
+
+void records_pack(struct particles *P, size_t n) {
+  double *restrict rec = P->rec;
+  const double *nur = P->nur;
+#pragma omp parallel for schedule(static)
+  for (size_t a = 0; a < n; a++) {
+    double *r = rec + a * REC_LEN;
+    r[REC_X] = P->x[a], r[REC_Y] = P->y[a], r[REC_Z] = P->z[a];
+    r[REC_U] = P->u[a], r[REC_V] = P->v[a], r[REC_W] = P->w[a];
+    r[REC_VOL] = P->vol[a], r[REC_RHO] = P->rho[a];
+    r[REC_M] = P->m[a], r[REC_PR2] = P->pr2[a], r[REC_C] = P->c[a];
+    r[REC_NUR] = nur ? nur[a] : 0.0;
+    for (int k = REC_NUR + 1; k < REC_LEN; k++) r[k] = 0.0;
+  }
+}
+
+static void gather_scalar(const double *restrict rec, const int32_t *restrict nl, int cnt, int half,
+                          double *restrict out, int ld) {
+  for (int f = 0; f < 8; f++) {
+    const double *restrict src = rec + 8 * half + f;
+    double *restrict dst = out + (size_t)f * ld;
+    for (int j = 0; j < cnt; j++) dst[j] = src[(size_t)nl[j] * REC_LEN];
+  }
+}
+
+#if REC_AVX512
+/* Eight half-records (rows) to eight fields (columns): unpack pairs of rows, then two rounds of
+   128-bit lane shuffles. */
+__attribute__((target("avx512f"))) static void gather_avx512(const double *restrict rec,
+                                                             const int32_t *restrict nl, int cnt,
+                                                             int half, double *restrict out,
+                                                             int ld) {
+  const double *base = rec + 8 * half;
+  int j = 0;
+  for (; j + 8 <= cnt; j += 8) {
+    __m512d r[8], t[8], s[8];
+    for (int k = 0; k < 8; k++) r[k] = _mm512_load_pd(base + (size_t)nl[j + k] * REC_LEN);
+    for (int k = 0; k < 8; k += 2) {
+      t[k] = _mm512_unpacklo_pd(r[k], r[k + 1]);     /* a0 b0 | a2 b2 | a4 b4 | a6 b6 */
+      t[k + 1] = _mm512_unpackhi_pd(r[k], r[k + 1]); /* a1 b1 | a3 b3 | a5 b5 | a7 b7 */
+    }
+    for (int k = 0; k < 8; k += 4) {
+      s[k] = _mm512_shuffle_f64x2(t[k], t[k + 2], 0x88);         /* a0b0 a4b4 c0d0 c4d4 */
+      s[k + 1] = _mm512_shuffle_f64x2(t[k], t[k + 2], 0xdd);     /* a2b2 a6b6 c2d2 c6d6 */
+      s[k + 2] = _mm512_shuffle_f64x2(t[k + 1], t[k + 3], 0x88); /* a1b1 a5b5 c1d1 c5d5 */
+      s[k + 3] = _mm512_shuffle_f64x2(t[k + 1], t[k + 3], 0xdd); /* a3b3 a7b7 c3d3 c7d7 */
+    }
+    double *o = out + j;
+    _mm512_store_pd(o + 0 * (size_t)ld, _mm512_shuffle_f64x2(s[0], s[4], 0x88));
+    _mm512_store_pd(o + 4 * (size_t)ld, _mm512_shuffle_f64x2(s[0], s[4], 0xdd));
+    _mm512_store_pd(o + 2 * (size_t)ld, _mm512_shuffle_f64x2(s[1], s[5], 0x88));
+    _mm512_store_pd(o + 6 * (size_t)ld, _mm512_shuffle_f64x2(s[1], s[5], 0xdd));
+    _mm512_store_pd(o + 1 * (size_t)ld, _mm512_shuffle_f64x2(s[2], s[6], 0x88));
+    _mm512_store_pd(o + 5 * (size_t)ld, _mm512_shuffle_f64x2(s[2], s[6], 0xdd));
+    _mm512_store_pd(o + 3 * (size_t)ld, _mm512_shuffle_f64x2(s[3], s[7], 0x88));
+    _mm512_store_pd(o + 7 * (size_t)ld, _mm512_shuffle_f64x2(s[3], s[7], 0xdd));
+  }
+  if (j < cnt) gather_scalar(rec, nl + j, cnt - j, half, out + j, ld);
+}
+#endif
+
+void records_gather(const double *rec, const int32_t *nl, int cnt, int half, double *out, int ld) {
+#if REC_AVX512
+  if (use_avx512) {
+    gather_avx512(rec, nl, cnt, half, out, ld);
+    return;
+  }
+#endif
+  gather_scalar(rec, nl, cnt, half, out, ld);
+}
