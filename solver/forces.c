@@ -284,7 +284,7 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
   const struct fctx C = {M, P, nb, W, fx, info->wall_ax};
   const size_t n = P->n, nchunk = (n + FORCE_CHUNK - 1) / FORCE_CHUNK;
   double amax2 = 0.0, gvmax = 0.0;
-#pragma omp parallel for schedule(static) reduction(max : amax2, gvmax)
+#pragma omp parallel for schedule(dynamic, 4) reduction(max : amax2, gvmax)
   for (size_t k = 0; k < nchunk; k++) {
     double mx[2] = {0.0, 0.0};
     const size_t a0 = k * FORCE_CHUNK, a1 = a0 + FORCE_CHUNK < n ? a0 + FORCE_CHUNK : n;

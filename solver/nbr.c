@@ -214,8 +214,10 @@ scan_avx512(const struct particles *restrict P, size_t a, size_t b0, size_t b1, 
     __mmask8 hit = _mm512_mask_cmp_pd_mask(live, r2, s2, _CMP_LT_OQ);
     if (a >= b && a - b < 8) hit &= (__mmask8) ~(1u << (a - b));
     if (cnt + 8 <= cap) {
-      _mm256_mask_compressstoreu_epi32(lb + cnt, hit, idx);
-      _mm512_mask_compressstoreu_pd(r2b + cnt, hit, r2);
+      /* compress in registers, then plain stores (a compress store to memory is slow on
+         several processors); the slots past the hits are scratch */
+      _mm256_storeu_si256((__m256i *)(lb + cnt), _mm256_maskz_compress_epi32(hit, idx));
+      _mm512_storeu_pd(r2b + cnt, _mm512_maskz_compress_pd(hit, r2));
     }
     cnt += __builtin_popcount(hit);
     idx = _mm256_add_epi32(idx, _mm256_set1_epi32(8));
@@ -400,7 +402,7 @@ void nbr_build(struct nbr *nb, const struct particles *P, const struct kernel *K
   for (;;) {
     int overflow = 0;
     nbr_scratch(nb);
-#pragma omp parallel for schedule(static) reduction(max : overflow)
+#pragma omp parallel for schedule(dynamic, 64) reduction(max : overflow)
     for (size_t c = 0; c < nb->ncell_own; c++) {
 #if NBR_AVX512
       const int o =

@@ -196,7 +196,7 @@ double turb_update(const struct model *M, struct particles *P, const struct nbr 
   double *restrict nur = P->nur, *restrict kr = P->kr;
   const double ih = K->inv_h, dg2 = M->delta_g * M->delta_g;
   double numax = nu;
-#pragma omp parallel for schedule(static) reduction(max : numax)
+#pragma omp parallel for schedule(dynamic, 256) reduction(max : numax)
   for (size_t a = 0; a < P->n; a++) {
     nur[a] = kr[a] = 0.0;
     if (kind[a] != KIND_FLUID) continue;
