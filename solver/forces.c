@@ -49,24 +49,25 @@ struct fsums {
   struct v3 gc;    /*!< corrected pressure difference gradient */
 };
 
-/** Sums over the neighbours j0 .. j1-1 of particle a, whose records were gathered into the
-    buffers bf (records.h: bf + REC_X * ld holds their x, and so on), for the operator `visc`,
-    the corrected (`corr`) or symmetric pressure gradient, with (`fluid`) or without the volume
-    diffusion. Always inlined with constant flags: one specialised loop per combination. */
+/** Sums over the neighbours j0 .. j1-1 of particle a for the operator `visc`, the corrected
+    (`corr`) or symmetric pressure gradient, with (`fluid`) or without the volume diffusion.
+    The neighbours' values are read from f[REC_X] .. f[REC_NUR]: either the buffers their
+    records were gathered into (`gathered`: neighbour j at index j, contiguous) or the
+    particle arrays (neighbour j at index nl[j]). Always inlined with constant flags: one
+    specialised loop per combination. */
 static inline __attribute__((always_inline)) void pair_sums(const struct fctx *C, size_t a,
-                                                            const double *restrict bf, int ld,
-                                                            int j0, int j1, const int fluid,
-                                                            const int visc, const int corr,
-                                                            struct fsums *out) {
+                                                            const double *const *f,
+                                                            const int32_t *restrict nl, int j0,
+                                                            int j1, const int gathered,
+                                                            const int fluid, const int visc,
+                                                            const int corr, struct fsums *out) {
   const struct model *M = C->M;
   const struct particles *P = C->P;
   const struct kernel K = M->k;
-  const double *restrict x = bf + REC_X * ld, *restrict y = bf + REC_Y * ld;
-  const double *restrict z = bf + REC_Z * ld, *restrict u = bf + REC_U * ld;
-  const double *restrict v = bf + REC_V * ld, *restrict w = bf + REC_W * ld;
-  const double *restrict vol = bf + REC_VOL * ld, *restrict rho = bf + REC_RHO * ld;
-  const double *restrict m = bf + REC_M * ld, *restrict pr2 = bf + REC_PR2 * ld;
-  const double *restrict c = bf + REC_C * ld, *restrict nur = bf + REC_NUR * ld;
+  const double *restrict x = f[REC_X], *restrict y = f[REC_Y], *restrict z = f[REC_Z];
+  const double *restrict u = f[REC_U], *restrict v = f[REC_V], *restrict w = f[REC_W];
+  const double *restrict vol = f[REC_VOL], *restrict rho = f[REC_RHO], *restrict m = f[REC_M];
+  const double *restrict pr2 = f[REC_PR2], *restrict c = f[REC_C], *restrict nur = f[REC_NUR];
   const double lx = M->lx, lz = M->lz, eta2 = M->eta2, nu = M->nu, np2 = M->dim + 2.0;
   const int d3 = M->dim == 3;
   const double dgrav = M->e.rho0 / (M->e.c0 * M->e.c0) * M->gy; /* Eq. 3.61 */
@@ -80,25 +81,26 @@ static inline __attribute__((always_inline)) void pair_sums(const struct fctx *C
 #pragma omp simd reduction(+ : gpx, gpy, gpz, vx, vy, vz, mo2, moyy, mo1, diff, m1x, m2x, m1z, \
                                m2z, axx, axy, axz, ayy, ayz, azz, gcx, gcy, gcz)
   for (int j = j0; j < j1; j++) {
-    const struct pair g = pair_geom(&K, lx, lz, d3, xa - x[j], ya - y[j], za - z[j]);
-    const double vb = vol[j], rb = rho[j];
+    const int32_t b = gathered ? j : nl[j];
+    const struct pair g = pair_geom(&K, lx, lz, d3, xa - x[b], ya - y[b], za - z[b]);
+    const double vb = vol[b], rb = rho[b];
     if (corr) {
       const struct sym3 t = term_moment(&g, vb);
       axx += t.xx, axy += t.xy, axz += t.xz, ayy += t.yy, ayz += t.yz, azz += t.zz;
-      const struct v3 d = term_difference(&g, vb, pr2[j] * rb * rb - pm_a);
+      const struct v3 d = term_difference(&g, vb, pr2[b] * rb * rb - pm_a);
       gcx += d.x, gcy += d.y, gcz += d.z;
     } else {
-      const struct v3 t = term_pressure(&g, m[j], pa, pr2[j]);
+      const struct v3 t = term_pressure(&g, m[b], pa, pr2[b]);
       gpx += t.x, gpy += t.y, gpz += t.z;
     }
-    const struct v3 uab = {ua - u[j], va - v[j], wa - w[j]};
+    const struct v3 uab = {ua - u[b], va - v[b], wa - w[b]};
     struct v3 t;
     if (visc == VK_MORRIS)
-      t = term_morris(&g, m[j], ira, vb, eta2, uab);
+      t = term_morris(&g, m[b], ira, vb, eta2, uab);
     else if (visc == VK_VIOLEAU)
       t = term_violeau(&g, vb, 0.5 * (ra + rb), np2, eta2, uab);
     else /* Eq. 2.100 with mu = rho (nu + nu_r) */
-      t = term_violeau(&g, vb, 0.5 * (mu_a + rb * (nu + nur[j])), np2, eta2, uab);
+      t = term_violeau(&g, vb, 0.5 * (mu_a + rb * (nu + nur[b])), np2, eta2, uab);
     vx += t.x, vy += t.y, vz += t.z;
     const struct v3 mo = term_moments(&g, vb);
     mo2 += mo.x, moyy += mo.y, mo1 += mo.z;
@@ -106,7 +108,7 @@ static inline __attribute__((always_inline)) void pair_sums(const struct fctx *C
       const struct v3 vm = term_violeau_moments(&g, vb, np2, eta2);
       m1x += vm.x, m2x += vm.x * g.dy, m1z += vm.y, m2z += vm.y * g.dy;
     }
-    if (fluid) diff += term_diffusion(&g, vb, ca, c[j], ra, rb, dgrav);
+    if (fluid) diff += term_diffusion(&g, vb, ca, c[b], ra, rb, dgrav);
   }
   *out = (struct fsums){{gpx, gpy, gpz},
                         {vx, vy, vz},
@@ -243,16 +245,28 @@ static inline __attribute__((always_inline)) void force_range(const struct fctx 
                                                               size_t a1, double mx[2],
                                                               const int visc, const int corr) {
   const struct nbr *nb = C->nb;
+  const struct particles *P = C->P;
   const int ld = nb->stride;
   double *bf = nb->pairbuf[omp_get_thread_num()];
+  /* gathered records (AVX-512) or the particle arrays */
+  const double *fb[REC_NUR + 1], *fp[REC_NUR + 1] = {P->x,   P->y,   P->z, P->u,   P->v, P->w,
+                                                     P->vol, P->rho, P->m, P->pr2, P->c, P->nur};
+  for (int k = 0; k <= REC_NUR; k++) fb[k] = bf + (size_t)k * ld;
+  const int gather = records_fast();
   for (size_t a = a0; a < a1; a++) {
-    if (C->P->kind[a] != KIND_FLUID) continue;
+    if (P->kind[a] != KIND_FLUID) continue;
     const int32_t *nl = nb->list + a * (size_t)nb->stride;
-    records_gather(C->P->rec, nl, nb->count[a], 0, bf, ld);
-    records_gather(C->P->rec, nl, nb->count[a], 1, bf + 8 * (size_t)ld, ld);
+    const int nf = nb->nfluid[a], n = nb->count[a];
     struct fsums s, sv;
-    pair_sums(C, a, bf, ld, 0, nb->nfluid[a], 1, visc, corr, &s);
-    pair_sums(C, a, bf, ld, nb->nfluid[a], nb->count[a], 0, visc, corr, &sv);
+    if (gather) {
+      records_gather(P->rec, nl, n, 0, bf, ld);
+      records_gather(P->rec, nl, n, 1, bf + 8 * (size_t)ld, ld);
+      pair_sums(C, a, fb, nl, 0, nf, 1, 1, visc, corr, &s);
+      pair_sums(C, a, fb, nl, nf, n, 1, 0, visc, corr, &sv);
+    } else {
+      pair_sums(C, a, fp, nl, 0, nf, 0, 1, visc, corr, &s);
+      pair_sums(C, a, fp, nl, nf, n, 0, 0, visc, corr, &sv);
+    }
     force_finish(C, a, &s, &sv, mx);
   }
 }

@@ -22,6 +22,10 @@ void records_init(void) {
 #endif
 }
 
+int records_fast(void) {
+  return use_avx512;
+}
+
 void records_pack(struct particles *P, size_t n) {
   double *restrict rec = P->rec;
   const double *nur = P->nur;

@@ -39,6 +39,10 @@ enum rec_field {
 /** @brief Choose the gather for this processor (AVX-512 or portable); call once, serially. */
 void records_init(void);
 
+/** @brief Whether the pair loops should gather records (the AVX-512 transpose) rather than
+           read the particle arrays through the index list (the faster choice without it). */
+int records_fast(void);
+
 /**
  * @brief Pack the records of slots 0 .. n-1 (owned and ghost particles) from the arrays of P
  *        (P->nur may be NULL: 0 is stored).

@@ -97,12 +97,17 @@ static CHANSPH_CLONES void gradient_sums(const struct model *M, const struct par
                                          const struct nbr *nb, size_t a, double A[6], double B[9]) {
   const struct kernel K = M->k;
   const int ld = nb->stride, cnt = nb->count[a];
-  double *bf = nb->pairbuf[omp_get_thread_num()];
-  records_gather(P->rec, nb->list + a * (size_t)nb->stride, cnt, 0, bf, ld);
-  const double *restrict x = bf + REC_X * ld, *restrict y = bf + REC_Y * ld;
-  const double *restrict z = bf + REC_Z * ld, *restrict u = bf + REC_U * ld;
-  const double *restrict v = bf + REC_V * ld, *restrict w = bf + REC_W * ld;
-  const double *restrict vol = bf + REC_VOL * ld;
+  const int32_t *restrict nl = nb->list + a * (size_t)nb->stride;
+  const double *restrict x = P->x, *restrict y = P->y, *restrict z = P->z;
+  const double *restrict u = P->u, *restrict v = P->v, *restrict w = P->w;
+  const double *restrict vol = P->vol;
+  const int gather = records_fast(); /* AVX-512: read gathered records contiguously */
+  if (gather) {
+    double *bf = nb->pairbuf[omp_get_thread_num()];
+    records_gather(P->rec, nl, cnt, 0, bf, ld);
+    x = bf + REC_X * ld, y = bf + REC_Y * ld, z = bf + REC_Z * ld;
+    u = bf + REC_U * ld, v = bf + REC_V * ld, w = bf + REC_W * ld, vol = bf + REC_VOL * ld;
+  }
   const double xa = P->x[a], ya = P->y[a], za = P->z[a], ua = P->u[a], va = P->v[a];
   const double wa = P->w[a], lx = M->lx, lz = M->lz;
   const int d3 = M->dim == 3;
@@ -111,12 +116,13 @@ static CHANSPH_CLONES void gradient_sums(const struct model *M, const struct par
 #pragma omp simd reduction(+ : axx, axy, axz, ayy, ayz, azz, bxx, bxy, bxz, byx, byy, byz, bzx, \
                                bzy, bzz)
   for (int j = 0; j < cnt; j++) {
-    const struct pair g = pair_geom(&K, lx, lz, d3, xa - x[j], ya - y[j], za - z[j]);
-    const struct sym3 t = term_moment(&g, vol[j]);
+    const int32_t b = gather ? j : nl[j];
+    const struct pair g = pair_geom(&K, lx, lz, d3, xa - x[b], ya - y[b], za - z[b]);
+    const struct sym3 t = term_moment(&g, vol[b]);
     axx += t.xx, axy += t.xy, axz += t.xz, ayy += t.yy, ayz += t.yz, azz += t.zz;
-    const struct v3 gu = term_difference(&g, vol[j], u[j] - ua);
-    const struct v3 gv = term_difference(&g, vol[j], v[j] - va);
-    const struct v3 gw = term_difference(&g, vol[j], w[j] - wa);
+    const struct v3 gu = term_difference(&g, vol[b], u[b] - ua);
+    const struct v3 gv = term_difference(&g, vol[b], v[b] - va);
+    const struct v3 gw = term_difference(&g, vol[b], w[b] - wa);
     bxx += gu.x, bxy += gu.y, bxz += gu.z, byx += gv.x, byy += gv.y, byz += gv.z;
     bzx += gw.x, bzy += gw.y, bzz += gw.z;
   }
