@@ -51,12 +51,12 @@ struct fsums {
 
 /** Sums over the neighbours j0 .. j1-1 of particle a for the operator `visc`, the corrected
     (`corr`) or symmetric pressure gradient, with (`fluid`) or without the volume diffusion.
-    The neighbours' values are read from f[REC_X] .. f[REC_NUR]: either the buffers their
-    records were gathered into (`gathered`: neighbour j at index j, contiguous) or the
+    The neighbours' values are read either from the buffers their records were gathered into
+    (`gathered`: bf + REC_X * ld holds the x of neighbour j at index j, and so on) or from the
     particle arrays (neighbour j at index nl[j]). Always inlined with constant flags: one
     specialised loop per combination. */
 static inline __attribute__((always_inline)) void pair_sums(const struct fctx *C, size_t a,
-                                                            const double *const *f,
+                                                            const double *bf, int ld,
                                                             const int32_t *restrict nl, int j0,
                                                             int j1, const int gathered,
                                                             const int fluid, const int visc,
@@ -64,10 +64,14 @@ static inline __attribute__((always_inline)) void pair_sums(const struct fctx *C
   const struct model *M = C->M;
   const struct particles *P = C->P;
   const struct kernel K = M->k;
-  const double *restrict x = f[REC_X], *restrict y = f[REC_Y], *restrict z = f[REC_Z];
-  const double *restrict u = f[REC_U], *restrict v = f[REC_V], *restrict w = f[REC_W];
-  const double *restrict vol = f[REC_VOL], *restrict rho = f[REC_RHO], *restrict m = f[REC_M];
-  const double *restrict pr2 = f[REC_PR2], *restrict c = f[REC_C], *restrict nur = f[REC_NUR];
+#define FIELD(k, arr) (gathered ? bf + (size_t)(k)*ld : P->arr)
+  const double *restrict x = FIELD(REC_X, x), *restrict y = FIELD(REC_Y, y);
+  const double *restrict z = FIELD(REC_Z, z), *restrict u = FIELD(REC_U, u);
+  const double *restrict v = FIELD(REC_V, v), *restrict w = FIELD(REC_W, w);
+  const double *restrict vol = FIELD(REC_VOL, vol), *restrict rho = FIELD(REC_RHO, rho);
+  const double *restrict m = FIELD(REC_M, m), *restrict pr2 = FIELD(REC_PR2, pr2);
+  const double *restrict c = FIELD(REC_C, c), *restrict nur = FIELD(REC_NUR, nur);
+#undef FIELD
   const double lx = M->lx, lz = M->lz, eta2 = M->eta2, nu = M->nu, np2 = M->dim + 2.0;
   const int d3 = M->dim == 3;
   const double dgrav = M->e.rho0 / (M->e.c0 * M->e.c0) * M->gy; /* Eq. 3.61 */
@@ -241,51 +245,57 @@ static void force_finish(const struct fctx *C, size_t a, const struct fsums *s,
 /** One specialised loop over the fluid particles a0 .. a1-1. */
 typedef void (*force_loop)(const struct fctx *C, size_t a0, size_t a1, double mx[2]);
 
+/* The loop over particles a0 .. a1-1 for one combination; `gathered`: read the neighbours'
+   gathered records (AVX-512), else the particle arrays through the list. */
 static inline __attribute__((always_inline)) void force_range(const struct fctx *C, size_t a0,
                                                               size_t a1, double mx[2],
-                                                              const int visc, const int corr) {
+                                                              const int visc, const int corr,
+                                                              const int gathered) {
   const struct nbr *nb = C->nb;
   const struct particles *P = C->P;
   const int ld = nb->stride;
   double *bf = nb->pairbuf[omp_get_thread_num()];
-  /* gathered records (AVX-512) or the particle arrays */
-  const double *fb[REC_NUR + 1], *fp[REC_NUR + 1] = {P->x,   P->y,   P->z, P->u,   P->v, P->w,
-                                                     P->vol, P->rho, P->m, P->pr2, P->c, P->nur};
-  for (int k = 0; k <= REC_NUR; k++) fb[k] = bf + (size_t)k * ld;
-  const int gather = records_fast();
   for (size_t a = a0; a < a1; a++) {
     if (P->kind[a] != KIND_FLUID) continue;
     const int32_t *nl = nb->list + a * (size_t)nb->stride;
     const int nf = nb->nfluid[a], n = nb->count[a];
-    struct fsums s, sv;
-    if (gather) {
+    if (gathered) {
       records_gather(P->rec, nl, n, 0, bf, ld);
       records_gather(P->rec, nl, n, 1, bf + 8 * (size_t)ld, ld);
-      pair_sums(C, a, fb, nl, 0, nf, 1, 1, visc, corr, &s);
-      pair_sums(C, a, fb, nl, nf, n, 1, 0, visc, corr, &sv);
-    } else {
-      pair_sums(C, a, fp, nl, 0, nf, 0, 1, visc, corr, &s);
-      pair_sums(C, a, fp, nl, nf, n, 0, 0, visc, corr, &sv);
     }
+    struct fsums s, sv;
+    pair_sums(C, a, bf, ld, nl, 0, nf, gathered, 1, visc, corr, &s);
+    pair_sums(C, a, bf, ld, nl, nf, n, gathered, 0, visc, corr, &sv);
     force_finish(C, a, &s, &sv, mx);
   }
 }
 
-#define FORCE_LOOP(name, visc, corr)                                                          \
+/* One function per combination, each built for several instruction sets (pair.h). */
+#define FORCE_LOOP(name, visc, corr, gathered)                                                \
   static CHANSPH_CLONES void name(const struct fctx *C, size_t a0, size_t a1, double mx[2]) { \
-    force_range(C, a0, a1, mx, visc, corr);                                                   \
+    force_range(C, a0, a1, mx, visc, corr, gathered);                                         \
   }
-FORCE_LOOP(forces_morris, VK_MORRIS, 0)
-FORCE_LOOP(forces_morris_corrected, VK_MORRIS, 1)
-FORCE_LOOP(forces_violeau, VK_VIOLEAU, 0)
-FORCE_LOOP(forces_violeau_corrected, VK_VIOLEAU, 1)
-FORCE_LOOP(forces_les, VK_LES, 0)
-FORCE_LOOP(forces_les_corrected, VK_LES, 1)
+FORCE_LOOP(forces_morris, VK_MORRIS, 0, 0)
+FORCE_LOOP(forces_morris_corrected, VK_MORRIS, 1, 0)
+FORCE_LOOP(forces_violeau, VK_VIOLEAU, 0, 0)
+FORCE_LOOP(forces_violeau_corrected, VK_VIOLEAU, 1, 0)
+FORCE_LOOP(forces_les, VK_LES, 0, 0)
+FORCE_LOOP(forces_les_corrected, VK_LES, 1, 0)
+FORCE_LOOP(forces_morris_rec, VK_MORRIS, 0, 1)
+FORCE_LOOP(forces_morris_corrected_rec, VK_MORRIS, 1, 1)
+FORCE_LOOP(forces_violeau_rec, VK_VIOLEAU, 0, 1)
+FORCE_LOOP(forces_violeau_corrected_rec, VK_VIOLEAU, 1, 1)
+FORCE_LOOP(forces_les_rec, VK_LES, 0, 1)
+FORCE_LOOP(forces_les_corrected_rec, VK_LES, 1, 1)
 
-/** The loops by viscous operator and pressure-gradient form (standard, corrected). */
-static const force_loop loops[VK_N][2] = {{forces_morris, forces_morris_corrected},
-                                          {forces_violeau, forces_violeau_corrected},
-                                          {forces_les, forces_les_corrected}};
+/** The loops by data path (particle arrays, gathered records), viscous operator and
+    pressure-gradient form (standard, corrected). */
+static const force_loop loops[2][VK_N][2] = {{{forces_morris, forces_morris_corrected},
+                                              {forces_violeau, forces_violeau_corrected},
+                                              {forces_les, forces_les_corrected}},
+                                             {{forces_morris_rec, forces_morris_corrected_rec},
+                                              {forces_violeau_rec, forces_violeau_corrected_rec},
+                                              {forces_les_rec, forces_les_corrected_rec}}};
 
 /** Particles per task of the force loop. */
 enum { FORCE_CHUNK = 128 };
@@ -294,7 +304,7 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
                 const struct walls *W, double fx, struct force_info *info) {
   timer_push("forces");
   const int visc = M->les ? VK_LES : M->viscous == VISCOUS_VIOLEAU ? VK_VIOLEAU : VK_MORRIS;
-  const force_loop loop = loops[visc][M->pgrad == PGRAD_CORRECTED];
+  const force_loop loop = loops[records_fast()][visc][M->pgrad == PGRAD_CORRECTED];
   const struct fctx C = {M, P, nb, W, fx, info->wall_ax};
   const size_t n = P->n, nchunk = (n + FORCE_CHUNK - 1) / FORCE_CHUNK;
   double amax2 = 0.0, gvmax = 0.0;

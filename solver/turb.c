@@ -92,22 +92,24 @@ static CHANSPH_CLONES double vertex_sums(const struct model *M, const struct par
 /** Corrected velocity-gradient sums of particle a over its whole list (fluid and vertices):
     A = -sum_b V_b F_ab r_ab (x) r_ab and B = sum_b V_b (v_b - v_a) (x) F_ab r_ab (thesis
     Eq. 2.88-2.90, k = 0), as turb_strain_gradient takes them. The neighbours' positions,
-    velocities and volumes come from their pair records (records.h). */
-static CHANSPH_CLONES void gradient_sums(const struct model *M, const struct particles *P,
-                                         const struct nbr *nb, size_t a, double A[6], double B[9]) {
+    velocities and volumes come from their gathered records (`gathered`, records.h) or from
+    the particle arrays through the list. */
+static inline __attribute__((always_inline)) void gradient_sums_t(const struct model *M,
+                                                                  const struct particles *P,
+                                                                  const struct nbr *nb, size_t a,
+                                                                  double A[6], double B[9],
+                                                                  const int gathered) {
   const struct kernel K = M->k;
   const int ld = nb->stride, cnt = nb->count[a];
   const int32_t *restrict nl = nb->list + a * (size_t)nb->stride;
-  const double *restrict x = P->x, *restrict y = P->y, *restrict z = P->z;
-  const double *restrict u = P->u, *restrict v = P->v, *restrict w = P->w;
-  const double *restrict vol = P->vol;
-  const int gather = records_fast(); /* AVX-512: read gathered records contiguously */
-  if (gather) {
-    double *bf = nb->pairbuf[omp_get_thread_num()];
-    records_gather(P->rec, nl, cnt, 0, bf, ld);
-    x = bf + REC_X * ld, y = bf + REC_Y * ld, z = bf + REC_Z * ld;
-    u = bf + REC_U * ld, v = bf + REC_V * ld, w = bf + REC_W * ld, vol = bf + REC_VOL * ld;
-  }
+  double *bf = nb->pairbuf[omp_get_thread_num()];
+  if (gathered) records_gather(P->rec, nl, cnt, 0, bf, ld);
+#define FIELD(k, arr) (gathered ? bf + (size_t)(k)*ld : P->arr)
+  const double *restrict x = FIELD(REC_X, x), *restrict y = FIELD(REC_Y, y);
+  const double *restrict z = FIELD(REC_Z, z), *restrict u = FIELD(REC_U, u);
+  const double *restrict v = FIELD(REC_V, v), *restrict w = FIELD(REC_W, w);
+  const double *restrict vol = FIELD(REC_VOL, vol);
+#undef FIELD
   const double xa = P->x[a], ya = P->y[a], za = P->z[a], ua = P->u[a], va = P->v[a];
   const double wa = P->w[a], lx = M->lx, lz = M->lz;
   const int d3 = M->dim == 3;
@@ -116,7 +118,7 @@ static CHANSPH_CLONES void gradient_sums(const struct model *M, const struct par
 #pragma omp simd reduction(+ : axx, axy, axz, ayy, ayz, azz, bxx, bxy, bxz, byx, byy, byz, bzx, \
                                bzy, bzz)
   for (int j = 0; j < cnt; j++) {
-    const int32_t b = gather ? j : nl[j];
+    const int32_t b = gathered ? j : nl[j];
     const struct pair g = pair_geom(&K, lx, lz, d3, xa - x[b], ya - y[b], za - z[b]);
     const struct sym3 t = term_moment(&g, vol[b]);
     axx += t.xx, axy += t.xy, axz += t.xz, ayy += t.yy, ayz += t.yz, azz += t.zz;
@@ -129,6 +131,17 @@ static CHANSPH_CLONES void gradient_sums(const struct model *M, const struct par
   A[0] = axx, A[1] = axy, A[2] = axz, A[3] = ayy, A[4] = ayz, A[5] = azz;
   B[0] = bxx, B[1] = bxy, B[2] = bxz, B[3] = byx, B[4] = byy, B[5] = byz;
   B[6] = bzx, B[7] = bzy, B[8] = bzz;
+}
+
+static CHANSPH_CLONES void gradient_sums(const struct model *M, const struct particles *P,
+                                         const struct nbr *nb, size_t a, double A[6], double B[9]) {
+  gradient_sums_t(M, P, nb, a, A, B, 0);
+}
+
+static CHANSPH_CLONES void gradient_sums_rec(const struct model *M, const struct particles *P,
+                                             const struct nbr *nb, size_t a, double A[6],
+                                             double B[9]) {
+  gradient_sums_t(M, P, nb, a, A, B, 1);
 }
 
 /** Violeau-Issa sum of particle a (thesis Eq. 5.48 without its factor 1 / (gamma_a rho_a)):
@@ -217,7 +230,10 @@ double turb_update(const struct model *M, struct particles *P, const struct nbr 
     double S;
     if (M->strain == STRAIN_GRADIENT) {
       double A[6], B[9];
-      gradient_sums(M, P, nb, a, A, B);
+      if (records_fast())
+        gradient_sums_rec(M, P, nb, a, A, B);
+      else
+        gradient_sums(M, P, nb, a, A, B);
       S = turb_strain_gradient(M->dim, A, B);
     } else { /* Violeau-Issa, Eq. 5.48 with nu_r,b = nu_r,a: S^3 - sum S - W / l_S^2 = 0 */
       const double ig = 1.0 / P->gam[a];
