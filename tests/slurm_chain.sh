@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # jobs/slurm/chansph.sbatch on a real single-node SLURM (issue 13, point 10): the test starts its
 # own munged, slurmctld and slurmd on localhost (configuration, state and logs under
-# RUNS/slurm_chain, ports 16817/16818, its own munge socket and key), submits a chain with
+# RUNS/slurm_chain, ports 16817/16818, its own munge socket and key), submits a chain (twice:
+# chansph launched by srun with MpiDefault=pmix, and by mpirun with CHAIN_LAUNCH=mpirun) with
 # options on the sbatch command line that differ from the script's #SBATCH defaults
 # (--cpus-per-task=1 against 16, --time=15 against 24:00:00, a job name, an output pattern), cut
 # into jobs of 40 steps (3 jobs), and checks that
@@ -27,7 +28,7 @@ d=$(cd "$runs" && pwd)/slurm_chain
 rm -rf "$d" && mkdir -p "$d/state" "$d/spool" "$d/log" || exit 1
 pids=()
 cleanup() {
-  scancel --quiet --full --name=chansph-slurm-test 2> /dev/null
+  scancel --quiet --full --name=chansph-slurm-test-srun,chansph-slurm-test-mpirun 2> /dev/null
   local p
   for p in "${pids[@]}"; do kill "$p" 2> /dev/null; done
   for p in "${pids[@]}"; do wait "$p" 2> /dev/null; done
@@ -94,48 +95,58 @@ ref=$d/ref
 "$chansph" run "$scene" --out "$ref" "${opts[@]}" > /dev/null || fail "reference run"
 cp "$ref/scene.used.ini" "$d/scene.ini"
 
-# the chain, with the user's options on the command line
-run=$d/run
-first=$(cd "$here" && RUN_DIR=$run SCENE=$d/scene.ini CHANSPH=$chansph \
-  CHAIN_SCRIPT=$here/jobs/slurm/chansph.sbatch CHANSPH_ARGS="--max-steps 40" \
-  sbatch --parsable --export=ALL --time=15 --cpus-per-task=1 --ntasks=1 \
-  --job-name=chansph-slurm-test --output="$d/log/chain-%j.out" jobs/slurm/chansph.sbatch) ||
-  fail "sbatch"
-echo "submitted job $first"
-for _ in $(seq 240); do
-  grep -q "chain: .* done after\|chain: chansph exited\|too many failures\|not resubmitting\|chain: sbatch failed" \
-    "$d"/log/chain-*.out 2> /dev/null && [ -z "$(squeue -h -n chansph-slurm-test)" ] && break
-  sleep 0.5
-done
-[ -z "$(squeue -h -n chansph-slurm-test)" ] || fail "the chain did not end within 2 minutes: $(squeue)"
-sleep 1 # the last job's completion record
-
+# two chains, with the user's options on the command line: launched by srun (Open MPI through
+# SLURM's PMIx, MpiDefault=pmix above) and by mpirun (CHAIN_LAUNCH=mpirun)
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 status=0
-jobs=0
-while read -r line; do
-  [[ $line == *"Name=chansph-slurm-test "* ]] || continue
-  jobs=$((jobs + 1))
-  id=$(sed -E 's/^JobId=([0-9]+) .*/\1/' <<< "$line")
-  state=$(grep -oE 'JobState=[A-Z_]+' <<< "$line")
-  code=$(grep -oE ' ExitCode=[0-9:]+' <<< "$line")
-  show=$(scontrol show job -o "$id")
-  cpt=$(grep -oE 'CPUs/Task=[0-9]+' <<< "$show")
-  tl=$(grep -oE 'TimeLimit=[0-9:-]+' <<< "$show")
-  echo "job $id: $state$code $cpt $tl $(grep -m1 -oE 'chain job [0-9]+' "$d/log/chain-$id.out")"
-  [ "$state" = JobState=COMPLETED ] && [ "$code" = " ExitCode=0:0" ] || {
-    echo "FAIL: job $id did not end COMPLETED with exit code 0"
+for launch in srun mpirun; do
+  run=$d/run_$launch
+  name=chansph-slurm-test-$launch
+  first=$(cd "$here" && RUN_DIR=$run SCENE=$d/scene.ini CHANSPH=$chansph CHAIN_LAUNCH=$launch \
+    CHAIN_SCRIPT=$here/jobs/slurm/chansph.sbatch CHANSPH_ARGS="--max-steps 40" \
+    sbatch --parsable --export=ALL --time=15 --cpus-per-task=1 --ntasks=1 \
+    --job-name="$name" --output="$d/log/$launch-%j.out" jobs/slurm/chansph.sbatch) ||
+    fail "sbatch"
+  echo "$launch: submitted job $first"
+  ends="chain: .* done after\|chain: chansph exited\|too many failures\|not resubmitting"
+  ends+="\|chain: sbatch failed"
+  for _ in $(seq 240); do
+    grep -q "$ends" "$d"/log/"$launch"-*.out 2> /dev/null &&
+      [ -z "$(squeue -h -n "$name")" ] && break
+    sleep 0.5
+  done
+  [ -z "$(squeue -h -n "$name")" ] || fail "the chain did not end within 2 minutes: $(squeue)"
+  sleep 1 # the last job's completion record
+  jobs=0
+  while read -r line; do
+    [[ $line == *"Name=$name "* ]] || continue
+    jobs=$((jobs + 1))
+    id=$(sed -E 's/^JobId=([0-9]+) .*/\1/' <<< "$line")
+    state=$(grep -oE 'JobState=[A-Z_]+' <<< "$line")
+    code=$(grep -oE ' ExitCode=[0-9:]+' <<< "$line")
+    show=$(scontrol show job -o "$id")
+    cpt=$(grep -oE 'CPUs/Task=[0-9]+' <<< "$show")
+    tl=$(grep -oE 'TimeLimit=[0-9:-]+' <<< "$show")
+    echo "  job $id: $state$code $cpt $tl" \
+      "$(grep -m1 -oE 'chain job [0-9]+' "$d/log/$launch-$id.out")"
+    [ "$state" = JobState=COMPLETED ] && [ "$code" = " ExitCode=0:0" ] || {
+      echo "FAIL: job $id did not end COMPLETED with exit code 0"
+      status=1
+    }
+    [ "$cpt" = CPUs/Task=1 ] && [ "$tl" = TimeLimit=00:15:00 ] || {
+      echo "FAIL: job $id lost the options of the submission (--cpus-per-task=1 --time=15)"
+      status=1
+    }
+  done < "$d/log/jobcomp.txt"
+  [ $jobs -ge 3 ] || { echo "FAIL: $jobs job(s) in the chain, expected at least 3"; status=1; }
+  grep -h "chain: .* done after" "$d"/log/"$launch"-*.out || {
+    echo "FAIL: no 'done' line"
     status=1
   }
-  [ "$cpt" = CPUs/Task=1 ] && [ "$tl" = TimeLimit=00:15:00 ] || {
-    echo "FAIL: job $id lost the options of the submission (--cpus-per-task=1 --time=15)"
-    status=1
-  }
-done < "$d/log/jobcomp.txt"
-[ $jobs -ge 3 ] || { echo "FAIL: $jobs job(s) in the chain, expected at least 3"; status=1; }
-grep -h "chain: .* done after" "$d"/log/chain-*.out || { echo "FAIL: no 'done' line"; status=1; }
-for f in stats.nc particles.nc; do
-  diff <("$here/tests/nc_content.sh" "$ref/$f") <("$here/tests/nc_content.sh" "$run/$f") \
-    > /dev/null || { echo "FAIL: $f differs from the uninterrupted run"; status=1; }
+  for f in stats.nc particles.nc; do
+    diff <("$here/tests/nc_content.sh" "$ref/$f") <("$here/tests/nc_content.sh" "$run/$f") \
+      > /dev/null || { echo "FAIL: $launch: $f differs from the uninterrupted run"; status=1; }
+  done
 done
 [ $status -eq 0 ] && echo PASS || fail "see above"
 exit $status
