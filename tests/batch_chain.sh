@@ -60,7 +60,9 @@ for ((i = 0; i < $# - 1; i++)); do
   [ "${args[i]}" = -v ] && { IFS=, read -r -a kv <<< "${args[i + 1]}";
     for x in "${kv[@]}"; do export "${x?}"; done; }
 done
-{ printf 'qsub:' && printf ' [%s]' "${@:1:$#-3}" && echo " WALLTIME=$WALLTIME"; } >> "$RUN_DIR.jobs"
+{ printf 'qsub:' && printf ' [%s]' "${@:1:$#-3}" && echo " WALLTIME=$WALLTIME"
+  echo "${@: -2:1}" | tr , '\n' | grep -q '^CHANSPH_ARGS=--max-steps 60$' ||
+    echo "qsub -v does not pass CHANSPH_ARGS"; } >> "$RUN_DIR.jobs"
 PBS_JOBID=$((${PBS_JOBID%%.*} + 1)).server bash "${@: -1}"
 X
 chmod +x "$fake"/*
