@@ -8,7 +8,8 @@ cd "$here"
 
 packages=(build-essential cmake pkg-config openmpi-bin libopenmpi-dev libhdf5-openmpi-dev
           hdf5-tools libnetcdf-mpi-dev netcdf-bin nco libfftw3-dev libinih-dev librandom123-dev
-          python3 python3-numpy python3-netcdf4 python3-h5py python3-matplotlib clang-format)
+          python3 python3-numpy python3-netcdf4 python3-h5py python3-matplotlib python3-xarray
+          clang-format)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

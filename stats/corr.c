@@ -276,6 +276,38 @@ int corr_nc_write(const struct corr *c, int ncid, char *err, size_t errlen) {
   for (int i = 0; i < nzh; i++) tmp[i] = nz > 1 ? two_pi * i / c->cfg.lz : 0.0;
   CK(ncout_def(g, "kz", NC_DOUBLE, 1, &dkz, "1/m", "spanwise wavenumber", &v));
   CK(nc_put_var_double(g, v, tmp));
+  /* the flattened r2c index: its coordinate, and the wavenumbers of each entry (kx negative
+     for ix > nx/2) as auxiliary coordinates of spectra */
+  {
+    const size_t nk = (size_t)nx * (size_t)nzh;
+    long long *ki = malloc(nk * sizeof *ki);
+    double *kk = malloc(2 * nk * sizeof *kk);
+    int vk, vkx, vkz;
+    rc = ki && kk ? NC_NOERR : NC_ENOMEM;
+    for (int i = 0; i < nx && rc == NC_NOERR; i++)
+      for (int k = 0; k < nzh; k++) {
+        const size_t j = (size_t)i * (size_t)nzh + (size_t)k;
+        ki[j] = (long long)j;
+        kk[j] = two_pi * (i <= nx / 2 ? i : i - nx) / c->cfg.lx;
+        kk[nk + j] = nz > 1 ? two_pi * k / c->cfg.lz : 0.0;
+      }
+    if (rc == NC_NOERR)
+      rc = ncout_def(g, "k_index", NC_INT64, 1, &dkk, "1",
+                     "index of the r2c grid entry [kx][kz]: ix (nz/2+1) + iz", &vk);
+    if (rc == NC_NOERR)
+      rc = ncout_def(g, "k_index_kx", NC_DOUBLE, 1, &dkk, "1/m",
+                     "streamwise wavenumber of the r2c entry", &vkx);
+    if (rc == NC_NOERR)
+      rc = ncout_def(g, "k_index_kz", NC_DOUBLE, 1, &dkk, "1/m",
+                     "spanwise wavenumber of the r2c entry", &vkz);
+    if (rc == NC_NOERR) rc = nc_put_var_longlong(g, vk, ki);
+    if (rc == NC_NOERR) rc = nc_put_var_double(g, vkx, kk);
+    if (rc == NC_NOERR) rc = nc_put_var_double(g, vkz, kk + nk);
+    free(ki), free(kk);
+    CK(rc);
+  }
+  static const char *const slots[CS_LEN] = {"uu", "vv", "ww", "Re_uv", "Im_uv"};
+  CK(ncout_labels(g, "spectrum_slot", dsl, "component of the summed spectra", slots));
   static const char *const comp[4] = {"uu", "vv", "ww", "uv"};
   for (int q = 0; q < 4; q++) {
     char name[32], ln[160];
@@ -287,20 +319,22 @@ int corr_nc_write(const struct corr *c, int ncid, char *err, size_t errlen) {
       snprintf(ln, sizeof ln, "two-point correlation <%c'(r) %c'(r + l e_%c)> (Eq. 5.57)",
                comp[q][0], comp[q][1], dir ? 'z' : 'x');
       CK(ncout_def(g, name, NC_DOUBLE, 2, dir ? d2z : d2x, "m^2/s^2", ln, &v));
+      CK(ncout_fill(g, v));
       for (int l = 0; l < nl; l++) {
         const size_t st[2] = {(size_t)l, 0}, ct[2] = {1, (size_t)n};
-        CK(nc_put_vara_double(g, v, st, ct, R + ((size_t)l * 4 + q) * n));
+        CK(ncout_put_filled(g, v, st, ct, R + ((size_t)l * 4 + q) * n, (size_t)n));
       }
       snprintf(name, sizeof name, "rho_%s_%c", comp[q], dir ? 'z' : 'x');
       snprintf(ln, sizeof ln, "normalised two-point correlation R_%s / <%c'%c'> (Eq. 5.58)",
                comp[q], comp[q][0], comp[q][0]);
       CK(ncout_def(g, name, NC_DOUBLE, 2, dir ? d2z : d2x, "1", ln, &v));
+      CK(ncout_fill(g, v));
       for (int l = 0; l < nl; l++) {
         const double *src = R + ((size_t)l * 4 + q) * n;
         const double r0 = R[((size_t)l * 4 + (q == 3 ? 0 : q)) * n];
         for (int i = 0; i < n; i++) tmp[i] = src[i] / r0;
         const size_t st[2] = {(size_t)l, 0}, ct[2] = {1, (size_t)n};
-        CK(nc_put_vara_double(g, v, st, ct, tmp));
+        CK(ncout_put_filled(g, v, st, ct, tmp, (size_t)n));
       }
     }
   }
@@ -314,9 +348,10 @@ int corr_nc_write(const struct corr *c, int ncid, char *err, size_t errlen) {
                "one-sided 1-D energy spectrum of %c' over k_%c (Eq. 5.59; sum E dk = <%c'%c'>)",
                comp[q][0], dir ? 'z' : 'x', comp[q][0], comp[q][0]);
       CK(ncout_def(g, name, NC_DOUBLE, 2, d2, "m^3/s^2", ln, &v));
+      CK(ncout_fill(g, v));
       for (int l = 0; l < nl; l++) {
         const size_t st[2] = {(size_t)l, 0}, ct[2] = {1, (size_t)n};
-        CK(nc_put_vara_double(g, v, st, ct, (dir ? ez : ex) + ((size_t)l * 3 + q) * n));
+        CK(ncout_put_filled(g, v, st, ct, (dir ? ez : ex) + ((size_t)l * 3 + q) * n, (size_t)n));
       }
     }
   }
@@ -326,6 +361,8 @@ int corr_nc_write(const struct corr *c, int ncid, char *err, size_t errlen) {
                  "raw sums over the planes of conj(F u_i) F u_j on the r2c grid [kx][kz]: uu, "
                  "vv, ww, Re uv, Im uv (unnormalised FFTW transforms of nx x nz)",
                  &v));
+    static const char coords[] = "k_index_kx k_index_kz";
+    CK(nc_put_att_text(g, v, "coordinates", strlen(coords), coords));
     CK(nc_put_var_double(g, v, c->spec));
   }
 done:

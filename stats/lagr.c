@@ -460,6 +460,8 @@ int lagr_nc_write(const struct lagr *g, int ncid, char *err, size_t errlen) {
   for (size_t k = 0; k < nlag; k++) tmp[k] = (double)k * c->horizon / c->n_lags;
   CK(ncout_def(gr, "lag", NC_DOUBLE, 1, &dk, "s", "time lag tau", &v));
   CK(nc_put_var_double(gr, v, tmp));
+  static const char *const components[3] = {"u", "v", "w"};
+  CK(ncout_labels(gr, "component", dc, "velocity component", components));
   static const char *const comp = "uvw", *const pos = "xyz";
   const struct {
     int row;
@@ -481,8 +483,7 @@ int lagr_nc_write(const struct lagr *g, int ncid, char *err, size_t errlen) {
       snprintf(name, sizeof name, q[j].fmt, q[j].letters[i]);
       snprintf(ln, sizeof ln, q[j].lfmt, q[j].letters[i], q[j].letters[i]);
       CK(ncout_def(gr, name, NC_DOUBLE, 2, d2, q[j].units, ln, &v));
-      const double fill = NC_FILL_DOUBLE;
-      CK(nc_put_att_double(gr, v, "_FillValue", NC_DOUBLE, 1, &fill));
+      CK(ncout_fill(gr, v));
       for (int l = 0; l < nl; l++)
         CK(put_rows(gr, v, l, nlag, fn + ((size_t)l * LF_LEN + (size_t)(q[j].row + i)) * nlag));
     }
@@ -506,8 +507,7 @@ int lagr_nc_write(const struct lagr *g, int ncid, char *err, size_t errlen) {
         "mean over the releases of their own T_L", "standard error of T_L over the releases"};
     for (int j = 0; j < 3 && rc == NC_NOERR; j++) {
       rc = ncout_def(gr, nm[j], NC_DOUBLE, 2, dlc, "s", lnm[j], &v);
-      const double fill = NC_FILL_DOUBLE;
-      if (rc == NC_NOERR) rc = nc_put_att_double(gr, v, "_FillValue", NC_DOUBLE, 1, &fill);
+      if (rc == NC_NOERR) rc = ncout_fill(gr, v);
       if (rc == NC_NOERR) rc = nc_put_var_double(gr, v, a + (size_t)j * 3 * nl);
     }
     free(a);
@@ -521,14 +521,26 @@ int lagr_nc_write(const struct lagr *g, int ncid, char *err, size_t errlen) {
     CK(nc_put_var_double(gr, v, c->station));
     for (int b = 0; b < nb; b++) tmp[b] = (b + 0.5) * 2.0 * c->delta / nb;
     CK(ncout_def(gr, "pdf_bin", NC_DOUBLE, 1, &db, "m", "y at the centre of the PDF bin", &v));
+    {
+      double *lo = malloc(2 * (size_t)nb * sizeof *lo), *hi = lo + nb;
+      rc = lo ? NC_NOERR : NC_ENOMEM;
+      for (int b = 0; b < nb && lo; b++)
+        lo[b] = b * 2.0 * c->delta / nb, hi[b] = (b + 1) * 2.0 * c->delta / nb;
+      if (rc == NC_NOERR)
+        rc = ncout_bounds(gr, "pdf_bin", v, db, "m", "limits of the PDF bin", lo, hi, (size_t)nb);
+      free(lo);
+      CK(rc);
+    }
     CK(nc_put_var_double(gr, v, tmp));
     const int d3[3] = {dl, dst, db}, dls[2] = {dl, dst};
     int vp, vmu, vvar, vn;
     CK(ncout_def(gr, "pdf_y", NC_DOUBLE, 3, d3, "1/m",
                  "PDF P(y; x) of the heights where the tracks cross the station", &vp));
     CK(ncout_def(gr, "pdf_mu_y", NC_DOUBLE, 2, dls, "m", "mean height mu_y (Eq. 5.67)", &vmu));
+    CK(ncout_fill(gr, vmu));
     CK(ncout_def(gr, "pdf_var_y", NC_DOUBLE, 2, dls, "m^2",
                  "variance of the height about mu_y (Eq. 5.68, printed there as sigma_y)", &vvar));
+    CK(ncout_fill(gr, vvar));
     CK(ncout_def(gr, "pdf_count", NC_DOUBLE, 2, dls, "1", "tracks that crossed the station", &vn));
     const double width = 2.0 * c->delta / nb;
     for (int l = 0; l < nl; l++)

@@ -5,6 +5,7 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <math.h>
 #include <netcdf.h>
 #include <netcdf_mem.h>
 #include <stdio.h>
@@ -93,6 +94,49 @@ int ncout_def(int ncid, const char *name, int type, int ndim, const int *dims, c
   return def_var(ncid, name, (nc_type)type, ndim, dims, units, long_name, varid);
 }
 
+int ncout_fill(int ncid, int varid) {
+  const double fill = NCOUT_FILL;
+  return nc_put_att_double(ncid, varid, "_FillValue", NC_DOUBLE, 1, &fill);
+}
+
+int ncout_put_filled(int ncid, int varid, const size_t *start, const size_t *count, const double *v,
+                     size_t n) {
+  double *tmp = malloc((n ? n : 1) * sizeof *tmp);
+  if (!tmp) return NC_ENOMEM;
+  for (size_t i = 0; i < n; i++) tmp[i] = isfinite(v[i]) ? v[i] : NCOUT_FILL;
+  const int rc = start ? nc_put_vara_double(ncid, varid, start, count, tmp)
+                       : nc_put_var_double(ncid, varid, tmp);
+  free(tmp);
+  return rc;
+}
+
+int ncout_labels(int ncid, const char *dim, int dimid, const char *long_name,
+                 const char *const *labels) {
+  size_t n;
+  int v, rc = nc_inq_dimlen(ncid, dimid, &n);
+  if (rc == NC_NOERR) rc = def_var(ncid, dim, NC_STRING, 1, &dimid, NULL, long_name, &v);
+  if (rc == NC_NOERR && n) rc = nc_put_var_string(ncid, v, (const char **)labels);
+  return rc;
+}
+
+int ncout_bounds(int ncid, const char *name, int varid, int dimid, const char *units,
+                 const char *long_name, const double *lo, const double *hi, size_t n) {
+  char bname[NC_MAX_NAME + 1];
+  snprintf(bname, sizeof bname, "%s_bounds", name);
+  int db, v;
+  int rc = nc_inq_dimid(ncid, "bnds", &db);
+  if (rc == NC_EBADDIM) rc = nc_def_dim(ncid, "bnds", 2, &db);
+  const int dims[2] = {dimid, db};
+  if (rc == NC_NOERR) rc = nc_put_att_text(ncid, varid, "bounds", strlen(bname), bname);
+  if (rc == NC_NOERR) rc = def_var(ncid, bname, NC_DOUBLE, 2, dims, units, long_name, &v);
+  double *b = malloc((n ? 2 * n : 1) * sizeof *b);
+  if (!b) return NC_ENOMEM;
+  for (size_t i = 0; i < n; i++) b[2 * i] = lo[i], b[2 * i + 1] = hi[i];
+  if (rc == NC_NOERR && n) rc = nc_put_var_double(ncid, v, b);
+  free(b);
+  return rc;
+}
+
 int ncout_stats(const char *path, const struct stats *st, const struct series *ts,
                 const struct nc_attr *attrs, int nattrs, char *err, size_t errlen) {
   char tmp[4096];
@@ -119,12 +163,21 @@ int ncout_stats(const char *path, const struct stats *st, const struct series *t
   for (int c = 0; c < ts->ncol && rc == NC_NOERR; c++) {
     rc = def_var(ncid, ts->names[c], NC_DOUBLE, 1, &dt, ts->units[c],
                  ts->long_names ? ts->long_names[c] : NULL, &vts[c]);
+    /* simulated time from the initial condition: no calendar date to refer to, so plain
+       seconds (udunits "s", what xarray keeps as float seconds) and the origin in words
+       (docs/stats-format.md) */
+    static const char ref[] =
+        "t = 0 is the initial condition of the run (simulated time, not a "
+        "calendar date)";
     if (rc == NC_NOERR && c == 0) rc = nc_put_att_text(ncid, vts[c], "standard_name", 4, "time");
+    if (rc == NC_NOERR && c == 0) rc = nc_put_att_text(ncid, vts[c], "axis", 1, "T");
+    if (rc == NC_NOERR && c == 0) rc = nc_put_att_text(ncid, vts[c], "reference", strlen(ref), ref);
+    if (rc == NC_NOERR && c > 0) rc = ncout_fill(ncid, vts[c]);
   }
   for (int c = 0; c < ts->ncol && rc == NC_NOERR && ts->n; c++) {
     for (size_t r = 0; r < ts->n; r++) col[r] = ts->data[r * (size_t)ts->ncol + c];
     const size_t start = 0, count = ts->n;
-    rc = nc_put_vara_double(ncid, vts[c], &start, &count, col);
+    rc = ncout_put_filled(ncid, vts[c], &start, &count, col, ts->n);
   }
   free(col), free(vts);
   NC(rc);

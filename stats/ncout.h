@@ -61,4 +61,35 @@ int ncout_columns(const char *path, const char *title, const char *dim, size_t n
 int ncout_def(int ncid, const char *name, int type, int ndim, const int *dims, const char *units,
               const char *long_name, int *varid);
 
+/** The value written for a missing value (NC_FILL_DOUBLE), declared as _FillValue. */
+#define NCOUT_FILL 9.9692099683868690e+36
+
+/**
+ * @brief Declare the _FillValue (NCOUT_FILL) of a double variable: the one missing-value
+ *        convention of chansph's netCDF files (no NaN is ever written).
+ */
+int ncout_fill(int ncid, int varid);
+
+/**
+ * @brief Write n doubles with non-finite values replaced by NCOUT_FILL.
+ * @param[in] start,count the hyperslab (NULL, NULL: the whole variable of n values)
+ */
+int ncout_put_filled(int ncid, int varid, const size_t *start, const size_t *count, const double *v,
+                     size_t n);
+
+/**
+ * @brief A categorical axis: the string coordinate variable named like dimension dim (one
+ *        label per index), so that xarray shows labelled axes.
+ */
+int ncout_labels(int ncid, const char *dim, int dimid, const char *long_name,
+                 const char *const *labels);
+
+/**
+ * @brief The CF cell bounds of a coordinate variable: NAME_bounds (dimensions: the coordinate's,
+ *        then "bnds" of length 2, defined in ncid if not visible there) with lo[i], hi[i], and the
+ *        attribute bounds = "NAME_bounds" on the coordinate.
+ */
+int ncout_bounds(int ncid, const char *name, int varid, int dimid, const char *units,
+                 const char *long_name, const double *lo, const double *hi, size_t n);
+
 #endif

@@ -149,6 +149,38 @@ int stats_warnings(const struct stats *st, char *buf, size_t len) {
   return st->cfg.lagr.n_levels ? lagr_warnings(&st->la, buf, len) : 0;
 }
 
+/* The limits of the wall-normal bins: uniform between cfg->y0 and y1, the first reaching down to
+   the wall and the last up to the other wall (the centre when folded), as the samples outside
+   [y0, y1] go to the end bins. */
+static void bin_bounds(const struct euler_config *c, double *lo, double *hi) {
+  const double w = (c->y1 - c->y0) / c->nb;
+  for (int b = 0; b < c->nb; b++) {
+    lo[b] = b == 0 ? 0.0 : c->y0 + b * w;
+    hi[b] = b == c->nb - 1 ? (c->fold ? 1.0 : 2.0) * c->delta : c->y0 + (b + 1) * w;
+  }
+}
+
+/* The bin coordinate y (centres, with bounds) on dimension dy of group ncid. */
+static int def_y(const struct euler_config *c, int ncid, int dy, const double *centre,
+                 const double *lo, const double *hi) {
+  int v, rc = ncout_def(ncid, "y", NC_DOUBLE, 1, &dy, "m", euler_prof_meta[EP_Y].long_name, &v);
+  if (rc == NC_NOERR) rc = nc_put_att_text(ncid, v, "axis", 1, "Y");
+  if (rc == NC_NOERR)
+    rc =
+        ncout_bounds(ncid, "y", v, dy, "m", "wall-normal limits of the bin", lo, hi, (size_t)c->nb);
+  if (rc == NC_NOERR) rc = nc_put_var_double(ncid, v, centre);
+  return rc;
+}
+
+static const char *const window_fields[WIN_LEN] = {
+    [WIN_T0] = "t_start",     [WIN_T1] = "t_end",           [WIN_NSNAP] = "snapshots",
+    [WIN_SUM_FX] = "sum_f_x", [WIN_SUM_TW0] = "sum_tau_w0", [WIN_SUM_TW1] = "sum_tau_w1"};
+static const char *const moment_names[MOM_LEN] = {
+    "count",     "mean_u",   "mean_v", "mean_w", "mean_p", "mean_rho", "mean_y",
+    "mean_nu_t", "mean_k_r", "C2_uu",  "C2_vv",  "C2_ww",  "C2_uv",    "C2_uw",
+    "C2_vw",     "M3_u",     "M3_v",   "M3_w",   "M4_u",   "M4_v",     "M4_w"};
+static const char *const scal_names[SCAL_LEN] = {"count", "mean", "M2"};
+
 /* t_reached: the time the run reached (NaN: not known); an incomplete last window ends there. */
 static int write_eulerian(const struct euler *e, double t_reached, int ncid, char *err,
                           size_t errlen) {
@@ -156,20 +188,17 @@ static int write_eulerian(const struct euler *e, double t_reached, int ncid, cha
   struct euler_result r;
   eulerian_result(e, &r);
   const size_t nb = (size_t)e->cfg.nb, rows = euler_rows(e);
+  double *lo = malloc(2 * nb * sizeof *lo), *hi = lo + nb;
+  if (!lo) return NC_ENOMEM;
+  bin_bounds(&e->cfg, lo, hi);
   CK(nc_def_dim(ncid, "y", nb, &dy));
+  CK(def_y(&e->cfg, ncid, dy, r.prof[EP_Y], lo, hi));
   for (int k = 0; k < EP_NPROF; k++) {
-    if ((k == EP_NUT || k == EP_KR) && !e->cfg.les) continue;
+    if (k == EP_Y || ((k == EP_NUT || k == EP_KR) && !e->cfg.les)) continue;
     const struct euler_meta *m = &euler_prof_meta[k];
     CK(ncout_def(ncid, m->name, NC_DOUBLE, 1, &dy, m->units, m->long_name, &vid));
-    if (k == EP_Y) {
-      CK(nc_put_att_text(ncid, vid, "axis", 1, "Y"));
-    } else {
-      const double fill = NC_FILL_DOUBLE;
-      CK(nc_put_att_double(ncid, vid, "_FillValue", NC_DOUBLE, 1, &fill));
-    }
-    for (int b = 0; b < r.nb; b++)
-      if (isnan(r.prof[k][b])) r.prof[k][b] = NC_FILL_DOUBLE;
-    CK(nc_put_var_double(ncid, vid, r.prof[k]));
+    CK(ncout_fill(ncid, vid));
+    CK(ncout_put_filled(ncid, vid, NULL, NULL, r.prof[k], nb));
   }
   const struct {
     const char *name;
@@ -205,10 +234,40 @@ static int write_eulerian(const struct euler *e, double t_reached, int ncid, cha
       "raw per-window moment records of the wall-normal bins; re-average any range of windows "
       "with chansph extract --window T0:T1 (docs/stats-format.md)";
   CK(nc_put_att_text(g, NC_GLOBAL, "description", strlen(desc), desc));
+  /* every dimension of the group has its coordinate variable here, so that xarray's
+     open_dataset(group="eulerian") has labelled axes: the bins again (a dimension y of the
+     group, the same as the root's), the windows by their middle time (bounds: start, end) and
+     the fields of the records by name */
   CK(nc_def_dim(g, "window", rows, &dw));
+  CK(nc_def_dim(g, "y", nb, &dy));
   CK(nc_def_dim(g, "window_field", WIN_LEN, &dwf));
   CK(nc_def_dim(g, "moment", MOM_LEN, &dm));
   CK(nc_def_dim(g, "snapshot_moment", SCAL_LEN, &ds));
+  CK(def_y(&e->cfg, g, dy, r.prof[EP_Y], lo, hi));
+  {
+    double *mid = malloc(3 * (rows ? rows : 1) * sizeof *mid), *t0 = mid + rows, *t1 = t0 + rows;
+    if (!mid) CK(NC_ENOMEM);
+    for (size_t w = 0; w < rows; w++) {
+      t0[w] = e->win[w * WIN_LEN + WIN_T0], t1[w] = e->win[w * WIN_LEN + WIN_T1];
+      mid[w] = 0.5 * (t0[w] + t1[w]);
+    }
+    int vt;
+    rc = ncout_def(g, "window", NC_DOUBLE, 1, &dw, "s", "middle of the averaging window", &vt);
+    if (rc == NC_NOERR)
+      rc = ncout_bounds(g, "window", vt, dw, "s", "nominal start and end of the window", t0, t1,
+                        rows);
+    if (rc == NC_NOERR && rows) rc = nc_put_var_double(g, vt, mid);
+    free(mid);
+    CK(rc);
+  }
+  CK(ncout_labels(g, "window_field", dwf, "fields of the window records", window_fields));
+  CK(ncout_labels(g, "moment", dm,
+                  "fields of the moment records: count, means, co-moments C2 (sums of products "
+                  "of deviations), third and fourth central moments M3, M4 (sums)",
+                  moment_names));
+  CK(ncout_labels(g, "snapshot_moment", ds,
+                  "fields of the records of per-snapshot bin means of u: count, mean, M2",
+                  scal_names));
   CK(ncout_def(g, "window_start", NC_DOUBLE, 1, &dw, "s", "start of the averaging window", &v0));
   CK(ncout_def(g, "window_end", NC_DOUBLE, 1, &dw, "s", "end of the averaging window", &v1));
   CK(ncout_def(g, "window_complete", NC_INT, 1, &dw, "1", "1: closed window, 0: still open", &vc));
@@ -236,9 +295,11 @@ static int write_eulerian(const struct euler *e, double t_reached, int ncid, cha
     CK(nc_put_var_double(g, vs, e->snp));
   }
   euler_result_free(&r);
+  free(lo);
   return NC_NOERR;
 fail:
   euler_result_free(&r);
+  free(lo);
   return rc ? rc : NC_EINVAL;
 }
 

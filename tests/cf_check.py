@@ -5,6 +5,12 @@ variable has a long_name or standard_name, the file declares Conventions, and th
 that count or flag are integers. Records of mixed quantities (eulerian/windows, moments,
 snapshot_u) carry no units. Provenance: history (a "DATE: chansph ..." line per run and resume,
 newest first), date_created (ISO 8601), source (version and git commit), ranks and threads.
+Axes: every dimension a variable uses has a coordinate variable of that name in the variable's
+own group (so xarray labels the axis; exempt: bnds, and particle, whose index is the id), the
+bin coordinates y and pdf_bin have CF bounds (contiguous, holding the centre), time has units
+"s" with a reference attribute. Missing values: no NaN or Inf anywhere, a value equal to the
+netCDF default fill only in a variable that declares it as _FillValue. xarray (python3-xarray)
+opens the file and every group without a warning, with every dimension indexed.
 
 usage: cf_check.py [resumed:]FILE.nc ...   (resumed: the history must hold a resume)
 """
@@ -13,12 +19,51 @@ import ctypes.util
 import re
 import sys
 
+import warnings
+
 import netCDF4
+import numpy as np
+import xarray
 
 INTEGER_ATTRS = ("dimension", "steps", "n_fluid", "n_snapshots", "n_windows", "fold", "les",
                  "step", "releases", "ranks", "threads")
 STAMP = r"\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ"
 MIXED = ("windows", "moments", "snapshot_u")
+NO_COORD = ("bnds", "particle")
+BINNED = ("y", "pdf_bin")
+FILL = netCDF4.default_fillvals["f8"]
+
+
+def check_bounds(g, name, where, problems, contiguous):
+    v = g.variables[name]
+    b = v.getncattr("bounds")
+    if b not in g.variables or g.variables[b].dimensions != (v.dimensions[0], "bnds"):
+        problems.append("%s: bounds %r is not a (%s, bnds) variable of the group" %
+                        (where, b, v.dimensions[0]))
+        return
+    c, lo, hi = np.asarray(v[:]), np.asarray(g.variables[b][:, 0]), np.asarray(g.variables[b][:, 1])
+    if not (np.all(lo <= c) and np.all(c <= hi) and np.all(lo < hi)):
+        problems.append("%s: bounds %s do not hold the values" % (where, b))
+    if contiguous and not np.array_equal(lo[1:], hi[:-1]):
+        problems.append("%s: bins %s are not contiguous" % (where, b))
+
+
+def check_xarray(path, groups, problems):
+    """Open the root and every group in xarray: no warning, every dimension indexed."""
+    for grp in groups:
+        with warnings.catch_warnings(record=True) as w:
+            warnings.simplefilter("always")
+            try:
+                with xarray.open_dataset(path, group=grp) as ds:
+                    ds.load()
+                    bare = [d for d in ds.dims if d not in ds.indexes and d not in NO_COORD]
+                    if bare:
+                        problems.append("%s:%s: xarray has no index for %s" %
+                                        (path, grp or "/", ", ".join(bare)))
+            except Exception as e:  # pylint: disable=broad-except
+                problems.append("%s:%s: xarray cannot open it: %s" % (path, grp or "/", e))
+        for x in w:
+            problems.append("%s:%s: xarray warns: %s" % (path, grp or "/", x.message))
 
 
 def udunits():
@@ -79,6 +124,30 @@ def main():
                 for name, v in g.variables.items():
                     attrs = v.ncattrs()
                     where = "%s:%s%s" % (path, prefix, name)
+                    for dim in v.dimensions:
+                        if dim not in NO_COORD and dim not in g.variables:
+                            problems.append("%s: dimension %s has no coordinate variable in "
+                                            "the group" % (where, dim))
+                    if name in BINNED and v.dimensions == (name,):
+                        if "bounds" not in attrs:
+                            problems.append("%s: bin coordinate without bounds" % where)
+                        else:
+                            check_bounds(g, name, where, problems, True)
+                    elif "bounds" in attrs:  # the windows: gaps where no sample fell
+                        check_bounds(g, name, where, problems, False)
+                    if name == "time" and v.dimensions == ("time",) and (
+                            v.getncattr("units") != "s" or "reference" not in attrs):
+                        problems.append("%s: time needs units 's' and a reference" % where)
+                    if getattr(v.dtype, "kind", "") == "f":
+                        v.set_auto_mask(False)
+                        data = np.asarray(v[:])
+                        if not np.all(np.isfinite(data)):
+                            problems.append("%s: NaN or Inf written (missing values are "
+                                            "_FillValue)" % where)
+                        if np.any(data == FILL) and "_FillValue" not in attrs:
+                            problems.append("%s: fill values without a _FillValue" % where)
+                        if "_FillValue" in attrs and v.getncattr("_FillValue") != FILL:
+                            problems.append("%s: _FillValue is not the netCDF default" % where)
                     if "long_name" not in attrs and "standard_name" not in attrs:
                         problems.append("%s: no long_name or standard_name" % where)
                     if "units" in attrs:
@@ -92,6 +161,14 @@ def main():
                 for name, sub in g.groups.items():
                     walk(sub, prefix + name + "/")
             walk(d, "")
+            groups = [None]
+            stack = [(d, "")]
+            while stack:
+                g, prefix = stack.pop()
+                for name, sub in g.groups.items():
+                    groups.append(prefix + "/" + name)
+                    stack.append((sub, prefix + "/" + name))
+        check_xarray(path, groups, problems)
     for p in problems:
         print(p)
     print("%d files, %d units attributes checked with libudunits2: %s" %

@@ -29,7 +29,7 @@ def nc_vars(path):
     with netCDF4.Dataset(path) as d:
         def walk(g, prefix):
             for name, v in g.variables.items():
-                if v.dtype.kind == "f":
+                if getattr(v.dtype, "kind", "") == "f":  # not the string labels
                     a = np.ma.asarray(v[:])
                     out.append((prefix + name, np.ma.compressed(a)))
             for name, sub in g.groups.items():

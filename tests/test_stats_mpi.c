@@ -348,7 +348,15 @@ static int compare_nc_group(int ga, int gb, int *nvar) {
       continue;
     }
     char *a = malloc(count * tsize + 1), *b = malloc(count * tsize + 1);
-    if (nc_get_var(ga, ids[i], a) || nc_get_var(gb, vb, b) || memcmp(a, b, count * tsize)) {
+    int differ = nc_get_var(ga, ids[i], a) || nc_get_var(gb, vb, b);
+    if (!differ && type == NC_STRING) { /* labels: compare the strings, not the pointers */
+      for (size_t j = 0; j < count; j++)
+        differ |= strcmp(((char **)(void *)a)[j], ((char **)(void *)b)[j]) != 0;
+      nc_free_string(count, (char **)(void *)a), nc_free_string(count, (char **)(void *)b);
+    } else if (!differ) {
+      differ = memcmp(a, b, count * tsize) != 0;
+    }
+    if (differ) {
       printf("  stats.nc: variable %s differs\n", name);
       bad++;
     }
