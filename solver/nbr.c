@@ -290,8 +290,8 @@ static inline int stencil_column(const struct nbr *nb, int lc, int dx, double *s
 /* Gap between a coordinate and the cell interval [j, j + 1) / c: a lower bound of the distance
    to any particle of the cell (particles outside the grid are clamped into the edge cells, on
    the far side from the interior, so the bound still holds). */
-static inline double cell_gap(double p, int j, double c) {
-  const double lo = j / c, hi = (j + 1) / c;
+static inline double cell_gap(double p, int j, double w) {
+  const double lo = j * w, hi = lo + w; /* w: the cell width (rounding is inside the margin) */
   return p < lo ? lo - p : p > hi ? p - hi : 0.0;
 }
 
@@ -307,6 +307,7 @@ static inline __attribute__((always_inline)) int build_cell_t(struct nbr *nb,
   /* rows of the stencil farther than 2h in y and z are skipped (with a margin: the skipped
      candidates are outside the support by far more than the rounding of the cell index) */
   const double prune2 = nb->support2 * (1.0 + 1e-9);
+  const double wy = 1.0 / nb->cy, wz = 1.0 / nb->cz; /* cell widths */
   const int lc = (int)(c % (size_t)nb->nxo);
   const int iy = (int)(c / (size_t)nb->nxo % (size_t)nb->ny);
   const int iz = (int)(c / ((size_t)nb->nxo * nb->ny));
@@ -324,11 +325,11 @@ static inline __attribute__((always_inline)) int build_cell_t(struct nbr *nb,
         jz += nb->nz, sz = -nb->lz;
       else if (jz >= nb->nz)
         jz -= nb->nz, sz = nb->lz;
-      const double gz = nb->dim == 3 ? cell_gap(P->z[a] - sz, jz, nb->cz) : 0.0;
+      const double gz = nb->dim == 3 ? cell_gap(P->z[a] - sz, jz, wz) : 0.0;
       for (int dy = -R; dy <= R; dy++) {
         const int jy = iy + dy;
         if (jy < 0 || jy >= nb->ny) continue;
-        const double gy = cell_gap(P->y[a], jy, nb->cy);
+        const double gy = cell_gap(P->y[a], jy, wy);
         if (gy * gy + gz * gz >= prune2) continue;
         const size_t row = (size_t)jz * nb->ny + jy;
         const int gx = nb->ix0 + lc;
