@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Quick start: set up, run the coarse turbulent channel jobs/scenes/quickstart.ini (wall-modelled
 # LES at Re_tau = 395 from the developed state jobs/states/les395_t6.nc, one eddy turnover time,
-# about 6 minutes on 2 cores) into runs/quickstart/, compare its profiles with the DNS of
+# about 4 minutes on 2 cores) into runs/quickstart/, compare its profiles with the DNS of
 # Moser, Kim & Mansour (1999) (table and plots), and say how converged its statistics are.
 # A laminar check instead: build/chansph run jobs/scenes/poiseuille3d.ini --out runs/laminar
 set -euo pipefail
@@ -10,7 +10,7 @@ cd "$here"
 jobs/setup.sh
 out=runs/quickstart
 dns=stats/dns/mkm1999/chan395.means
-echo "quickstart: running jobs/scenes/quickstart.ini into $out/ (about 6 minutes on 2 cores)"
+echo "quickstart: running jobs/scenes/quickstart.ini into $out/ (about 4 minutes on 2 cores)"
 start=$(date +%s)
 build/chansph run jobs/scenes/quickstart.ini --out "$out" --overwrite
 echo "quickstart: run took $(($(date +%s) - start)) s"
