@@ -308,6 +308,19 @@ static void warn_settings(struct output *o, const struct sim *S) {
                every, S->t, sc->t_end);
 }
 
+/* The provenance attributes of every netCDF file a run writes (CF: source, history,
+   date_created; the run's ranks, threads, identity and scene). */
+// clang-format off
+#define PROVENANCE_ATTRS(o, S, date)                                                   \
+  {"source", CHANSPH_SOURCE, 0, 0},                                                   \
+  {"history", (o)->history ? (o)->history : "", 0, 0},                                \
+  {"date_created", (date), 0, 0},                                                     \
+  {"ranks", NULL, (double)(S)->dd.size, 1},                                           \
+  {"threads", NULL, (double)omp_get_max_threads(), 1},                                \
+  {"run_id", (o)->run_id, 0, 0},                                                      \
+  {"scene", (o)->scene_text, 0, 0}
+// clang-format on
+
 static int write_stats(struct output *o, const struct sim *S) {
   const struct scene *sc = S->sc;
   char path[4096], err[4096];
@@ -339,13 +352,7 @@ static int write_stats(struct output *o, const struct sim *S) {
       {"n_fluid", NULL, (double)S->P.n_fluid, 1},
       {"n_snapshots", NULL, (double)o->st.samples, 1},
       {"code_version", CHANSPH_VERSION, 0, 0},
-      {"source", CHANSPH_SOURCE, 0, 0},
-      {"history", o->history ? o->history : "", 0, 0},
-      {"date_created", date, 0, 0},
-      {"ranks", NULL, (double)S->dd.size, 1},
-      {"threads", NULL, (double)omp_get_max_threads(), 1},
-      {"run_id", o->run_id, 0, 0},
-      {"scene", o->scene_text, 0, 0},
+      PROVENANCE_ATTRS(o, S, date),
   };
   int rc = CHANSPH_OK;
   o->st.t_reached = S->t; /* an incomplete last window ends here, not at its nominal end */
@@ -523,15 +530,8 @@ static int write_particles(struct output *o, const struct sim *S) {
                                                "pressure",
                                                "wall renormalisation factor",
                                                "mass (per metre of span in 2-D)"};
-    const struct nc_attr attrs[] = {{"time", NULL, S->t, 0},
-                                    {"step", NULL, (double)S->step, 1},
-                                    {"source", CHANSPH_SOURCE, 0, 0},
-                                    {"history", o->history ? o->history : "", 0, 0},
-                                    {"date_created", date, 0, 0},
-                                    {"ranks", NULL, (double)S->dd.size, 1},
-                                    {"threads", NULL, (double)omp_get_max_threads(), 1},
-                                    {"run_id", o->run_id, 0, 0},
-                                    {"scene", o->scene_text, 0, 0}};
+    const struct nc_attr attrs[] = {
+        {"time", NULL, S->t, 0}, {"step", NULL, (double)S->step, 1}, PROVENANCE_ATTRS(o, S, date)};
     char path[4096], err[4096];
     snprintf(path, sizeof path, "%s/particles.nc", o->dir);
     rc = ncout_columns(path, "chansph particle state", "particle", n, NC, names, long_names, units,
