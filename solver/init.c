@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "dns_lm180.h"
 #include "error.h"
 #include "kernel.h"
 #include "walllaw.h"
@@ -302,11 +303,150 @@ static int from_file(const struct scene *sc, struct particles *P) {
   return CHANSPH_OK;
 }
 
+/* ---- synthetic-eddy start-up (Jarrin et al. 2006; docs/theory.md) ---- */
+
+void init_dns180(double yplus, double out[5]) {
+  const int n = DNS_LM180_N;
+  const double yp = fmax(0.0, yplus);
+  if (yp >= dns_lm180[n - 1][0]) {
+    for (int c = 0; c < 5; c++) out[c] = dns_lm180[n - 1][c + 1];
+    return;
+  }
+  int i = 0;
+  while (i < n - 2 && dns_lm180[i + 1][0] <= yp) i++;
+  const double t = (yp - dns_lm180[i][0]) / (dns_lm180[i + 1][0] - dns_lm180[i][0]);
+  for (int c = 0; c < 5; c++)
+    out[c] = dns_lm180[i][c + 1] + t * (dns_lm180[i + 1][c + 1] - dns_lm180[i][c + 1]);
+}
+
+int init_sem_make(struct init_sem *E, const struct scene *sc) {
+  memset(E, 0, sizeof *E);
+  const double sig = sc->init_eddy_size * sc->delta;
+  E->sigma = sig, E->lx = sc->lx, E->lz = sc->lz, E->y0 = -sig;
+  E->ly = 2.0 * sc->delta + 2.0 * sig;
+  const double vol = E->lx * E->ly * E->lz;
+  long n = sc->init_eddies;
+  if (n <= 0) n = (long)fmax(1.0, floor(vol / (sig * sig * sig) + 0.5));
+  E->n = (size_t)n;
+  E->scale = sqrt(vol / (sig * sig * sig) / (double)n);
+  /* cells of width >= sigma; fewer than 3 along a periodic direction: one cell (the nearest
+     image is then the only one within sigma, as sigma <= l/2) */
+  E->nx = (int)floor(E->lx / sig), E->ny = (int)fmax(1.0, floor(E->ly / sig));
+  E->nz = (int)floor(E->lz / sig);
+  if (E->nx < 3) E->nx = 1;
+  if (E->nz < 3) E->nz = 1;
+  const size_t ncell = (size_t)E->nx * E->ny * E->nz;
+  E->pos = malloc(E->n * 3 * sizeof(double));
+  E->eps = malloc(E->n * 3 * sizeof(double));
+  E->start = calloc(ncell + 1, sizeof(size_t));
+  E->order = malloc(E->n * sizeof(size_t));
+  size_t *fill = malloc(ncell * sizeof(size_t));
+  int *cellof = malloc(E->n * sizeof(int));
+  if (!E->pos || !E->eps || !E->start || !E->order || !fill || !cellof)
+    die("out of memory for %zu synthetic eddies", E->n);
+  const double lo[3] = {0.0, E->y0, 0.0}, len[3] = {E->lx, E->ly, E->lz};
+  const int nc[3] = {E->nx, E->ny, E->nz};
+  for (size_t k = 0; k < E->n; k++) {
+    int ci[3];
+    for (int c = 0; c < 3; c++) {
+      /* uniform in [lo, lo + len) and a random sign, keyed by (seed, eddy index, stream):
+         streams 16-21 (the particle noise uses 0-2 of the particle ids) */
+      const double r = 0.5 * (init_noise(sc->init_seed, (long long)k, 16 + c) + 1.0);
+      E->pos[3 * k + c] = lo[c] + len[c] * r;
+      E->eps[3 * k + c] = init_noise(sc->init_seed, (long long)k, 19 + c) < 0.0 ? -1.0 : 1.0;
+      ci[c] = (int)fmin(nc[c] - 1, floor(r * nc[c]));
+    }
+    cellof[k] = (ci[2] * E->ny + ci[1]) * E->nx + ci[0];
+    E->start[cellof[k] + 1]++;
+  }
+  for (size_t c = 0; c < ncell; c++) E->start[c + 1] += E->start[c];
+  memcpy(fill, E->start, ncell * sizeof *fill);
+  for (size_t k = 0; k < E->n; k++) E->order[fill[cellof[k]]++] = k; /* by eddy index */
+  free(fill), free(cellof);
+  return CHANSPH_OK;
+}
+
+void init_sem_free(struct init_sem *E) {
+  free(E->pos), free(E->eps), free(E->start), free(E->order);
+  memset(E, 0, sizeof *E);
+}
+
+void init_sem_xi(const struct init_sem *E, double x, double y, double z, double xi[3]) {
+  const double sig = E->sigma, inv = 1.0 / sig;
+  const double fn = 1.5 * sqrt(1.5); /* (3/2)^(3/2): integral of f^2 over the cube is sigma^3 */
+  const double xr = x - E->lx * floor(x / E->lx), zr = z - E->lz * floor(z / E->lz);
+  const int cx = (int)fmin(E->nx - 1, floor(xr / E->lx * E->nx));
+  const int cy = (int)fmin(E->ny - 1, fmax(0.0, floor((y - E->y0) / E->ly * E->ny)));
+  const int cz = (int)fmin(E->nz - 1, floor(zr / E->lz * E->nz));
+  const int rx = E->nx >= 3 ? 1 : 0, rz = E->nz >= 3 ? 1 : 0;
+  double s[3] = {0.0, 0.0, 0.0};
+  for (int k = -rz; k <= rz; k++)
+    for (int j = -1; j <= 1; j++) {
+      if (cy + j < 0 || cy + j >= E->ny) continue;
+      for (int i = -rx; i <= rx; i++) {
+        const int ix = (cx + i + E->nx) % E->nx, iz = (cz + k + E->nz) % E->nz;
+        const size_t c = ((size_t)iz * E->ny + cy + j) * E->nx + ix;
+        for (size_t q = E->start[c]; q < E->start[c + 1]; q++) {
+          const size_t e = E->order[q];
+          const double ax = fabs(wrap(x - E->pos[3 * e], E->lx)) * inv;
+          const double ay = fabs(y - E->pos[3 * e + 1]) * inv;
+          const double az = fabs(wrap(z - E->pos[3 * e + 2], E->lz)) * inv;
+          if (ax >= 1.0 || ay >= 1.0 || az >= 1.0) continue;
+          const double f = fn * (1.0 - ax) * (1.0 - ay) * (1.0 - az);
+          for (int d = 0; d < 3; d++) s[d] += E->eps[3 * e + d] * f;
+        }
+      }
+    }
+  for (int d = 0; d < 3; d++) xi[d] = E->scale * s[d];
+}
+
+void init_sem_velocity(const struct init_sem *E, const struct scene *sc, double ut, double x,
+                       double y, double z, double vel[3]) {
+  const double yw = fmin(y, 2.0 * sc->delta - y);
+  const double sign =
+      sc->drive_mode == DRIVE_FLUX ? (sc->u_bulk < 0 ? -1.0 : 1.0) : (sc->force < 0 ? -1.0 : 1.0);
+  double d[5]; /* U+, u'u'+, v'v'+, w'w'+, u'v'+ */
+  init_dns180(yw * ut / sc->nu, d);
+  vel[0] = vel[1] = vel[2] = 0.0;
+  if (!(yw > 0.0)) return; /* at (or beyond) a wall: no slip, no fluctuation */
+  /* Lund et al. (1998): Cholesky factor of the local Reynolds-stress tensor; u'v' changes
+     sign in the upper half */
+  const double uv = (y > sc->delta ? -1.0 : 1.0) * d[4];
+  const double a11 = sqrt(fmax(0.0, d[1]));
+  const double a21 = a11 > 0.0 ? uv / a11 : 0.0;
+  const double a22 = sqrt(fmax(0.0, d[2] - a21 * a21)), a33 = sqrt(fmax(0.0, d[3]));
+  double xi[3];
+  init_sem_xi(E, x, y, z, xi);
+  /* a flow towards -x is the mirror image: u (mean and fluctuation) changes sign */
+  vel[0] = sign * ut * (d[0] + a11 * xi[0]);
+  vel[1] = ut * (a21 * xi[0] + a22 * xi[1]);
+  vel[2] = ut * a33 * xi[2];
+}
+
+static void synthetic(const struct scene *sc, double ut, struct particles *P) {
+  struct init_sem E;
+  init_sem_make(&E, sc);
+#pragma omp parallel for schedule(static)
+  for (size_t a = 0; a < P->n_fluid; a++) {
+    double vel[3];
+    init_sem_velocity(&E, sc, ut, P->x[a], P->y[a], P->z[a], vel);
+    P->u[a] = vel[0], P->v[a] = vel[1], P->w[a] = vel[2];
+  }
+  msg("init: synthetic eddies (Jarrin et al. 2006): %zu eddies of size %.4g m, Lee & Moser "
+      "Re_tau = 180 profiles with u_tau = %.6g m/s (Re_tau = %.4g)\n",
+      E.n, E.sigma, ut, ut * sc->delta / sc->nu);
+  init_sem_free(&E);
+}
+
 int init_fields(const struct scene *sc, struct particles *P) {
   const struct wall_law_def L = wall_law_make(WALL_LAW_REICHARDT, sc->kappa, sc->log_b);
-  const double ut = sc->init_profile == INIT_REICHARDT ? init_reichardt_utau(sc) : 0.0;
+  const double ut = sc->init_profile == INIT_REICHARDT || sc->init_profile == INIT_SYNTHETIC
+                        ? init_reichardt_utau(sc)
+                        : 0.0;
   if (sc->init_from[0]) {
     TRY(from_file(sc, P));
+  } else if (sc->init_profile == INIT_SYNTHETIC) {
+    synthetic(sc, ut, P);
   } else {
     for (size_t a = 0; a < P->n_fluid; a++) P->u[a] = mean_u(sc, &L, ut, P->y[a]);
     if (sc->init_profile == INIT_WAVE) /* thesis Sec. 3.1.2 */
@@ -335,6 +475,7 @@ int init_fields(const struct scene *sc, struct particles *P) {
       if (sc->dim == 3) P->w[a] += sc->init_noise * init_noise(sc->init_seed, id, 2);
     }
   }
-  if (ut > 0.0) msg("init: Reichardt profile with u_tau = %.6g m/s\n", ut);
+  if (ut > 0.0 && sc->init_profile == INIT_REICHARDT)
+    msg("init: Reichardt profile with u_tau = %.6g m/s\n", ut);
   return CHANSPH_OK;
 }

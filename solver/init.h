@@ -34,4 +34,37 @@ double init_reichardt_utau(const struct scene *sc);
  */
 double init_noise(long seed, long long id, int stream);
 
+/** @brief A set of synthetic eddies (Jarrin et al. 2006) in the periodic box extended by sigma
+    beyond both walls, binned in cells of width >= sigma. */
+struct init_sem {
+  size_t n;              /*!< eddies */
+  double sigma;          /*!< half-width [m] */
+  double lx, ly, lz, y0; /*!< box: [0, lx) x [y0, y0 + ly) x [0, lz) */
+  double scale;          /*!< (V_B / (N sigma^3))^(1/2) */
+  double *pos, *eps;     /*!< 3 n positions, 3 n signs (+-1) */
+  int nx, ny, nz;        /*!< cells */
+  size_t *start, *order; /*!< cell start offsets (ncell + 1), eddies by cell */
+};
+
+/** @brief The eddy set of a scene: count init.eddies (0: box volume / sigma^3), size
+    init.eddy_size delta, positions and signs from init_noise keyed by init.seed and eddy
+    index (streams 16-21). Returns CHANSPH_OK (dies when out of memory). */
+int init_sem_make(struct init_sem *E, const struct scene *sc);
+void init_sem_free(struct init_sem *E);
+
+/** @brief Normalised fluctuation xi (zero mean, unit variance, uncorrelated components in
+    expectation) at a point: (V_B / N)^(1/2) sum_k eps_k f_sigma(x - x_k), tent shape
+    functions; summed in a fixed order, so independent of threads and ranks. */
+void init_sem_xi(const struct init_sem *E, double x, double y, double z, double xi[3]);
+
+/** @brief Velocity of profile = synthetic at a point: u_tau (U+(y+) e_x + a xi) with a the
+    Cholesky factor (Lund et al. 1998) of the Lee & Moser Re_tau = 180 Reynolds stresses at
+    y+ = min(y, 2 delta - y) u_tau / nu; exactly zero at the walls. */
+void init_sem_velocity(const struct init_sem *E, const struct scene *sc, double ut, double x,
+                       double y, double z, double vel[3]);
+
+/** @brief Lee & Moser Re_tau = 180 profiles at y+ (linear in y+, the centre-line values
+    beyond the table): U+, u'u'+, v'v'+, w'w'+, u'v'+ (solver/dns_lm180.h). */
+void init_dns180(double yplus, double out[5]);
+
 #endif

@@ -182,12 +182,16 @@ static const struct key keys[] = {
      OFF(c_gamma)},
     {"time", "max_steps", T_LONG, "0", 0, 1e18, 0, NULL, "-",
      "Stop after this many steps even if t_end is not reached (0 = no limit).", OFF(max_steps)},
-    {"init", "profile", T_CHOICE, "rest", 0, 0, 0, "rest|laminar|reichardt|wave", "-",
+    {"init", "profile", T_CHOICE, "rest", 0, 0, 0, "rest|laminar|reichardt|wave|synthetic", "-",
      "Initial mean velocity: at rest; the laminar Poiseuille profile of the force (force mode) "
      "or of the target bulk velocity (flux mode); or Reichardt's turbulent profile (thesis Eq. "
      "5.53) with u_tau = (force delta)^(1/2) (force mode) or the u_tau whose profile has the "
      "target bulk velocity (flux mode); or the wall-normal wave v = init.wave sin(4 pi y / "
-     "(2 delta)) of the energy experiment of thesis Sec. 3.1.2.",
+     "(2 delta)) of the energy experiment of thesis Sec. 3.1.2; or synthetic: a synthetic-eddy "
+     "field (Jarrin et al. 2006) carrying the Lee & Moser Re_tau = 180 DNS mean profile U+(y+) "
+     "and Reynolds-stress tensor (u'u', v'v', w'w', u'v'), scaled with the u_tau above and "
+     "this scene's nu (3-D only; not divergence-free; docs/theory.md, \"Synthetic-eddy "
+     "start-up\").",
      OFF(init_profile)},
     {"init", "wave", T_DOUBLE, "0", -BIG, BIG, 0, NULL, "m/s",
      "Amplitude of the wall-normal wave of profile = wave (the thesis uses c0/10).",
@@ -212,8 +216,16 @@ static const struct key keys[] = {
      "Philox generator (Random123) keyed by seed and particle id: independent of threads and "
      "ranks.",
      OFF(init_noise)},
-    {"init", "seed", T_LONG, "1", 0, 1e15, 0, NULL, "-", "Key of the random noise.",
-     OFF(init_seed)},
+    {"init", "seed", T_LONG, "1", 0, 1e15, 0, NULL, "-",
+     "Key of the random noise and of the synthetic eddies.", OFF(init_seed)},
+    {"init", "eddies", T_LONG, "0", 0, 1e9, 0, NULL, "-",
+     "Number N of synthetic eddies of profile = synthetic, placed in the box lx x (2 delta + "
+     "2 eddy_size) x lz; 0 = the box volume / eddy_size^3.",
+     OFF(init_eddies)},
+    {"init", "eddy_size", T_DOUBLE, "0.2", 0, BIG, LO_OPEN, NULL, "delta",
+     "Half-width sigma of the synthetic eddies (tent shape functions), in units of delta; at "
+     "most lx/2 and lz/2.",
+     OFF(init_eddy_size)},
     {"init", "from", T_STRING, "", 0, 0, 0, NULL, "-",
      "particles.nc of an earlier run with the same domain: with the same particle count its "
      "positions and velocities are taken as they are (by id); otherwise its velocity field is "
@@ -665,6 +677,18 @@ static void validate(struct parse_state *ps) {
                  "y+ levels need stats.u_tau_ref > 0 unless a positive drive.force gives it "
                  "(u_tau_ref = %g, force = %g)",
                  s->u_tau_ref, s->force);
+  if (s->init_profile == INIT_SYNTHETIC) {
+    const double sig = s->init_eddy_size * s->delta;
+    if (s->dim != 3)
+      inconsistent(ps, "init.profile", "synthetic needs a 3-D scene (dimension = %g)%.0s",
+                   (double)s->dim, 0.0);
+    else if (sig > 0.5 * s->lx || sig > 0.5 * s->lz)
+      inconsistent(ps, "init.eddy_size",
+                   "eddy size sigma = %g (eddy_size delta) is more than half of min(lx, lz) = %g",
+                   sig, fmin(s->lx, s->lz));
+    if (!(s->nu > 0.0))
+      inconsistent(ps, "fluid.nu", "profile = synthetic needs nu > 0 (got %g)%.0s", s->nu, 0.0);
+  }
   if (s->dt_fixed > 0.0 && s->dt_fixed > s->t_end)
     inconsistent(ps, "time.dt", "fixed dt = %g is larger than t_end = %g", s->dt_fixed, s->t_end);
 }

@@ -18,7 +18,13 @@ enum wall_pressure {
   WALL_PRESSURE_ANALYTIC = 2
 };
 enum laplacian_norm { LAPNORM_WALL_NORMAL = 0, LAPNORM_TRACE = 1, LAPNORM_NONE = 2 };
-enum init_profile { INIT_REST = 0, INIT_LAMINAR = 1, INIT_REICHARDT = 2, INIT_WAVE = 3 };
+enum init_profile {
+  INIT_REST = 0,
+  INIT_LAMINAR = 1,
+  INIT_REICHARDT = 2,
+  INIT_WAVE = 3,
+  INIT_SYNTHETIC = 4
+};
 enum les_model { LES_NONE = 0, LES_SMAGORINSKY = 1 };
 enum les_strain { STRAIN_GRADIENT = 0, STRAIN_VIOLEAU_ISSA = 1 };
 enum pressure_gradient { PGRAD_STANDARD = 0, PGRAD_CORRECTED = 1 };
@@ -84,16 +90,18 @@ struct scene {
   double c_gamma;  /*!< factor of Eq. 2.163 [-]; 0 disables */
   long max_steps;  /*!< stop after this many steps (0 = no limit) */
   /* [init] */
-  int init_profile;    /*!< enum init_profile */
-  double init_wave;    /*!< amplitude of the wall-normal wave [m/s] */
-  double init_streaks; /*!< amplitude of streamwise streaks [m/s] */
-  int init_streak_kz;  /*!< streaks across lz [-] */
-  double init_modes;   /*!< amplitude of the divergence-free sinusoidal modes [m/s] */
-  int init_mode_kx;    /*!< their wavenumber along x (periods in lx) [-] */
-  int init_mode_kz;    /*!< their wavenumber along z (periods in lz) [-] */
-  double init_noise;   /*!< amplitude of the random noise per component [m/s] */
-  long init_seed;      /*!< key of the counter-based generator [-] */
-  char init_from[512]; /*!< particles.nc of an earlier run to start from, or empty */
+  int init_profile;      /*!< enum init_profile */
+  double init_wave;      /*!< amplitude of the wall-normal wave [m/s] */
+  double init_streaks;   /*!< amplitude of streamwise streaks [m/s] */
+  int init_streak_kz;    /*!< streaks across lz [-] */
+  double init_modes;     /*!< amplitude of the divergence-free sinusoidal modes [m/s] */
+  int init_mode_kx;      /*!< their wavenumber along x (periods in lx) [-] */
+  int init_mode_kz;      /*!< their wavenumber along z (periods in lz) [-] */
+  double init_noise;     /*!< amplitude of the random noise per component [m/s] */
+  long init_seed;        /*!< key of the counter-based generator [-] */
+  long init_eddies;      /*!< synthetic eddies (0 = box volume / sigma^3) [-] */
+  double init_eddy_size; /*!< synthetic-eddy half-width sigma [delta] */
+  char init_from[512];   /*!< particles.nc of an earlier run to start from, or empty */
   /* [output] */
   int log_every;          /*!< steps between log lines */
   int series_every;       /*!< steps between time-series records */

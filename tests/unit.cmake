@@ -65,3 +65,10 @@ add_executable(energy_check energy_check.c)
 target_link_libraries(energy_check PRIVATE chansph_core)
 add_test(NAME stability_energy COMMAND energy_check --check)
 set_tests_properties(stability_energy PROPERTIES LABELS "stability;validation")
+
+#   test_init:   synthetic-eddy start-up (init.profile = synthetic) against the Lee & Moser 180
+#                mean and Reynolds stresses, zero at the walls, bitwise across thread counts
+add_executable(test_init test_init.c)
+target_link_libraries(test_init PRIVATE chansph_core m)
+add_test(NAME unit_init COMMAND test_init)
+set_tests_properties(unit_init PROPERTIES LABELS unit)
