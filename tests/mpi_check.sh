@@ -4,6 +4,8 @@
 #   bitwise2d  2-D channel, 200 steps, every statistics engine, ranks 1-4
 #   bitwise3d  3-D LES (Smagorinsky, Reichardt wall law), 200 steps, every engine, ranks 1-4,
 #              and 2 ranks x 2 threads
+#   synthetic  3-D quasi-DNS smoke box from the synthetic-eddy start-up (init.profile =
+#              synthetic), 20 steps: 1 rank = 2 ranks = 1 rank x 2 threads = 2 ranks x 2 threads
 #   migration  fast 2-D flow (Mach 0.5) on 3 and 4 ranks, ids checked after every step,
 #              load checks every 7 steps (4 ranks start from a skewed partition); equals 1 rank
 #   too_many   more ranks than the slabs allow: a message naming domain.lx, exit 1
@@ -113,6 +115,18 @@ case $case in
       cmp -s r2/checkpoints/ckpt_0000000200.h5 r$np/checkpoints/ckpt_0000000200.h5 ||
         { echo "FAIL: the checkpoints of 2 and $np ranks differ in bytes"; fail=1; }
     done
+    ;;
+  synthetic)
+    scene=$scenes/qdns180_smoke.ini
+    args=(--set init.profile=synthetic --set init.streaks=0 --set init.modes=0 --set init.noise=0
+      --set init.seed=11 --set time.max_steps=20 --set output.stats_every=5)
+    for run in 1:1 2:1 1:2 2:2; do
+      np=${run%:*} nt=${run#*:}
+      OMP_NUM_THREADS=$nt mpi "$np" run "$scene" --out r${np}x$nt --overwrite "${args[@]}" \
+        > r${np}x$nt.txt 2>&1 || { tail -20 r${np}x$nt.txt; echo "FAIL: $np ranks x $nt threads"; exit 1; }
+    done
+    grep -h "init: synthetic" r1x1.txt
+    for r in r2x1 r1x2 r2x2; do compare r1x1 $r 20; done
     ;;
   migration)
     scene=$scenes/poiseuille2d.ini
