@@ -329,10 +329,14 @@ int init_sem_make(struct init_sem *E, const struct scene *sc) {
   if (n <= 0) n = (long)fmax(1.0, floor(vol / (sig * sig * sig) + 0.5));
   E->n = (size_t)n;
   E->scale = sqrt(vol / (sig * sig * sig) / (double)n);
-  /* cells of width >= sigma; fewer than 3 along a periodic direction: one cell (the nearest
-     image is then the only one within sigma, as sigma <= l/2) */
-  E->nx = (int)floor(E->lx / sig), E->ny = (int)fmax(1.0, floor(E->ly / sig));
-  E->nz = (int)floor(E->lz / sig);
+  /* cells of width w >= sigma, no more cells than about 4 per eddy (w grows for a few eddies
+     in a large box); fewer than 3 along a periodic direction: one cell (the nearest image is
+     then the only one within sigma, as sigma <= l/2) */
+  double w = sig;
+  while (floor(E->lx / w) * floor(E->ly / w) * floor(E->lz / w) > 4.0 * (double)E->n + 64.0)
+    w *= 1.25;
+  E->nx = (int)floor(E->lx / w), E->ny = (int)fmax(1.0, floor(E->ly / w));
+  E->nz = (int)floor(E->lz / w);
   if (E->nx < 3) E->nx = 1;
   if (E->nz < 3) E->nz = 1;
   const size_t ncell = (size_t)E->nx * E->ny * E->nz;

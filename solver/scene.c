@@ -218,9 +218,9 @@ static const struct key keys[] = {
      OFF(init_noise)},
     {"init", "seed", T_LONG, "1", 0, 1e15, 0, NULL, "-",
      "Key of the random noise and of the synthetic eddies.", OFF(init_seed)},
-    {"init", "eddies", T_LONG, "0", 0, 1e9, 0, NULL, "-",
+    {"init", "eddies", T_LONG, "0", 0, 1e8, 0, NULL, "-",
      "Number N of synthetic eddies of profile = synthetic, placed in the box lx x (2 delta + "
-     "2 eddy_size) x lz; 0 = the box volume / eddy_size^3.",
+     "2 sigma) x lz (sigma = eddy_size delta); 0 = the box volume / sigma^3.",
      OFF(init_eddies)},
     {"init", "eddy_size", T_DOUBLE, "0.2", 0, BIG, LO_OPEN, NULL, "delta",
      "Half-width sigma of the synthetic eddies (tent shape functions), in units of delta; at "

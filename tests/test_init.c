@@ -10,6 +10,8 @@
  *     eddies, not of particles; the expectation is the table exactly (the reference is the
  *     same interpolation at the same y), the 1% is for the estimate of the standard error;
  *   - -u'v' / (u_rms v_rms) in 20 < y+ < 100 between 0.35 and 0.55 (DNS about 0.45);
+ *   - the cell search of the eddies equals a sum over all eddies (3000 points, default count
+ *     and 40 eddies);
  *   - exactly zero velocity at the walls (y = 0, y = 2 delta);
  *   - bitwise identical velocities with 1 and 2 threads.
  */
@@ -123,6 +125,38 @@ int main(int argc, char **argv) {
   const double rho = rho_sum / nband;
   printf("  -u'v'/(u_rms v_rms) = %.3f (DNS %.3f), want 0.35-0.55\n", rho, rho_dns / nband);
   fail |= !(rho > 0.35 && rho < 0.55);
+
+  /* the cell search against a sum over all eddies, at the default count (cells of width
+     sigma) and at 40 eddies (wider cells) */
+  double brute = 0.0;
+  for (int pass = 0; pass < 2; pass++) {
+    sc.init_eddies = pass ? 40 : 0;
+    struct init_sem B;
+    init_sem_make(&B, &sc);
+    for (int k = 0; k < 3000; k++) {
+      const double x = sc.lx * (init_noise(5, k, 0) + 1) / 2 - 1.0, y = (init_noise(5, k, 1) + 1);
+      const double z = sc.lz * (init_noise(5, k, 2) + 1) / 2 + 2.0, f = 1.5 * sqrt(1.5);
+      double xi[3], want[3] = {0, 0, 0};
+      init_sem_xi(&B, x, y, z, xi);
+      for (size_t e = 0; e < B.n; e++) {
+        double dx = x - B.pos[3 * e], dz = z - B.pos[3 * e + 2];
+        dx -= sc.lx * floor(dx / sc.lx + 0.5), dz -= sc.lz * floor(dz / sc.lz + 0.5);
+        const double ax = fabs(dx) / B.sigma, ay = fabs(y - B.pos[3 * e + 1]) / B.sigma;
+        const double az = fabs(dz) / B.sigma;
+        if (ax < 1 && ay < 1 && az < 1)
+          for (int c = 0; c < 3; c++)
+            want[c] += B.eps[3 * e + c] * f * (1 - ax) * (1 - ay) * (1 - az) * B.scale;
+      }
+      for (int c = 0; c < 3; c++) brute = fmax(brute, fabs(xi[c] - want[c]));
+    }
+    printf(
+        "cell search (%zu eddies, %d x %d x %d cells) against all eddies: max |difference| "
+        "%.2e (tol 1e-12)\n",
+        B.n, B.nx, B.ny, B.nz, brute);
+    init_sem_free(&B);
+  }
+  fail |= !(brute < 1e-12);
+  sc.init_eddies = 0;
 
   /* walls: exactly zero */
   struct init_sem E;
