@@ -439,6 +439,10 @@ static void synthetic(const struct scene *sc, double ut, struct particles *P) {
   msg("init: synthetic eddies (Jarrin et al. 2006): %zu eddies of size %.4g m, Lee & Moser "
       "Re_tau = 180 profiles with u_tau = %.6g m/s (Re_tau = %.4g)\n",
       E.n, E.sigma, ut, ut * sc->delta / sc->nu);
+  if (ut * sc->delta / sc->nu > 1.1 * dns_lm180_re_tau)
+    msg("init: note: Re_tau = %.4g is above the table's %.6g: beyond y+ = %.4g the synthetic "
+        "field has the table's centre-line values (docs/theory.md)\n",
+        ut * sc->delta / sc->nu, dns_lm180_re_tau, dns_lm180[DNS_LM180_N - 1][0]);
   init_sem_free(&E);
 }
 
