@@ -4,8 +4,10 @@
  *        sum, assembled from the pair terms of pair.h.
  *
  * The terms a scene needs are fixed for the whole run, so the pair loop is specialised once per
- * combination (viscous operator x pressure-gradient form: the table `loops` below) and chosen
- * before the particle loop; the loops have no branches per pair and vectorise. Each particle's
+ * combination (data path x viscous operator x pressure-gradient form: the table `loops` below)
+ * and chosen before the particle loop; the loops have no branches per pair and vectorise. The
+ * data path: with AVX-512 the neighbours' pair records are gathered into contiguous buffers
+ * (records.h), otherwise the loops read the particle arrays through the list. Each particle's
  * neighbour list holds its fluid neighbours first, then the wall vertices (nbr.h): the fluid
  * part adds the volume diffusion, the vertex part gives the viscous pull of the wall for the
  * wall shear stress of the statistics. The per-particle part (normalisation, wall terms,
