@@ -16,11 +16,11 @@ rm -rf "$d"
 pid=$!
 # under way: its first checkpoint is written (at most 300 s on a loaded machine)
 for _ in $(seq 3000); do
-  ls "$d"/checkpoints/ckpt_*.h5 > /dev/null 2>&1 && break
+  compgen -G "$d/checkpoints/ckpt_*.h5" > /dev/null && break
   kill -0 $pid 2> /dev/null || break
   sleep 0.1
 done
-ls "$d"/checkpoints/ckpt_*.h5 > /dev/null 2>&1 || fail "the run did not start"
+compgen -G "$d/checkpoints/ckpt_*.h5" > /dev/null || fail "the run did not start"
 before=$(ls "$d/checkpoints" | head -n 1)
 out=$("$chansph" resume "$d" --max-steps 2 2>&1) # --max-steps: no long run without the lock
 rc=$?
