@@ -86,10 +86,44 @@ __attribute__((target("avx512f"))) static void gather_avx512(const double *restr
 }
 #endif
 
+#if REC_AVX512
+/* Half 1 holds only four fields (REC_M .. REC_NUR): 256-bit loads of eight records, paired
+   into 512-bit rows, then one round of unpacks and one of two-source permutes. */
+__attribute__((target("avx512f"))) static void gather4_avx512(const double *restrict rec,
+                                                              const int32_t *restrict nl, int cnt,
+                                                              double *restrict out, int ld) {
+  const double *base = rec + 8;
+  const __m512i lo = _mm512_setr_epi64(0, 1, 8, 9, 4, 5, 12, 13);
+  const __m512i hi = _mm512_setr_epi64(2, 3, 10, 11, 6, 7, 14, 15);
+  int j = 0;
+  for (; j + 8 <= cnt; j += 8) {
+    __m512d z[4];
+    for (int k = 0; k < 4; k++) /* records k and k + 4: a0 a1 a2 a3 | e0 e1 e2 e3 */
+      z[k] = _mm512_insertf64x4(
+          _mm512_castpd256_pd512(_mm256_load_pd(base + (size_t)nl[j + k] * REC_LEN)),
+          _mm256_load_pd(base + (size_t)nl[j + k + 4] * REC_LEN), 1);
+    const __m512d t0 = _mm512_unpacklo_pd(z[0], z[1]); /* a0 b0 a2 b2 | e0 f0 e2 f2 */
+    const __m512d t1 = _mm512_unpackhi_pd(z[0], z[1]); /* a1 b1 a3 b3 | e1 f1 e3 f3 */
+    const __m512d t2 = _mm512_unpacklo_pd(z[2], z[3]); /* c0 d0 c2 d2 | g0 h0 g2 h2 */
+    const __m512d t3 = _mm512_unpackhi_pd(z[2], z[3]); /* c1 d1 c3 d3 | g1 h1 g3 h3 */
+    double *o = out + j;
+    _mm512_store_pd(o + 0 * (size_t)ld, _mm512_permutex2var_pd(t0, lo, t2));
+    _mm512_store_pd(o + 2 * (size_t)ld, _mm512_permutex2var_pd(t0, hi, t2));
+    _mm512_store_pd(o + 1 * (size_t)ld, _mm512_permutex2var_pd(t1, lo, t3));
+    _mm512_store_pd(o + 3 * (size_t)ld, _mm512_permutex2var_pd(t1, hi, t3));
+  }
+  for (; j < cnt; j++)
+    for (int f = 0; f < 4; f++) out[(size_t)f * ld + j] = base[(size_t)nl[j] * REC_LEN + f];
+}
+#endif
+
 void records_gather(const double *rec, const int32_t *nl, int cnt, int half, double *out, int ld) {
 #if REC_AVX512
   if (use_avx512) {
-    gather_avx512(rec, nl, cnt, half, out, ld);
+    if (half == 1)
+      gather4_avx512(rec, nl, cnt, out, ld); /* fields 8 + 4 .. 15 are spare: not gathered */
+    else
+      gather_avx512(rec, nl, cnt, half, out, ld);
     return;
   }
 #endif

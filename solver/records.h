@@ -51,7 +51,8 @@ void records_pack(struct particles *P, size_t n);
 
 /**
  * @brief Copy half `half` (fields 8 half .. 8 half + 7) of the records of the particles
- *        nl[0 .. cnt-1] to out[f * ld + j], f = 0 .. 7, j = 0 .. cnt-1.
+ *        nl[0 .. cnt-1] to out[f * ld + j], f = 0 .. 7, j = 0 .. cnt-1 (of half 1 only the
+ *        fields in use, REC_M .. REC_NUR, are guaranteed).
  * @param ld leading dimension of out, a multiple of 8; out 64-byte aligned
  */
 void records_gather(const double *rec, const int32_t *nl, int cnt, int half, double *out, int ld);
