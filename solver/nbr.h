@@ -16,6 +16,7 @@
 #include <stdint.h>
 
 #include "kernel.h"
+#include "pair.h"
 #include "part.h"
 
 /** Cells per kernel support radius 2h: cells of size >= h, a stencil of 5 cells per direction
@@ -137,11 +138,7 @@ void nbr_build(struct nbr *nb, const struct particles *P, const struct kernel *K
 
 /** @brief Minimum-image separation in a periodic direction of length l (|d| < l/2 after). */
 static inline double nbr_wrap(double d, const double l) {
-  if (d > 0.5 * l)
-    d -= l;
-  else if (d < -0.5 * l)
-    d += l;
-  return d;
+  return pair_wrap(d, l, 0.5 * l);
 }
 
 #endif
