@@ -142,7 +142,7 @@ static CHANSPH_CLONES void vertex_shepard(const struct model *M, const struct pa
                                           const struct nbr *nb, size_t v, double out[3]) {
   const struct kernel K = M->k;
   const double *restrict x = P->x, *restrict y = P->y, *restrict z = P->z, *restrict m = P->m;
-  const double *restrict rho = P->rho, *restrict p = P->p;
+  const double *restrict rho = P->rho, *restrict p = P->p, *restrict V = P->vol;
   const int32_t *restrict nl = nb->list + v * (size_t)nb->stride;
   const double xv = x[v], yv = y[v], zv = z[v], lx = M->lx, lz = M->lz, gy = M->gy;
   const int d3 = M->dim == 3;
@@ -151,7 +151,7 @@ static CHANSPH_CLONES void vertex_shepard(const struct model *M, const struct pa
   for (int j = 0; j < nb->nfluid[v]; j++) {
     const int32_t b = nl[j];
     const struct pair g = pair_geom(&K, lx, lz, d3, xv - x[b], yv - y[b], zv - z[b]);
-    const double wvb = pair_w(&K, g.r), vol = m[b] / rho[b];
+    const double wvb = pair_w(&K, g.r), vol = V[b]; /* m_b / rho_b, set by sph_density */
     alpha += vol * wvb;
     mw += m[b] * wvb;
     pw += vol * (p[b] / rho[b] + gy * g.dy) * wvb;
