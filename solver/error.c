@@ -14,15 +14,29 @@ static int my_rank(void) {
   return rank;
 }
 
+/* One message line, formatted whole and written with one call: under mpirun a rank's stdout
+   and stderr reach the terminal through separate pipes, and a line written in pieces can be
+   split by a line of the other stream (seen: "error: " + a log line + the message). */
+static void emit(FILE *to, const char *prefix, const char *fmt, va_list ap) {
+  char buf[4096];
+  int n = snprintf(buf, sizeof buf, "%s", prefix);
+  if (n < 0) n = 0;
+  const int m = vsnprintf(buf + n, sizeof buf - (size_t)n - 1, fmt, ap);
+  size_t len = (size_t)n + (m > 0 ? (size_t)m : 0);
+  if (len > sizeof buf - 2) len = sizeof buf - 2;
+  buf[len++] = '\n';
+  fwrite(buf, 1, len, to);
+  fflush(to);
+}
+
 noreturn void error_die(const char *file, int line, const char *func, const char *fmt, ...) {
   fflush(stdout);
-  fprintf(stderr, "[%d] %s:%d %s(): ", my_rank(), file, line, func);
+  char prefix[512];
+  snprintf(prefix, sizeof prefix, "[%d] %s:%d %s(): ", my_rank(), file, line, func);
   va_list ap;
   va_start(ap, fmt);
-  vfprintf(stderr, fmt, ap);
+  emit(stderr, prefix, fmt, ap);
   va_end(ap);
-  fputc('\n', stderr);
-  fflush(stderr);
   int init = 0, fin = 0;
   MPI_Initialized(&init);
   MPI_Finalized(&fin);
@@ -32,25 +46,19 @@ noreturn void error_die(const char *file, int line, const char *func, const char
 
 void error_warn(const char *fmt, ...) {
   fflush(stdout);
-  fprintf(stderr, "warning: ");
   va_list ap;
   va_start(ap, fmt);
-  vfprintf(stderr, fmt, ap);
+  emit(stderr, "warning: ", fmt, ap);
   va_end(ap);
-  fputc('\n', stderr);
-  fflush(stderr);
 }
 
 void error_input(const char *fmt, ...) {
   if (my_rank() != 0) return;
   fflush(stdout);
-  fprintf(stderr, "error: ");
   va_list ap;
   va_start(ap, fmt);
-  vfprintf(stderr, fmt, ap);
+  emit(stderr, "error: ", fmt, ap);
   va_end(ap);
-  fputc('\n', stderr);
-  fflush(stderr);
 }
 
 void error_msg(const char *fmt, ...) {
@@ -58,11 +66,10 @@ void error_msg(const char *fmt, ...) {
   char stamp[32];
   const time_t now = time(NULL);
   strftime(stamp, sizeof stamp, "%H:%M:%S", localtime(&now));
-  printf("[%s] ", stamp);
+  char prefix[40];
+  snprintf(prefix, sizeof prefix, "[%s] ", stamp);
   va_list ap;
   va_start(ap, fmt);
-  vprintf(fmt, ap);
+  emit(stdout, prefix, fmt, ap);
   va_end(ap);
-  putchar('\n');
-  fflush(stdout);
 }
