@@ -451,6 +451,17 @@ static hid_t open_dataset(hid_t file, const char *name, const char *path, char *
   return ds;
 }
 
+/* 1 if every component of a path exists (a dataset of an earlier format may not). */
+static int link_exists(hid_t file, const char *name) {
+  char part[128];
+  for (const char *s = strchr(name, '/');; s = strchr(s + 1, '/')) {
+    const int len = s ? (int)(s - name) : (int)strlen(name);
+    snprintf(part, sizeof part, "%.*s", len, name);
+    if (H5Lexists(file, part, H5P_DEFAULT) <= 0) return 0;
+    if (!s) return 1;
+  }
+}
+
 /* Read a string dataset (shape (1,), fixed length) into a malloc'd string. */
 static char *read_text(hid_t file, const char *name, const char *path, char *err, size_t errlen) {
   const hid_t ds = open_dataset(file, name, path, err, errlen);
@@ -587,6 +598,7 @@ static int read_field(hid_t file, struct state_field *f, const char *path, char 
     *(char **)f->data = text;
     return 0;
   }
+  if (f->optional && !link_exists(file, f->name)) return 0;
   const hid_t ds = open_dataset(file, f->name, path, err, errlen);
   if (ds < 0) return 1;
   int rc = 1;

@@ -27,7 +27,8 @@ enum {
   F_AX,
   F_AY,
   F_AZ,
-  F_ID,
+  F_SX, /* SX_LEN parts of the x-acceleration (the momentum budget), zero unless live */
+  F_ID = F_SX + SX_LEN,
   F_KIND,
   F_LEN
 };
@@ -53,6 +54,7 @@ static void pack(const struct particles *P, size_t a, double *r) {
   r[F_RHO] = P->rho[a], r[F_M] = P->m[a], r[F_GAM] = P->gam[a];
   r[F_KSUM] = P->ksum[a], r[F_DDIFF] = P->ddiff[a];
   r[F_AX] = P->ax[a], r[F_AY] = P->ay[a], r[F_AZ] = P->az[a];
+  for (int k = 0; k < SX_LEN; k++) r[F_SX + k] = P->sx && P->sx_live ? P->sx[a * SX_LEN + k] : 0.0;
   memcpy(&r[F_ID], &P->id[a], sizeof(double));
   r[F_KIND] = P->kind[a];
 }
@@ -63,6 +65,8 @@ static void unpack(struct particles *P, size_t a, const double *r) {
   P->rho[a] = r[F_RHO], P->m[a] = r[F_M], P->gam[a] = r[F_GAM];
   P->ksum[a] = r[F_KSUM], P->ddiff[a] = r[F_DDIFF];
   P->ax[a] = r[F_AX], P->ay[a] = r[F_AY], P->az[a] = r[F_AZ];
+  if (P->sx && P->sx_live)
+    for (int k = 0; k < SX_LEN; k++) P->sx[a * SX_LEN + k] = r[F_SX + k];
   memcpy(&P->id[a], &r[F_ID], sizeof(double));
   P->kind[a] = (uint8_t)r[F_KIND];
 }

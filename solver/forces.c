@@ -37,6 +37,7 @@ struct fctx {
   const struct walls *W;
   double fx;       /*!< driving acceleration (time-step limit only) [m/s^2] */
   double *wall_ax; /*!< x-acceleration from the walls, or NULL */
+  double *sx;      /*!< parts of the x-acceleration (enum part_sx), or NULL */
 };
 
 /** Pair sums of one particle over one part of its neighbour list. */
@@ -49,6 +50,7 @@ struct fsums {
   double m1z, m2z; /*!< and z part */
   struct sym3 A;   /*!< moment matrix of the corrected gradient */
   struct v3 gc;    /*!< corrected pressure difference gradient */
+  double vmx;      /*!< LES: x part of the viscous sum with the molecular viscosity only */
 };
 
 /** Sums over the neighbours j0 .. j1-1 of particle a for the operator `visc`, the corrected
@@ -84,8 +86,9 @@ static inline __attribute__((always_inline)) void pair_sums(const struct fctx *C
   double gpx = 0, gpy = 0, gpz = 0, vx = 0, vy = 0, vz = 0, mo2 = 0, moyy = 0, mo1 = 0;
   double diff = 0, m1x = 0, m2x = 0, m1z = 0, m2z = 0;
   double axx = 0, axy = 0, axz = 0, ayy = 0, ayz = 0, azz = 0, gcx = 0, gcy = 0, gcz = 0;
+  double vmx = 0;
 #pragma omp simd reduction(+ : gpx, gpy, gpz, vx, vy, vz, mo2, moyy, mo1, diff, m1x, m2x, m1z, \
-                               m2z, axx, axy, axz, ayy, ayz, azz, gcx, gcy, gcz)
+                               m2z, axx, axy, axz, ayy, ayz, azz, gcx, gcy, gcz, vmx)
   for (int j = j0; j < j1; j++) {
     const int32_t b = gathered ? j : nl[j];
     const struct pair g = pair_geom(&K, lx, lz, d3, xa - x[b], ya - y[b], za - z[b]);
@@ -105,8 +108,10 @@ static inline __attribute__((always_inline)) void pair_sums(const struct fctx *C
       t = term_morris(&g, m[b], ira, vb, eta2, uab);
     else if (visc == VK_VIOLEAU)
       t = term_violeau(&g, vb, 0.5 * (ra + rb), np2, eta2, uab);
-    else /* Eq. 2.100 with mu = rho (nu + nu_r) */
+    else { /* Eq. 2.100 with mu = rho (nu + nu_r); its molecular part for the budget */
       t = term_violeau(&g, vb, 0.5 * (mu_a + rb * (nu + nur[b])), np2, eta2, uab);
+      vmx += term_violeau(&g, vb, 0.5 * (ra + rb) * nu, np2, eta2, uab).x;
+    }
     vx += t.x, vy += t.y, vz += t.z;
     const struct v3 mo = term_moments(&g, vb);
     mo2 += mo.x, moyy += mo.y, mo1 += mo.z;
@@ -125,7 +130,8 @@ static inline __attribute__((always_inline)) void pair_sums(const struct fctx *C
                         m1z,
                         m2z,
                         {axx, axy, axz, ayy, ayz, azz},
-                        {gcx, gcy, gcz}};
+                        {gcx, gcy, gcz},
+                        vmx};
 }
 
 /** Lattice excess of the pressure wall weight at q = d/h: linear between the layers of the
@@ -137,6 +143,29 @@ static double lattice_excess(const struct model *M, double q) {
   while (k < M->n_lat - 1 && M->lat_q[k] < q) k++;
   const double t = (q - M->lat_q[k - 1]) / (M->lat_q[k] - M->lat_q[k - 1]);
   return (1.0 - t) * M->lat_e[k - 1] + t * M->lat_e[k];
+}
+
+/** The x-acceleration of particle a by its fluid neighbours, split by term into
+    sx[SX_PRESSURE .. SX_MODEL]: the expressions of force_finish applied to the fluid part s of
+    the sums (sv: the vertex part, for the matrix of the corrected gradient, which both parts
+    share); visk: the viscous prefactor with its normalisation. The rest of ax is the walls'. */
+static void budget_parts(const struct fctx *C, size_t a, const struct fsums *s,
+                         const struct fsums *sv, double visk, double *sx) {
+  const struct model *M = C->M;
+  const struct particles *P = C->P;
+  if (M->pgrad == PGRAD_CORRECTED) { /* -(1/rho_a) L_a g, g of the fluid neighbours only */
+    const double A[6] = {s->A.xx + sv->A.xx, s->A.xy + sv->A.xy, s->A.xz + sv->A.xz,
+                         s->A.yy + sv->A.yy, s->A.yz + sv->A.yz, s->A.zz + sv->A.zz};
+    const double gc[3] = {s->gc.x, s->gc.y, s->gc.z};
+    double gr[3];
+    sph_solve_sym(M->dim, A, gc, gr);
+    sx[SX_PRESSURE] = -gr[0] / P->rho[a];
+  } else {
+    sx[SX_PRESSURE] = -s->gp.x / P->gam[a];
+  }
+  /* with LES the viscous sum holds rho (nu + nu_r); vmx the same sum with rho nu */
+  sx[SX_VISCOUS] = visk * (M->les ? s->vmx : s->vis.x);
+  sx[SX_MODEL] = M->les ? visk * s->vis.x - sx[SX_VISCOUS] : 0.0;
 }
 
 /** Acceleration of fluid particle a from its pair sums (fluid part s, vertex part sv): the
@@ -236,7 +265,11 @@ static void force_finish(const struct fctx *C, size_t a, const struct fsums *s,
     if (g > gv) gv = g;
   }
   aya += M->gy;
+  if (C->sx) budget_parts(C, a, s, sv, vis * kx, C->sx + a * SX_LEN);
   P->ax[a] = axa, P->ay[a] = aya, P->az[a] = aza;
+  if (C->sx)
+    C->sx[a * SX_LEN + SX_WALL] = axa - C->sx[a * SX_LEN + SX_PRESSURE] -
+                                  C->sx[a * SX_LEN + SX_VISCOUS] - C->sx[a * SX_LEN + SX_MODEL];
   if (C->wall_ax) C->wall_ax[a] = awall;
   P->ddiff[a] = s->diff * M->inv_xi; /* enters gamma rho directly (Eq. 3.64): no 1/gamma */
   const double ax2 = (axa + C->fx) * (axa + C->fx) + aya * aya + aza * aza;
@@ -307,7 +340,7 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
   timer_push("forces");
   const int visc = M->les ? VK_LES : M->viscous == VISCOUS_VIOLEAU ? VK_VIOLEAU : VK_MORRIS;
   const force_loop loop = loops[records_fast()][visc][M->pgrad == PGRAD_CORRECTED];
-  const struct fctx C = {M, P, nb, W, fx, info->wall_ax};
+  const struct fctx C = {M, P, nb, W, fx, info->wall_ax, info->sx};
   const size_t n = P->n, nchunk = (n + FORCE_CHUNK - 1) / FORCE_CHUNK;
   double amax2 = 0.0, gvmax = 0.0;
 #pragma omp parallel for schedule(dynamic, 4) reduction(max : amax2, gvmax)

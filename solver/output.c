@@ -429,6 +429,7 @@ int output_step(struct output *o, struct sim *S) {
                                         .ax = P->ax,
                                         .ay = P->ay,
                                         .az = P->az,
+                                        .sx = P->sx_live ? P->sx : NULL,
                                         .id = P->id,
                                         .skip = P->kind,
                                         .t = S->t,

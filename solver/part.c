@@ -80,6 +80,7 @@ static size_t arrays(struct particles *P, struct array *t) {
                               {(void **)&P->ax, "ax", d, 1},
                               {(void **)&P->ay, "ay", d, 1},
                               {(void **)&P->az, "az", d, 1},
+                              {(void **)&P->sx, "stress_ax", SX_LEN * d, 0},
                               {(void **)&P->tmp, "sort_scratch", d, 1},
                               {(void **)&P->id, "id", sizeof(int64_t), 1},
                               {(void **)&P->tmp_i, "sort_scratch_i", sizeof(int64_t), 1},
@@ -199,6 +200,12 @@ void part_permute(struct particles *P, size_t i0, size_t n, const size_t *perm) 
   double *arrs[] = {P->x, P->y,   P->z,    P->u,     P->v,  P->w,  P->rho,
                     P->m, P->gam, P->ksum, P->ddiff, P->ax, P->ay, P->az};
   for (size_t i = 0; i < sizeof arrs / sizeof arrs[0]; i++) permute_d(arrs[i], P->tmp, i0, n, perm);
+  if (P->sx && P->sx_live) /* the budget parts of a sampled step, one column at a time */
+    for (int k = 0; k < SX_LEN; k++) {
+      double *restrict col = P->tmp;
+      for (size_t i = 0; i < n; i++) col[i] = P->sx[(i0 + perm[i]) * SX_LEN + k];
+      for (size_t i = 0; i < n; i++) P->sx[(i0 + i) * SX_LEN + k] = col[i];
+    }
   int64_t *restrict id = P->tmp_i;
   uint8_t *restrict kind = (uint8_t *)P->tmp; /* P->tmp is free after the doubles */
   for (size_t i = 0; i < n; i++) id[i] = P->id[i0 + perm[i]], kind[i] = P->kind[i0 + perm[i]];

@@ -47,6 +47,11 @@ struct particles {
   double *rec;          /*!< pair records, REC_LEN doubles a slot (records.h) */
   double *ax, *ay, *az; /*!< acceleration without the driving force at the start of the last
                              step [m/s^2]; permuted (and migrated) with the particles */
+  /** x-acceleration of the last sampled force pass split by what exerts it, SX_LEN per
+      particle (enum part_sx) [m/s^2]: the momentum budget of the statistics (euler.h). NULL
+      without Eulerian statistics; permuted and migrated with the particles while sx_live. */
+  double *sx;
+  int sx_live; /*!< 1: sx holds the values of the last force pass (a sampled step) */
   /* turbulence model (turb.h), allocated only when used, NULL otherwise; recomputed from the
      state after every step, so not permuted */
   double *nur;       /*!< eddy viscosity nu_r [m^2/s] */
@@ -56,6 +61,11 @@ struct particles {
   double *tmp;
   int64_t *tmp_i;
 };
+
+/** Parts of the x-acceleration in part.sx: the pair forces of the fluid neighbours (pressure,
+    molecular viscous, eddy-viscous) and everything the walls exert (vertex neighbours, wall
+    shear or wall law); their sum is ax. */
+enum part_sx { SX_PRESSURE, SX_VISCOUS, SX_MODEL, SX_WALL, SX_LEN };
 
 /** Wall values on the vertex lattice: index (wall * nx + i) * nz + k, wall 0 at y = 0. */
 struct walls {

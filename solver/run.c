@@ -91,7 +91,10 @@ int sim_create(struct sim *S, const struct scene *sc) {
     part_destroy(&S->P, &S->W);
     return CHANSPH_ERR;
   }
-  if (sc->stats_eulerian) S->wall_ax = part_alloc("wall_ax", sizeof(double));
+  if (sc->stats_eulerian) {
+    S->wall_ax = part_alloc("wall_ax", sizeof(double));
+    S->P.sx = part_alloc("stress_ax", S->P.cap * SX_LEN * sizeof(double));
+  }
   S->wall_fx[0] = S->wall_fx[1] = NAN;
   drive_init(&S->drive, sc);
   S->fx = S->drive.force;
@@ -137,6 +140,7 @@ void sim_free(struct sim *S) {
   for (int k = 0; k < 4; k++) part_free(S->scratch[k]);
   part_free(S->ksum_new);
   if (S->wall_ax) part_free(S->wall_ax);
+  part_free(S->P.sx), S->P.sx = NULL;
   part_destroy(&S->P, &S->W);
 }
 
@@ -228,7 +232,11 @@ void sim_step(struct sim *S) {
   struct particles *P = &S->P;
   /* the wall shear stress is gathered only on steps whose end state the statistics sample */
   const int wall_sample = S->wall_ax && (S->step + 1) % S->sc->stats_every == 0;
-  struct force_info fi = {.wall_ax = wall_sample ? S->wall_ax : NULL};
+  /* and so are the parts of the x-acceleration of the momentum budget, which then travel with
+     their particles through the sort and the migration until the sample */
+  P->sx_live = wall_sample && P->sx;
+  struct force_info fi = {.wall_ax = wall_sample ? S->wall_ax : NULL,
+                          .sx = P->sx_live ? P->sx : NULL};
   const double ub = S->drive.mode == DRIVE_FLUX ? bulk_velocity(S) : 0.0;
   sph_forces(&S->M, P, &S->nb, &S->W, S->fx, &fi);
   if (wall_sample) wall_force(S);

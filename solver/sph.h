@@ -55,6 +55,10 @@ struct force_info {
       term plus the viscous interaction with vertex particles) [m/s^2]; it gives the wall
       shear stress of the statistics (u_tau). Zero for particles away from the walls. */
   double *wall_ax;
+  /** Input: if not NULL, receives per particle the parts of the x-acceleration (SX_LEN each,
+      enum part_sx): the pair forces of the fluid neighbours by term and the walls' part; the
+      momentum budget of the statistics (method of planes, docs/theory.md). */
+  double *sx;
 };
 
 /** @brief Derive the model constants from the scene. */

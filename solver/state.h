@@ -42,7 +42,8 @@ struct state_field {
   const char *units;           /*!< physical units, or NULL */
   /** For fields sized on reading: return memory for the stored shape (or NULL). */
   void *(*reserve)(void *owner, int rank, const size_t *dims);
-  void *owner; /*!< first argument of reserve */
+  void *owner;  /*!< first argument of reserve */
+  int optional; /*!< 1: a checkpoint of an earlier format may lack it (reading leaves it) */
   /** Distributed fields (total > 0): this rank holds rows offset .. offset+dims[0]-1 of a
       dataset of total rows (the other dimensions whole); each rank reads and writes its own
       rows. total = 0: the whole field, the same on every rank. */

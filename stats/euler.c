@@ -11,8 +11,11 @@
 #include "state.h"
 
 /* Per-(column, bin) partial of one snapshot: a moment record, then the sum of u and the count
-   (the weight sum with EULER_SPH) behind the per-snapshot bin mean of u. */
-enum { EU_PART_U = MOM_LEN, EU_PART_N, EU_PART };
+   (the weight sum with EULER_SPH) behind the per-snapshot bin mean of u, then the momentum
+   budget: for each side of the channel (y < delta, y > delta; folded: the first) the sums of
+   m a_x of each part of the acceleration and of m. */
+enum { HB_MASS = EULER_SX, HB_LEN };
+enum { EU_PART_U = MOM_LEN, EU_PART_N, EU_PART_PL, EU_PART = EU_PART_PL + 2 * HB_LEN };
 
 /* Scratch of euler_sample. The columns are merged over a fixed binary tree on the global
    column index: node [lo, hi) with hi - lo >= 2 has the children [lo, mid) and [mid, hi),
@@ -61,11 +64,48 @@ const struct euler_meta euler_prof_meta[EP_NPROF] = {
     [EP_FLAT_W] = {"w_flatness", "1", "flatness (kurtosis) of w"},
     [EP_VISC] = {"viscous_stress", "m^2/s^2",
                  "viscous shear stress (nu + <nu_t>) dU/dy (Eq. 5.11; nu_t with LES only)"},
-    [EP_TOTAL] = {"total_stress", "m^2/s^2", "total shear stress nu dU/dy - <u'v'> (Eq. 5.12)"},
+    [EP_TOTAL] = {"total_stress", "m^2/s^2",
+                  "total shear stress: the sum of the momentum budget reynolds_stress + "
+                  "viscous_pair_stress + model_pair_stress + pair_stress + wall_term_stress "
+                  "(method of planes); without it (no sampled forces) nu dU/dy - <u'v'> "
+                  "(Eq. 5.12)"},
     [EP_TOTAL_EXPECTED] = {"total_stress_expected", "m^2/s^2",
-                           "tau_w / rho (1 - y / delta) with the force-balance tau_w (Eq. 5.13)"},
+                           "what the total must be in a steady state: the body force on the fluid "
+                           "between the plane and the centre per unit area and rho0, tau_w / rho "
+                           "(1 - y / delta) for a uniform density (Eq. 5.13)"},
     [EP_NUT] = {"nu_t_mean", "m^2/s", "mean eddy viscosity (LES, thesis Eq. 5.45)"},
     [EP_KR] = {"k_r_mean", "m^2/s^2", "mean residual kinetic energy (LES, Yoshizawa)"},
+    [EP_TAU_REYNOLDS] = {"reynolds_stress", "m^2/s^2",
+                         "momentum budget: the kinetic flux of the particles -<u'v'>"},
+    [EP_TAU_VISCOUS] = {"viscous_pair_stress", "m^2/s^2",
+                        "momentum budget: x-momentum flux through the plane carried by the "
+                        "viscous pair forces (molecular viscosity), method of planes"},
+    [EP_TAU_MODEL] = {"model_pair_stress", "m^2/s^2",
+                      "momentum budget: flux carried by the eddy-viscous pair forces (LES)"},
+    [EP_TAU_PAIR] = {"pair_stress", "m^2/s^2",
+                     "momentum budget: flux carried by the pressure pair forces, background "
+                     "pressure included: the configurational stress of the particle arrangement, "
+                     "the scheme's own numerical stress"},
+    [EP_TAU_WALL] = {"wall_term_stress", "m^2/s^2",
+                     "momentum budget: x-force of the wall terms on the fluid between the plane "
+                     "and the centre per unit area and rho0"},
+    [EP_TAU_SOURCE] = {"pair_momentum_source", "m^2/s^2",
+                       "net x-force of all pair forces on the fluid of this side of the channel "
+                       "per unit area and rho0 (the scheme's momentum source; zero if the pair "
+                       "forces conserve momentum): the walls balance it with drag in excess of "
+                       "the body force"},
+    [EP_SE_TAU + 0] = {"reynolds_stress_stderr", "m^2/s^2",
+                       "standard error of reynolds_stress (batch means)"},
+    [EP_SE_TAU + 1] = {"viscous_pair_stress_stderr", "m^2/s^2",
+                       "standard error of viscous_pair_stress (batch means)"},
+    [EP_SE_TAU + 2] = {"model_pair_stress_stderr", "m^2/s^2",
+                       "standard error of model_pair_stress (batch means)"},
+    [EP_SE_TAU + 3] = {"pair_stress_stderr", "m^2/s^2",
+                       "standard error of pair_stress (batch means)"},
+    [EP_SE_TAU + 4] = {"wall_term_stress_stderr", "m^2/s^2",
+                       "standard error of wall_term_stress (batch means)"},
+    [EP_SE_TAU + 5] = {"total_stress_stderr", "m^2/s^2",
+                       "standard error of total_stress (batch means)"},
 };
 
 static void *xrealloc(void *p, size_t bytes) {
@@ -90,9 +130,11 @@ static void reserve_rows(struct euler *e, size_t rows) {
   e->win = xrealloc(e->win, cap * WIN_LEN * sizeof(double));
   e->mom = xrealloc(e->mom, cap * nb * MOM_LEN * sizeof(double));
   e->snp = xrealloc(e->snp, cap * nb * SCAL_LEN * sizeof(double));
+  e->pln = xrealloc(e->pln, cap * nb * PL_LEN * sizeof(double));
   memset(e->win + old * WIN_LEN, 0, (cap - old) * WIN_LEN * sizeof(double));
   memset(e->mom + old * nb * MOM_LEN, 0, (cap - old) * nb * MOM_LEN * sizeof(double));
   memset(e->snp + old * nb * SCAL_LEN, 0, (cap - old) * nb * SCAL_LEN * sizeof(double));
+  memset(e->pln + old * nb * PL_LEN, 0, (cap - old) * nb * PL_LEN * sizeof(double));
   e->cap = cap;
 }
 
@@ -144,7 +186,7 @@ void euler_init(struct euler *e, const struct euler_config *cfg) {
 void euler_free(struct euler *e) {
   struct euler_work *k = e->work;
   if (k) free(k->part), free(k->mine), free(k->all), free(k->scr), free(k->node), free(k);
-  free(e->win), free(e->mom), free(e->snp);
+  free(e->win), free(e->mom), free(e->snp), free(e->pln);
   memset(e, 0, sizeof *e);
 }
 
@@ -166,7 +208,7 @@ static void node_merge(double *restrict a, const double *restrict b, size_t nb) 
     double *x = a + i * EU_PART;
     const double *y = b + i * EU_PART;
     mom_merge(x, y);
-    x[EU_PART_U] += y[EU_PART_U], x[EU_PART_N] += y[EU_PART_N];
+    for (int k = EU_PART_U; k < EU_PART; k++) x[k] += y[k];
   }
 }
 
@@ -212,6 +254,52 @@ static void node_record(struct euler_work *k, size_t nb, int lo, int hi, const d
   node_record(k, nb, lo, mid, rec, nn, depth + 1, out);
   node_record(k, nb, mid, hi, rec, nn, depth + 1, right);
   node_merge(out, right, nb);
+}
+
+/* The momentum budget of one snapshot from its merged per-bin sums (snap: one EU_PART record
+   per bin), added to the window's plane sums pl (docs/theory.md, "Momentum budget"). The
+   planes are the bin edges, where no particle layer of the initial lattice lies (with
+   output.n_bins = 0 the layers are the bin centres); a bin gets the mean of its two edges.
+   The flux through a plane is what the fluid between it and the centre receives across it:
+   minus the net pair force on that fluid, by term, and the pull of the wall on it (below the
+   centre, or folded: the fluid of y < delta above the plane and the wall y = 0; above the
+   centre: the fluid of y > delta below the plane, the wall y = 2 delta, and the signs of the
+   stress convention, force on the fluid below). In a steady state they balance the body force
+   on that fluid. The net pair force on a whole side (zero for a momentum-conserving scheme)
+   is the momentum source. */
+static void budget_planes(const struct euler_config *c, const double *snap, double fx, double *pl) {
+  const int nb = c->nb;
+  double tot[2][HB_LEN] = {{0}}, below[2][HB_LEN] = {{0}}, prev[PL_LEN] = {0};
+  for (int b = 0; b < nb; b++)
+    for (int k = 0; k < 2 * HB_LEN; k++)
+      tot[k / HB_LEN][k % HB_LEN] += snap[(size_t)b * EU_PART + EU_PART_PL + k];
+  const double norm = c->rho0 * c->area * (c->fold ? 2.0 : 1.0), w = (c->y1 - c->y0) / nb;
+  for (int e = 0; e <= nb; e++) { /* edge e: the bins below it are in `below` */
+    double at[PL_LEN] = {0};
+    const int lower = c->fold || c->y0 + e * w <= c->delta;
+    /* the centre side of the plane: sums over it (-1 in the lower half: above the plane) */
+    for (int k = 0; k < HB_LEN; k++) {
+      const double centre = lower ? tot[0][k] - below[0][k] : below[1][k];
+      const double sum = lower ? -centre : centre; /* stress convention */
+      if (k < EULER_SX_WALL) {
+        at[PL_PRESSURE + k] = sum / norm;
+        at[PL_SOURCE] += (lower ? tot[0][k] : -tot[1][k]) / norm;
+      } else if (k == EULER_SX_WALL) {
+        at[PL_WALL] = sum / norm;
+      } else {
+        at[PL_DRIVE] = (lower ? fx : -fx) * centre / norm;
+      }
+    }
+    if (e > 0) {
+      double *P = pl + (size_t)(e - 1) * PL_LEN;
+      for (int k = PL_PRESSURE; k < PL_LEN; k++) P[k] += 0.5 * (prev[k] + at[k]);
+      P[PL_N] += 1.0;
+    }
+    for (int k = 0; k < PL_LEN; k++) prev[k] = at[k];
+    if (e < nb)
+      for (int k = 0; k < 2 * HB_LEN; k++)
+        below[k / HB_LEN][k % HB_LEN] += snap[(size_t)e * EU_PART + EU_PART_PL + k];
+  }
 }
 
 void euler_sample(struct euler *e, const struct stats_snapshot *s) {
@@ -264,6 +352,14 @@ void euler_sample(struct euler *e, const struct stats_snapshot *s) {
                                 y,
                                 s->nu_t ? s->nu_t[a] : 0.0,
                                 s->k_r ? s->k_r[a] : 0.0};
+    if (s->sx) { /* the momentum budget: to the bin of the particle, by side */
+      int hb = (int)floor((y - c->y0) * scale);
+      hb = hb < 0 ? 0 : hb >= c->nb ? c->nb - 1 : hb;
+      double *H = P + (size_t)hb * EU_PART + EU_PART_PL + (size_t)(!c->fold && upper) * HB_LEN;
+      const double ma = s->m ? s->m[a] : 1.0;
+      for (int k = 0; k < EULER_SX; k++) H[k] += ma * s->sx[a * EULER_SX + k];
+      H[HB_MASS] += ma;
+    }
     if (c->method == EULER_SPH) {
       /* Eq. 5.56 averaged over the plane y = y_i: every profile point within 2h takes the
          sample with weight V_a W1(|y_a - y_i| / h) (a weighted one-sample merge) */
@@ -323,6 +419,7 @@ void euler_sample(struct euler *e, const struct stats_snapshot *s) {
     mom_merge(row + b * MOM_LEN, R);
     if (R[EU_PART_N] > 0.0) scal_add(srow + b * SCAL_LEN, R[EU_PART_U] / R[EU_PART_N]);
   }
+  if (s->sx) budget_planes(c, snap, s->fx, e->pln + e->nwin * nb * PL_LEN);
   win[WIN_NSNAP] += 1.0;
   win[WIN_SUM_FX] += s->fx;
   /* wall shear stress over density: minus the wall force on the fluid per unit area */
@@ -343,8 +440,53 @@ static double deriv(const double *x, const double *f, const int *ok, int n, int 
          (h1 / (h2 * (h1 + h2))) * f[r];
 }
 
+/* Profiles of the momentum budget over rows [r0, r1) (pln: the plane sums): the mean of each
+   part, the Reynolds part -<u'v'>, their sum as total_stress and the drive as its expected
+   value, with batch-means standard errors over the complete windows. Returns 0 if no snapshot
+   of the range carried the forces (the profiles stay as they are). */
+static int budget_profiles(const struct euler_config *cfg, const double *mom, const double *pln,
+                           const int *complete, size_t r0, size_t r1, struct euler_result *res) {
+  const int nb = cfg->nb;
+  int any = 0;
+  for (int b = 0; b < nb; b++) {
+    double sum[PL_LEN] = {0}, batch[6][SCAL_LEN] = {{0}};
+    for (size_t r = r0; r < r1; r++) {
+      const double *p = pln + (r * (size_t)nb + (size_t)b) * PL_LEN;
+      for (int k = 0; k < PL_LEN; k++) sum[k] += p[k];
+      const double *m = mom + (r * (size_t)nb + (size_t)b) * MOM_LEN;
+      if (!complete[r] || p[PL_N] <= 0.0 || m[MOM_N] <= 0.0) continue;
+      double w[6] = {-m[MOM_C2 + MOM_UV] / m[MOM_N], 0, 0, 0, 0, 0};
+      for (int k = 0; k < 4; k++) w[1 + k] = p[PL_PRESSURE + k] / p[PL_N];
+      const double pressure = w[1];
+      w[1] = w[2], w[2] = w[3], w[3] = pressure; /* order of EP_TAU_*: viscous, model, pair */
+      w[5] = w[0] + w[1] + w[2] + w[3] + w[4];
+      for (int k = 0; k < 6; k++) scal_add(batch[k], w[k]);
+    }
+    if (sum[PL_N] <= 0.0) {
+      for (int k = EP_TAU_REYNOLDS; k < EP_SE_TAU_END; k++) res->prof[k][b] = NAN;
+      continue;
+    }
+    any = 1;
+    const double n = sum[PL_N];
+    double *const *pr = res->prof;
+    pr[EP_TAU_REYNOLDS][b] = -pr[EP_UV][b];
+    pr[EP_TAU_VISCOUS][b] = sum[PL_VISCOUS] / n, pr[EP_TAU_MODEL][b] = sum[PL_MODEL] / n;
+    pr[EP_TAU_PAIR][b] = sum[PL_PRESSURE] / n, pr[EP_TAU_WALL][b] = sum[PL_WALL] / n;
+    pr[EP_TOTAL][b] = pr[EP_TAU_REYNOLDS][b] + pr[EP_TAU_VISCOUS][b] + pr[EP_TAU_MODEL][b] +
+                      pr[EP_TAU_PAIR][b] + pr[EP_TAU_WALL][b];
+    pr[EP_TOTAL_EXPECTED][b] = sum[PL_DRIVE] / n;
+    pr[EP_TAU_SOURCE][b] = sum[PL_SOURCE] / n;
+    for (int k = 0; k < 6; k++)
+      pr[EP_SE_TAU + k][b] =
+          batch[k][SCAL_N] >= 2.0
+              ? sqrt(batch[k][SCAL_M2] / (batch[k][SCAL_N] - 1.0) / batch[k][SCAL_N])
+              : NAN;
+  }
+  return any;
+}
+
 void euler_finalise(const struct euler_config *cfg, const double *win, const double *mom,
-                    const double *snp, const int *complete, size_t r0, size_t r1,
+                    const double *snp, const double *pln, const int *complete, size_t r0, size_t r1,
                     struct euler_result *res) {
   const int nb = cfg->nb;
   memset(res, 0, sizeof *res);
@@ -446,6 +588,12 @@ void euler_finalise(const struct euler_config *cfg, const double *win, const dou
     res->prof[EP_VISC][b] = nu_eff * dudy;
     res->prof[EP_TOTAL][b] = nu_eff * dudy - res->prof[EP_UV][b];
     res->prof[EP_TOTAL_EXPECTED][b] = tw_force * (1.0 - yb / cfg->delta);
+  }
+  res->budget = pln && budget_profiles(cfg, mom, pln, complete, r0, r1, res);
+  if (!res->budget)
+    for (int k = EP_TAU_REYNOLDS; k < EP_SE_TAU_END; k++)
+      for (int b = 0; b < nb; b++) res->prof[k][b] = nan;
+  for (int b = 0; b < nb; b++) {
     if (b > 0 && b < nb - 1 && ok[b] && tw_force > 0.0) {
       const double err = fabs(res->prof[EP_TOTAL][b] - res->prof[EP_TOTAL_EXPECTED][b]) / tw_force;
       if (err > res->balance_error) res->balance_error = err;
@@ -481,6 +629,13 @@ static void *reserve_snp(void *owner, int rank, const size_t *dims) {
   return e->snp;
 }
 
+static void *reserve_pln(void *owner, int rank, const size_t *dims) {
+  struct euler *e = owner;
+  if (rank != 3 || dims[1] != (size_t)e->cfg.nb || dims[2] != PL_LEN) return NULL;
+  reserve_rows(e, dims[0]);
+  return e->pln;
+}
+
 void euler_state(struct euler *e, struct state_list *L) {
   const size_t rows = e->nwin + 1, nb = (size_t)e->cfg.nb;
   const size_t dw[2] = {rows, WIN_LEN}, dm[3] = {rows, nb, MOM_LEN}, ds[3] = {rows, nb, SCAL_LEN};
@@ -490,4 +645,8 @@ void euler_state(struct euler *e, struct state_list *L) {
   f->reserve = reserve_mom, f->owner = e;
   f = state_add(L, "stats/eulerian/snapshot_u", STATE_F64, 3, ds, e->snp, NULL);
   f->reserve = reserve_snp, f->owner = e;
+  const size_t dp[3] = {rows, nb, PL_LEN};
+  f = state_add(L, "stats/eulerian/planes", STATE_F64, 3, dp, e->pln, NULL);
+  f->reserve = reserve_pln, f->owner = e;
+  f->optional = 1; /* checkpoints of format 1.1 have no budget: zero rows, no budget profiles */
 }

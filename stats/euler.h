@@ -20,6 +20,17 @@
 
 struct state_list;
 
+/** Parts of the x-acceleration a snapshot may carry (stats_snapshot.sx). */
+enum { EULER_SX_PRESSURE, EULER_SX_VISCOUS, EULER_SX_MODEL, EULER_SX_WALL, EULER_SX };
+
+/** Per window and profile point, the momentum budget by the method of planes (docs/theory.md,
+    "Momentum budget"): snapshots with the parts, then sums over them of the x-momentum flux
+    through the plane y = y_i per unit area and rho0 carried by the pressure, viscous and
+    eddy-viscous pair forces and the walls, the body force on the fluid between the plane and
+    the centre (what the flux must balance) and the net pair force on the fluid of that side
+    (the scheme's momentum source, zero if it conserves momentum) [m^2/s^2]. */
+enum { PL_N, PL_PRESSURE, PL_VISCOUS, PL_MODEL, PL_WALL, PL_DRIVE, PL_SOURCE, PL_LEN };
+
 /** Per-window scalars: nominal interval, snapshots, sums over snapshots. */
 enum { WIN_T0, WIN_T1, WIN_NSNAP, WIN_SUM_FX, WIN_SUM_TW0, WIN_SUM_TW1, WIN_LEN };
 
@@ -53,6 +64,7 @@ struct euler {
   double *win;               /*!< [row][WIN_LEN] */
   double *mom;               /*!< [row][nb][MOM_LEN] moment records of the samples */
   double *snp;               /*!< [row][nb][SCAL_LEN] moments of the per-snapshot bin means of u */
+  double *pln;               /*!< [row][nb][PL_LEN] momentum budget sums (enum above) */
   void *work;                /*!< scratch of euler_sample across ranks (euler.c) */
   size_t nsub;               /*!< column subtrees gathered at the last snapshot (diagnostic) */
   double w1[EULER_W1_N + 1]; /*!< plane-averaged kernel W1(q), q = |y_a - y_i| / h (SPH) */
@@ -77,19 +89,23 @@ struct stats_snapshot {
   const double *u, *v, *w;    /*!< velocities [m/s] */
   const double *p, *rho, *m;  /*!< pressure [Pa], density [kg/m^3], mass [kg] */
   const double *ax, *ay, *az; /*!< accelerations without the body force [m/s^2], or NULL */
-  const double *nu_t;         /*!< eddy viscosity [m^2/s], or NULL (no LES) */
-  const double *k_r;          /*!< residual kinetic energy [m^2/s^2], or NULL (no LES) */
-  const int64_t *id;          /*!< global ids */
-  const uint8_t *skip;        /*!< nonzero: not a fluid particle, not sampled */
-  double t;                   /*!< simulated time [s] */
-  double fx;                  /*!< streamwise body acceleration applied [m/s^2] */
-  long step;                  /*!< step number */
-  double wall_fx[2];          /*!< x-force of the walls y = 0, 2 delta on the fluid [N];
-                                   NaN if unknown */
-  const int *col;             /*!< global cell column of each particle, or NULL (all in col0) */
-  int ncol;                   /*!< global cell columns along x (0 with col = NULL: serial) */
-  int col0, col1;             /*!< this rank's columns [col0, col1) */
-  MPI_Comm comm;              /*!< ranks sharing the snapshot; MPI_COMM_NULL: serial */
+  /** Parts of the x-acceleration of the force pass that led to this state, EULER_SX per
+      particle (pressure, molecular viscous and eddy-viscous pair forces of the fluid
+      neighbours, the walls' part) [m/s^2], or NULL: the momentum budget (EULER_PLANES). */
+  const double *sx;
+  const double *nu_t;  /*!< eddy viscosity [m^2/s], or NULL (no LES) */
+  const double *k_r;   /*!< residual kinetic energy [m^2/s^2], or NULL (no LES) */
+  const int64_t *id;   /*!< global ids */
+  const uint8_t *skip; /*!< nonzero: not a fluid particle, not sampled */
+  double t;            /*!< simulated time [s] */
+  double fx;           /*!< streamwise body acceleration applied [m/s^2] */
+  long step;           /*!< step number */
+  double wall_fx[2];   /*!< x-force of the walls y = 0, 2 delta on the fluid [N];
+                            NaN if unknown */
+  const int *col;      /*!< global cell column of each particle, or NULL (all in col0) */
+  int ncol;            /*!< global cell columns along x (0 with col = NULL: serial) */
+  int col0, col1;      /*!< this rank's columns [col0, col1) */
+  MPI_Comm comm;       /*!< ranks sharing the snapshot; MPI_COMM_NULL: serial */
 };
 
 /** Finished profiles: names, units and long names are in euler_prof_meta. */
@@ -121,7 +137,15 @@ enum {
   EP_TOTAL_EXPECTED,
   EP_NUT,
   EP_KR,
-  EP_NPROF
+  EP_TAU_REYNOLDS, /* the momentum budget, method of planes: see euler_prof_meta */
+  EP_TAU_VISCOUS,
+  EP_TAU_MODEL,
+  EP_TAU_PAIR,
+  EP_TAU_WALL,
+  EP_TAU_SOURCE,
+  EP_SE_TAU, /* stderr of the five above and of total_stress, in that order */
+  EP_SE_TAU_END = EP_SE_TAU + 6,
+  EP_NPROF = EP_SE_TAU_END
 };
 
 /** Name, units and long name of each finished profile. */
@@ -141,6 +165,8 @@ struct euler_result {
   double re_tau;          /*!< u_tau delta / nu */
   double corr_time;       /*!< integrated correlation time of the bin means of u [s] */
   double balance_error;   /*!< max |total - expected| / u_tau_force^2 over interior bins */
+  int budget;             /*!< 1: total_stress is the method-of-planes budget (snapshots with
+                               the parts of the acceleration); 0: nu dU/dy - <u'v'> */
   double t0, t1;          /*!< averaged interval [s] */
   double snapshots;       /*!< snapshots averaged */
   int n_batches;          /*!< complete windows used as batches for the standard errors */
@@ -175,12 +201,12 @@ void euler_sample(struct euler *e, const struct stats_snapshot *s);
  *        force), the total shear stress of Eq. 5.11-5.13.
  *        Standard errors from the batch means of the complete windows in the range.
  * @param[in] cfg configuration (bins, delta, nu, rho0, area)
- * @param[in] win,mom,snp raw rows, as in struct euler
+ * @param[in] win,mom,snp,pln raw rows, as in struct euler (pln may be NULL: no budget)
  * @param[in] complete per-row flag: 1 for a closed window (batch), 0 for a partial one
  * @param[out] res result (allocated; free with euler_result_free)
  */
 void euler_finalise(const struct euler_config *cfg, const double *win, const double *mom,
-                    const double *snp, const int *complete, size_t r0, size_t r1,
+                    const double *snp, const double *pln, const int *complete, size_t r0, size_t r1,
                     struct euler_result *res);
 
 /** @brief Free a result. */

@@ -51,7 +51,7 @@ static int find_prof(const char *name) {
 struct stored {
   struct euler_config cfg;
   size_t rows;
-  double *win, *mom, *snp;
+  double *win, *mom, *snp, *pln; /* pln: NULL in a file without the momentum budget */
   int *complete;
   double t_reached; /* the run's reached time (global attribute t_reached; NaN if absent) */
 };
@@ -105,13 +105,21 @@ static int read_stored(const char *path, struct stored *s) {
       fprintf(stderr, "error: %s: cannot read the raw windows\n", path);
       bad = 1;
     }
+    int vp; /* the momentum budget: absent in files of earlier versions */
+    if (!bad && s->rows && nc_inq_varid(g, "planes", &vp) == NC_NOERR) {
+      s->pln = malloc(r * nb * PL_LEN * sizeof(double));
+      if (!s->pln || nc_get_var_double(g, vp, s->pln)) {
+        fprintf(stderr, "error: %s: cannot read the raw windows (planes)\n", path);
+        bad = 1;
+      }
+    }
   }
   nc_close(ncid);
   return bad;
 }
 
 static void free_stored(struct stored *s) {
-  free(s->win), free(s->mom), free(s->snp), free(s->complete);
+  free(s->win), free(s->mom), free(s->snp), free(s->pln), free(s->complete);
 }
 
 /* A time of --window between text and stop: empty gives dflt; anything but one finite number
@@ -195,7 +203,7 @@ int extract_main(int argc, char **argv) {
     return 1;
   }
   struct euler_result res;
-  euler_finalise(&s.cfg, s.win, s.mom, s.snp, s.complete, r0, r1, &res);
+  euler_finalise(&s.cfg, s.win, s.mom, s.snp, s.pln, s.complete, r0, r1, &res);
   /* columns */
   int cols[64], rms[64], nc = 0;
   char *list = strdup(vars);

@@ -75,7 +75,7 @@ static void eulerian_result(const struct euler *e, struct euler_result *res) {
   const size_t rows = euler_rows(e);
   int *complete = calloc(rows ? rows : 1, sizeof *complete);
   for (size_t r = 0; r < rows; r++) complete[r] = r < e->nwin;
-  euler_finalise(&e->cfg, e->win, e->mom, e->snp, complete, 0, rows, res);
+  euler_finalise(&e->cfg, e->win, e->mom, e->snp, e->pln, complete, 0, rows, res);
   free(complete);
 }
 
@@ -114,6 +114,30 @@ void stats_progress(const struct stats *st, const struct stats_target *tg,
   euler_result_free(&r);
 }
 
+void stats_turbulence(const struct euler_config *c, const struct euler_result *r,
+                      struct stats_turb *t) {
+  const double ut = r->u_tau > 0.0 ? r->u_tau : r->u_tau_force, ut2 = ut * ut;
+  t->uv_peak = t->y_peak = t->r_uv = t->pair_share = t->resolved_share = NAN;
+  double rsum = 0.0, best = INFINITY;
+  int rn = 0;
+  for (int b = 0; b < r->nb; b++) {
+    const double y = r->prof[EP_Y_MEAN][b], up = !c->fold && y > c->delta;
+    const double yp = (up ? 2.0 * c->delta - y : y) * ut / c->nu;
+    const double muv = (up ? 1.0 : -1.0) * r->prof[EP_UV][b]; /* -u'v' towards the centre */
+    if (!isfinite(muv) || !(ut2 > 0.0)) continue;
+    if (!(muv / ut2 <= t->uv_peak)) t->uv_peak = muv / ut2, t->y_peak = yp;
+    const double rms = sqrt(r->prof[EP_UU][b] * r->prof[EP_VV][b]);
+    if (yp >= 30.0 && yp <= 100.0 && rms > 0.0) rsum += muv / rms, rn++;
+    const double tot = r->prof[EP_TOTAL][b];
+    if (r->budget && fabs(yp - 30.0) < best && fabs(tot) > 0.0) { /* the bin nearest y+ = 30 */
+      best = fabs(yp - 30.0);
+      t->pair_share = r->prof[EP_TAU_PAIR][b] / tot;
+      t->resolved_share = r->prof[EP_TAU_REYNOLDS][b] / tot;
+    }
+  }
+  if (rn) t->r_uv = rsum / rn;
+}
+
 void stats_convergence_line(const struct stats *st, char *buf, size_t len) {
   buf[0] = '\0';
   if (!st->cfg.eulerian || euler_rows(&st->eu) == 0) return;
@@ -135,7 +159,27 @@ void stats_convergence_line(const struct stats *st, char *buf, size_t len) {
            : win < 5.0 * r.corr_time ? " (windows shorter than 5 correlation times: error bars "
                                        "too small; increase stats.window)"
                                      : "");
+  /* is it turbulent? the -u'v' peak and R_uv of the last window, the budget's split at y+ 30 */
+  struct stats_turb all, last;
+  stats_turbulence(&st->cfg.eul, &r, &all);
   euler_result_free(&r);
+  const struct euler *e = &st->eu;
+  const size_t rows = euler_rows(e), r0 = e->nwin > 0 ? e->nwin - 1 : 0; /* last complete */
+  int *complete = malloc(rows * sizeof(int));
+  if (!complete) return;
+  for (size_t w = 0; w < rows; w++) complete[w] = w < e->nwin;
+  euler_finalise(&e->cfg, e->win, e->mom, e->snp, e->pln, complete, r0, r0 + 1, &r);
+  stats_turbulence(&st->cfg.eul, &r, &last);
+  euler_result_free(&r);
+  free(complete);
+  const size_t used = strlen(buf);
+  if (used > 0 && used < len) buf[used - 1] = ';';
+  snprintf(buf + used, len - used,
+           " turbulence (last window): -u'v'+ peak %.3g at y+ %.3g, R_uv(30<y+<100) %.3g; "
+           "average -u'v'+ peak %.3g; stress at y+ 30: resolved %.0f%%, pair (numerical) "
+           "%.0f%%\n",
+           last.uv_peak, last.y_peak, last.r_uv, all.uv_peak, 100.0 * all.resolved_share,
+           100.0 * all.pair_share);
 }
 
 #define CK(call) NC_TRY(call, fail)
@@ -180,6 +224,10 @@ static const char *const moment_names[MOM_LEN] = {
     "mean_nu_t", "mean_k_r", "C2_uu",  "C2_vv",  "C2_ww",  "C2_uv",    "C2_uw",
     "C2_vw",     "M3_u",     "M3_v",   "M3_w",   "M4_u",   "M4_v",     "M4_w"};
 static const char *const scal_names[SCAL_LEN] = {"count", "mean", "M2"};
+static const char *const plane_names[PL_LEN] = {
+    [PL_N] = "snapshots",         [PL_PRESSURE] = "sum_pair_stress",
+    [PL_VISCOUS] = "sum_viscous", [PL_MODEL] = "sum_model",
+    [PL_WALL] = "sum_wall",       [PL_DRIVE] = "sum_drive"};
 
 /* t_reached: the time the run reached (NaN: not known); an incomplete last window ends there. */
 static int write_eulerian(const struct euler *e, double t_reached, int ncid, char *err,
@@ -194,7 +242,8 @@ static int write_eulerian(const struct euler *e, double t_reached, int ncid, cha
   CK(nc_def_dim(ncid, "y", nb, &dy));
   CK(def_y(&e->cfg, ncid, dy, r.prof[EP_Y], lo, hi));
   for (int k = 0; k < EP_NPROF; k++) {
-    if (k == EP_Y || ((k == EP_NUT || k == EP_KR) && !e->cfg.les)) continue;
+    const int model = k == EP_NUT || k == EP_KR || k == EP_TAU_MODEL || k == EP_SE_TAU + 2;
+    if (k == EP_Y || (model && !e->cfg.les)) continue;
     const struct euler_meta *m = &euler_prof_meta[k];
     CK(ncout_def(ncid, m->name, NC_DOUBLE, 1, &dy, m->units, m->long_name, &vid));
     CK(ncout_fill(ncid, vid));
@@ -228,7 +277,7 @@ static int write_eulerian(const struct euler *e, double t_reached, int ncid, cha
       CK(put_att_d(ncid, NC_GLOBAL, scal[i].name, scal[i].v));
     }
   /* the raw windows: the complete accumulator state, re-averaged by chansph extract */
-  int g, dw, dwf, dm, ds, vw, vm, vs, vc, v0, v1;
+  int g, dw, dwf, dm, ds, dp, vw, vm, vs, vp, vc, v0, v1;
   CK(nc_def_grp(ncid, "eulerian", &g));
   static const char desc[] =
       "raw per-window moment records of the wall-normal bins; re-average any range of windows "
@@ -243,6 +292,7 @@ static int write_eulerian(const struct euler *e, double t_reached, int ncid, cha
   CK(nc_def_dim(g, "window_field", WIN_LEN, &dwf));
   CK(nc_def_dim(g, "moment", MOM_LEN, &dm));
   CK(nc_def_dim(g, "snapshot_moment", SCAL_LEN, &ds));
+  CK(nc_def_dim(g, "plane_field", PL_LEN, &dp));
   CK(def_y(&e->cfg, g, dy, r.prof[EP_Y], lo, hi));
   {
     double *mid = malloc(3 * (rows ? rows : 1) * sizeof *mid), *t0 = mid + rows, *t1 = t0 + rows;
@@ -268,10 +318,11 @@ static int write_eulerian(const struct euler *e, double t_reached, int ncid, cha
   CK(ncout_labels(g, "snapshot_moment", ds,
                   "fields of the records of per-snapshot bin means of u: count, mean, M2",
                   scal_names));
+  CK(ncout_labels(g, "plane_field", dp, "fields of the momentum-budget records", plane_names));
   CK(ncout_def(g, "window_start", NC_DOUBLE, 1, &dw, "s", "start of the averaging window", &v0));
   CK(ncout_def(g, "window_end", NC_DOUBLE, 1, &dw, "s", "end of the averaging window", &v1));
   CK(ncout_def(g, "window_complete", NC_INT, 1, &dw, "1", "1: closed window, 0: still open", &vc));
-  const int d2[2] = {dw, dwf}, d3m[3] = {dw, dy, dm}, d3s[3] = {dw, dy, ds};
+  const int d2[2] = {dw, dwf}, d3m[3] = {dw, dy, dm}, d3s[3] = {dw, dy, ds}, d3p[3] = {dw, dy, dp};
   CK(ncout_def(g, "windows", NC_DOUBLE, 2, d2, NULL,
                "per window: t_start [s], t_end [s], snapshots, sum of body force [m/s^2], sums "
                "of tau_w/rho at y=0 and y=2delta [m^2/s^2]",
@@ -282,6 +333,12 @@ static int write_eulerian(const struct euler *e, double t_reached, int ncid, cha
                &vm));
   CK(ncout_def(g, "snapshot_u", NC_DOUBLE, 3, d3s, NULL,
                "per window and bin: count, mean and M2 of the per-snapshot bin means of u", &vs));
+  CK(ncout_def(g, "planes", NC_DOUBLE, 3, d3p, NULL,
+               "per window and plane y (bin centre): snapshots with forces, sums over them of the "
+               "momentum flux through the plane by the pressure, viscous and eddy-viscous pair "
+               "forces and the walls, and of the body force it balances, per unit area and rho0 "
+               "[m^2/s^2] (docs/stats-format.md, momentum budget)",
+               &vp));
   for (size_t w = 0; w < rows; w++) {
     const size_t st[1] = {w}, ct[1] = {1};
     const int cpl = w < e->nwin;
@@ -293,6 +350,7 @@ static int write_eulerian(const struct euler *e, double t_reached, int ncid, cha
     CK(nc_put_var_double(g, vw, e->win));
     CK(nc_put_var_double(g, vm, e->mom));
     CK(nc_put_var_double(g, vs, e->snp));
+    CK(nc_put_var_double(g, vp, e->pln));
   }
   euler_result_free(&r);
   free(lo);

@@ -85,6 +85,20 @@ size_t stats_memory(const struct stats *st);
  */
 void stats_convergence_line(const struct stats *st, char *buf, size_t len);
 
+/** Is it turbulent? Indicators of a finished Eulerian result (wall units of its u_tau). */
+struct stats_turb {
+  double uv_peak;        /*!< peak of -u'v'+ (upper half mirrored) */
+  double y_peak;         /*!< its y+ */
+  double r_uv;           /*!< -u'v' / (u_rms v_rms) averaged over 30 <= y+ <= 100 (about 0.4-0.5
+                              in wall turbulence, near 0 for particle noise) */
+  double resolved_share; /*!< reynolds_stress / total_stress in the bin nearest y+ = 30 */
+  double pair_share;     /*!< pair_stress / total_stress there (the scheme's numerical stress) */
+};
+
+/** @brief The indicators of a result (NaN where not available: no budget, no samples). */
+void stats_turbulence(const struct euler_config *c, const struct euler_result *r,
+                      struct stats_turb *t);
+
 /** A convergence target (scene keys stats.target_*). */
 struct stats_target {
   double rel_stderr; /*!< target relative standard error (> 0) */

@@ -1,0 +1,76 @@
+#!/usr/bin/python3
+"""Check the momentum budget of a run (stats.nc, method of planes; docs/stats-format.md).
+
+usage: budget_check.py STATS.nc --tol T [--laminar]
+
+Asserts, in wall units of the force balance (u_tau_force^2):
+  - total_stress is the sum of its parts (reynolds, viscous, model, pair, wall) to round-off;
+  - the budget closes: max over every bin |total_stress - total_stress_expected| <= T;
+  - with --laminar: the pressure pair stress and the Reynolds stress are below 0.005, and where
+    no wall term acts (farther than 2h from the walls; not the end bins, where nu dU/dy is
+    one-sided) the viscous pair stress equals the continuum nu dU/dy (viscous_stress) within
+    0.01.
+Prints the split of the stress in every bin. Exit 1 on a failed check.
+"""
+import argparse
+import sys
+
+import netCDF4
+import numpy as np
+
+PARTS = ("reynolds_stress", "viscous_pair_stress", "model_pair_stress", "pair_stress",
+         "wall_term_stress")
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("stats")
+    ap.add_argument("--tol", type=float, required=True)
+    ap.add_argument("--laminar", action="store_true")
+    a = ap.parse_args()
+    d = netCDF4.Dataset(a.stats)
+    ut2 = float(d.u_tau_force) ** 2
+    if "pair_stress" not in d.variables:
+        print(f"FAIL: {a.stats} has no momentum budget (pair_stress)")
+        return 1
+    v = {n: np.asarray(d[n][:], dtype=float) / ut2 for n in d.variables
+         if n in PARTS + ("total_stress", "total_stress_expected", "viscous_stress",
+                          "pair_momentum_source")}
+    y = np.asarray(d["y"][:])
+    parts = [n for n in PARTS if n in v]
+    print("  y      " + " ".join(f"{n[:12]:>12}" for n in parts + ["total_stress",
+                                                              "total_stress_expected"]))
+    for i in range(len(y)):
+        print(f"  {y[i]:.4f} " + " ".join(f"{v[n][i]:12.5f}" for n in parts + [
+            "total_stress", "total_stress_expected"]))
+    fail = 0
+    s = sum(v[n] for n in parts)
+    dsum = np.nanmax(np.abs(s - v["total_stress"]))
+    if not dsum <= 1e-9:
+        print(f"FAIL: total_stress differs from the sum of its parts by {dsum:.3g}")
+        fail = 1
+    err = np.abs(v["total_stress"] - v["total_stress_expected"])
+    worst = int(np.nanargmax(err))
+    print(f"closure: max |total - expected| = {err[worst]:.3g} u_tau^2 at y = {y[worst]:.4f} "
+          f"(tolerance {a.tol}); momentum source {np.nanmean(v['pair_momentum_source']):.4f}")
+    if not err[worst] <= a.tol:
+        print("FAIL: the budget does not close")
+        fail = 1
+    if a.laminar:
+        for n in ("pair_stress", "reynolds_stress"):
+            m = np.nanmax(np.abs(v[n]))
+            if not m <= 0.005:
+                print(f"FAIL: laminar flow with |{n}| up to {m:.3g} u_tau^2")
+                fail = 1
+        inner = np.abs(v["wall_term_stress"]) < 1e-12
+        inner[0] = inner[-1] = False  # nu dU/dy is one-sided there
+        dv = np.nanmax(np.abs(v["viscous_pair_stress"] - v["viscous_stress"])[inner])
+        print(f"viscous pair stress vs nu dU/dy away from the walls: max difference {dv:.3g}")
+        if not dv <= 0.01:
+            print("FAIL: the viscous pair stress is not nu dU/dy")
+            fail = 1
+    return fail
+
+
+if __name__ == "__main__":
+    sys.exit(main())

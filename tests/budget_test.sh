@@ -1,0 +1,14 @@
+#!/usr/bin/env bash
+# budget_test.sh CHANSPH SCENE RUNS NAME TOL [--laminar] [-- chansph --set args...]
+# Runs SCENE into RUNS/budget_NAME and checks its momentum budget (tests/budget_check.py).
+set -uo pipefail
+chansph=$1 scene=$2 runs=$3 name=$4 tol=$5
+shift 5
+check=()
+[ "${1:-}" = --laminar ] && check=(--laminar) && shift
+[ "${1:-}" = -- ] && shift
+out=$runs/budget_$name
+"$chansph" run "$scene" --out "$out" --overwrite "$@" > "$out.log" 2>&1 ||
+  { tail "$out.log"; echo "FAIL: run"; exit 1; }
+grep "^stats:" "$out.log" | tail -n 1
+/usr/bin/python3 "$(dirname "$0")/budget_check.py" "$out/stats.nc" --tol "$tol" "${check[@]}"
