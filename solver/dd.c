@@ -11,7 +11,7 @@
 #include "reduce.h"
 #include "timers.h"
 
-/* A particle on the wire: the permuted arrays of part.h, id and kind. */
+/* A particle on the wire: the permuted arrays of part.h (shift_dy when in use), id and kind. */
 enum {
   F_X,
   F_Y,
@@ -27,6 +27,7 @@ enum {
   F_AX,
   F_AY,
   F_AZ,
+  F_SDY,
   F_ID,
   F_KIND,
   F_LEN
@@ -53,6 +54,7 @@ static void pack(const struct particles *P, size_t a, double *r) {
   r[F_RHO] = P->rho[a], r[F_M] = P->m[a], r[F_GAM] = P->gam[a];
   r[F_KSUM] = P->ksum[a], r[F_DDIFF] = P->ddiff[a];
   r[F_AX] = P->ax[a], r[F_AY] = P->ay[a], r[F_AZ] = P->az[a];
+  r[F_SDY] = P->shift_dy ? P->shift_dy[a] : 0.0;
   memcpy(&r[F_ID], &P->id[a], sizeof(double));
   r[F_KIND] = P->kind[a];
 }
@@ -63,6 +65,7 @@ static void unpack(struct particles *P, size_t a, const double *r) {
   P->rho[a] = r[F_RHO], P->m[a] = r[F_M], P->gam[a] = r[F_GAM];
   P->ksum[a] = r[F_KSUM], P->ddiff[a] = r[F_DDIFF];
   P->ax[a] = r[F_AX], P->ay[a] = r[F_AY], P->az[a] = r[F_AZ];
+  if (P->shift_dy) P->shift_dy[a] = r[F_SDY];
   memcpy(&P->id[a], &r[F_ID], sizeof(double));
   P->kind[a] = (uint8_t)r[F_KIND];
 }

@@ -128,17 +128,6 @@ static inline __attribute__((always_inline)) void pair_sums(const struct fctx *C
                         {gcx, gcy, gcz}};
 }
 
-/** Lattice excess of the pressure wall weight at q = d/h: linear between the layers of the
-    lattice, constant below the first layer, zero at q = 2. */
-static double lattice_excess(const struct model *M, double q) {
-  if (q >= 2.0) return 0.0;
-  if (q <= M->lat_q[0]) return M->lat_e[0];
-  int k = 1;
-  while (k < M->n_lat - 1 && M->lat_q[k] < q) k++;
-  const double t = (q - M->lat_q[k - 1]) / (M->lat_q[k] - M->lat_q[k - 1]);
-  return (1.0 - t) * M->lat_e[k - 1] + t * M->lat_e[k];
-}
-
 /** Acceleration of fluid particle a from its pair sums (fluid part s, vertex part sv): the
     normalisation of the viscous sum, the wall terms, the body force; the time-step maxima go to
     mx[0] (max |a|^2) and mx[1] (max |grad gamma . v|). */
@@ -204,7 +193,8 @@ static void force_finish(const struct fctx *C, size_t a, const struct fsums *s,
        the particle lattice (so that a uniform pressure leaves the lattice in equilibrium yet
        pushes a displaced particle back), or of the current particles, or nothing
        (docs/theory.md) */
-    const double pw = M->wall_pressure == WALL_PRESSURE_LATTICE      ? dg + lattice_excess(M, q)
+    const double pw = M->wall_pressure == WALL_PRESSURE_LATTICE
+                          ? dg + sph_lattice_table(M, M->lat_e, q)
                       : M->wall_pressure == WALL_PRESSURE_CONSISTENT ? fmax(dg, ny * mom1)
                                                                      : dg;
     if (!corrected) aya += ig * rs * (pa + ps / (rs * rs)) * pw * ny;
