@@ -11,7 +11,7 @@
 #include "reduce.h"
 #include "timers.h"
 
-/* A particle on the wire: the permuted arrays of part.h, id and kind. */
+/* A particle on the wire: the permuted arrays of part.h (shift_dy when in use), id and kind. */
 enum {
   F_X,
   F_Y,
@@ -28,7 +28,8 @@ enum {
   F_AY,
   F_AZ,
   F_SX, /* SX_LEN parts of the x-acceleration (the momentum budget), zero unless live */
-  F_ID = F_SX + SX_LEN,
+  F_SDY = F_SX + SX_LEN,
+  F_ID,
   F_KIND,
   F_LEN
 };
@@ -55,6 +56,7 @@ static void pack(const struct particles *P, size_t a, double *r) {
   r[F_KSUM] = P->ksum[a], r[F_DDIFF] = P->ddiff[a];
   r[F_AX] = P->ax[a], r[F_AY] = P->ay[a], r[F_AZ] = P->az[a];
   for (int k = 0; k < SX_LEN; k++) r[F_SX + k] = P->sx && P->sx_live ? P->sx[a * SX_LEN + k] : 0.0;
+  r[F_SDY] = P->shift_dy ? P->shift_dy[a] : 0.0;
   memcpy(&r[F_ID], &P->id[a], sizeof(double));
   r[F_KIND] = P->kind[a];
 }
@@ -67,6 +69,7 @@ static void unpack(struct particles *P, size_t a, const double *r) {
   P->ax[a] = r[F_AX], P->ay[a] = r[F_AY], P->az[a] = r[F_AZ];
   if (P->sx && P->sx_live)
     for (int k = 0; k < SX_LEN; k++) P->sx[a * SX_LEN + k] = r[F_SX + k];
+  if (P->shift_dy) P->shift_dy[a] = r[F_SDY];
   memcpy(&P->id[a], &r[F_ID], sizeof(double));
   P->kind[a] = (uint8_t)r[F_KIND];
 }

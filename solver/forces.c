@@ -134,17 +134,6 @@ static inline __attribute__((always_inline)) void pair_sums(const struct fctx *C
                         vmx};
 }
 
-/** Lattice excess of the pressure wall weight at q = d/h: linear between the layers of the
-    lattice, constant below the first layer, zero at q = 2. */
-static double lattice_excess(const struct model *M, double q) {
-  if (q >= 2.0) return 0.0;
-  if (q <= M->lat_q[0]) return M->lat_e[0];
-  int k = 1;
-  while (k < M->n_lat - 1 && M->lat_q[k] < q) k++;
-  const double t = (q - M->lat_q[k - 1]) / (M->lat_q[k] - M->lat_q[k - 1]);
-  return (1.0 - t) * M->lat_e[k - 1] + t * M->lat_e[k];
-}
-
 /** The x-acceleration of particle a by its fluid neighbours, split by term into
     sx[SX_PRESSURE .. SX_MODEL]: the expressions of force_finish applied to the fluid part s of
     the sums (sv: the vertex part, for the matrix of the corrected gradient, which both parts
@@ -233,7 +222,8 @@ static void force_finish(const struct fctx *C, size_t a, const struct fsums *s,
        the particle lattice (so that a uniform pressure leaves the lattice in equilibrium yet
        pushes a displaced particle back), or of the current particles, or nothing
        (docs/theory.md) */
-    const double pw = M->wall_pressure == WALL_PRESSURE_LATTICE      ? dg + lattice_excess(M, q)
+    const double pw = M->wall_pressure == WALL_PRESSURE_LATTICE
+                          ? dg + sph_lattice_table(M, M->lat_e, q)
                       : M->wall_pressure == WALL_PRESSURE_CONSISTENT ? fmax(dg, ny * mom1)
                                                                      : dg;
     if (!corrected) aya += ig * rs * (pa + ps / (rs * rs)) * pw * ny;

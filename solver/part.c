@@ -88,7 +88,8 @@ static size_t arrays(struct particles *P, struct array *t) {
                               {(void **)&P->nur, "nu_r", d, 0},
                               {(void **)&P->kr, "k_r", d, 0},
                               {(void **)&P->twx, "wall_law_tx", d, 0},
-                              {(void **)&P->twz, "wall_law_tz", d, 0}};
+                              {(void **)&P->twz, "wall_law_tz", d, 0},
+                              {(void **)&P->shift_dy, "shift_dy", d, 0}};
   const size_t n = sizeof all / sizeof all[0];
   memcpy(t, all, sizeof all);
   return n;
@@ -161,7 +162,7 @@ void part_create(struct particles *P, struct walls *W, const struct scene *s) {
 void part_destroy(struct particles *P, struct walls *W) {
   struct array t[N_ARRAYS_MAX];
   for (size_t i = 0, na = arrays(P, t); i < na; i++)
-    if (t[i].core) part_free(*t[i].p), *t[i].p = NULL; /* the others are turb_free's */
+    if (t[i].core) part_free(*t[i].p), *t[i].p = NULL; /* the others: turb_free, sim_free */
   part_free(W->rho), part_free(W->p);
   W->rho = W->p = NULL;
 }
@@ -206,6 +207,7 @@ void part_permute(struct particles *P, size_t i0, size_t n, const size_t *perm) 
       for (size_t i = 0; i < n; i++) col[i] = P->sx[(i0 + perm[i]) * SX_LEN + k];
       for (size_t i = 0; i < n; i++) P->sx[(i0 + i) * SX_LEN + k] = col[i];
     }
+  if (P->shift_dy) permute_d(P->shift_dy, P->tmp, i0, n, perm);
   int64_t *restrict id = P->tmp_i;
   uint8_t *restrict kind = (uint8_t *)P->tmp; /* P->tmp is free after the doubles */
   for (size_t i = 0; i < n; i++) id[i] = P->id[i0 + perm[i]], kind[i] = P->kind[i0 + perm[i]];

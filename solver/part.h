@@ -57,6 +57,11 @@ struct particles {
   double *nur;       /*!< eddy viscosity nu_r [m^2/s] */
   double *kr;        /*!< residual kinetic energy k_r [m^2/s^2] */
   double *twx, *twz; /*!< wall-law stress rho u_tau^2 e_t of the nearest wall [Pa] */
+  /** particle shifting (shift.h), allocated only when used, NULL otherwise: the wall-normal
+      shift of the last step [m], the y-part of the wall-normal momentum flux m u delta y that
+      shifting adds (docs/theory.md); computed before the re-sort, so permuted and migrated
+      with the particles; not checkpointed (every step sets it before anything reads it) */
+  double *shift_dy;
   /* sort scratch */
   double *tmp;
   int64_t *tmp_i;

@@ -10,6 +10,7 @@
 #include "init.h"
 #include "records.h"
 #include "reduce.h"
+#include "shift.h"
 #include "timers.h"
 #include "turb.h"
 
@@ -95,6 +96,7 @@ int sim_create(struct sim *S, const struct scene *sc) {
     S->wall_ax = part_alloc("wall_ax", sizeof(double));
     S->P.sx = part_alloc("stress_ax", S->P.cap * SX_LEN * sizeof(double));
   }
+  if (sc->shifting != SHIFT_NONE) S->P.shift_dy = part_alloc("shift_dy", S->P.cap * sizeof(double));
   S->wall_fx[0] = S->wall_fx[1] = NAN;
   drive_init(&S->drive, sc);
   S->fx = S->drive.force;
@@ -141,6 +143,7 @@ void sim_free(struct sim *S) {
   part_free(S->ksum_new);
   if (S->wall_ax) part_free(S->wall_ax);
   part_free(S->P.sx), S->P.sx = NULL;
+  part_free(S->P.shift_dy), S->P.shift_dy = NULL;
   part_destroy(&S->P, &S->W);
 }
 
@@ -245,6 +248,9 @@ void sim_step(struct sim *S) {
   fi.amax = maxima[0], fi.gvmax = maxima[1];
   const double dt = time_step(S, &fi);
   const double fx = drive_force(&S->drive, ub, dt);
+  /* particle shifting at the positions of the neighbour list (scratch 0-1 are free here) */
+  double *sx = S->scratch[0], *sz = S->scratch[1];
+  if (S->M.shifting != SHIFT_NONE) shift_compute(&S->M, P, &S->nb, sx, P->shift_dy, sz);
   timer_push("integrate");
 #pragma omp parallel for schedule(static)
   for (size_t a = 0; a < P->n; a++) {
@@ -256,6 +262,7 @@ void sim_step(struct sim *S) {
     P->y[a] += dt * P->v[a];
     P->z[a] += dt * P->w[a];
   }
+  if (S->M.shifting != SHIFT_NONE) shift_apply(P, sx, P->shift_dy, sz); /* velocities kept */
   timer_pop();
   S->t += dt, S->dt = dt, S->fx = fx, S->step++;
   if (S->dd.size > 1 && S->sc->balance_every > 0 && S->step % S->sc->balance_every == 0)

@@ -82,6 +82,19 @@ static const struct key keys[] = {
      "2.88 built from fluid and vertex neighbours, exact for linear pressure fields and without "
      "a wall term (Sec. 6.2.2-6.2.3; docs/theory.md).",
      OFF(pgrad)},
+    {"sph", "shifting", T_CHOICE, "none", 0, 0, 0, "none|fickian", "-",
+     "Particle shifting after each position update: none, or the Fickian shift "
+     "delta r_a = -C h^2 grad C_a of Lind et al. (2012) with the anti-clustering term of "
+     "Skillen et al. (2013) / Sun et al. (2017, 2018) and the walls' part of grad C_a taken "
+     "from grad gamma with the pressure wall weight; at most 0.1 dr per step; velocities are "
+     "not changed (docs/theory.md, \"Particle shifting\").",
+     OFF(shifting)},
+    {"sph", "shift_coefficient", T_DOUBLE, "0.05", 0, 0.3, LO_OPEN, NULL, "-",
+     "Shifting coefficient C of delta r_a = -C h^2 grad C_a per step (sph.shifting = fickian). "
+     "0.05 relaxes a displaced particle per step as much as Sun et al. (2018)'s CFL Ma (2h)^2 "
+     "with h = 2 dr at CFL Ma = 0.08 (this code's cfl 0.8 at Mach 0.1) does; 0.5 is unstable "
+     "in 2-D (docs/theory.md).",
+     OFF(shift_coef)},
     {"sph", "wall_dmin", T_DOUBLE, "1", 0, BIG, LO_OPEN, NULL, "dr",
      "Lower bound delta r of the wall distance in the wall shear term (thesis Eq. 2.148), in "
      "units of dr.",

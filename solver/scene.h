@@ -28,6 +28,7 @@ enum init_profile {
 enum les_model { LES_NONE = 0, LES_SMAGORINSKY = 1 };
 enum les_strain { STRAIN_GRADIENT = 0, STRAIN_VIOLEAU_ISSA = 1 };
 enum pressure_gradient { PGRAD_STANDARD = 0, PGRAD_CORRECTED = 1 };
+enum shifting { SHIFT_NONE = 0, SHIFT_FICKIAN = 1 };
 
 enum { SCENE_LIST_MAX = 8 };
 
@@ -55,6 +56,8 @@ struct scene {
   int wall_weight;   /*!< enum wall_weight */
   int wall_pressure; /*!< enum wall_pressure */
   int pgrad;         /*!< enum pressure_gradient */
+  int shifting;      /*!< enum shifting: particle shifting after each step */
+  double shift_coef; /*!< shifting coefficient C of delta r = -C h^2 grad C_a [-] */
   /* [les] */
   int les;         /*!< enum les_model */
   double cs;       /*!< Smagorinsky constant C_S [-] */

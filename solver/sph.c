@@ -42,6 +42,10 @@ void sph_model_init(struct model *M, const struct scene *s) {
   M->cy = s->cy;
   M->law = wall_law_make(s->wall_law, s->kappa, s->log_b);
   M->wall_tau = M->les || s->wall_law != WALL_LAW_LAMINAR;
+  M->shifting = s->shifting;
+  M->shift_ch2 = s->shift_coef * M->h * M->h;
+  M->shift_iwdr = 1.0 / kernel_w(&M->k, s->dr);
+  M->shift_max = 0.1 * s->dr;
   sph_lattice_excess_table(M);
   sph_violeau_table(M);
   records_init();
@@ -93,7 +97,8 @@ void sph_lattice_excess_table(struct model *M) {
   const int reach = (int)ceil(2.0 * M->h / dr); /* lattice offsets within the support */
   int n = 0;
   for (int j = 1; j * dr < 2.0 * M->h && n < LATTICE_KNOTS - 1; j++) {
-    double mom1 = 0.0; /* sum_b V_b (y_a - y_b) F_ab over the virtual lattice around layer j */
+    double mom1 = 0.0;  /* sum_b V_b (y_a - y_b) F_ab over the virtual lattice around layer j */
+    double mom1s = 0.0; /* the same with the shift's anti-clustering factor */
     for (int k = 0; k <= j + reach; k++) {
       const double v = k == 0 ? 0.5 * vol : vol, dy = (j - k) * dr; /* k = 0: vertex row */
       for (int i = -reach; i <= reach; i++)
@@ -101,15 +106,26 @@ void sph_lattice_excess_table(struct model *M) {
           if (k == j && i == 0 && l == 0) continue;
           const double r = sqrt((i * i + l * l) * dr * dr + dy * dy);
           mom1 += v * kernel_f(K, r) * dy;
+          mom1s += v * kernel_f(K, r) * dy * (1.0 + sph_anticluster(kernel_w(K, r), M->shift_iwdr));
         }
     }
     const double q = j * dr * ih;
     M->lat_q[n] = q;
     M->lat_e[n] = fmax(0.0, mom1 - wall_dgamma(M->dim, q) * ih);
+    M->lat_s[n] = mom1s - wall_dgamma(M->dim, q) * ih;
     n++;
   }
-  M->lat_q[n] = 2.0, M->lat_e[n] = 0.0;
+  M->lat_q[n] = 2.0, M->lat_e[n] = M->lat_s[n] = 0.0;
   M->n_lat = n + 1;
+}
+
+double sph_lattice_table(const struct model *M, const double *e, double q) {
+  if (q >= 2.0) return 0.0;
+  if (q <= M->lat_q[0]) return e[0];
+  int k = 1;
+  while (k < M->n_lat - 1 && M->lat_q[k] < q) k++;
+  const double t = (q - M->lat_q[k - 1]) / (M->lat_q[k] - M->lat_q[k - 1]);
+  return (1.0 - t) * e[k - 1] + t * e[k];
 }
 
 /** gamma of the channel: both walls' missing parts subtracted (they never overlap). */

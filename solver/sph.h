@@ -45,7 +45,21 @@ struct model {
   int n_lat;                   /*!< knots of the lattice excess of the pressure wall weight */
   double lat_q[LATTICE_KNOTS]; /*!< their wall distances d/h, increasing, the last one 2 */
   double lat_e[LATTICE_KNOTS]; /*!< excess of sum_b V_b (r_ab . n) F_ab over |grad gamma| [1/m] */
+  /** the same (signed, not clipped) for the particle shift's moment, whose pair weight has the
+      anti-clustering factor 1 + R (w_ab / w(dr))^n (shift.h) [1/m] */
+  double lat_s[LATTICE_KNOTS];
+  int shifting;      /*!< enum shifting */
+  double shift_ch2;  /*!< C h^2 of delta r = -C h^2 grad C_a [m^2] */
+  double shift_iwdr; /*!< 1 / w(dr), the anti-clustering term's reference [m^dim] */
+  double shift_max;  /*!< largest shift per step [m] */
 };
+
+/** Anti-clustering term of the particle shift (Skillen et al. 2013; Sun et al. 2017):
+    R (w_ab / w(dr))^n with R = 0.2, n = 4. */
+static inline double sph_anticluster(double w, double iwdr) {
+  const double t = w * iwdr, t2 = t * t;
+  return 0.2 * t2 * t2;
+}
 
 /** Per-step maxima from the force pass, for the time-step limits. */
 struct force_info {
@@ -80,6 +94,10 @@ void sph_lattice_excess_table(struct model *M);
  * @param[in,out] M model
  */
 void sph_violeau_table(struct model *M);
+
+/** @brief A lattice table (lat_e or lat_s) at q = d/h: linear between the layers of the
+           lattice, constant below the first layer, zero at q = 2. */
+double sph_lattice_table(const struct model *M, const double *e, double q);
 
 /** @brief Violeau's wall moment at q = d/h (linear in the table; 0 for q >= 2). */
 double sph_violeau_moment(const struct model *M, double q);

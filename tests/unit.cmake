@@ -72,3 +72,10 @@ add_executable(test_init test_init.c)
 target_link_libraries(test_init PRIVATE chansph_core m)
 add_test(NAME unit_init COMMAND test_init)
 set_tests_properties(unit_init PROPERTIES LABELS unit)
+
+#   test_shift:  particle shifting: the lattice at rest is an equilibrium (walls included), a
+#                perturbed lattice is ordered by the shift (docs/theory.md, "Particle shifting")
+add_executable(test_shift test_shift.c)
+target_link_libraries(test_shift PRIVATE chansph_core)
+add_test(NAME unit_shift COMMAND test_shift)
+set_tests_properties(unit_shift PROPERTIES LABELS unit)

@@ -1,0 +1,84 @@
+/** @file shift.c @brief Implementation of shift.h; a gather loop over the neighbour list. */
+#include "shift.h"
+
+#include <math.h>
+
+#include "pair.h"
+#include "timers.h"
+#include "wall.h"
+
+/** Particle part of grad C_a: sum_b V_b [1 + R (w_ab / w(dr))^n] F_ab r_ab over fluid and
+    vertex neighbours (Lind et al. 2012, Eq. 22; anti-clustering term of Sun et al. 2017). */
+static CHANSPH_CLONES struct v3 shift_gradient(const struct model *M, const struct particles *P,
+                                               const struct nbr *nb, size_t a) {
+  const struct kernel K = M->k;
+  const double *restrict x = P->x, *restrict y = P->y, *restrict z = P->z, *restrict V = P->vol;
+  const int32_t *restrict nl = nb->list + a * (size_t)nb->stride;
+  const double xa = x[a], ya = y[a], za = z[a], lx = M->lx, lz = M->lz, iwdr = M->shift_iwdr;
+  const int d3 = M->dim == 3;
+  double gx = 0.0, gy = 0.0, gz = 0.0;
+#pragma omp simd reduction(+ : gx, gy, gz)
+  for (int j = 0; j < nb->count[a]; j++) {
+    const int32_t b = nl[j];
+    const struct pair g = pair_geom(&K, lx, lz, d3, xa - x[b], ya - y[b], za - z[b]);
+    const double s = V[b] * (1.0 + sph_anticluster(pair_w(&K, g.r), iwdr)) * g.f;
+    gx += s * g.dx, gy += s * g.dy, gz += s * g.dz;
+  }
+  return (struct v3){gx, gy, gz};
+}
+
+/** Shift of fluid particle a from the particle part g of grad C_a: the walls' part, the factor
+    -C h^2, the cap |delta r| <= shift_max and the wall guard. */
+static struct v3 shift_finish(const struct model *M, double ya, struct v3 g) {
+  const double ih = M->k.inv_h, gy0 = g.y;
+  double dist[2];
+  for (int wall = 0; wall < 2; wall++) {
+    const double d = wall ? M->ly - ya : ya, q = d * ih;
+    dist[wall] = d;
+    if (q >= 2.0) continue;
+    const double dg = wall_dgamma(M->dim, q) * ih; /* |grad gamma_as| */
+    const double ny = wall ? -1.0 : 1.0;           /* inward normal */
+    /* the wall's part of grad C_a, -W_as n_s: the region behind the wall counts as filled, with
+       the weight of the pressure wall term (lattice: |grad gamma_as| plus the lattice excess of
+       this sum, so that the initial lattice is at rest under the shift) */
+    const double pw = M->wall_pressure == WALL_PRESSURE_LATTICE
+                          ? dg + sph_lattice_table(M, M->lat_s, q)
+                      : M->wall_pressure == WALL_PRESSURE_CONSISTENT ? fmax(dg, ny * gy0)
+                                                                     : dg;
+    g.y -= pw * ny;
+  }
+  struct v3 s = {-M->shift_ch2 * g.x, -M->shift_ch2 * g.y, -M->shift_ch2 * g.z};
+  const double len = sqrt(s.x * s.x + s.y * s.y + s.z * s.z);
+  if (len > M->shift_max) { /* at most 0.1 dr per step */
+    const double f = M->shift_max / len;
+    s.x *= f, s.y *= f, s.z *= f;
+  }
+  /* never more than half-way to a wall: the shift alone cannot carry a particle through it */
+  if (s.y < -0.5 * dist[0]) s.y = -0.5 * dist[0];
+  if (s.y > 0.5 * dist[1]) s.y = 0.5 * dist[1];
+  return s;
+}
+
+void shift_compute(const struct model *M, const struct particles *P, const struct nbr *nb,
+                   double *sx, double *sy, double *sz) {
+  timer_push("shift");
+#pragma omp parallel for schedule(dynamic, 64)
+  for (size_t a = 0; a < P->n; a++) {
+    if (P->kind[a] != KIND_FLUID) {
+      sx[a] = sy[a] = sz[a] = 0.0;
+      continue;
+    }
+    const struct v3 s = shift_finish(M, P->y[a], shift_gradient(M, P, nb, a));
+    sx[a] = s.x, sy[a] = s.y, sz[a] = s.z;
+  }
+  timer_pop();
+}
+
+void shift_apply(struct particles *P, const double *sx, const double *sy, const double *sz) {
+#pragma omp parallel for schedule(static)
+  for (size_t a = 0; a < P->n; a++) {
+    P->x[a] += sx[a];
+    P->y[a] += sy[a];
+    P->z[a] += sz[a];
+  }
+}
