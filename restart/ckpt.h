@@ -1,6 +1,6 @@
 /**
  * @file ckpt.h
- * @brief The checkpoint file: a state list (solver/state.h) as one HDF5 dataset per field,
+ * @brief The checkpoint file: a state list (solver/base/state.h) as one HDF5 dataset per field,
  *        with a format version, a completion mark and a Fletcher32 checksum on every dataset
  *        (docs/checkpoint-format.md).
  *

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "alloc.h"
 #include "error.h"
 #include "reduce.h"
 #include "timers.h"
@@ -35,16 +36,10 @@ enum {
 /* tags: a message going to the left neighbour, one going to the right */
 enum { TAG_LEFT = 11, TAG_RIGHT = 12 };
 
-static void *xrealloc(void *p, size_t bytes) {
-  void *q = realloc(p, bytes ? bytes : 1);
-  if (!q) die("out of memory in the domain decomposition (%zu bytes)", bytes);
-  return q;
-}
-
 static void reserve_buf(double **buf, size_t *cap, size_t n) {
   if (n <= *cap) return;
   *cap = n + n / 2;
-  *buf = xrealloc(*buf, *cap * sizeof(double));
+  *buf = mem_realloc(*buf, *cap, sizeof(double), "domain decomposition");
 }
 
 static void pack(const struct particles *P, size_t a, double *r) {
@@ -85,7 +80,7 @@ int dd_init(struct dd *d, const struct scene *sc, dd_reserve_fn reserve, void *c
   d->halo = d->size > 1 ? NBR_REACH : 0;
   d->reserve = reserve, d->ctx = ctx;
   d->left = (d->rank + d->size - 1) % d->size, d->right = (d->rank + 1) % d->size;
-  d->first = xrealloc(NULL, (size_t)(d->size + 1) * sizeof(int));
+  d->first = mem_alloc((size_t)(d->size + 1), sizeof(int), "domain decomposition");
   if (d->size > 1 && d->ncol < 2 * d->halo * d->size) {
     error_input(
         "%s: key 'domain.lx': lx = %g gives %d cell columns of size h along x; %d MPI "
@@ -209,7 +204,8 @@ static size_t edge_slots(const struct nbr *nb, int c0, int c1, size_t **out, siz
   size_t n = 0;
   for (int pass = 0; pass < 2; pass++) {
     if (pass == 1) {
-      if (n > *cap) *cap = n + n / 2, *out = xrealloc(*out, *cap * sizeof(size_t));
+      if (n > *cap)
+        *cap = n + n / 2, *out = mem_realloc(*out, *cap, sizeof(size_t), "domain decomposition");
       n = 0;
     }
     for (int iz = 0; iz < nb->nz; iz++)
@@ -293,7 +289,8 @@ void dd_halo(struct dd *d, struct particles *P, struct nbr *nb) {
   P->n_ghost = ng;
   nbr_sort_ghosts(nb, P, d->nrecv[0]);
   if (ng > d->cap_ghost) d->cap_ghost = ng + ng / 2;
-  d->ghost = xrealloc(d->ghost, (d->cap_ghost ? d->cap_ghost : 1) * sizeof(size_t));
+  d->ghost = mem_realloc(d->ghost, (d->cap_ghost ? d->cap_ghost : 1), sizeof(size_t),
+                         "domain decomposition");
   for (size_t i = 0; i < ng; i++) d->ghost[nb->perm[i]] = P->n + i;
   d->seconds += MPI_Wtime() - t0;
   timer_pop();
@@ -350,7 +347,7 @@ void dd_update_walls(struct dd *d, const struct particles *P, int nf, double *co
 void dd_sum(const struct dd *d, const struct nbr *nb, int nv, const double *const *x, double *out) {
   if (nv > 8) die("dd_sum: at most 8 arrays (got %d)", nv);
   const int nxo = nb->nxo, ncol = d->ncol;
-  double *all = xrealloc(NULL, (size_t)ncol * nv * sizeof(double));
+  double *all = mem_alloc((size_t)ncol * nv, sizeof(double), "domain decomposition");
   double *mine = all + (size_t)nb->ix0 * nv; /* this rank's columns, [column][v] */
 #pragma omp parallel for schedule(static)
   for (int lc = 0; lc < nxo; lc++) {
@@ -364,14 +361,14 @@ void dd_sum(const struct dd *d, const struct nbr *nb, int nv, const double *cons
     for (int v = 0; v < nv; v++) mine[(size_t)lc * nv + v] = s[v];
   }
   if (d->size > 1) {
-    int *cnt = xrealloc(NULL, (size_t)d->size * sizeof(int));
-    int *dsp = xrealloc(NULL, (size_t)d->size * sizeof(int));
+    int *cnt = mem_alloc((size_t)d->size, sizeof(int), "domain decomposition");
+    int *dsp = mem_alloc((size_t)d->size, sizeof(int), "domain decomposition");
     for (int r = 0; r < d->size; r++)
       cnt[r] = (d->first[r + 1] - d->first[r]) * nv, dsp[r] = d->first[r] * nv;
     MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_DATATYPE_NULL, all, cnt, dsp, MPI_DOUBLE, MPI_COMM_WORLD);
     free(cnt), free(dsp);
   }
-  double *col = xrealloc(NULL, (size_t)ncol * sizeof(double));
+  double *col = mem_alloc((size_t)ncol, sizeof(double), "domain decomposition");
   for (int v = 0; v < nv; v++) {
     for (int c = 0; c < ncol; c++) col[c] = all[(size_t)c * nv + v];
     out[v] = reduce_pairwise(col, (size_t)ncol);
@@ -383,7 +380,7 @@ int dd_balance(struct dd *d, struct nbr *nb, double threshold) {
   if (d->size == 1) return 0;
   /* particles per column, gathered in column order */
   const int ncol = d->ncol;
-  double *cnt = xrealloc(NULL, (size_t)ncol * sizeof(double));
+  double *cnt = mem_alloc((size_t)ncol, sizeof(double), "domain decomposition");
   memset(cnt, 0, (size_t)ncol * sizeof(double));
   for (int lc = 0; lc < nb->nxo; lc++)
     for (int iz = 0; iz < nb->nz; iz++)
@@ -407,7 +404,7 @@ int dd_balance(struct dd *d, struct nbr *nb, double threshold) {
   }
   /* cut where the running count passes r * mean, keeping 2 halo columns per rank */
   const int minw = 2 * d->halo;
-  int *nf = xrealloc(NULL, (size_t)(d->size + 1) * sizeof(int));
+  int *nf = mem_alloc((size_t)(d->size + 1), sizeof(int), "domain decomposition");
   nf[0] = 0, nf[d->size] = ncol;
   double run = 0.0;
   int c = 0;
@@ -439,14 +436,14 @@ size_t dd_check_ids(const struct dd *d, const struct particles *P, size_t n_tota
   int cnt = (int)P->n, *cnts = NULL, *disp = NULL;
   int64_t *all = NULL;
   if (d->rank == 0) {
-    cnts = xrealloc(NULL, (size_t)d->size * sizeof(int));
-    disp = xrealloc(NULL, (size_t)d->size * sizeof(int));
+    cnts = mem_alloc((size_t)d->size, sizeof(int), "domain decomposition");
+    disp = mem_alloc((size_t)d->size, sizeof(int), "domain decomposition");
   }
   MPI_Gather(&cnt, 1, MPI_INT, cnts, 1, MPI_INT, 0, MPI_COMM_WORLD);
   size_t total = 0;
   if (d->rank == 0) {
     for (int r = 0; r < d->size; r++) disp[r] = (int)total, total += (size_t)cnts[r];
-    all = xrealloc(NULL, (total ? total : 1) * sizeof(int64_t));
+    all = mem_alloc((total ? total : 1), sizeof(int64_t), "domain decomposition");
   }
   MPI_Gatherv(P->id, cnt, MPI_INT64_T, all, cnts, disp, MPI_INT64_T, 0, MPI_COMM_WORLD);
   long long bad = -1;
@@ -481,7 +478,7 @@ void dd_gather_fluid(const struct dd *d, const struct particles *P, int nf, cons
   const size_t n = P->n_fluid, rec = (size_t)nf + 1;
   size_t mine = 0;
   for (size_t a = 0; a < P->n; a++) mine += P->kind[a] == KIND_FLUID;
-  double *buf = xrealloc(NULL, (mine ? mine : 1) * rec * sizeof(double));
+  double *buf = mem_alloc((mine ? mine : 1) * rec, sizeof(double), "domain decomposition");
   for (size_t a = 0, k = 0; a < P->n; a++) {
     if (P->kind[a] != KIND_FLUID) continue;
     buf[k * rec] = (double)P->id[a]; /* ids below 2^53 are exact */
@@ -491,9 +488,9 @@ void dd_gather_fluid(const struct dd *d, const struct particles *P, int nf, cons
   int cnt = (int)(mine * rec), *cnts = NULL, *disp = NULL;
   double *all = NULL;
   if (d->rank == 0) {
-    cnts = xrealloc(NULL, (size_t)d->size * sizeof(int));
-    disp = xrealloc(NULL, (size_t)d->size * sizeof(int));
-    all = xrealloc(NULL, (n ? n : 1) * rec * sizeof(double));
+    cnts = mem_alloc((size_t)d->size, sizeof(int), "domain decomposition");
+    disp = mem_alloc((size_t)d->size, sizeof(int), "domain decomposition");
+    all = mem_alloc((n ? n : 1) * rec, sizeof(double), "domain decomposition");
   }
   MPI_Gather(&cnt, 1, MPI_INT, cnts, 1, MPI_INT, 0, MPI_COMM_WORLD);
   if (d->rank == 0)
