@@ -13,6 +13,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "error.h"
+
 /** Identity of the run (ckpt_set_run_id), written into every file; "" = none. */
 static char run_id[CKPT_RUN_ID_MAX];
 
@@ -111,8 +113,8 @@ size_t ckpt_state_bytes(const struct state_list *L) {
 
 static int put_attr_text(hid_t obj, const char *name, const char *text) {
   const hid_t t = H5Tcopy(H5T_C_S1);
-  H5Tset_size(t, strlen(text) + 1);
-  H5Tset_strpad(t, H5T_STR_NULLTERM);
+  CHECK_H5(H5Tset_size(t, strlen(text) + 1));
+  CHECK_H5(H5Tset_strpad(t, H5T_STR_NULLTERM));
   const hid_t sp = H5Screate(H5S_SCALAR);
   const hid_t a = H5Acreate2(obj, name, t, sp, H5P_DEFAULT, H5P_DEFAULT);
   const herr_t rc = a < 0 ? -1 : H5Awrite(a, t, text);
@@ -166,7 +168,7 @@ static herr_t write_part(hid_t ds, hid_t mtype, hid_t fsp, int rank, const hsize
   else
     rc = H5Sselect_none(fsp) < 0 || H5Sselect_none(msp) < 0 ? -1 : 0;
   const hid_t dxpl = H5Pcreate(H5P_DATASET_XFER);
-  H5Pset_dxpl_mpio(dxpl, H5FD_MPIO_COLLECTIVE); /* filtered (Fletcher32) writes need it */
+  CHECK_H5(H5Pset_dxpl_mpio(dxpl, H5FD_MPIO_COLLECTIVE)); /* filtered (Fletcher32) writes need it */
   if (rc >= 0) rc = H5Dwrite(ds, mtype, msp, fsp, dxpl, buf);
   close_keeping_errors(dxpl, H5Pclose);
   close_keeping_errors(msp, H5Sclose);
@@ -193,19 +195,19 @@ static int write_field(hid_t file, const struct state_field *f, hid_t gcpl, int 
   if (f->type == STATE_TEXT) {
     const char *text = *(char *const *)f->data;
     ftype = H5Tcopy(H5T_C_S1);
-    H5Tset_size(ftype, strlen(text) + 1);
-    H5Tset_strpad(ftype, H5T_STR_NULLTERM);
+    CHECK_H5(H5Tset_size(ftype, strlen(text) + 1));
+    CHECK_H5(H5Tset_strpad(ftype, H5T_STR_NULLTERM));
     mtype = ftype, buf = text, rank = 1, dims[0] = chunk[0] = count[0] = 1, n = 1;
   } else {
     ftype = file_type(f->type), mtype = mem_type(f->type);
   }
   const hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
-  H5Pset_obj_track_times(dcpl, 0);
+  CHECK_H5(H5Pset_obj_track_times(dcpl, 0));
   if (n > 0) {
     const size_t rows = CHUNK_BYTES / (row ? row : 1);
     if (chunk[0] > rows) chunk[0] = rows ? rows : 1;
-    H5Pset_chunk(dcpl, rank, chunk);
-    H5Pset_fletcher32(dcpl);
+    CHECK_H5(H5Pset_chunk(dcpl, rank, chunk));
+    CHECK_H5(H5Pset_fletcher32(dcpl));
     /* parallel HDF5 allocates chunks when the dataset is created: no fill-value writes */
     if (par) H5Pset_fill_time(dcpl, H5D_FILL_TIME_NEVER);
   }
@@ -242,10 +244,10 @@ int ckpt_agree(int rc, char *err, size_t errlen) {
   MPI_Comm_rank(MPI_COMM_WORLD, &me);
   MPI_Comm_size(MPI_COMM_WORLD, &size);
   int mine = rc ? me : size;
-  MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD));
   if (first == size) return 0;
   if (errlen > 0 && me != first) err[0] = '\0';
-  MPI_Bcast(err, (int)errlen, MPI_CHAR, first, MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Bcast(err, (int)errlen, MPI_CHAR, first, MPI_COMM_WORLD));
   return 1;
 }
 
@@ -295,16 +297,16 @@ static int write_file(const char *path, const char *format, const struct state_l
   snprintf(tmp, sizeof tmp, "%s.tmp", path);
   const hid_t fcpl = H5Pcreate(H5P_FILE_CREATE), fapl = H5Pcreate(H5P_FILE_ACCESS);
   const hid_t gcpl = H5Pcreate(H5P_GROUP_CREATE);
-  H5Pset_obj_track_times(fcpl, 0);
-  H5Pset_obj_track_times(gcpl, 0);
-  H5Pset_libver_bounds(fapl, H5F_LIBVER_V18, H5F_LIBVER_V18); /* checksummed metadata */
+  CHECK_H5(H5Pset_obj_track_times(fcpl, 0));
+  CHECK_H5(H5Pset_obj_track_times(gcpl, 0));
+  CHECK_H5(H5Pset_libver_bounds(fapl, H5F_LIBVER_V18, H5F_LIBVER_V18)); /* checksummed metadata */
   if (par) {
-    H5Pset_fapl_mpio(fapl, MPI_COMM_WORLD, MPI_INFO_NULL);
-    H5Pset_all_coll_metadata_ops(fapl, 1);
-    H5Pset_coll_metadata_write(fapl, 1);
+    CHECK_H5(H5Pset_fapl_mpio(fapl, MPI_COMM_WORLD, MPI_INFO_NULL));
+    CHECK_H5(H5Pset_all_coll_metadata_ops(fapl, 1));
+    CHECK_H5(H5Pset_coll_metadata_write(fapl, 1));
   } else { /* one allocation for the whole file: the state plus room for the metadata */
-    H5Pset_fapl_core(fapl, ckpt_state_bytes(L) + (scene ? strlen(scene) : 0) + ((size_t)1 << 20),
-                     1);
+    CHECK_H5(H5Pset_fapl_core(
+        fapl, ckpt_state_bytes(L) + (scene ? strlen(scene) : 0) + ((size_t)1 << 20), 1));
   }
   if (par) { /* the state, the scene and room for the metadata (4 kB a dataset, 64 kB) */
     const size_t need = ckpt_state_bytes(L) + (scene ? strlen(scene) : 0) +
@@ -414,7 +416,7 @@ static int get_attr_text(hid_t obj, const char *name, char *buf, size_t n) {
     const size_t sz = H5Tget_size(ft);
     char *tmp = calloc(sz + 1, 1);
     const hid_t mt = H5Tcopy(H5T_C_S1);
-    H5Tset_size(mt, sz);
+    CHECK_H5(H5Tset_size(mt, sz));
     if (tmp && H5Aread(a, mt, tmp) >= 0) {
       snprintf(buf, n, "%s", tmp);
       rc = 0;
@@ -463,7 +465,7 @@ static char *read_text(hid_t file, const char *name, const char *path, char *err
     const size_t sz = H5Tget_size(ft);
     text = calloc(sz + 1, 1);
     const hid_t mt = H5Tcopy(H5T_C_S1);
-    H5Tset_size(mt, sz);
+    CHECK_H5(H5Tset_size(mt, sz));
     if (!text || H5Dread(ds, mt, H5S_ALL, H5S_ALL, H5P_DEFAULT, text) < 0) {
       fail(err, errlen, "%s: cannot read dataset /%s (checksum or data error)", path, name);
       free(text);

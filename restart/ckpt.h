@@ -13,7 +13,16 @@
 
 #include <stddef.h>
 
+#include "error.h"
 #include "state.h"
+
+/** Run an HDF5 call whose failure is a bug, not an input or disk error (property lists, types):
+    a negative result dies naming the call, file and line. The writer and reader paths that a
+    full disk or a corrupt file can fail return a status instead (CKPT errors). */
+#define CHECK_H5(call)                                  \
+  do {                                                  \
+    if ((call) < 0) die("HDF5 call failed: %s", #call); \
+  } while (0)
 
 /** Value of the root attribute "format". */
 #define CKPT_FORMAT "chansph-checkpoint"

@@ -250,7 +250,8 @@ int restart_resume(const char *dir, int n_set, char *const *set, struct scene *s
   }
   int rank = 0;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  MPI_Barrier(MPI_COMM_WORLD); /* every rank listed the files before rank 0 removes any */
+  CHECK_MPI(
+      MPI_Barrier(MPI_COMM_WORLD)); /* every rank listed the files before rank 0 removes any */
   const int tmp = rank == 0 ? rotate_remove_tmp(dir) : 0;
   /* the checkpoints skipped, with why: 98 KB, on the heap */
   struct skipped *sk = mem_calloc(1, sizeof *sk, "the list of skipped checkpoints");

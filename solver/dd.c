@@ -181,11 +181,11 @@ void dd_migrate(struct dd *d, struct particles *P, const struct nbr *nb) {
     fill[dest[a]] += F_LEN;
   }
   P->n = k;
-  MPI_Alltoall(scount, 1, MPI_INT, rcount, 1, MPI_INT, MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Alltoall(scount, 1, MPI_INT, rcount, 1, MPI_INT, MPI_COMM_WORLD));
   for (int r = 0; r < np; r++) rdisp[r + 1] = rdisp[r] + rcount[r];
   reserve_buf(&d->rbuf, &d->cap_rbuf, (size_t)rdisp[np]);
-  MPI_Alltoallv(d->sbuf, scount, sdisp, MPI_DOUBLE, d->rbuf, rcount, rdisp, MPI_DOUBLE,
-                MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Alltoallv(d->sbuf, scount, sdisp, MPI_DOUBLE, d->rbuf, rcount, rdisp, MPI_DOUBLE,
+                          MPI_COMM_WORLD));
   const size_t arriving = (size_t)rdisp[np] / F_LEN;
   d->reserve(d->ctx, P->n + arriving);
   for (size_t i = 0; i < arriving; i++) unpack(P, P->n + i, d->rbuf + i * F_LEN);
@@ -231,15 +231,15 @@ static void exchange(struct dd *d, int nf, void (*pack_fn)(const void *, size_t,
       pack_fn(arg, d->send[s][i], d->sbuf + ((size_t)off + i) * nf);
   MPI_Request req[4];
   /* my left halo comes from the left neighbour's message to the right, and vice versa */
-  MPI_Irecv(d->rbuf, (int)(d->nrecv[0] * nf), MPI_DOUBLE, d->left, TAG_RIGHT, MPI_COMM_WORLD,
-            &req[0]);
-  MPI_Irecv(d->rbuf + d->nrecv[0] * nf, (int)(d->nrecv[1] * nf), MPI_DOUBLE, d->right, TAG_LEFT,
-            MPI_COMM_WORLD, &req[1]);
-  MPI_Isend(d->sbuf, (int)(d->nsend[0] * nf), MPI_DOUBLE, d->left, TAG_LEFT, MPI_COMM_WORLD,
-            &req[2]);
-  MPI_Isend(d->sbuf + d->nsend[0] * nf, (int)(d->nsend[1] * nf), MPI_DOUBLE, d->right, TAG_RIGHT,
-            MPI_COMM_WORLD, &req[3]);
-  MPI_Waitall(4, req, MPI_STATUSES_IGNORE);
+  CHECK_MPI(MPI_Irecv(d->rbuf, (int)(d->nrecv[0] * nf), MPI_DOUBLE, d->left, TAG_RIGHT,
+                      MPI_COMM_WORLD, &req[0]));
+  CHECK_MPI(MPI_Irecv(d->rbuf + d->nrecv[0] * nf, (int)(d->nrecv[1] * nf), MPI_DOUBLE, d->right,
+                      TAG_LEFT, MPI_COMM_WORLD, &req[1]));
+  CHECK_MPI(MPI_Isend(d->sbuf, (int)(d->nsend[0] * nf), MPI_DOUBLE, d->left, TAG_LEFT,
+                      MPI_COMM_WORLD, &req[2]));
+  CHECK_MPI(MPI_Isend(d->sbuf + d->nsend[0] * nf, (int)(d->nsend[1] * nf), MPI_DOUBLE, d->right,
+                      TAG_RIGHT, MPI_COMM_WORLD, &req[3]));
+  CHECK_MPI(MPI_Waitall(4, req, MPI_STATUSES_IGNORE));
   d->messages += 2;
   d->bytes += (double)ns * nf * sizeof(double);
 }
@@ -276,11 +276,11 @@ void dd_halo(struct dd *d, struct particles *P, struct nbr *nb) {
   /* counts: what my left neighbour sends right is my left halo */
   unsigned long sc[2] = {d->nsend[0], d->nsend[1]}, rc[2];
   MPI_Request req[4];
-  MPI_Irecv(&rc[0], 1, MPI_UNSIGNED_LONG, d->left, TAG_RIGHT, MPI_COMM_WORLD, &req[0]);
-  MPI_Irecv(&rc[1], 1, MPI_UNSIGNED_LONG, d->right, TAG_LEFT, MPI_COMM_WORLD, &req[1]);
-  MPI_Isend(&sc[0], 1, MPI_UNSIGNED_LONG, d->left, TAG_LEFT, MPI_COMM_WORLD, &req[2]);
-  MPI_Isend(&sc[1], 1, MPI_UNSIGNED_LONG, d->right, TAG_RIGHT, MPI_COMM_WORLD, &req[3]);
-  MPI_Waitall(4, req, MPI_STATUSES_IGNORE);
+  CHECK_MPI(MPI_Irecv(&rc[0], 1, MPI_UNSIGNED_LONG, d->left, TAG_RIGHT, MPI_COMM_WORLD, &req[0]));
+  CHECK_MPI(MPI_Irecv(&rc[1], 1, MPI_UNSIGNED_LONG, d->right, TAG_LEFT, MPI_COMM_WORLD, &req[1]));
+  CHECK_MPI(MPI_Isend(&sc[0], 1, MPI_UNSIGNED_LONG, d->left, TAG_LEFT, MPI_COMM_WORLD, &req[2]));
+  CHECK_MPI(MPI_Isend(&sc[1], 1, MPI_UNSIGNED_LONG, d->right, TAG_RIGHT, MPI_COMM_WORLD, &req[3]));
+  CHECK_MPI(MPI_Waitall(4, req, MPI_STATUSES_IGNORE));
   d->nrecv[0] = rc[0], d->nrecv[1] = rc[1];
   exchange(d, H_LEN, pack_ghost, P);
   const size_t ng = d->nrecv[0] + d->nrecv[1];
@@ -365,7 +365,8 @@ void dd_sum(const struct dd *d, const struct nbr *nb, int nv, const double *cons
     int *dsp = mem_alloc((size_t)d->size, sizeof(int), "domain decomposition");
     for (int r = 0; r < d->size; r++)
       cnt[r] = (d->first[r + 1] - d->first[r]) * nv, dsp[r] = d->first[r] * nv;
-    MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_DATATYPE_NULL, all, cnt, dsp, MPI_DOUBLE, MPI_COMM_WORLD);
+    CHECK_MPI(MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_DATATYPE_NULL, all, cnt, dsp, MPI_DOUBLE,
+                             MPI_COMM_WORLD));
     free(cnt), free(dsp);
   }
   double *col = mem_alloc((size_t)ncol, sizeof(double), "domain decomposition");
@@ -388,7 +389,8 @@ int dd_balance(struct dd *d, struct nbr *nb, double threshold) {
         const size_t c = nbr_owned_cell(nb, lc, iy, iz);
         cnt[nb->ix0 + lc] += (double)(nb->start[c + 1] - nb->start[c]);
       }
-  MPI_Allreduce(MPI_IN_PLACE, cnt, ncol, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD); /* integers */
+  CHECK_MPI(
+      MPI_Allreduce(MPI_IN_PLACE, cnt, ncol, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD)); /* integers */
   double total = 0.0, most = 0.0;
   for (int c = 0; c < ncol; c++) total += cnt[c];
   for (int r = 0; r < d->size; r++) {
@@ -439,13 +441,13 @@ size_t dd_check_ids(const struct dd *d, const struct particles *P, size_t n_tota
     cnts = mem_alloc((size_t)d->size, sizeof(int), "domain decomposition");
     disp = mem_alloc((size_t)d->size, sizeof(int), "domain decomposition");
   }
-  MPI_Gather(&cnt, 1, MPI_INT, cnts, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Gather(&cnt, 1, MPI_INT, cnts, 1, MPI_INT, 0, MPI_COMM_WORLD));
   size_t total = 0;
   if (d->rank == 0) {
     for (int r = 0; r < d->size; r++) disp[r] = (int)total, total += (size_t)cnts[r];
     all = mem_alloc((total ? total : 1), sizeof(int64_t), "domain decomposition");
   }
-  MPI_Gatherv(P->id, cnt, MPI_INT64_T, all, cnts, disp, MPI_INT64_T, 0, MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Gatherv(P->id, cnt, MPI_INT64_T, all, cnts, disp, MPI_INT64_T, 0, MPI_COMM_WORLD));
   long long bad = -1;
   int dup = 0;
   if (d->rank == 0) {
@@ -462,10 +464,10 @@ size_t dd_check_ids(const struct dd *d, const struct particles *P, size_t n_tota
       if (!seen[id]) bad = (long long)id;
     free(seen), free(all), free(cnts), free(disp);
   }
-  MPI_Bcast(&bad, 1, MPI_LONG_LONG, 0, MPI_COMM_WORLD);
-  MPI_Bcast(&dup, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Bcast(&bad, 1, MPI_LONG_LONG, 0, MPI_COMM_WORLD));
+  CHECK_MPI(MPI_Bcast(&dup, 1, MPI_INT, 0, MPI_COMM_WORLD));
   unsigned long long t = total;
-  MPI_Bcast(&t, 1, MPI_UNSIGNED_LONG_LONG, 0, MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Bcast(&t, 1, MPI_UNSIGNED_LONG_LONG, 0, MPI_COMM_WORLD));
   if (bad >= 0)
     die("run.check_ids: after step %ld particle id %lld is %s (%llu particles on %d ranks, "
         "expected %zu)",
@@ -492,10 +494,10 @@ void dd_gather_fluid(const struct dd *d, const struct particles *P, int nf, cons
     disp = mem_alloc((size_t)d->size, sizeof(int), "domain decomposition");
     all = mem_alloc((n ? n : 1) * rec, sizeof(double), "domain decomposition");
   }
-  MPI_Gather(&cnt, 1, MPI_INT, cnts, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Gather(&cnt, 1, MPI_INT, cnts, 1, MPI_INT, 0, MPI_COMM_WORLD));
   if (d->rank == 0)
     for (int r = 0, off = 0; r < d->size; off += cnts[r], r++) disp[r] = off;
-  MPI_Gatherv(buf, cnt, MPI_DOUBLE, all, cnts, disp, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Gatherv(buf, cnt, MPI_DOUBLE, all, cnts, disp, MPI_DOUBLE, 0, MPI_COMM_WORLD));
   if (d->rank == 0)
     for (size_t k = 0; k < n; k++) {
       const size_t id = (size_t)all[k * rec]; /* fluid ids are 0 .. n_fluid-1 */

@@ -12,6 +12,7 @@
 
 #include "euler.h"
 #include "moments.h"
+#include "ncutil.h"
 
 /** How a profile scales: velocity, stress, pressure, length, or not at all. */
 enum unit_class { UC_NONE, UC_VEL, UC_STRESS, UC_PRESSURE, UC_LENGTH, UC_VISC };
@@ -107,7 +108,7 @@ static int read_stored(const char *path, struct stored *s) {
       bad = 1;
     }
   }
-  nc_close(ncid);
+  CHECK_NC(nc_close(ncid));
   return bad;
 }
 

@@ -48,7 +48,7 @@ void spar_open(struct spar *p, const struct stats_snapshot *s) {
   p->dsp = p->cnt + p->size;
   const int mine[3] = {p->col0, p->col1, p->ncol};
   int *all = p->cnt; /* [rank][3], scratch until the first gather */
-  MPI_Allgather(mine, 3, MPI_INT, all, 3, MPI_INT, p->comm);
+  CHECK_MPI(MPI_Allgather(mine, 3, MPI_INT, all, 3, MPI_INT, p->comm));
   for (int r = 0; r < p->size; r++) {
     p->range[2 * r] = all[3 * r], p->range[2 * r + 1] = all[3 * r + 1];
     if (all[3 * r + 2] != p->ncol) fail("the ranks disagree on the number of columns");
@@ -77,7 +77,7 @@ size_t spar_gather_var(struct spar *p, const double *local, size_t n, size_t len
   if (p->size > 1) {
     int mine = (int)(n * len);
     if (n * len > (size_t)2147483647) fail("gather larger than 2^31 doubles");
-    MPI_Allgather(&mine, 1, MPI_INT, p->cnt, 1, MPI_INT, p->comm);
+    CHECK_MPI(MPI_Allgather(&mine, 1, MPI_INT, p->cnt, 1, MPI_INT, p->comm));
     size_t off = 0;
     for (int r = 0; r < p->size; r++) {
       if (off > (size_t)2147483647) fail("gather larger than 2^31 doubles");
@@ -92,7 +92,8 @@ size_t spar_gather_var(struct spar *p, const double *local, size_t n, size_t len
   if (p->size == 1) {
     if (n) memcpy(*buf, local, n * len * sizeof(double));
   } else {
-    MPI_Allgatherv(local, p->cnt[p->rank], MPI_DOUBLE, *buf, p->cnt, p->dsp, MPI_DOUBLE, p->comm);
+    CHECK_MPI(MPI_Allgatherv(local, p->cnt[p->rank], MPI_DOUBLE, *buf, p->cnt, p->dsp, MPI_DOUBLE,
+                             p->comm));
   }
   return total;
 }

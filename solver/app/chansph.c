@@ -150,6 +150,8 @@ int main(int argc, char **argv) {
   if (argc > 1 && !strcmp(argv[1], "compare"))
     return compare_main(argc - 2, argv + 2, CHANSPH_STATS_DIR);
   MPI_Init(&argc, &argv);
+  /* failed MPI calls return to CHECK_MPI, which names the call, file and line */
+  MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN);
   int rc = 0;
   struct cli c;
   struct scene sc;

@@ -299,22 +299,22 @@ int cli_bench(const struct scene *sc, long steps) {
   double nbr = 0.0, mine = (double)S.P.n;
   for (size_t a = 0; a < S.P.n; a++)
     if (S.P.kind[a] == KIND_FLUID) nbr += S.nb.count[a];
-  MPI_Allreduce(MPI_IN_PLACE, &nbr, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Allreduce(MPI_IN_PLACE, &nbr, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD));
   const int warm = 3;
   for (int i = 0; i < warm; i++) sim_step(&S);
   timer_reset();
   const double halo0 = S.dd.seconds, bytes0 = S.dd.bytes, msg0 = (double)S.dd.messages;
-  MPI_Barrier(MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Barrier(MPI_COMM_WORLD));
   const double t0 = timer_now(), sim0 = S.t;
   for (long i = 0; i < steps; i++) sim_step(&S);
-  MPI_Barrier(MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Barrier(MPI_COMM_WORLD));
   const double wall = timer_now() - t0, simt = S.t - sim0;
   double yard = S.dd.size == 1 ? yardstick(&S, steps) : 0.0;
   /* the exchanges per rank: max and mean of time, bytes and messages; particles per rank */
   double x[4] = {S.dd.seconds - halo0, S.dd.bytes - bytes0, (double)S.dd.messages - msg0, mine};
   double mx[4], sum[4];
-  MPI_Allreduce(x, mx, 4, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
-  MPI_Allreduce(x, sum, 4, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Allreduce(x, mx, 4, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD));
+  CHECK_MPI(MPI_Allreduce(x, sum, 4, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD));
   if (root) {
     printf("chansph bench: %dD, %zu fluid + %zu vertex particles, %d MPI ranks x %d threads\n",
            sc->dim, S.P.n_fluid, S.P.n_vertex, ranks, omp_get_max_threads());
