@@ -13,6 +13,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "error.h"
+
 /** Identity of the run (ckpt_set_run_id), written into every file; "" = none. */
 static char run_id[CKPT_RUN_ID_MAX];
 
@@ -111,8 +113,8 @@ size_t ckpt_state_bytes(const struct state_list *L) {
 
 static int put_attr_text(hid_t obj, const char *name, const char *text) {
   const hid_t t = H5Tcopy(H5T_C_S1);
-  H5Tset_size(t, strlen(text) + 1);
-  H5Tset_strpad(t, H5T_STR_NULLTERM);
+  CHECK_H5(H5Tset_size(t, strlen(text) + 1));
+  CHECK_H5(H5Tset_strpad(t, H5T_STR_NULLTERM));
   const hid_t sp = H5Screate(H5S_SCALAR);
   const hid_t a = H5Acreate2(obj, name, t, sp, H5P_DEFAULT, H5P_DEFAULT);
   const herr_t rc = a < 0 ? -1 : H5Awrite(a, t, text);
@@ -166,7 +168,7 @@ static herr_t write_part(hid_t ds, hid_t mtype, hid_t fsp, int rank, const hsize
   else
     rc = H5Sselect_none(fsp) < 0 || H5Sselect_none(msp) < 0 ? -1 : 0;
   const hid_t dxpl = H5Pcreate(H5P_DATASET_XFER);
-  H5Pset_dxpl_mpio(dxpl, H5FD_MPIO_COLLECTIVE); /* filtered (Fletcher32) writes need it */
+  CHECK_H5(H5Pset_dxpl_mpio(dxpl, H5FD_MPIO_COLLECTIVE)); /* filtered (Fletcher32) writes need it */
   if (rc >= 0) rc = H5Dwrite(ds, mtype, msp, fsp, dxpl, buf);
   close_keeping_errors(dxpl, H5Pclose);
   close_keeping_errors(msp, H5Sclose);
@@ -193,19 +195,19 @@ static int write_field(hid_t file, const struct state_field *f, hid_t gcpl, int 
   if (f->type == STATE_TEXT) {
     const char *text = *(char *const *)f->data;
     ftype = H5Tcopy(H5T_C_S1);
-    H5Tset_size(ftype, strlen(text) + 1);
-    H5Tset_strpad(ftype, H5T_STR_NULLTERM);
+    CHECK_H5(H5Tset_size(ftype, strlen(text) + 1));
+    CHECK_H5(H5Tset_strpad(ftype, H5T_STR_NULLTERM));
     mtype = ftype, buf = text, rank = 1, dims[0] = chunk[0] = count[0] = 1, n = 1;
   } else {
     ftype = file_type(f->type), mtype = mem_type(f->type);
   }
   const hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
-  H5Pset_obj_track_times(dcpl, 0);
+  CHECK_H5(H5Pset_obj_track_times(dcpl, 0));
   if (n > 0) {
     const size_t rows = CHUNK_BYTES / (row ? row : 1);
     if (chunk[0] > rows) chunk[0] = rows ? rows : 1;
-    H5Pset_chunk(dcpl, rank, chunk);
-    H5Pset_fletcher32(dcpl);
+    CHECK_H5(H5Pset_chunk(dcpl, rank, chunk));
+    CHECK_H5(H5Pset_fletcher32(dcpl));
     /* parallel HDF5 allocates chunks when the dataset is created: no fill-value writes */
     if (par) H5Pset_fill_time(dcpl, H5D_FILL_TIME_NEVER);
   }
@@ -242,10 +244,10 @@ int ckpt_agree(int rc, char *err, size_t errlen) {
   MPI_Comm_rank(MPI_COMM_WORLD, &me);
   MPI_Comm_size(MPI_COMM_WORLD, &size);
   int mine = rc ? me : size;
-  MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD));
   if (first == size) return 0;
   if (errlen > 0 && me != first) err[0] = '\0';
-  MPI_Bcast(err, (int)errlen, MPI_CHAR, first, MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Bcast(err, (int)errlen, MPI_CHAR, first, MPI_COMM_WORLD));
   return 1;
 }
 
@@ -283,29 +285,105 @@ static int probe_space(const char *tmp, size_t bytes, char *err, size_t errlen) 
    calls on every rank (collective metadata operations and writes), collective raw-data writes of
    each rank's rows; after every dataset the ranks agree on the outcome, so a failure on one rank
    stops them all at the same call. Rank 0 then fsyncs, renames and fsyncs the directory. */
+/* Where write_file() is: the file for the messages, this rank, and the error text. */
+struct wctx {
+  const char *noun, *tmp; /* "checkpoint" or "snapshot"; the temporary file */
+  int par, me;            /* collective write; this rank */
+  char *err;
+  size_t errlen;
+};
+
+/* The file access properties: MPI-IO for a collective write, else one in-memory image of the
+   whole file (the state plus room for the metadata), written on close. */
+static hid_t file_access(const struct state_list *L, const char *scene, int par) {
+  const hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+  CHECK_H5(H5Pset_libver_bounds(fapl, H5F_LIBVER_V18, H5F_LIBVER_V18)); /* checksummed metadata */
+  if (par) {
+    CHECK_H5(H5Pset_fapl_mpio(fapl, MPI_COMM_WORLD, MPI_INFO_NULL));
+    CHECK_H5(H5Pset_all_coll_metadata_ops(fapl, 1));
+    CHECK_H5(H5Pset_coll_metadata_write(fapl, 1));
+  } else {
+    CHECK_H5(H5Pset_fapl_core(
+        fapl, ckpt_state_bytes(L) + (scene ? strlen(scene) : 0) + ((size_t)1 << 20), 1));
+  }
+  return fapl;
+}
+
+/* The root attributes, the scene, every field and, last, the completion mark; 1 on failure
+   (the ranks agree after each part). */
+static int write_content(hid_t file, hid_t gcpl, const char *format, const struct state_list *L,
+                         const char *scene, long step, double time, const struct wctx *w) {
+  char *err = w->err;
+  const size_t errlen = w->errlen;
+  int rc = 0;
+  const int64_t step64 = step;
+  const int32_t major = CKPT_VERSION_MAJOR, minor = CKPT_VERSION_MINOR;
+  if (put_attr_text(file, "format", format) ||
+      put_attr_num(file, "format_version_major", H5T_STD_I32LE, H5T_NATIVE_INT32, &major) ||
+      put_attr_num(file, "format_version_minor", H5T_STD_I32LE, H5T_NATIVE_INT32, &minor) ||
+      put_attr_text(file, "code_version", CHANSPH_VERSION) ||
+      put_attr_num(file, "step", H5T_STD_I64LE, H5T_NATIVE_INT64, &step64) ||
+      put_attr_num(file, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &time) ||
+      (run_id[0] && put_attr_text(file, "run_id", run_id))) {
+    fail(err, errlen, "cannot write the root attributes of %s %s", w->noun, w->tmp);
+    rc = 1;
+  }
+  if (w->par) rc = ckpt_agree(rc, err, errlen);
+  char *scene_copy = (char *)scene;
+  struct state_field sf = {.name = "scene", .type = STATE_TEXT, .data = &scene_copy};
+  if (!rc && scene && write_field(file, &sf, gcpl, w->par, w->me)) {
+    fail(err, errlen, "cannot write dataset /scene of %s %s", w->noun, w->tmp);
+    rc = 1;
+  }
+  if (w->par) rc = ckpt_agree(rc, err, errlen);
+  for (int i = 0; i < L->n && !rc; i++) {
+    if (write_field(file, &L->f[i], gcpl, w->par, w->me)) {
+      fail(err, errlen, "cannot write dataset /%s of %s %s", L->f[i].name, w->noun, w->tmp);
+      rc = 1;
+    }
+    if (w->par) rc = ckpt_agree(rc, err, errlen);
+  }
+  const int32_t one = 1; /* written last: a file without it is incomplete */
+  if (!rc && put_attr_num(file, "complete", H5T_STD_I32LE, H5T_NATIVE_INT32, &one)) {
+    fail(err, errlen, "cannot write the completion mark of %s %s", w->noun, w->tmp);
+    rc = 1;
+  }
+  if (w->par) rc = ckpt_agree(rc, err, errlen);
+  return rc;
+}
+
+/* After the close: fsync the temporary file, rename it to path, fsync the directory (rank 0);
+   on failure the temporary file is removed. */
+static int commit_file(const char *path, int rc, const struct wctx *w) {
+  if (w->me == 0 && !rc && sync_path(w->tmp, 0)) {
+    snprintf(w->err, w->errlen, "cannot fsync %s %s: %s", w->noun, w->tmp, strerror(errno));
+    rc = 1;
+  }
+  if (w->me == 0 && !rc && rename(w->tmp, path)) {
+    snprintf(w->err, w->errlen, "cannot rename %s to %s: %s", w->tmp, path, strerror(errno));
+    rc = 1;
+  }
+  if (w->me == 0 && rc) remove(w->tmp);
+  if (w->me == 0 && !rc) rc = sync_dir(path, w->err, w->errlen);
+  if (w->par) rc = ckpt_agree(rc, w->err, w->errlen);
+  return rc;
+}
+
 static int write_file(const char *path, const char *format, const struct state_list *L,
                       const char *scene, long step, double time, int par, char *err,
                       size_t errlen) {
   H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
   int me = 0;
-  if (par) MPI_Comm_rank(MPI_COMM_WORLD, &me);
-  /* what the messages call the file: "checkpoint", "snapshot" (chansph-<noun>) */
-  const char *noun = strncmp(format, "chansph-", 8) ? "file" : format + 8;
+  if (par) CHECK_MPI(MPI_Comm_rank(MPI_COMM_WORLD, &me));
   char tmp[4096];
   snprintf(tmp, sizeof tmp, "%s.tmp", path);
-  const hid_t fcpl = H5Pcreate(H5P_FILE_CREATE), fapl = H5Pcreate(H5P_FILE_ACCESS);
+  /* what the messages call the file: "checkpoint", "snapshot" (chansph-<noun>) */
+  const struct wctx w = {
+      strncmp(format, "chansph-", 8) ? "file" : format + 8, tmp, par, me, err, errlen};
+  const hid_t fcpl = H5Pcreate(H5P_FILE_CREATE), fapl = file_access(L, scene, par);
   const hid_t gcpl = H5Pcreate(H5P_GROUP_CREATE);
-  H5Pset_obj_track_times(fcpl, 0);
-  H5Pset_obj_track_times(gcpl, 0);
-  H5Pset_libver_bounds(fapl, H5F_LIBVER_V18, H5F_LIBVER_V18); /* checksummed metadata */
-  if (par) {
-    H5Pset_fapl_mpio(fapl, MPI_COMM_WORLD, MPI_INFO_NULL);
-    H5Pset_all_coll_metadata_ops(fapl, 1);
-    H5Pset_coll_metadata_write(fapl, 1);
-  } else { /* one allocation for the whole file: the state plus room for the metadata */
-    H5Pset_fapl_core(fapl, ckpt_state_bytes(L) + (scene ? strlen(scene) : 0) + ((size_t)1 << 20),
-                     1);
-  }
+  CHECK_H5(H5Pset_obj_track_times(fcpl, 0));
+  CHECK_H5(H5Pset_obj_track_times(gcpl, 0));
   if (par) { /* the state, the scene and room for the metadata (4 kB a dataset, 64 kB) */
     const size_t need = ckpt_state_bytes(L) + (scene ? strlen(scene) : 0) +
                         4096 * (size_t)(L->n + 1) + ((size_t)1 << 16);
@@ -317,7 +395,7 @@ static int write_file(const char *path, const char *format, const struct state_l
   const hid_t file = H5Fcreate(tmp, H5F_ACC_TRUNC, fcpl, fapl);
   H5Pclose(fcpl), H5Pclose(fapl);
   int rc = file < 0;
-  if (rc) fail(err, errlen, "cannot write %s %s (%s)", noun, tmp, strerror(errno));
+  if (rc) fail(err, errlen, "cannot write %s %s (%s)", w.noun, tmp, strerror(errno));
   if (par) rc = ckpt_agree(rc, err, errlen);
   if (rc) {
     H5Pclose(gcpl);
@@ -325,57 +403,14 @@ static int write_file(const char *path, const char *format, const struct state_l
     if (me == 0) remove(tmp);
     return 1;
   }
-  const int64_t step64 = step;
-  const int32_t major = CKPT_VERSION_MAJOR, minor = CKPT_VERSION_MINOR;
-  if (put_attr_text(file, "format", format) ||
-      put_attr_num(file, "format_version_major", H5T_STD_I32LE, H5T_NATIVE_INT32, &major) ||
-      put_attr_num(file, "format_version_minor", H5T_STD_I32LE, H5T_NATIVE_INT32, &minor) ||
-      put_attr_text(file, "code_version", CHANSPH_VERSION) ||
-      put_attr_num(file, "step", H5T_STD_I64LE, H5T_NATIVE_INT64, &step64) ||
-      put_attr_num(file, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &time) ||
-      (run_id[0] && put_attr_text(file, "run_id", run_id))) {
-    fail(err, errlen, "cannot write the root attributes of %s %s", noun, tmp);
-    rc = 1;
-  }
-  if (par) rc = ckpt_agree(rc, err, errlen);
-  char *scene_copy = (char *)scene;
-  struct state_field sf = {.name = "scene", .type = STATE_TEXT, .data = &scene_copy};
-  if (!rc && scene && write_field(file, &sf, gcpl, par, me)) {
-    fail(err, errlen, "cannot write dataset /scene of %s %s", noun, tmp);
-    rc = 1;
-  }
-  if (par) rc = ckpt_agree(rc, err, errlen);
-  for (int i = 0; i < L->n && !rc; i++) {
-    if (write_field(file, &L->f[i], gcpl, par, me)) {
-      fail(err, errlen, "cannot write dataset /%s of %s %s", L->f[i].name, noun, tmp);
-      rc = 1;
-    }
-    if (par) rc = ckpt_agree(rc, err, errlen);
-  }
-  const int32_t one = 1; /* written last: a file without it is incomplete */
-  if (!rc && put_attr_num(file, "complete", H5T_STD_I32LE, H5T_NATIVE_INT32, &one)) {
-    fail(err, errlen, "cannot write the completion mark of %s %s", noun, tmp);
-    rc = 1;
-  }
-  if (par) rc = ckpt_agree(rc, err, errlen);
+  rc = write_content(file, gcpl, format, L, scene, step, time, &w);
   H5Pclose(gcpl);
   if (H5Fclose(file) < 0 && !rc) {
-    fail(err, errlen, "cannot write %s %s", noun, tmp);
+    fail(err, errlen, "cannot write %s %s", w.noun, tmp);
     rc = 1;
   }
   if (par) rc = ckpt_agree(rc, err, errlen);
-  if (me == 0 && !rc && sync_path(tmp, 0)) {
-    snprintf(err, errlen, "cannot fsync %s %s: %s", noun, tmp, strerror(errno));
-    rc = 1;
-  }
-  if (me == 0 && !rc && rename(tmp, path)) {
-    snprintf(err, errlen, "cannot rename %s to %s: %s", tmp, path, strerror(errno));
-    rc = 1;
-  }
-  if (me == 0 && rc) remove(tmp);
-  if (me == 0 && !rc) rc = sync_dir(path, err, errlen);
-  if (par) rc = ckpt_agree(rc, err, errlen);
-  return rc;
+  return commit_file(path, rc, &w);
 }
 
 int ckpt_write_fields(const char *path, const char *format, const struct state_list *L,
@@ -414,7 +449,7 @@ static int get_attr_text(hid_t obj, const char *name, char *buf, size_t n) {
     const size_t sz = H5Tget_size(ft);
     char *tmp = calloc(sz + 1, 1);
     const hid_t mt = H5Tcopy(H5T_C_S1);
-    H5Tset_size(mt, sz);
+    CHECK_H5(H5Tset_size(mt, sz));
     if (tmp && H5Aread(a, mt, tmp) >= 0) {
       snprintf(buf, n, "%s", tmp);
       rc = 0;
@@ -474,7 +509,7 @@ static char *read_text(hid_t file, const char *name, const char *path, char *err
     const size_t sz = H5Tget_size(ft);
     text = calloc(sz + 1, 1);
     const hid_t mt = H5Tcopy(H5T_C_S1);
-    H5Tset_size(mt, sz);
+    CHECK_H5(H5Tset_size(mt, sz));
     if (!text || H5Dread(ds, mt, H5S_ALL, H5S_ALL, H5P_DEFAULT, text) < 0) {
       fail(err, errlen, "%s: cannot read dataset /%s (checksum or data error)", path, name);
       free(text);

@@ -1,6 +1,6 @@
 /**
  * @file ckpt.h
- * @brief The checkpoint file: a state list (solver/state.h) as one HDF5 dataset per field,
+ * @brief The checkpoint file: a state list (solver/base/state.h) as one HDF5 dataset per field,
  *        with a format version, a completion mark and a Fletcher32 checksum on every dataset
  *        (docs/checkpoint-format.md).
  *
@@ -13,7 +13,16 @@
 
 #include <stddef.h>
 
+#include "error.h"
 #include "state.h"
+
+/** Run an HDF5 call whose failure is a bug, not an input or disk error (property lists, types):
+    a negative result dies naming the call, file and line. The writer and reader paths that a
+    full disk or a corrupt file can fail return a status instead (CKPT errors). */
+#define CHECK_H5(call)                                  \
+  do {                                                  \
+    if ((call) < 0) die("HDF5 call failed: %s", #call); \
+  } while (0)
 
 /** Value of the root attribute "format". */
 #define CKPT_FORMAT "chansph-checkpoint"

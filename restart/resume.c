@@ -10,6 +10,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "alloc.h"
 #include "ckpt.h"
 #include "error.h"
 #include "restart.h"
@@ -224,6 +225,20 @@ static int try_one(const char *dir, struct candidate *cd, int n_set, char *const
   return CHANSPH_OK;
 }
 
+/* Rename the skipped checkpoints (rank 0's files) to *.skipped and log why each was skipped. */
+static void rename_skipped(struct output *o, const struct skipped *sk, int rank) {
+  for (int i = 0; i < sk->n; i++) {
+    char to[4200];
+    struct stat st;
+    snprintf(to, sizeof to, "%s.skipped", sk->path[i]);
+    for (int k = 1; lstat(to, &st) == 0 && k < 1000; k++) /* never replace an earlier one */
+      snprintf(to, sizeof to, "%s.skipped.%d", sk->path[i], k);
+    const int moved = rank == 0 && rename(sk->path[i], to) == 0; /* rank 0's files */
+    output_log(o, "resume: skipped %s%s: %s\n", sk->path[i], moved ? " (renamed *.skipped)" : "",
+               sk->why[i]);
+  }
+}
+
 int restart_resume(const char *dir, int n_set, char *const *set, struct scene *sc, struct sim *S,
                    struct output *o) {
   long *steps;
@@ -235,10 +250,11 @@ int restart_resume(const char *dir, int n_set, char *const *set, struct scene *s
   }
   int rank = 0;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  MPI_Barrier(MPI_COMM_WORLD); /* every rank listed the files before rank 0 removes any */
+  CHECK_MPI(
+      MPI_Barrier(MPI_COMM_WORLD)); /* every rank listed the files before rank 0 removes any */
   const int tmp = rank == 0 ? rotate_remove_tmp(dir) : 0;
-  static struct skipped sk;
-  memset(&sk, 0, sizeof sk);
+  /* the checkpoints skipped, with why: 98 KB, on the heap */
+  struct skipped *sk = mem_calloc(1, sizeof *sk, "the list of skipped checkpoints");
   struct scene old;
   int fatal = 0, found = -1;
   double seconds[2] = {0.0, 0.0}; /* read, restore */
@@ -248,15 +264,16 @@ int restart_resume(const char *dir, int n_set, char *const *set, struct scene *s
   for (int i = n - 1; i >= 0 && !fatal && found < 0; i--) {
     rotate_path(path, sizeof path, dir, steps[i]);
     cd.name_step = steps[i];
-    if (!try_one(dir, &cd, n_set, set, sc, S, o, &sk, &old, &fatal, seconds)) found = i;
+    if (!try_one(dir, &cd, n_set, set, sc, S, o, sk, &old, &fatal, seconds)) found = i;
   }
   free(steps);
-  if (fatal) return CHANSPH_ERR;
-  if (found < 0) {
-    error_input(
-        "%s/checkpoints: none of the %d checkpoint(s) is valid (see above); nothing was "
-        "deleted",
-        dir, n);
+  if (fatal || found < 0) {
+    if (!fatal)
+      error_input(
+          "%s/checkpoints: none of the %d checkpoint(s) is valid (see above); nothing was "
+          "deleted",
+          dir, n);
+    free(sk);
     return CHANSPH_ERR;
   }
   /* the run's identity: the directory's; a directory without one (a run started before
@@ -267,6 +284,7 @@ int restart_resume(const char *dir, int n_set, char *const *set, struct scene *s
     if (rc) {
       output_close(o);
       sim_free(S);
+      free(sk);
       return CHANSPH_ERR;
     }
     output_log(o, "resume: %s/run_id was missing: the run's identity is now %s (%s)\n", dir,
@@ -278,16 +296,8 @@ int restart_resume(const char *dir, int n_set, char *const *set, struct scene *s
   output_log(o, "resume: from %s (step %ld, t = %.9g s; read in %.3f s, restored in %.3f s)\n",
              path, S->step, S->t, seconds[0], seconds[1]);
   if (tmp) output_log(o, "resume: removed %d temporary file(s) of interrupted writes\n", tmp);
-  for (int i = 0; i < sk.n; i++) {
-    char to[4200];
-    struct stat st;
-    snprintf(to, sizeof to, "%s.skipped", sk.path[i]);
-    for (int k = 1; lstat(to, &st) == 0 && k < 1000; k++) /* never replace an earlier one */
-      snprintf(to, sizeof to, "%s.skipped.%d", sk.path[i], k);
-    const int moved = rank == 0 && rename(sk.path[i], to) == 0; /* rank 0's files */
-    output_log(o, "resume: skipped %s%s: %s\n", sk.path[i], moved ? " (renamed *.skipped)" : "",
-               sk.why[i]);
-  }
+  rename_skipped(o, sk, rank);
+  free(sk);
   log_changes(o, &old, sc);
   return CHANSPH_OK;
 }

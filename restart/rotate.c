@@ -114,7 +114,7 @@ int restart_save(struct output *o, struct sim *S, double *seconds) {
     error_input("%s: cannot create the checkpoint directory (%s)", path, strerror(errno));
     rc = 1;
   }
-  MPI_Bcast(&rc, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Bcast(&rc, 1, MPI_INT, 0, MPI_COMM_WORLD));
   if (rc) {
     timer_pop();
     return CHANSPH_ERR;
@@ -129,7 +129,7 @@ int restart_save(struct output *o, struct sim *S, double *seconds) {
   state_free(&L);
   timer_pop();
   *seconds = timer_now() - t0;
-  MPI_Bcast(seconds, 1, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Bcast(seconds, 1, MPI_DOUBLE, 0, MPI_COMM_WORLD));
   if (rc) {
     error_input("%s", err);
     if (o->log) fprintf(o->log, "error: %s\n", err), fflush(o->log);
@@ -196,6 +196,6 @@ int restart_prepare_new(const char *dir, int overwrite) {
   int rank = 0, rc = CHANSPH_OK;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   if (rank == 0) rc = prepare_new(dir, overwrite); /* the files are rank 0's to touch */
-  MPI_Bcast(&rc, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Bcast(&rc, 1, MPI_INT, 0, MPI_COMM_WORLD));
   return rc;
 }

@@ -27,8 +27,8 @@ static int rank0(void) {
 
 /* Every rank takes rank 0's result (and text). */
 static int agree(int rc, char *text, int n) {
-  MPI_Bcast(&rc, 1, MPI_INT, 0, MPI_COMM_WORLD);
-  if (text) MPI_Bcast(text, n, MPI_CHAR, 0, MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Bcast(&rc, 1, MPI_INT, 0, MPI_COMM_WORLD));
+  if (text) CHECK_MPI(MPI_Bcast(text, n, MPI_CHAR, 0, MPI_COMM_WORLD));
   return rc;
 }
 

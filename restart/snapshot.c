@@ -166,7 +166,7 @@ int snapshot_write(const char *dir, const struct sim *S) {
     free(pos), free(vel), free(id);
   }
   free(g);
-  MPI_Bcast(&rc, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Bcast(&rc, 1, MPI_INT, 0, MPI_COMM_WORLD));
   timer_pop();
   return rc;
 }

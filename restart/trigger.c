@@ -104,7 +104,7 @@ static int local_check(struct trigger *T, long step) {
 int trigger_check(struct trigger *T, long step) {
   int why = local_check(T, step);
   /* the strongest reason of any rank (signals, the STOP file and the clocks differ) */
-  MPI_Allreduce(MPI_IN_PLACE, &why, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Allreduce(MPI_IN_PLACE, &why, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD));
   return why;
 }
 

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "alloc.h"
 #include "error.h"
 #include "reduce.h"
 #include "timers.h"
@@ -37,16 +38,10 @@ enum {
 /* tags: a message going to the left neighbour, one going to the right */
 enum { TAG_LEFT = 11, TAG_RIGHT = 12 };
 
-static void *xrealloc(void *p, size_t bytes) {
-  void *q = realloc(p, bytes ? bytes : 1);
-  if (!q) die("out of memory in the domain decomposition (%zu bytes)", bytes);
-  return q;
-}
-
 static void reserve_buf(double **buf, size_t *cap, size_t n) {
   if (n <= *cap) return;
   *cap = n + n / 2;
-  *buf = xrealloc(*buf, *cap * sizeof(double));
+  *buf = mem_realloc(*buf, *cap, sizeof(double), "domain decomposition");
 }
 
 static void pack(const struct particles *P, size_t a, double *r) {
@@ -92,7 +87,7 @@ int dd_init(struct dd *d, const struct scene *sc, dd_reserve_fn reserve, void *c
   d->halo = d->size > 1 ? NBR_REACH : 0;
   d->reserve = reserve, d->ctx = ctx;
   d->left = (d->rank + d->size - 1) % d->size, d->right = (d->rank + 1) % d->size;
-  d->first = xrealloc(NULL, (size_t)(d->size + 1) * sizeof(int));
+  d->first = mem_alloc((size_t)(d->size + 1), sizeof(int), "domain decomposition");
   if (d->size > 1 && d->ncol < 2 * d->halo * d->size) {
     error_input(
         "%s: key 'domain.lx': lx = %g gives %d cell columns of size h along x; %d MPI "
@@ -193,11 +188,11 @@ void dd_migrate(struct dd *d, struct particles *P, const struct nbr *nb) {
     fill[dest[a]] += F_LEN;
   }
   P->n = k;
-  MPI_Alltoall(scount, 1, MPI_INT, rcount, 1, MPI_INT, MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Alltoall(scount, 1, MPI_INT, rcount, 1, MPI_INT, MPI_COMM_WORLD));
   for (int r = 0; r < np; r++) rdisp[r + 1] = rdisp[r] + rcount[r];
   reserve_buf(&d->rbuf, &d->cap_rbuf, (size_t)rdisp[np]);
-  MPI_Alltoallv(d->sbuf, scount, sdisp, MPI_DOUBLE, d->rbuf, rcount, rdisp, MPI_DOUBLE,
-                MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Alltoallv(d->sbuf, scount, sdisp, MPI_DOUBLE, d->rbuf, rcount, rdisp, MPI_DOUBLE,
+                          MPI_COMM_WORLD));
   const size_t arriving = (size_t)rdisp[np] / F_LEN;
   d->reserve(d->ctx, P->n + arriving);
   for (size_t i = 0; i < arriving; i++) unpack(P, P->n + i, d->rbuf + i * F_LEN);
@@ -216,7 +211,8 @@ static size_t edge_slots(const struct nbr *nb, int c0, int c1, size_t **out, siz
   size_t n = 0;
   for (int pass = 0; pass < 2; pass++) {
     if (pass == 1) {
-      if (n > *cap) *cap = n + n / 2, *out = xrealloc(*out, *cap * sizeof(size_t));
+      if (n > *cap)
+        *cap = n + n / 2, *out = mem_realloc(*out, *cap, sizeof(size_t), "domain decomposition");
       n = 0;
     }
     for (int iz = 0; iz < nb->nz; iz++)
@@ -242,15 +238,15 @@ static void exchange(struct dd *d, int nf, void (*pack_fn)(const void *, size_t,
       pack_fn(arg, d->send[s][i], d->sbuf + ((size_t)off + i) * nf);
   MPI_Request req[4];
   /* my left halo comes from the left neighbour's message to the right, and vice versa */
-  MPI_Irecv(d->rbuf, (int)(d->nrecv[0] * nf), MPI_DOUBLE, d->left, TAG_RIGHT, MPI_COMM_WORLD,
-            &req[0]);
-  MPI_Irecv(d->rbuf + d->nrecv[0] * nf, (int)(d->nrecv[1] * nf), MPI_DOUBLE, d->right, TAG_LEFT,
-            MPI_COMM_WORLD, &req[1]);
-  MPI_Isend(d->sbuf, (int)(d->nsend[0] * nf), MPI_DOUBLE, d->left, TAG_LEFT, MPI_COMM_WORLD,
-            &req[2]);
-  MPI_Isend(d->sbuf + d->nsend[0] * nf, (int)(d->nsend[1] * nf), MPI_DOUBLE, d->right, TAG_RIGHT,
-            MPI_COMM_WORLD, &req[3]);
-  MPI_Waitall(4, req, MPI_STATUSES_IGNORE);
+  CHECK_MPI(MPI_Irecv(d->rbuf, (int)(d->nrecv[0] * nf), MPI_DOUBLE, d->left, TAG_RIGHT,
+                      MPI_COMM_WORLD, &req[0]));
+  CHECK_MPI(MPI_Irecv(d->rbuf + d->nrecv[0] * nf, (int)(d->nrecv[1] * nf), MPI_DOUBLE, d->right,
+                      TAG_LEFT, MPI_COMM_WORLD, &req[1]));
+  CHECK_MPI(MPI_Isend(d->sbuf, (int)(d->nsend[0] * nf), MPI_DOUBLE, d->left, TAG_LEFT,
+                      MPI_COMM_WORLD, &req[2]));
+  CHECK_MPI(MPI_Isend(d->sbuf + d->nsend[0] * nf, (int)(d->nsend[1] * nf), MPI_DOUBLE, d->right,
+                      TAG_RIGHT, MPI_COMM_WORLD, &req[3]));
+  CHECK_MPI(MPI_Waitall(4, req, MPI_STATUSES_IGNORE));
   d->messages += 2;
   d->bytes += (double)ns * nf * sizeof(double);
 }
@@ -287,11 +283,11 @@ void dd_halo(struct dd *d, struct particles *P, struct nbr *nb) {
   /* counts: what my left neighbour sends right is my left halo */
   unsigned long sc[2] = {d->nsend[0], d->nsend[1]}, rc[2];
   MPI_Request req[4];
-  MPI_Irecv(&rc[0], 1, MPI_UNSIGNED_LONG, d->left, TAG_RIGHT, MPI_COMM_WORLD, &req[0]);
-  MPI_Irecv(&rc[1], 1, MPI_UNSIGNED_LONG, d->right, TAG_LEFT, MPI_COMM_WORLD, &req[1]);
-  MPI_Isend(&sc[0], 1, MPI_UNSIGNED_LONG, d->left, TAG_LEFT, MPI_COMM_WORLD, &req[2]);
-  MPI_Isend(&sc[1], 1, MPI_UNSIGNED_LONG, d->right, TAG_RIGHT, MPI_COMM_WORLD, &req[3]);
-  MPI_Waitall(4, req, MPI_STATUSES_IGNORE);
+  CHECK_MPI(MPI_Irecv(&rc[0], 1, MPI_UNSIGNED_LONG, d->left, TAG_RIGHT, MPI_COMM_WORLD, &req[0]));
+  CHECK_MPI(MPI_Irecv(&rc[1], 1, MPI_UNSIGNED_LONG, d->right, TAG_LEFT, MPI_COMM_WORLD, &req[1]));
+  CHECK_MPI(MPI_Isend(&sc[0], 1, MPI_UNSIGNED_LONG, d->left, TAG_LEFT, MPI_COMM_WORLD, &req[2]));
+  CHECK_MPI(MPI_Isend(&sc[1], 1, MPI_UNSIGNED_LONG, d->right, TAG_RIGHT, MPI_COMM_WORLD, &req[3]));
+  CHECK_MPI(MPI_Waitall(4, req, MPI_STATUSES_IGNORE));
   d->nrecv[0] = rc[0], d->nrecv[1] = rc[1];
   exchange(d, H_LEN, pack_ghost, P);
   const size_t ng = d->nrecv[0] + d->nrecv[1];
@@ -300,7 +296,8 @@ void dd_halo(struct dd *d, struct particles *P, struct nbr *nb) {
   P->n_ghost = ng;
   nbr_sort_ghosts(nb, P, d->nrecv[0]);
   if (ng > d->cap_ghost) d->cap_ghost = ng + ng / 2;
-  d->ghost = xrealloc(d->ghost, (d->cap_ghost ? d->cap_ghost : 1) * sizeof(size_t));
+  d->ghost = mem_realloc(d->ghost, (d->cap_ghost ? d->cap_ghost : 1), sizeof(size_t),
+                         "domain decomposition");
   for (size_t i = 0; i < ng; i++) d->ghost[nb->perm[i]] = P->n + i;
   d->seconds += MPI_Wtime() - t0;
   timer_pop();
@@ -357,7 +354,7 @@ void dd_update_walls(struct dd *d, const struct particles *P, int nf, double *co
 void dd_sum(const struct dd *d, const struct nbr *nb, int nv, const double *const *x, double *out) {
   if (nv > 8) die("dd_sum: at most 8 arrays (got %d)", nv);
   const int nxo = nb->nxo, ncol = d->ncol;
-  double *all = xrealloc(NULL, (size_t)ncol * nv * sizeof(double));
+  double *all = mem_alloc((size_t)ncol * nv, sizeof(double), "domain decomposition");
   double *mine = all + (size_t)nb->ix0 * nv; /* this rank's columns, [column][v] */
 #pragma omp parallel for schedule(static)
   for (int lc = 0; lc < nxo; lc++) {
@@ -371,14 +368,15 @@ void dd_sum(const struct dd *d, const struct nbr *nb, int nv, const double *cons
     for (int v = 0; v < nv; v++) mine[(size_t)lc * nv + v] = s[v];
   }
   if (d->size > 1) {
-    int *cnt = xrealloc(NULL, (size_t)d->size * sizeof(int));
-    int *dsp = xrealloc(NULL, (size_t)d->size * sizeof(int));
+    int *cnt = mem_alloc((size_t)d->size, sizeof(int), "domain decomposition");
+    int *dsp = mem_alloc((size_t)d->size, sizeof(int), "domain decomposition");
     for (int r = 0; r < d->size; r++)
       cnt[r] = (d->first[r + 1] - d->first[r]) * nv, dsp[r] = d->first[r] * nv;
-    MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_DATATYPE_NULL, all, cnt, dsp, MPI_DOUBLE, MPI_COMM_WORLD);
+    CHECK_MPI(MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_DATATYPE_NULL, all, cnt, dsp, MPI_DOUBLE,
+                             MPI_COMM_WORLD));
     free(cnt), free(dsp);
   }
-  double *col = xrealloc(NULL, (size_t)ncol * sizeof(double));
+  double *col = mem_alloc((size_t)ncol, sizeof(double), "domain decomposition");
   for (int v = 0; v < nv; v++) {
     for (int c = 0; c < ncol; c++) col[c] = all[(size_t)c * nv + v];
     out[v] = reduce_pairwise(col, (size_t)ncol);
@@ -390,7 +388,7 @@ int dd_balance(struct dd *d, struct nbr *nb, double threshold) {
   if (d->size == 1) return 0;
   /* particles per column, gathered in column order */
   const int ncol = d->ncol;
-  double *cnt = xrealloc(NULL, (size_t)ncol * sizeof(double));
+  double *cnt = mem_alloc((size_t)ncol, sizeof(double), "domain decomposition");
   memset(cnt, 0, (size_t)ncol * sizeof(double));
   for (int lc = 0; lc < nb->nxo; lc++)
     for (int iz = 0; iz < nb->nz; iz++)
@@ -398,7 +396,8 @@ int dd_balance(struct dd *d, struct nbr *nb, double threshold) {
         const size_t c = nbr_owned_cell(nb, lc, iy, iz);
         cnt[nb->ix0 + lc] += (double)(nb->start[c + 1] - nb->start[c]);
       }
-  MPI_Allreduce(MPI_IN_PLACE, cnt, ncol, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD); /* integers */
+  CHECK_MPI(
+      MPI_Allreduce(MPI_IN_PLACE, cnt, ncol, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD)); /* integers */
   double total = 0.0, most = 0.0;
   for (int c = 0; c < ncol; c++) total += cnt[c];
   for (int r = 0; r < d->size; r++) {
@@ -414,7 +413,7 @@ int dd_balance(struct dd *d, struct nbr *nb, double threshold) {
   }
   /* cut where the running count passes r * mean, keeping 2 halo columns per rank */
   const int minw = 2 * d->halo;
-  int *nf = xrealloc(NULL, (size_t)(d->size + 1) * sizeof(int));
+  int *nf = mem_alloc((size_t)(d->size + 1), sizeof(int), "domain decomposition");
   nf[0] = 0, nf[d->size] = ncol;
   double run = 0.0;
   int c = 0;
@@ -446,16 +445,16 @@ size_t dd_check_ids(const struct dd *d, const struct particles *P, size_t n_tota
   int cnt = (int)P->n, *cnts = NULL, *disp = NULL;
   int64_t *all = NULL;
   if (d->rank == 0) {
-    cnts = xrealloc(NULL, (size_t)d->size * sizeof(int));
-    disp = xrealloc(NULL, (size_t)d->size * sizeof(int));
+    cnts = mem_alloc((size_t)d->size, sizeof(int), "domain decomposition");
+    disp = mem_alloc((size_t)d->size, sizeof(int), "domain decomposition");
   }
-  MPI_Gather(&cnt, 1, MPI_INT, cnts, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Gather(&cnt, 1, MPI_INT, cnts, 1, MPI_INT, 0, MPI_COMM_WORLD));
   size_t total = 0;
   if (d->rank == 0) {
     for (int r = 0; r < d->size; r++) disp[r] = (int)total, total += (size_t)cnts[r];
-    all = xrealloc(NULL, (total ? total : 1) * sizeof(int64_t));
+    all = mem_alloc((total ? total : 1), sizeof(int64_t), "domain decomposition");
   }
-  MPI_Gatherv(P->id, cnt, MPI_INT64_T, all, cnts, disp, MPI_INT64_T, 0, MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Gatherv(P->id, cnt, MPI_INT64_T, all, cnts, disp, MPI_INT64_T, 0, MPI_COMM_WORLD));
   long long bad = -1;
   int dup = 0;
   if (d->rank == 0) {
@@ -472,10 +471,10 @@ size_t dd_check_ids(const struct dd *d, const struct particles *P, size_t n_tota
       if (!seen[id]) bad = (long long)id;
     free(seen), free(all), free(cnts), free(disp);
   }
-  MPI_Bcast(&bad, 1, MPI_LONG_LONG, 0, MPI_COMM_WORLD);
-  MPI_Bcast(&dup, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Bcast(&bad, 1, MPI_LONG_LONG, 0, MPI_COMM_WORLD));
+  CHECK_MPI(MPI_Bcast(&dup, 1, MPI_INT, 0, MPI_COMM_WORLD));
   unsigned long long t = total;
-  MPI_Bcast(&t, 1, MPI_UNSIGNED_LONG_LONG, 0, MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Bcast(&t, 1, MPI_UNSIGNED_LONG_LONG, 0, MPI_COMM_WORLD));
   if (bad >= 0)
     die("run.check_ids: after step %ld particle id %lld is %s (%llu particles on %d ranks, "
         "expected %zu)",
@@ -488,7 +487,7 @@ void dd_gather_fluid(const struct dd *d, const struct particles *P, int nf, cons
   const size_t n = P->n_fluid, rec = (size_t)nf + 1;
   size_t mine = 0;
   for (size_t a = 0; a < P->n; a++) mine += P->kind[a] == KIND_FLUID;
-  double *buf = xrealloc(NULL, (mine ? mine : 1) * rec * sizeof(double));
+  double *buf = mem_alloc((mine ? mine : 1) * rec, sizeof(double), "domain decomposition");
   for (size_t a = 0, k = 0; a < P->n; a++) {
     if (P->kind[a] != KIND_FLUID) continue;
     buf[k * rec] = (double)P->id[a]; /* ids below 2^53 are exact */
@@ -498,14 +497,14 @@ void dd_gather_fluid(const struct dd *d, const struct particles *P, int nf, cons
   int cnt = (int)(mine * rec), *cnts = NULL, *disp = NULL;
   double *all = NULL;
   if (d->rank == 0) {
-    cnts = xrealloc(NULL, (size_t)d->size * sizeof(int));
-    disp = xrealloc(NULL, (size_t)d->size * sizeof(int));
-    all = xrealloc(NULL, (n ? n : 1) * rec * sizeof(double));
+    cnts = mem_alloc((size_t)d->size, sizeof(int), "domain decomposition");
+    disp = mem_alloc((size_t)d->size, sizeof(int), "domain decomposition");
+    all = mem_alloc((n ? n : 1) * rec, sizeof(double), "domain decomposition");
   }
-  MPI_Gather(&cnt, 1, MPI_INT, cnts, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Gather(&cnt, 1, MPI_INT, cnts, 1, MPI_INT, 0, MPI_COMM_WORLD));
   if (d->rank == 0)
     for (int r = 0, off = 0; r < d->size; off += cnts[r], r++) disp[r] = off;
-  MPI_Gatherv(buf, cnt, MPI_DOUBLE, all, cnts, disp, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Gatherv(buf, cnt, MPI_DOUBLE, all, cnts, disp, MPI_DOUBLE, 0, MPI_COMM_WORLD));
   if (d->rank == 0)
     for (size_t k = 0; k < n; k++) {
       const size_t id = (size_t)all[k * rec]; /* fluid ids are 0 .. n_fluid-1 */

@@ -6,6 +6,7 @@
 #include <mpi.h>
 #include <stdio.h>
 
+#include "error.h"
 #include "timers.h"
 
 enum { OK = 0, NOT_FINITE = 1, THROUGH_WALL = 2, SUPERSONIC = 3 };
@@ -45,7 +46,7 @@ int health_check(const struct model *M, const struct particles *P, long step, do
   }
   /* the failing particle of lowest id over all ranks; its owner writes the report */
   long long mine = worst;
-  MPI_Allreduce(MPI_IN_PLACE, &worst, 1, MPI_LONG_LONG, MPI_MIN, MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Allreduce(MPI_IN_PLACE, &worst, 1, MPI_LONG_LONG, MPI_MIN, MPI_COMM_WORLD));
   int rc = OK;
   for (size_t a = 0; worst != LLONG_MAX && mine == worst && a < P->n; a++) {
     if (P->id[a] != worst || P->kind[a] != KIND_FLUID) continue;
@@ -65,9 +66,9 @@ int health_check(const struct model *M, const struct particles *P, long step, do
     int owner[2] = {rc, 0}, rank;
     MPI_Comm_rank(MPI_COMM_WORLD, &rank);
     owner[1] = rc != OK ? rank : -1;
-    MPI_Allreduce(MPI_IN_PLACE, owner, 2, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+    CHECK_MPI(MPI_Allreduce(MPI_IN_PLACE, owner, 2, MPI_INT, MPI_MAX, MPI_COMM_WORLD));
     rc = owner[0];
-    MPI_Bcast(rep->what, (int)sizeof rep->what, MPI_CHAR, owner[1], MPI_COMM_WORLD);
+    CHECK_MPI(MPI_Bcast(rep->what, (int)sizeof rep->what, MPI_CHAR, owner[1], MPI_COMM_WORLD));
   }
   timer_pop();
   return rc;

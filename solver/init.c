@@ -11,6 +11,7 @@
 #include "dns_lm180.h"
 #include "error.h"
 #include "kernel.h"
+#include "ncutil.h"
 #include "walllaw.h"
 
 double init_noise(long seed, long long id, int stream) {
@@ -121,7 +122,7 @@ static int read_source(const char *path, const struct scene *sc, struct source *
     src->id = malloc((n ? n : 1) * sizeof(long long));
     ok = src->id && !nc_inq_varid(nc, "id", &vid) && !nc_get_var_longlong(nc, vid, src->id);
   }
-  nc_close(nc);
+  CHECK_NC(nc_close(nc));
   if (!ok) {
     error_input(
         "%s (init.from): not a chansph particles.nc (needs dimension 'particle', "

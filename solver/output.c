@@ -58,7 +58,7 @@ static int rank0(void) {
 
 /* Every rank takes rank 0's result of a file operation only rank 0 did. */
 static int agree(int rc) {
-  MPI_Bcast(&rc, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Bcast(&rc, 1, MPI_INT, 0, MPI_COMM_WORLD));
   return rc;
 }
 
@@ -549,8 +549,8 @@ static void log_decomposition(struct output *o, struct sim *S, double wall) {
   const struct dd *d = &S->dd;
   if (d->size == 1) return;
   double x[3] = {d->seconds, d->bytes, (double)d->migrated}, mx[3], sum[3];
-  MPI_Allreduce(x, mx, 3, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
-  MPI_Allreduce(x, sum, 3, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Allreduce(x, mx, 3, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD));
+  CHECK_MPI(MPI_Allreduce(x, sum, 3, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD));
   output_log(o,
              "decomposition: %d ranks, %d cell columns; halo exchange and migration %.3f s "
              "(max over ranks, %.1f%% of the wall time); %.2f MB sent in all; %.0f particles "

@@ -3,6 +3,8 @@
 
 #include <mpi.h>
 
+#include "error.h"
+
 double reduce_pairwise(const double *x, size_t n) {
   if (n <= 8) {
     double s = 0.0;
@@ -14,9 +16,9 @@ double reduce_pairwise(const double *x, size_t n) {
 }
 
 void reduce_global_max(double *v, int nv) {
-  MPI_Allreduce(MPI_IN_PLACE, v, nv, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Allreduce(MPI_IN_PLACE, v, nv, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD));
 }
 
 void reduce_global_min(double *v, int nv) {
-  MPI_Allreduce(MPI_IN_PLACE, v, nv, MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Allreduce(MPI_IN_PLACE, v, nv, MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD));
 }

@@ -172,7 +172,7 @@ static void check_fixed_dt(struct sim *S, double dt) {
   double mine[5] = {best, best >= 0.0 ? (double)P->id[who] : 0.0, 0, 0, 0};
   if (best >= 0.0) mine[2] = P->x[who], mine[3] = P->y[who], mine[4] = P->z[who];
   double *all = part_alloc("cfl_report", 5 * (size_t)S->dd.size * sizeof(double));
-  MPI_Allgather(mine, 5, MPI_DOUBLE, all, 5, MPI_DOUBLE, MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Allgather(mine, 5, MPI_DOUBLE, all, 5, MPI_DOUBLE, MPI_COMM_WORLD));
   const double *w = all;
   for (int r = 1; r < S->dd.size; r++) {
     const double *c = all + 5 * r;
@@ -335,13 +335,14 @@ static void block_state(struct sim *S, size_t lo, size_t hi) {
       r[G_LEN] = S->W.rho[slot], r[G_LEN + 1] = S->W.p[slot];
     }
   }
-  MPI_Alltoall(cnt, 1, MPI_INT, rcnt, 1, MPI_INT, MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Alltoall(cnt, 1, MPI_INT, rcnt, 1, MPI_INT, MPI_COMM_WORLD));
   rdisp[0] = 0;
   for (int r = 1; r < size; r++) rdisp[r] = rdisp[r - 1] + rcnt[r - 1];
   const size_t got = (size_t)(rdisp[size - 1] + rcnt[size - 1]) / R;
   if (got != nb) die("checkpoint blocks: %zu particles arrived for the %zu ids %zu..", got, nb, lo);
   double *buf = part_alloc("ckpt_recv", (nb ? nb : 1) * R * sizeof(double));
-  MPI_Alltoallv(rec, cnt, sdisp, MPI_DOUBLE, buf, rcnt, rdisp, MPI_DOUBLE, MPI_COMM_WORLD);
+  CHECK_MPI(
+      MPI_Alltoallv(rec, cnt, sdisp, MPI_DOUBLE, buf, rcnt, rdisp, MPI_DOUBLE, MPI_COMM_WORLD));
   part_free(rec), free(fill), free(dest), free(cnt);
   for (int k = 0; k < SIM_GATHER; k++) free(S->gather[k]), S->gather[k] = NULL;
   const size_t w0 = lo > P->n_fluid ? lo : P->n_fluid, nw = hi > w0 ? hi - w0 : 0;

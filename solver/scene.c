@@ -9,6 +9,7 @@
 #include <ini.h>
 #include <limits.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -594,8 +595,7 @@ static char *reader(char *str, int num, void *stream) {
 }
 
 /** Report a geometry or combination problem at the line of the first key involved. */
-static void inconsistent(struct parse_state *ps, const char *key, const char *fmt, double a,
-                         double b) {
+static void inconsistent(struct parse_state *ps, const char *key, const char *fmt, ...) {
   const char *dot = strchr(key, '.');
   char sec[32];
   snprintf(sec, sizeof sec, "%.*s", (int)(dot - key), key);
@@ -604,7 +604,10 @@ static void inconsistent(struct parse_state *ps, const char *key, const char *fm
   ps->set_text = k >= 0 ? ps->set_arg[k] : NULL; /* a key given with --set: name the argument */
   location(ps, k >= 0 ? ps->where[k] : 0, loc, sizeof loc);
   ps->set_text = NULL;
-  snprintf(text, sizeof text, fmt, a, b);
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(text, sizeof text, fmt, ap);
+  va_end(ap);
   error_input("%s: key '%s': %s", loc, key, text);
   ps->errors++;
 }
@@ -655,7 +658,7 @@ static void validate(struct parse_state *ps) {
                  6.0 * h);
   if (s->dim == 3) {
     if (s->lz <= 0.0)
-      inconsistent(ps, "domain.lz", "a 3-D scene needs lz > 0 (got %g)%.0s", s->lz, 0.0);
+      inconsistent(ps, "domain.lz", "a 3-D scene needs lz > 0 (got %g)", s->lz);
     else if (!is_multiple(s->lz, s->dr))
       inconsistent(ps, "domain.lz", "lz = %g is not a multiple of dr = %g", s->lz, s->dr);
     else if (s->lz < 6.0 * h * (1.0 - 1e-12))
@@ -665,15 +668,13 @@ static void validate(struct parse_state *ps) {
     inconsistent(ps, "domain.lz", "lz = %g is given for a 2-D scene (dimension = %g)", s->lz, 2.0);
   }
   if (s->drive_mode == DRIVE_FLUX && s->u_bulk == 0.0)
-    inconsistent(ps, "drive.mode", "flux mode needs drive.u_bulk != 0 (got %g)%.0s", s->u_bulk,
-                 0.0);
+    inconsistent(ps, "drive.mode", "flux mode needs drive.u_bulk != 0 (got %g)", s->u_bulk);
   if (s->les != LES_NONE && s->viscous != VISCOUS_VIOLEAU)
     inconsistent(ps, "les.model",
                  "the eddy viscosity needs the variable-viscosity operator: set sph.viscous = "
-                 "violeau (thesis Eq. 2.100)%.0s%.0s",
-                 0.0, 0.0);
+                 "violeau (thesis Eq. 2.100)");
   if ((s->les != LES_NONE || s->wall_law != 0) && !(s->nu > 0.0))
-    inconsistent(ps, "fluid.nu", "wall laws and LES need nu > 0 (got %g)%.0s", s->nu, 0.0);
+    inconsistent(ps, "fluid.nu", "wall laws and LES need nu > 0 (got %g)", s->nu);
   if ((s->les != LES_NONE || s->wall_law != 0) && two_delta < 4.0 * h * (1.0 - 1e-12))
     inconsistent(ps, "domain.delta",
                  "wall laws and LES need 2 delta = %g >= 4h = %g (no particle near both walls)",
@@ -693,14 +694,14 @@ static void validate(struct parse_state *ps) {
   if (s->init_profile == INIT_SYNTHETIC) {
     const double sig = s->init_eddy_size * s->delta;
     if (s->dim != 3)
-      inconsistent(ps, "init.profile", "synthetic needs a 3-D scene (dimension = %g)%.0s",
-                   (double)s->dim, 0.0);
+      inconsistent(ps, "init.profile", "synthetic needs a 3-D scene (dimension = %g)",
+                   (double)s->dim);
     else if (sig > 0.5 * s->lx || sig > 0.5 * s->lz)
       inconsistent(ps, "init.eddy_size",
                    "eddy size sigma = %g (eddy_size delta) is more than half of min(lx, lz) = %g",
                    sig, fmin(s->lx, s->lz));
     if (!(s->nu > 0.0))
-      inconsistent(ps, "fluid.nu", "profile = synthetic needs nu > 0 (got %g)%.0s", s->nu, 0.0);
+      inconsistent(ps, "fluid.nu", "profile = synthetic needs nu > 0 (got %g)", s->nu);
   }
   if (s->dt_fixed > 0.0 && s->dt_fixed > s->t_end)
     inconsistent(ps, "time.dt", "fixed dt = %g is larger than t_end = %g", s->dt_fixed, s->t_end);

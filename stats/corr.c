@@ -10,20 +10,13 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "alloc.h"
+#include "error.h"
 #include "ncout.h"
 #include "spar.h"
 #include "state.h"
 
 static const double two_pi = 6.283185307179586;
-
-static void *xalloc(size_t bytes) {
-  void *p = calloc(1, bytes ? bytes : 1);
-  if (!p) {
-    fprintf(stderr, "error: out of memory in the correlation engine\n");
-    abort();
-  }
-  return p;
-}
 
 void corr_init(struct corr *c, const struct corr_config *cfg) {
   memset(c, 0, sizeof *c);
@@ -32,15 +25,12 @@ void corr_init(struct corr *c, const struct corr_config *cfg) {
   const int nx = cfg->nx, nz = cfg->nz;
   c->nzh = nz / 2 + 1;
   const size_t nk = (size_t)nx * (size_t)c->nzh;
-  c->spec = xalloc((size_t)cfg->n_levels * nk * CS_LEN * sizeof(double));
-  c->samples = xalloc((size_t)cfg->n_levels * sizeof(double));
-  c->empty = xalloc((size_t)cfg->n_levels * sizeof(double));
+  c->spec = mem_calloc((size_t)cfg->n_levels * nk * CS_LEN, sizeof(double), "correlation engine");
+  c->samples = mem_calloc((size_t)cfg->n_levels, sizeof(double), "correlation engine");
+  c->empty = mem_calloc((size_t)cfg->n_levels, sizeof(double), "correlation engine");
   c->grid = fftw_malloc(4 * (size_t)nx * (size_t)nz * sizeof(double));
   c->out = fftw_malloc(3 * nk * sizeof(fftw_complex));
-  if (!c->grid || !c->out) {
-    fprintf(stderr, "error: out of memory in the correlation engine\n");
-    abort();
-  }
+  if (!c->grid || !c->out) die("out of memory: correlation engine (FFTW arrays)");
   /* three transforms of nx x nz at once; FFTW_ESTIMATE chooses the plan without timing, so
      the same sizes give the same plan, and the same sums, on every run and restart */
   const int n[2] = {nx, nz};
@@ -144,7 +134,7 @@ void corr_sample(struct corr *c, const struct stats_snapshot *s) {
       const size_t q = (size_t)ix * (size_t)nz + (size_t)iz;
       if (nh == c->hits_cap) {
         c->hits_cap = c->hits_cap ? 2 * c->hits_cap : 1024;
-        c->hits = spar_realloc(c->hits, c->hits_cap * sizeof(struct hit));
+        c->hits = mem_realloc(c->hits, c->hits_cap, sizeof(struct hit), "statistics engine");
       }
       struct hit *h = (struct hit *)c->hits + nh++;
       h->key = ((uint64_t)pl * ncl + (uint64_t)spar_lcol(&par, s, a)) * np + q;
@@ -159,7 +149,7 @@ void corr_sample(struct corr *c, const struct stats_snapshot *s) {
   for (size_t i = 0; i < nh;) {
     if (ne == c->ent_cap) {
       c->ent_cap = c->ent_cap ? 2 * c->ent_cap : 1024;
-      c->ent = spar_realloc(c->ent, c->ent_cap * CORR_ENT * sizeof(double));
+      c->ent = mem_realloc(c->ent, c->ent_cap * CORR_ENT, sizeof(double), "statistics engine");
     }
     double *e = c->ent + ne++ * CORR_ENT;
     const uint64_t key = H[i].key, pl = key / (ncl * np), q = key % np;

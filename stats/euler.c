@@ -6,6 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "alloc.h"
+#include "error.h"
 #include "moments.h"
 #include "spar.h"
 #include "state.h"
@@ -108,15 +110,6 @@ const struct euler_meta euler_prof_meta[EP_NPROF] = {
                        "standard error of total_stress (batch means)"},
 };
 
-static void *xrealloc(void *p, size_t bytes) {
-  void *q = realloc(p, bytes ? bytes : 1);
-  if (!q) {
-    fprintf(stderr, "error: out of memory in the statistics engine\n");
-    abort();
-  }
-  return q;
-}
-
 double euler_centre(const struct euler_config *cfg, int i) {
   return cfg->y0 + (i + 0.5) * (cfg->y1 - cfg->y0) / cfg->nb;
 }
@@ -127,10 +120,10 @@ static void reserve_rows(struct euler *e, size_t rows) {
   const size_t nb = (size_t)e->cfg.nb, old = e->cap;
   size_t cap = old ? old : 8;
   while (cap < rows) cap *= 2;
-  e->win = xrealloc(e->win, cap * WIN_LEN * sizeof(double));
-  e->mom = xrealloc(e->mom, cap * nb * MOM_LEN * sizeof(double));
-  e->snp = xrealloc(e->snp, cap * nb * SCAL_LEN * sizeof(double));
-  e->pln = xrealloc(e->pln, cap * nb * PL_LEN * sizeof(double));
+  e->win = mem_realloc(e->win, cap * WIN_LEN, sizeof(double), "Eulerian statistics");
+  e->mom = mem_realloc(e->mom, cap * nb * MOM_LEN, sizeof(double), "Eulerian statistics");
+  e->snp = mem_realloc(e->snp, cap * nb * SCAL_LEN, sizeof(double), "Eulerian statistics");
+  e->pln = mem_realloc(e->pln, cap * nb * PL_LEN, sizeof(double), "Eulerian statistics");
   memset(e->win + old * WIN_LEN, 0, (cap - old) * WIN_LEN * sizeof(double));
   memset(e->mom + old * nb * MOM_LEN, 0, (cap - old) * nb * MOM_LEN * sizeof(double));
   memset(e->snp + old * nb * SCAL_LEN, 0, (cap - old) * nb * SCAL_LEN * sizeof(double));
@@ -218,7 +211,7 @@ static void subtrees(struct euler_work *k, size_t *n, int lo, int hi, int c0, in
   if (c0 <= lo && hi <= c1) {
     if (*n == k->node_cap) {
       k->node_cap = k->node_cap ? 2 * k->node_cap : 64;
-      k->node = xrealloc(k->node, 2 * k->node_cap * sizeof(int));
+      k->node = mem_realloc(k->node, 2 * k->node_cap, sizeof(int), "Eulerian statistics");
     }
     k->node[2 * *n] = lo, k->node[2 * *n + 1] = hi, (*n)++;
     return;
@@ -326,13 +319,13 @@ void euler_sample(struct euler *e, const struct stats_snapshot *s) {
   struct spar par;
   spar_open(&par, s);
   if (!e->work) {
-    e->work = xrealloc(NULL, sizeof(struct euler_work));
+    e->work = mem_alloc(1, sizeof(struct euler_work), "Eulerian statistics");
     memset(e->work, 0, sizeof(struct euler_work));
   }
   struct euler_work *k = e->work;
   const size_t ncol = (size_t)par.ncol, len = nb * EU_PART;
   if (ncol > k->part_cap) {
-    k->part = xrealloc(k->part, ncol * len * sizeof(double));
+    k->part = mem_realloc(k->part, ncol * len, sizeof(double), "Eulerian statistics");
     k->part_cap = ncol;
   }
   double *mine = k->part + (size_t)par.col0 * len;
@@ -389,13 +382,13 @@ void euler_sample(struct euler *e, const struct stats_snapshot *s) {
   int depth = 1;
   while ((1 << (depth - 1)) < par.ncol) depth++;
   if ((size_t)depth > k->scr_cap) {
-    k->scr = xrealloc(k->scr, (size_t)depth * len * sizeof(double));
+    k->scr = mem_realloc(k->scr, (size_t)depth * len, sizeof(double), "Eulerian statistics");
     k->scr_cap = (size_t)depth;
   }
   size_t nmine = 0;
   subtrees(k, &nmine, 0, par.ncol, par.col0, par.col1);
   if (nmine + 1 > k->mine_cap) { /* + 1: the root record below */
-    k->mine = xrealloc(k->mine, (nmine + 1) * len * sizeof(double));
+    k->mine = mem_realloc(k->mine, (nmine + 1) * len, sizeof(double), "Eulerian statistics");
     k->mine_cap = nmine + 1;
   }
   for (size_t i = 0; i < nmine; i++)
@@ -407,10 +400,7 @@ void euler_sample(struct euler *e, const struct stats_snapshot *s) {
   for (int r = 0; r < par.size; r++)
     subtrees(k, &nn, 0, par.ncol, par.range[2 * r], par.range[2 * r + 1]);
   spar_close(&par);
-  if (nn != nall) {
-    fprintf(stderr, "error: statistics: %zu column subtrees gathered, %zu expected\n", nall, nn);
-    abort();
-  }
+  if (nn != nall) die("statistics: %zu column subtrees gathered, %zu expected", nall, nn);
   double *snap = k->mine; /* the root record: every bin of the snapshot */
   node_record(k, nb, 0, (int)ncol, k->all, nn, 0, snap);
   e->nsub = nn;
@@ -491,11 +481,13 @@ void euler_finalise(const struct euler_config *cfg, const double *win, const dou
   const int nb = cfg->nb;
   memset(res, 0, sizeof *res);
   res->nb = nb;
-  for (int k = 0; k < EP_NPROF; k++) res->prof[k] = xrealloc(NULL, (size_t)nb * sizeof(double));
-  double *tot = xrealloc(NULL, (size_t)nb * MOM_LEN * sizeof(double));
-  double *bm = xrealloc(NULL, (size_t)nb * 11 * SCAL_LEN * sizeof(double)); /* batch moments */
-  double *sn = xrealloc(NULL, (size_t)nb * SCAL_LEN * sizeof(double));
-  double *within = xrealloc(NULL, (size_t)nb * 2 * sizeof(double));
+  for (int k = 0; k < EP_NPROF; k++)
+    res->prof[k] = mem_alloc((size_t)nb, sizeof(double), "Eulerian statistics");
+  double *tot = mem_alloc((size_t)nb * MOM_LEN, sizeof(double), "Eulerian statistics");
+  double *bm = mem_alloc((size_t)nb * 11 * SCAL_LEN, sizeof(double),
+                         "Eulerian statistics"); /* batch moments */
+  double *sn = mem_alloc((size_t)nb * SCAL_LEN, sizeof(double), "Eulerian statistics");
+  double *within = mem_alloc((size_t)nb * 2, sizeof(double), "Eulerian statistics");
   memset(tot, 0, (size_t)nb * MOM_LEN * sizeof(double));
   memset(bm, 0, (size_t)nb * 11 * SCAL_LEN * sizeof(double));
   memset(sn, 0, (size_t)nb * SCAL_LEN * sizeof(double));
@@ -529,7 +521,7 @@ void euler_finalise(const struct euler_config *cfg, const double *win, const dou
   }
   res->snapshots = snaps;
   const double nan = NAN;
-  int *ok = xrealloc(NULL, (size_t)nb * sizeof(int));
+  int *ok = mem_alloc((size_t)nb, sizeof(int), "Eulerian statistics");
   double tau_sum = 0.0;
   int tau_n = 0;
   for (int b = 0; b < nb; b++) {

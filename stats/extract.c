@@ -2,6 +2,7 @@
 #include "extract.h"
 
 #include <errno.h>
+#include <getopt.h>
 #include <math.h>
 #include <netcdf.h>
 #include <stdio.h>
@@ -11,6 +12,7 @@
 
 #include "euler.h"
 #include "moments.h"
+#include "ncutil.h"
 
 /** How a profile scales: velocity, stress, pressure, length, or not at all. */
 enum unit_class { UC_NONE, UC_VEL, UC_STRESS, UC_PRESSURE, UC_LENGTH, UC_VISC };
@@ -114,7 +116,7 @@ static int read_stored(const char *path, struct stored *s) {
       }
     }
   }
-  nc_close(ncid);
+  CHECK_NC(nc_close(ncid));
   return bad;
 }
 
@@ -146,92 +148,119 @@ static void usage(FILE *f) {
           "  (standard errors are printed next to the variables that have them)\n");
 }
 
-int extract_main(int argc, char **argv) {
-  const char *path = NULL, *vars = "u_mean,u_rms,v_rms,w_rms,uv", *units = "wall", *fmt = "csv";
-  double t0 = -INFINITY, t1 = INFINITY;
-  for (int i = 0; i < argc; i++) {
-    const int more = i + 1 < argc;
-    if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
+/* The options of one extract command. */
+struct extract_args {
+  const char *path, *vars, *units, *fmt;
+  double t0, t1; /* --window */
+};
+
+/* Parse the command line (argv[0]: the command name); 1: input error, -1: --help printed. */
+static int extract_parse(int argc, char **argv, struct extract_args *a) {
+  static const struct option opts[] = {
+      {"help", no_argument, NULL, 'h'},         {"var", required_argument, NULL, 'v'},
+      {"units", required_argument, NULL, 'u'},  {"format", required_argument, NULL, 'f'},
+      {"window", required_argument, NULL, 'w'}, {NULL, 0, NULL, 0}};
+  *a = (struct extract_args){NULL,    "u_mean,u_rms,v_rms,w_rms,uv", "wall", "csv", -INFINITY,
+                             INFINITY};
+  opterr = 0, optind = 1; /* "-": positional arguments in order (code 1); ':' missing value */
+  for (;;) {
+    const int at = optind, code = getopt_long(argc, argv, "-:h", opts, NULL);
+    if (code == -1) break;
+    if (code == 'h') {
       usage(stdout);
-      return 0;
-    } else if (!strcmp(argv[i], "--var") && more)
-      vars = argv[++i];
-    else if (!strcmp(argv[i], "--units") && more)
-      units = argv[++i];
-    else if (!strcmp(argv[i], "--format") && more)
-      fmt = argv[++i];
-    else if (!strcmp(argv[i], "--window") && more) {
-      const char *w = argv[++i], *colon = strchr(w, ':');
-      if (!colon || parse_time(w, colon, -INFINITY, &t0) ||
-          parse_time(colon + 1, colon + strlen(colon), INFINITY, &t1) || t0 > t1) {
+      return -1;
+    }
+    if (code == 'v' || code == 'u' || code == 'f') {
+      *(code == 'v' ? &a->vars : code == 'u' ? &a->units : &a->fmt) = optarg;
+    } else if (code == 'w') {
+      const char *w = optarg, *colon = strchr(w, ':');
+      if (!colon || parse_time(w, colon, -INFINITY, &a->t0) ||
+          parse_time(colon + 1, colon + strlen(colon), INFINITY, &a->t1) || a->t0 > a->t1) {
         fprintf(stderr,
                 "error: --window %s: expected T0:T1, two times in seconds with T0 <= T1 (either "
                 "may be empty: from the first or to the last window)\n",
                 w);
         return 1;
       }
-    } else if (argv[i][0] != '-' && !path)
-      path = argv[i];
-    else {
-      fprintf(stderr, "error: unexpected argument '%s'\n", argv[i]);
+    } else if (code == 1 && !a->path) {
+      a->path = optarg;
+    } else {
+      fprintf(stderr, "error: unexpected argument '%s'\n", code == 1 ? optarg : argv[at]);
       usage(stderr);
       return 1;
     }
   }
-  if (!path || (strcmp(units, "wall") && strcmp(units, "outer")) ||
-      (strcmp(fmt, "csv") && strcmp(fmt, "tsv"))) {
+  if (optind < argc && !a->path) a->path = argv[optind++]; /* after "--" */
+  if (!a->path || optind < argc || (strcmp(a->units, "wall") && strcmp(a->units, "outer")) ||
+      (strcmp(a->fmt, "csv") && strcmp(a->fmt, "tsv"))) {
     usage(stderr);
     return 1;
   }
-  const int wall = !strcmp(units, "wall");
-  const char sep = !strcmp(fmt, "csv") ? ',' : '\t';
-  struct stored s;
-  if (read_stored(path, &s)) {
-    free_stored(&s);
-    return 1;
-  }
-  /* windows wholly inside [t0, t1] (with a relative tolerance for the nominal bounds) */
-  size_t r0 = s.rows, r1 = 0;
-  const double tol = 1e-9 * s.cfg.window;
-  for (size_t r = 0; r < s.rows; r++) {
-    const double a = s.win[r * WIN_LEN + WIN_T0], b = s.win[r * WIN_LEN + WIN_T1];
-    if (a >= t0 - tol && b <= t1 + tol) r0 = r < r0 ? r : r0, r1 = r + 1;
-  }
-  if (r1 <= r0) {
-    fprintf(stderr, "error: %s: no averaging window lies inside %g:%g\n", path, t0, t1);
-    free_stored(&s);
-    return 1;
-  }
-  struct euler_result res;
-  euler_finalise(&s.cfg, s.win, s.mom, s.snp, s.pln, s.complete, r0, r1, &res);
-  /* columns */
-  int cols[64], rms[64], nc = 0;
+  return 0;
+}
+
+/* The columns of --var: profile index and whether it is printed as an rms; -1 on error. */
+static int extract_columns(const char *vars, int *cols, int *rms, int max) {
+  int nc = 0;
   char *list = strdup(vars);
-  for (char *tok = strtok(list, ","); tok && nc < 64; tok = strtok(NULL, ",")) {
+  for (char *tok = strtok(list, ","); tok && nc < max; tok = strtok(NULL, ",")) {
     int k = find_prof(tok), is_rms = 0;
     if (k < 0 && strlen(tok) == 5 && !strcmp(tok + 1, "_rms") && strchr("uvw", tok[0]))
       k = EP_UU + (tok[0] - 'u'), is_rms = 1;
     if (k < 0) {
       fprintf(stderr, "error: unknown variable '%s'\n", tok);
       usage(stderr);
-      free(list), free_stored(&s), euler_result_free(&res);
-      return 1;
+      free(list);
+      return -1;
     }
     cols[nc] = k, rms[nc++] = is_rms;
   }
   free(list);
-  const double ut = res.u_tau, delta = s.cfg.delta;
+  return nc;
+}
+
+/* The factor that takes profile k to wall units (wall) or outer units. */
+static double extract_scale(int k, int wall, const struct euler_config *cfg, double ut) {
+  if (!wall) return class_of(k) == UC_LENGTH ? 1.0 / cfg->delta : 1.0;
+  switch (class_of(k)) {
+    case UC_VEL:
+      return 1.0 / ut;
+    case UC_STRESS:
+      return 1.0 / (ut * ut);
+    case UC_PRESSURE:
+      return 1.0 / (cfg->rho0 * ut * ut);
+    case UC_LENGTH:
+      return ut / cfg->nu;
+    case UC_VISC:
+      return 1.0 / cfg->nu;
+    case UC_NONE:
+      break;
+  }
+  return 1.0;
+}
+
+/* The profile of the standard error of profile k, or -1. */
+static int stderr_of(int k) {
+  return k >= EP_U && k <= EP_VW ? EP_SE_U + (k - EP_U) : -1;
+}
+
+/* The header lines and the column names. */
+static void extract_header(const struct extract_args *a, const struct stored *s,
+                           const struct euler_result *res, size_t r0, size_t r1, const int *cols,
+                           const int *rms, int nc) {
+  const int wall = !strcmp(a->units, "wall");
+  const char sep = !strcmp(a->fmt, "csv") ? ',' : '\t';
   /* a run that stopped inside its last window reached t_reached, not the window's end */
-  const double t_last = isnan(s.t_reached) ? res.t1 : fmin(res.t1, s.t_reached);
+  const double t_last = isnan(s->t_reached) ? res->t1 : fmin(res->t1, s->t_reached);
   printf(
       "# chansph extract %s: windows %zu..%zu, t = %.9g .. %.9g s, %.0f snapshots, %d "
       "batches\n",
-      path, r0, r1 - 1, res.t0, t_last, res.snapshots, res.n_batches);
+      a->path, r0, r1 - 1, res->t0, t_last, res->snapshots, res->n_batches);
   printf(
       "# u_tau = %.9g m/s (wall shear %.9g, force balance %.9g, stderr %.3g), Re_tau = %.6g, "
       "correlation time %.4g s, stress balance error %.4g\n",
-      ut, res.u_tau_wall, res.u_tau_force, res.u_tau_stderr, res.re_tau, res.corr_time,
-      res.balance_error);
+      res->u_tau, res->u_tau_wall, res->u_tau_force, res->u_tau_stderr, res->re_tau, res->corr_time,
+      res->balance_error);
   printf("# units: %s\n", wall ? "wall (y+ = y u_tau/nu, velocities/u_tau, stresses/u_tau^2, "
                                  "p/(rho0 u_tau^2), nu_t/nu)"
                                : "outer (y/delta; values in SI units)");
@@ -241,41 +270,26 @@ int extract_main(int argc, char **argv) {
     char rname[16];
     if (rms[c]) snprintf(rname, sizeof rname, "%c_rms", name[0]), name = rname;
     printf("%c%s", sep, name);
-    const int se = cols[c] >= EP_U && cols[c] <= EP_VW ? EP_SE_U + (cols[c] - EP_U) : -1;
-    if (se >= 0) printf("%c%s_stderr", sep, name);
+    if (stderr_of(cols[c]) >= 0) printf("%c%s_stderr", sep, name);
   }
   printf("\n");
-  for (int b = 0; b < res.nb; b++) {
-    const double y = res.prof[EP_Y_MEAN][b];
-    printf("%.9g%c%.9g", y, sep, wall ? y * ut / s.cfg.nu : y / delta);
+}
+
+/* One row per bin: y, y+ or y/delta, then each column (and its standard error). */
+static void extract_rows(const struct extract_args *a, const struct stored *s,
+                         const struct euler_result *res, const int *cols, const int *rms, int nc) {
+  const int wall = !strcmp(a->units, "wall");
+  const char sep = !strcmp(a->fmt, "csv") ? ',' : '\t';
+  const double ut = res->u_tau;
+  for (int b = 0; b < res->nb; b++) {
+    const double y = res->prof[EP_Y_MEAN][b];
+    printf("%.9g%c%.9g", y, sep, wall ? y * ut / s->cfg.nu : y / s->cfg.delta);
     for (int c = 0; c < nc; c++) {
-      const int k = cols[c];
-      const int se = k >= EP_U && k <= EP_VW ? EP_SE_U + (k - EP_U) : -1;
-      double scale = 1.0;
-      if (wall) switch (class_of(k)) {
-          case UC_VEL:
-            scale = 1.0 / ut;
-            break;
-          case UC_STRESS:
-            scale = 1.0 / (ut * ut);
-            break;
-          case UC_PRESSURE:
-            scale = 1.0 / (s.cfg.rho0 * ut * ut);
-            break;
-          case UC_LENGTH:
-            scale = ut / s.cfg.nu;
-            break;
-          case UC_VISC:
-            scale = 1.0 / s.cfg.nu;
-            break;
-          case UC_NONE:
-            break;
-        }
-      else if (class_of(k) == UC_LENGTH)
-        scale = 1.0 / delta;
-      double v = res.prof[k][b] * scale, e = se >= 0 ? res.prof[se][b] * scale : NAN;
+      const int k = cols[c], se = stderr_of(k);
+      const double scale = extract_scale(k, wall, &s->cfg, ut);
+      double v = res->prof[k][b] * scale, e = se >= 0 ? res->prof[se][b] * scale : NAN;
       if (rms[c]) { /* rms and its standard error by the delta method */
-        const double r = sqrt(res.prof[k][b]) * (wall ? 1.0 / ut : 1.0);
+        const double r = sqrt(res->prof[k][b]) * (wall ? 1.0 / ut : 1.0);
         e = r > 0 ? 0.5 * e / r : NAN, v = r;
       }
       printf("%c%.9g", sep, v);
@@ -283,6 +297,39 @@ int extract_main(int argc, char **argv) {
     }
     printf("\n");
   }
+}
+
+int extract_main(int argc, char **argv) {
+  struct extract_args a;
+  const int prc = extract_parse(argc, argv, &a);
+  if (prc) return prc < 0 ? 0 : 1;
+  struct stored s;
+  if (read_stored(a.path, &s)) {
+    free_stored(&s);
+    return 1;
+  }
+  /* windows wholly inside [t0, t1] (with a relative tolerance for the nominal bounds) */
+  size_t r0 = s.rows, r1 = 0;
+  const double tol = 1e-9 * s.cfg.window;
+  for (size_t r = 0; r < s.rows; r++) {
+    const double w0 = s.win[r * WIN_LEN + WIN_T0], w1 = s.win[r * WIN_LEN + WIN_T1];
+    if (w0 >= a.t0 - tol && w1 <= a.t1 + tol) r0 = r < r0 ? r : r0, r1 = r + 1;
+  }
+  if (r1 <= r0) {
+    fprintf(stderr, "error: %s: no averaging window lies inside %g:%g\n", a.path, a.t0, a.t1);
+    free_stored(&s);
+    return 1;
+  }
+  int cols[64], rms[64];
+  const int nc = extract_columns(a.vars, cols, rms, 64);
+  if (nc < 0) {
+    free_stored(&s);
+    return 1;
+  }
+  struct euler_result res;
+  euler_finalise(&s.cfg, s.win, s.mom, s.snp, s.pln, s.complete, r0, r1, &res);
+  extract_header(&a, &s, &res, r0, r1, cols, rms, nc);
+  extract_rows(&a, &s, &res, cols, rms, nc);
   euler_result_free(&res);
   free_stored(&s);
   return 0;

@@ -9,8 +9,9 @@
 /**
  * @brief Run `chansph extract STATS.nc [--var a,b] [--units wall|outer] [--format csv|tsv]
  *        [--window T0:T1]` and print to stdout.
- * @param[in] argc,argv the arguments after the command name
- * @return process exit code (0 success, 1 input error)
+ * @param[in] argc,argv the command name ("extract", as getopt_long's program name) and
+ *            its arguments
+ * @return process exit code (0 success or --help, 1 input error)
  */
 int extract_main(int argc, char **argv);
 

@@ -8,6 +8,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "alloc.h"
+#include "error.h"
 #include "moments.h"
 #include "ncout.h"
 #include "spar.h"
@@ -17,15 +19,6 @@
    the snapshot has none), 1 if a release candidate (fluid, in a release slab). */
 enum { LR_ID, LR_X, LR_Y, LR_Z, LR_U, LR_V, LR_W, LR_AX, LR_AY, LR_AZ, LR_CAND, LR_LEN };
 _Static_assert((int)LR_LEN == (int)LAGR_REC, "LAGR_REC in lagr.h");
-
-static void *xcalloc(size_t n, size_t size) {
-  void *p = calloc(n ? n : 1, size);
-  if (!p) {
-    fprintf(stderr, "error: out of memory in the Lagrangian engine\n");
-    abort();
-  }
-  return p;
-}
 
 static size_t rec(const struct lagr *g, int level, size_t k) { /* offset of a sums record */
   return ((size_t)level * g->nlag + k) * LG_LEN;
@@ -43,13 +36,14 @@ void lagr_init(struct lagr *g, const struct lagr_config *cfg) {
   g->nlag = (size_t)cfg->n_lags + 1;
   g->n_slots = (int)ceil(cfg->horizon / cfg->release_every - 1e-9) + 1;
   const size_t nl = (size_t)cfg->n_levels;
-  g->sums = xcalloc(nl * g->nlag * LG_LEN, sizeof(double));
-  g->slot_sums = xcalloc((size_t)g->n_slots * nl * g->nlag * LG_LEN, sizeof(double));
-  g->slots = xcalloc((size_t)g->n_slots * SL_LEN, sizeof(double));
-  g->tl = xcalloc(nl * 3 * SCAL_LEN, sizeof(double));
+  g->sums = mem_calloc(nl * g->nlag * LG_LEN, sizeof(double), "Lagrangian engine");
+  g->slot_sums =
+      mem_calloc((size_t)g->n_slots * nl * g->nlag * LG_LEN, sizeof(double), "Lagrangian engine");
+  g->slots = mem_calloc((size_t)g->n_slots * SL_LEN, sizeof(double), "Lagrangian engine");
+  g->tl = mem_calloc(nl * 3 * SCAL_LEN, sizeof(double), "Lagrangian engine");
   g->pdf =
-      xcalloc(nl * (size_t)(cfg->n_stations ? cfg->n_stations : 1) * (size_t)(cfg->pdf_bins + 3),
-              sizeof(double));
+      mem_calloc(nl * (size_t)(cfg->n_stations ? cfg->n_stations : 1) * (size_t)(cfg->pdf_bins + 3),
+                 sizeof(double), "Lagrangian engine");
   g->next_release = cfg->t_start;
 }
 
@@ -68,11 +62,7 @@ static void reserve_tracks(struct lagr *g, size_t n) {
   if (n <= g->cap) return;
   size_t cap = g->cap ? g->cap : 256;
   while (cap < n) cap *= 2;
-  g->tracks = realloc(g->tracks, cap * TR_LEN * sizeof(double));
-  if (!g->tracks) {
-    fprintf(stderr, "error: out of memory in the Lagrangian engine\n");
-    abort();
-  }
+  g->tracks = mem_realloc(g->tracks, cap * TR_LEN, sizeof(double), "Lagrangian tracks");
   g->cap = cap;
 }
 
@@ -130,7 +120,7 @@ double lagr_tl(const double *rho, size_t nlag, double dtau) {
 static void retire(struct lagr *g, int slot) {
   const int nl = g->cfg.n_levels;
   const double dtau = g->cfg.horizon / g->cfg.n_lags;
-  double *rho = xcalloc(g->nlag, sizeof(double));
+  double *rho = mem_calloc(g->nlag, sizeof(double), "Lagrangian engine");
   for (int l = 0; l < nl; l++) {
     for (size_t k = 0; k < g->nlag; k++) {
       const double *R = slot_rec(g, slot, l, k);
@@ -184,7 +174,7 @@ static void gather(struct lagr *g, const struct stats_snapshot *s, int due) {
     if (id >= 0 && (size_t)id + 1 > len) len = (size_t)id + 1;
   }
   if (len > g->index_len) {
-    g->index = spar_realloc(g->index, len * sizeof(long));
+    g->index = mem_realloc(g->index, len, sizeof(long), "statistics engine");
     for (size_t i = g->index_len; i < len; i++) g->index[i] = -1;
     g->index_len = len;
   }
@@ -202,7 +192,7 @@ static void gather(struct lagr *g, const struct stats_snapshot *s, int due) {
     if (!tracked && !cand) continue;
     if (n == g->mine_cap) {
       g->mine_cap = g->mine_cap ? 2 * g->mine_cap : 256;
-      g->mine = spar_realloc(g->mine, g->mine_cap * LR_LEN * sizeof(double));
+      g->mine = mem_realloc(g->mine, g->mine_cap * LR_LEN, sizeof(double), "statistics engine");
     }
     double *p = g->mine + n++ * LR_LEN;
     p[LR_ID] = (double)id, p[LR_X] = s->x[a], p[LR_Y] = s->y[a], p[LR_Z] = s->z ? s->z[a] : 0.0;
@@ -220,11 +210,8 @@ static void gather(struct lagr *g, const struct stats_snapshot *s, int due) {
   spar_close(&par);
   if (g->nall) qsort(g->all, g->nall, LR_LEN * sizeof(double), rec_cmp);
   for (size_t i = 1; i < g->nall; i++)
-    if (g->all[i * LR_LEN + LR_ID] == g->all[(i - 1) * LR_LEN + LR_ID]) {
-      fprintf(stderr, "error: statistics: particle id %.0f held by two ranks\n",
-              g->all[i * LR_LEN + LR_ID]);
-      abort();
-    }
+    if (g->all[i * LR_LEN + LR_ID] == g->all[(i - 1) * LR_LEN + LR_ID])
+      die("statistics: particle id %.0f held by two ranks", g->all[i * LR_LEN + LR_ID]);
 }
 
 /* The gathered record of particle id, or NULL (not on any rank). */

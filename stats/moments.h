@@ -95,18 +95,4 @@ static inline void scal_add(double *restrict a, double x) {
   a[SCAL_N] = n;
 }
 
-/** @brief Merge scalar record b into a (Chan et al. 1979). */
-static inline void scal_merge(double *restrict a, const double *restrict b) {
-  const double na = a[SCAL_N], nb = b[SCAL_N];
-  if (nb == 0.0) return;
-  if (na == 0.0) {
-    a[0] = b[0], a[1] = b[1], a[2] = b[2];
-    return;
-  }
-  const double n = na + nb, d = b[SCAL_MEAN] - a[SCAL_MEAN];
-  a[SCAL_M2] += b[SCAL_M2] + d * d * na * nb / n;
-  a[SCAL_MEAN] += d * nb / n;
-  a[SCAL_N] = n;
-}
-
 #endif

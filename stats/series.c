@@ -6,6 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "alloc.h"
+
 void series_init(struct series *s, int ncol, const char *const *names, const char *const *units,
                  const char *const *long_names) {
   memset(s, 0, sizeof *s);
@@ -15,12 +17,7 @@ void series_init(struct series *s, int ncol, const char *const *names, const cha
 void series_add(struct series *s, const double *row) {
   if (s->n == s->cap) {
     s->cap = s->cap ? 2 * s->cap : 256;
-    double *d = realloc(s->data, s->cap * (size_t)s->ncol * sizeof *d);
-    if (!d) {
-      fprintf(stderr, "error: out of memory in the time series\n");
-      abort();
-    }
-    s->data = d;
+    s->data = mem_realloc(s->data, s->cap * (size_t)s->ncol, sizeof *s->data, "time series");
   }
   memcpy(s->data + s->n * (size_t)s->ncol, row, (size_t)s->ncol * sizeof *row);
   s->n++;

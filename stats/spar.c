@@ -5,18 +5,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-void *spar_realloc(void *q, size_t bytes) {
-  void *r = realloc(q, bytes ? bytes : 1);
-  if (!r) {
-    fprintf(stderr, "error: out of memory in the statistics engine\n");
-    abort();
-  }
-  return r;
-}
+#include "alloc.h"
+#include "error.h"
 
 static void fail(const char *msg) {
-  fprintf(stderr, "error: statistics snapshot: %s\n", msg);
-  abort();
+  die("statistics snapshot: %s", msg);
 }
 
 /* A zero-initialised MPI_Comm (designated initialisers that leave .comm out) is serial too. */
@@ -36,7 +29,7 @@ void spar_open(struct spar *p, const struct stats_snapshot *s) {
     MPI_Comm_size(p->comm, &p->size);
     MPI_Comm_rank(p->comm, &p->rank);
   }
-  p->range = spar_realloc(NULL, 2 * (size_t)p->size * sizeof(int));
+  p->range = mem_alloc(2 * (size_t)p->size, sizeof(int), "statistics engine");
   p->ncol = s->ncol, p->col0 = s->col0, p->col1 = s->col1;
   if (!s->col && s->ncol == 0) { /* layout left unset: serial, everything in column 0 */
     if (p->size > 1) fail("several ranks need the column layout (ncol, col0, col1)");
@@ -51,11 +44,11 @@ void spar_open(struct spar *p, const struct stats_snapshot *s) {
     p->range[0] = p->col0, p->range[1] = p->col1;
     return;
   }
-  p->cnt = spar_realloc(NULL, 3 * (size_t)p->size * sizeof(int));
+  p->cnt = mem_alloc(3 * (size_t)p->size, sizeof(int), "statistics engine");
   p->dsp = p->cnt + p->size;
   const int mine[3] = {p->col0, p->col1, p->ncol};
   int *all = p->cnt; /* [rank][3], scratch until the first gather */
-  MPI_Allgather(mine, 3, MPI_INT, all, 3, MPI_INT, p->comm);
+  CHECK_MPI(MPI_Allgather(mine, 3, MPI_INT, all, 3, MPI_INT, p->comm));
   for (int r = 0; r < p->size; r++) {
     p->range[2 * r] = all[3 * r], p->range[2 * r + 1] = all[3 * r + 1];
     if (all[3 * r + 2] != p->ncol) fail("the ranks disagree on the number of columns");
@@ -84,7 +77,7 @@ size_t spar_gather_var(struct spar *p, const double *local, size_t n, size_t len
   if (p->size > 1) {
     int mine = (int)(n * len);
     if (n * len > (size_t)2147483647) fail("gather larger than 2^31 doubles");
-    MPI_Allgather(&mine, 1, MPI_INT, p->cnt, 1, MPI_INT, p->comm);
+    CHECK_MPI(MPI_Allgather(&mine, 1, MPI_INT, p->cnt, 1, MPI_INT, p->comm));
     size_t off = 0;
     for (int r = 0; r < p->size; r++) {
       if (off > (size_t)2147483647) fail("gather larger than 2^31 doubles");
@@ -93,13 +86,14 @@ size_t spar_gather_var(struct spar *p, const double *local, size_t n, size_t len
     total = off / len;
   }
   if (total > *cap) {
-    *buf = spar_realloc(*buf, total * len * sizeof(double));
+    *buf = mem_realloc(*buf, total * len, sizeof(double), "statistics engine");
     *cap = total;
   }
   if (p->size == 1) {
     if (n) memcpy(*buf, local, n * len * sizeof(double));
   } else {
-    MPI_Allgatherv(local, p->cnt[p->rank], MPI_DOUBLE, *buf, p->cnt, p->dsp, MPI_DOUBLE, p->comm);
+    CHECK_MPI(MPI_Allgatherv(local, p->cnt[p->rank], MPI_DOUBLE, *buf, p->cnt, p->dsp, MPI_DOUBLE,
+                             p->comm));
   }
   return total;
 }

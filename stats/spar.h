@@ -48,7 +48,4 @@ int spar_lcol(const struct spar *p, const struct stats_snapshot *s, size_t a);
 size_t spar_gather_var(struct spar *p, const double *local, size_t n, size_t len, double **buf,
                        size_t *cap);
 
-/** @brief realloc that aborts with a message on failure. */
-void *spar_realloc(void *q, size_t bytes);
-
 #endif

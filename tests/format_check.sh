@@ -7,6 +7,6 @@ case "$version" in
   *"version 14."*) ;;
   *) echo "format check needs clang-format 14, found: $version"; exit 1 ;;
 esac
-clang-format --dry-run --Werror solver/*.c solver/*.h stats/*.c stats/*.h restart/*.c restart/*.h \
+clang-format --dry-run --Werror solver/*.c solver/*.h solver/*/*.c solver/*/*.h stats/*.c stats/*.h restart/*.c restart/*.h \
   tests/*.c tests/*.h
 echo "all C sources formatted"

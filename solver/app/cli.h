@@ -24,6 +24,7 @@ struct cli {
   long max_steps;       /*!< run/resume: --max-steps, steps of this process (0: no limit) */
   const char *walltime; /*!< run/resume: --walltime HH:MM:SS (NULL: none) */
   char *cmdline;        /*!< the command line (malloc'd), for the history of the run */
+  int help;             /*!< COMMAND --help: print the command's usage and exit 0 */
 };
 
 /**
@@ -32,8 +33,11 @@ struct cli {
  */
 int cli_parse(int argc, char **argv, struct cli *c);
 
-/** @brief Print the usage text. */
+/** @brief Print the usage text of every command. */
 void cli_usage(void);
+
+/** @brief Print the usage of one command (`chansph COMMAND --help`). */
+void cli_command_usage(enum command cmd);
 
 /**
  * @brief The default benchmark case (issue 2, acceptance 8): 3-D channel 1.6 x 1.0 x 1.0,

@@ -44,6 +44,14 @@ noreturn void error_die(const char *file, int line, const char *func, const char
   exit(2);
 }
 
+noreturn void error_mpi(const char *file, int line, const char *func, const char *call, int code) {
+  char text[MPI_MAX_ERROR_STRING] = "";
+  int len = 0;
+  if (MPI_Error_string(code, text, &len) != MPI_SUCCESS)
+    snprintf(text, sizeof text, "code %d", code);
+  error_die(file, line, func, "MPI call failed: %s: %s", call, text);
+}
+
 void error_warn(const char *fmt, ...) {
   fflush(stdout);
   va_list ap;

@@ -146,15 +146,19 @@ static int run(struct scene *sc, const struct cli *c) {
 int main(int argc, char **argv) {
   trigger_mark_start();
   /* post-processing commands: serial, no MPI */
-  if (argc > 1 && !strcmp(argv[1], "extract")) return extract_main(argc - 2, argv + 2);
+  if (argc > 1 && !strcmp(argv[1], "extract")) return extract_main(argc - 1, argv + 1);
   if (argc > 1 && !strcmp(argv[1], "compare"))
     return compare_main(argc - 2, argv + 2, CHANSPH_STATS_DIR);
   MPI_Init(&argc, &argv);
+  /* failed MPI calls return to CHECK_MPI, which names the call, file and line */
+  MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN);
   int rc = 0;
   struct cli c;
   struct scene sc;
   if (cli_parse(argc, argv, &c)) {
     rc = 1;
+  } else if (c.help) {
+    cli_command_usage(c.cmd);
   } else if (c.cmd == CMD_HELP) {
     cli_usage();
   } else if (c.cmd == CMD_VERSION) {

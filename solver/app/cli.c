@@ -1,43 +1,79 @@
 /** @file cli.c @brief Implementation of cli.h. */
 #include "cli.h"
 
+#include <getopt.h>
 #include <mpi.h>
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "alloc.h"
 #include "error.h"
 #include "run.h"
 #include "timers.h"
 
+/* One entry per command: its name and its usage lines (cli_usage prints them all, and
+   `chansph COMMAND --help` the command's own). */
+static const struct cli_command {
+  const char *name;
+  enum command cmd;
+  const char *usage;
+} commands[] = {
+    {"run", CMD_RUN,
+     "  chansph run SCENE.ini [--out DIR] [--set section.key=value ...] [--overwrite] [--fpe]\n"
+     "              [--inject-nan STEP:ID]  (test aid: u of particle ID becomes NaN after STEP)\n"
+     "              [--max-steps N] [--walltime HH:MM:SS]\n"},
+    {"resume", CMD_RESUME,
+     "  chansph resume DIR [--set section.key=value ...] [--fpe] [--max-steps N]\n"
+     "                 [--walltime HH:MM:SS]\n"},
+    {"bench", CMD_BENCH, "  chansph bench [SCENE.ini] [--steps N] [--set section.key=value ...]\n"},
+    {"scene-doc", CMD_SCENE_DOC,
+     "  chansph scene-doc            print the scene key reference (docs/scenes.md)\n"},
+    {"help", CMD_HELP, NULL},
+    {"--help", CMD_HELP, NULL},
+    {"-h", CMD_HELP, NULL},
+    {"--version", CMD_VERSION, NULL},
+};
+enum { N_COMMANDS = sizeof commands / sizeof commands[0] };
+
+static const char *const cli_notes =
+    "run writes DIR/log.txt, scene.used.ini, stats.nc, particles.nc (default DIR:\n"
+    "runs/<scene name>) and DIR/checkpoints/ckpt_<step>.h5; resume continues a run from\n"
+    "its newest valid checkpoint. Threads: OMP_NUM_THREADS or run.threads. Exit codes: 0 done,\n"
+    "1 input error, 2 internal error, 3 numerical failure (health check), 74 cannot write\n"
+    "a checkpoint or output, 75 checkpointed before the end (signal, DIR/STOP, --walltime,\n"
+    "--max-steps): resume me (docs/batch-jobs.md).\n";
+
 void cli_usage(void) {
+  printf("usage:\n");
+  for (int i = 0; i < N_COMMANDS; i++)
+    if (commands[i].usage && commands[i].cmd != CMD_SCENE_DOC) printf("%s", commands[i].usage);
   printf(
-      "usage:\n"
-      "  chansph run SCENE.ini [--out DIR] [--set section.key=value ...] [--overwrite] [--fpe]\n"
-      "              [--inject-nan STEP:ID]  (test aid: u of particle ID becomes NaN after STEP)\n"
-      "  chansph resume DIR [--set section.key=value ...] [--fpe]\n"
-      "      run and resume also take --max-steps N and --walltime HH:MM:SS\n"
-      "  chansph bench [SCENE.ini] [--steps N] [--set section.key=value ...]\n"
       "  chansph scene-doc            print the scene key reference (docs/scenes.md)\n"
       "  chansph extract STATS.nc [--var a,b] [--units wall|outer] [--format csv|tsv]\n"
       "                  [--window T0:T1]   print profiles (docs/stats-format.md)\n"
       "  chansph compare STATS.nc --dns FILE [--out DIR]   errors against DNS, PNG plots\n"
-      "  chansph --version | --help   (also: chansph run|resume|bench|extract --help)\n"
-      "run writes DIR/log.txt, scene.used.ini, stats.nc, particles.nc (default DIR:\n"
-      "runs/<scene name>) and DIR/checkpoints/ckpt_<step>.h5; resume continues a run from\n"
-      "its newest valid checkpoint. Threads: OMP_NUM_THREADS or run.threads. Exit codes: 0 done,\n"
-      "1 input error, 2 internal error, 3 numerical failure (health check), 74 cannot write\n"
-      "a checkpoint or output, 75 checkpointed before the end (signal, DIR/STOP, --walltime,\n"
-      "--max-steps): resume me (docs/batch-jobs.md).\n");
+      "  chansph --version | --help   (also: chansph COMMAND --help)\n"
+      "%s",
+      cli_notes);
+}
+
+void cli_command_usage(enum command cmd) {
+  for (int i = 0; i < N_COMMANDS; i++)
+    if (commands[i].cmd == cmd && commands[i].usage) {
+      printf("usage:\n%s", commands[i].usage);
+      if (cmd == CMD_RUN || cmd == CMD_RESUME) printf("%s", cli_notes);
+      return;
+    }
+  cli_usage();
 }
 
 /* The command line as one string, arguments with blanks or quotes single-quoted. */
 static char *command_line(int argc, char **argv) {
   size_t n = 1;
   for (int i = 0; i < argc; i++) n += 4 * strlen(argv[i]) + 3;
-  char *s = calloc(n, 1);
-  if (!s) return NULL;
+  char *s = mem_calloc(n, 1, "command line");
   for (int i = 0; i < argc; i++) {
     const char *a = argv[i];
     if (i == 0 && strrchr(a, '/')) a = strrchr(a, '/') + 1; /* chansph, not its path */
@@ -53,87 +89,79 @@ static char *command_line(int argc, char **argv) {
   return s;
 }
 
-int cli_parse(int argc, char **argv, struct cli *c) {
-  memset(c, 0, sizeof *c);
-  c->set = calloc((size_t)argc + 1, sizeof *c->set);
-  c->cmdline = command_line(argc, argv);
-  c->steps = 50;
-  c->inject_id = -1;
-  if (argc < 2) {
-    c->cmd = CMD_HELP;
-    return CHANSPH_OK;
-  }
-  const char *cmd = argv[1];
-  if (!strcmp(cmd, "run"))
-    c->cmd = CMD_RUN;
-  else if (!strcmp(cmd, "resume"))
-    c->cmd = CMD_RESUME;
-  else if (!strcmp(cmd, "bench"))
-    c->cmd = CMD_BENCH;
-  else if (!strcmp(cmd, "scene-doc"))
-    c->cmd = CMD_SCENE_DOC;
-  else if (!strcmp(cmd, "--help") || !strcmp(cmd, "-h") || !strcmp(cmd, "help"))
-    c->cmd = CMD_HELP;
-  else if (!strcmp(cmd, "--version"))
-    c->cmd = CMD_VERSION;
-  else {
-    error_input("unknown command '%s'", cmd);
-    cli_usage();
+/* The long options of the commands (getopt_long); the value is the option's code. */
+enum {
+  OPT_SET = 256,
+  OPT_OUT,
+  OPT_STEPS,
+  OPT_MAX_STEPS,
+  OPT_WALLTIME,
+  OPT_OVERWRITE,
+  OPT_FPE,
+  OPT_INJECT_NAN
+};
+static const struct option cli_options[] = {
+    {"help", no_argument, NULL, 'h'},
+    {"set", required_argument, NULL, OPT_SET},
+    {"out", required_argument, NULL, OPT_OUT},
+    {"steps", required_argument, NULL, OPT_STEPS},
+    {"max-steps", required_argument, NULL, OPT_MAX_STEPS},
+    {"walltime", required_argument, NULL, OPT_WALLTIME},
+    {"overwrite", no_argument, NULL, OPT_OVERWRITE},
+    {"fpe", no_argument, NULL, OPT_FPE},
+    {"inject-nan", required_argument, NULL, OPT_INJECT_NAN},
+    {NULL, 0, NULL, 0},
+};
+
+/* A positive integer option value, or an input error naming the option. */
+static int positive(const char *opt, const char *s, long *v) {
+  char *end;
+  *v = strtol(s, &end, 10);
+  if (!*s || *end || *v < 1) {
+    error_input("%s %s: expected a positive integer", opt, s);
     return CHANSPH_ERR;
   }
-  for (int i = 2; i < argc; i++) {
-    const char *a = argv[i];
-    const int has_next = i + 1 < argc;
-    if (!strcmp(a, "--help") || !strcmp(a, "-h")) { /* chansph run --help: the usage, exit 0 */
-      c->cmd = CMD_HELP;
+  return CHANSPH_OK;
+}
+
+/* Apply one option (code from getopt_long, arg its value); 1: --help. */
+static int cli_option(struct cli *c, int code, char *arg) {
+  switch (code) {
+    case OPT_SET:
+      c->set[c->n_set++] = arg;
       return CHANSPH_OK;
-    }
-    if (!strcmp(a, "--set") && has_next)
-      c->set[c->n_set++] = argv[++i];
-    else if (!strncmp(a, "--set=", 6))
-      c->set[c->n_set++] = argv[i] + 6;
-    else if (!strcmp(a, "--out") && has_next)
-      snprintf(c->out, sizeof c->out, "%s", argv[++i]);
-    else if (!strcmp(a, "--steps") && has_next) {
-      char *end;
-      c->steps = strtol(argv[++i], &end, 10);
-      if (*end || c->steps < 1) {
-        error_input("--steps %s: expected a positive integer", argv[i]);
-        return CHANSPH_ERR;
-      }
-    } else if (!strcmp(a, "--max-steps") && has_next) {
-      char *end;
-      c->max_steps = strtol(argv[++i], &end, 10);
-      if (*end || c->max_steps < 1) {
-        error_input("--max-steps %s: expected a positive integer", argv[i]);
-        return CHANSPH_ERR;
-      }
-    } else if (!strcmp(a, "--walltime") && has_next)
-      c->walltime = argv[++i];
-    else if (!strcmp(a, "--overwrite"))
+    case OPT_OUT:
+      snprintf(c->out, sizeof c->out, "%s", arg);
+      return CHANSPH_OK;
+    case OPT_STEPS:
+      return positive("--steps", arg, &c->steps);
+    case OPT_MAX_STEPS:
+      return positive("--max-steps", arg, &c->max_steps);
+    case OPT_WALLTIME:
+      c->walltime = arg;
+      return CHANSPH_OK;
+    case OPT_OVERWRITE:
       c->overwrite = 1;
-    else if (!strcmp(a, "--fpe"))
+      return CHANSPH_OK;
+    case OPT_FPE:
       c->fpe = 1;
-    else if (!strcmp(a, "--inject-nan") && i + 1 < argc) {
+      return CHANSPH_OK;
+    case OPT_INJECT_NAN: {
       char *end;
-      c->inject_step = strtol(argv[++i], &end, 10);
+      c->inject_step = strtol(arg, &end, 10);
       c->inject_id = *end == ':' ? strtoll(end + 1, &end, 10) : -1;
       if (*end || c->inject_step < 0 || c->inject_id < 0) {
-        error_input("--inject-nan %s: expected STEP:ID with non-negative integers", argv[i]);
+        error_input("--inject-nan %s: expected STEP:ID with non-negative integers", arg);
         return CHANSPH_ERR;
       }
-    } else if (a[0] != '-' && !c->scene)
-      c->scene = a;
-    else {
-      error_input("unexpected argument '%s'%s", a,
-                  (!strcmp(a, "--set") || !strcmp(a, "--out") || !strcmp(a, "--steps") ||
-                   !strcmp(a, "--max-steps") || !strcmp(a, "--walltime"))
-                      ? " (missing value)"
-                      : "");
-      cli_usage();
-      return CHANSPH_ERR;
+      return CHANSPH_OK;
     }
   }
+  return CHANSPH_ERR;
+}
+
+/* After the options: the positional argument each command needs, the default run directory. */
+static int cli_finish(struct cli *c) {
   if (c->cmd == CMD_RUN && !c->scene) {
     error_input("run: missing SCENE.ini");
     cli_usage();
@@ -156,13 +184,66 @@ int cli_parse(int argc, char **argv, struct cli *c) {
   return CHANSPH_OK;
 }
 
+/* The command named by argv[1], or -1 after an error. */
+static int cli_command(const char *name) {
+  for (int i = 0; i < N_COMMANDS; i++)
+    if (!strcmp(name, commands[i].name)) return (int)commands[i].cmd;
+  error_input("unknown command '%s'", name);
+  cli_usage();
+  return -1;
+}
+
+int cli_parse(int argc, char **argv, struct cli *c) {
+  memset(c, 0, sizeof *c);
+  c->set = mem_calloc((size_t)argc + 1, sizeof *c->set, "command line");
+  c->cmdline = command_line(argc, argv);
+  c->steps = 50;
+  c->inject_id = -1;
+  const int cmd = argc < 2 ? (int)CMD_HELP : cli_command(argv[1]);
+  if (cmd < 0) return CHANSPH_ERR;
+  c->cmd = (enum command)cmd;
+  if (c->cmd == CMD_HELP || c->cmd == CMD_VERSION) return CHANSPH_OK;
+  /* argv[1], the command, plays the program name for getopt_long; a leading '-' returns the
+     positional arguments in order (code 1), ':' reports a missing value as ':' */
+  opterr = 0, optind = 1;
+  char **args = argv + 1;
+  for (;;) {
+    const int at = optind; /* the argument getopt_long reads now */
+    const int code = getopt_long(argc - 1, args, "-:h", cli_options, NULL);
+    if (code == -1) break;
+    if (code == 'h') { /* chansph COMMAND --help: the command's usage, exit 0 */
+      c->help = 1;
+      return CHANSPH_OK;
+    }
+    if (code == 1 && !c->scene) {
+      c->scene = optarg;
+    } else if (code == 1 || code == '?' || code == ':') {
+      error_input("unexpected argument '%s'%s", code == 1 ? optarg : args[at],
+                  code == ':' ? " (missing value)" : "");
+      cli_usage();
+      return CHANSPH_ERR;
+    } else if (cli_option(c, code, optarg)) {
+      return CHANSPH_ERR;
+    }
+  }
+  for (int i = optind; i < argc - 1; i++) { /* after "--": positional arguments only */
+    if (c->scene) {
+      error_input("unexpected argument '%s'", args[i]);
+      cli_usage();
+      return CHANSPH_ERR;
+    }
+    c->scene = args[i];
+  }
+  return cli_finish(c);
+}
+
 int cli_bench_scene(struct scene *sc, const struct cli *c) {
   static char *defaults[] = {"domain.dimension=3", "domain.lx=1.6",   "domain.delta=0.5",
                              "domain.lz=1.0",      "domain.dr=0.025", "sph.h_over_dr=1.3",
                              "fluid.nu=0.1",       "fluid.c0=10",     "fluid.rho0=1000",
                              "drive.force=0.8",    "time.t_end=1e6"};
   enum { ND = sizeof defaults / sizeof defaults[0] };
-  char **set = calloc((size_t)(ND + c->n_set), sizeof *set);
+  char **set = mem_calloc((size_t)(ND + c->n_set), sizeof *set, "bench settings");
   int n = 0;
   if (!c->scene)
     for (int i = 0; i < ND; i++) set[n++] = defaults[i];
@@ -218,22 +299,22 @@ int cli_bench(const struct scene *sc, long steps) {
   double nbr = 0.0, mine = (double)S.P.n;
   for (size_t a = 0; a < S.P.n; a++)
     if (S.P.kind[a] == KIND_FLUID) nbr += S.nb.count[a];
-  MPI_Allreduce(MPI_IN_PLACE, &nbr, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Allreduce(MPI_IN_PLACE, &nbr, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD));
   const int warm = 3;
   for (int i = 0; i < warm; i++) sim_step(&S);
   timer_reset();
   const double halo0 = S.dd.seconds, bytes0 = S.dd.bytes, msg0 = (double)S.dd.messages;
-  MPI_Barrier(MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Barrier(MPI_COMM_WORLD));
   const double t0 = timer_now(), sim0 = S.t;
   for (long i = 0; i < steps; i++) sim_step(&S);
-  MPI_Barrier(MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Barrier(MPI_COMM_WORLD));
   const double wall = timer_now() - t0, simt = S.t - sim0;
   double yard = S.dd.size == 1 ? yardstick(&S, steps) : 0.0;
   /* the exchanges per rank: max and mean of time, bytes and messages; particles per rank */
   double x[4] = {S.dd.seconds - halo0, S.dd.bytes - bytes0, (double)S.dd.messages - msg0, mine};
   double mx[4], sum[4];
-  MPI_Allreduce(x, mx, 4, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
-  MPI_Allreduce(x, sum, 4, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  CHECK_MPI(MPI_Allreduce(x, mx, 4, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD));
+  CHECK_MPI(MPI_Allreduce(x, sum, 4, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD));
   if (root) {
     printf("chansph bench: %dD, %zu fluid + %zu vertex particles, %d MPI ranks x %d threads\n",
            sc->dim, S.P.n_fluid, S.P.n_vertex, ranks, omp_get_max_threads());

@@ -1,0 +1,34 @@
+/** @file alloc.c @brief Implementation of alloc.h. */
+#include "alloc.h"
+
+#include <stdint.h>
+#include <stdlib.h>
+
+#include "error.h"
+
+static size_t bytes_of(size_t n, size_t size, const char *label) {
+  if (size && n > SIZE_MAX / size) die("out of memory: %s (%zu x %zu bytes)", label, n, size);
+  const size_t bytes = n * size;
+  return bytes ? bytes : 1;
+}
+
+void *mem_alloc(size_t n, size_t size, const char *label) {
+  const size_t bytes = bytes_of(n, size, label);
+  void *p = malloc(bytes);
+  if (!p) die("out of memory: %s (%zu bytes)", label, bytes);
+  return p;
+}
+
+void *mem_calloc(size_t n, size_t size, const char *label) {
+  const size_t bytes = bytes_of(n, size, label);
+  void *p = calloc(1, bytes);
+  if (!p) die("out of memory: %s (%zu bytes)", label, bytes);
+  return p;
+}
+
+void *mem_realloc(void *p, size_t n, size_t size, const char *label) {
+  const size_t bytes = bytes_of(n, size, label);
+  void *q = realloc(p, bytes);
+  if (!q) die("out of memory: %s (%zu bytes)", label, bytes);
+  return q;
+}
