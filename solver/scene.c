@@ -152,7 +152,9 @@ static const struct key keys[] = {
     {"fluid", "p_background", T_DOUBLE, "0.01", 0, 10, 0, NULL, "rho0 c0^2",
      "Background pressure added to the Tait equation of state, in units of rho0 c0^2; it "
      "gives the particle arrangement a restoring force and, with the lattice pressure wall "
-     "weight, stops the transverse instability of the sheared lattice (docs/theory.md).",
+     "weight, stops the transverse instability of the sheared lattice (docs/theory.md). "
+     "For turbulence use 0: its pair stress destroys resolved turbulence within 0.15 "
+     "delta/u_tau (docs/validation/turbulent_channel.md).",
      OFF(p_background)},
     {"fluid", "gravity_y", T_DOUBLE, "0", -BIG, BIG, 0, NULL, "m/s^2",
      "Wall-normal body acceleration; enters the momentum equation, the wall pressure "

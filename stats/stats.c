@@ -227,7 +227,8 @@ static const char *const scal_names[SCAL_LEN] = {"count", "mean", "M2"};
 static const char *const plane_names[PL_LEN] = {
     [PL_N] = "snapshots",         [PL_PRESSURE] = "sum_pair_stress",
     [PL_VISCOUS] = "sum_viscous", [PL_MODEL] = "sum_model",
-    [PL_WALL] = "sum_wall",       [PL_DRIVE] = "sum_drive"};
+    [PL_WALL] = "sum_wall",       [PL_DRIVE] = "sum_drive",
+    [PL_SOURCE] = "sum_source"};
 
 /* t_reached: the time the run reached (NaN: not known); an incomplete last window ends there. */
 static int write_eulerian(const struct euler *e, double t_reached, int ncid, char *err,
@@ -336,8 +337,8 @@ static int write_eulerian(const struct euler *e, double t_reached, int ncid, cha
   CK(ncout_def(g, "planes", NC_DOUBLE, 3, d3p, NULL,
                "per window and plane y (bin centre): snapshots with forces, sums over them of the "
                "momentum flux through the plane by the pressure, viscous and eddy-viscous pair "
-               "forces and the walls, and of the body force it balances, per unit area and rho0 "
-               "[m^2/s^2] (docs/stats-format.md, momentum budget)",
+               "forces and the walls, of the body force it balances and of the momentum source, "
+               "per unit area and rho0 [m^2/s^2] (docs/stats-format.md, momentum budget)",
                &vp));
   for (size_t w = 0; w < rows; w++) {
     const size_t st[1] = {w}, ct[1] = {1};
