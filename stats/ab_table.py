@@ -10,8 +10,8 @@ R_uv = -u'v' / (u_rms v_rms) over 30 <= y+ <= 100, and the momentum budget (meth
 planes; docs/stats-format.md): the shares of the total stress carried by the resolved
 turbulence (-u'v') and by the pressure pair forces (the scheme's numerical stress) at y+ = 30
 and y = delta/2, with batch-means standard errors of the window values; the closure error and
-the momentum source; and the cost per eddy turnover delta/u_tau in particle-steps and in
-wall seconds on the machine that ran it. Wall units from the force balance (u_tau^2 = delta f).
+the momentum source; and the cost per eddy turnover delta/u_tau in particle-steps (wall
+seconds depend on what else the machine ran; divide by `chansph bench`'s rate). Wall units from the force balance (u_tau^2 = delta f).
 """
 import argparse
 import math
@@ -50,10 +50,11 @@ def window_values(mom, pln, delta, fold, ut, nu):
                  ub=np.sum(u[ok] * n[ok]) / np.sum(n[ok]) / ut)
         if p is not None and p[:, 0].max() > 0:
             pn = np.maximum(p[:, 0], 1)
-            sign = np.where(np.asarray(m[:, MEAN + 5]) > delta, -1.0, 1.0) if not fold else 1.0
-            tot = -uv * (1 if fold else 1) + sign * 0  # placeholder replaced below
             parts = {key: p[:, i] / pn for key, i in PL.items() if key != "n"}
-            rey = np.where(np.asarray(m[:, MEAN + 5]) > delta, uv, -uv) if not fold else -uv
+            if not fold:  # mirrored like -u'v' above: the stresses of the upper half change sign
+                for key in parts:
+                    parts[key] = np.where(up, -parts[key], parts[key])
+            rey = -uv  # -u'v' towards the centre (upper half mirrored above)
             total = rey + parts["pair"] + parts["visc"] + parts["model"] + parts["wall"]
             for name, target in (("30", 30.0), ("half", 0.5 * delta * ut / nu)):
                 i = int(np.nanargmin(np.abs(yp - target) + np.where(ok, 0, np.inf)))
@@ -91,8 +92,7 @@ def main():
     ap.add_argument("--markdown", action="store_true")
     a = ap.parse_args()
     cols = ["run", "-u'v'+ pk", "u_rms+ pk", "v_rms+ pk", "U_b+", "R_uv",
-            "res y+30", "pair y+30", "res d/2", "pair d/2", "closure", "source", "Mp-st/ETT",
-            "s/ETT"]
+            "res y+30", "pair y+30", "res d/2", "pair d/2", "closure", "source", "Mp-st/ETT"]
     rows = []
     for run in a.runs:
         try:
@@ -124,7 +124,7 @@ def main():
         rows.append([os.path.basename(run.rstrip("/")), ms("uv_peak"), ms("urms"), ms("vrms"),
                      ms("ub"), ms("ruv"), ms("res_30"), ms("pair_30"), ms("res_half"),
                      ms("pair_half"), f"{np.nanmax([v.get('closure', math.nan) for v in vals]):.3f}",
-                     ms("source"), f"{pst / 1e6:.0f}", f"{wall:.0f}"])
+                     ms("source"), f"{pst / 1e6:.0f}"])
         print(f"# {run}: windows {win[sel[0], 0]:.3g}-{win[sel[-1], 1]:.3g} ({len(sel)}), "
               f"u_tau {ut:.4g}", file=sys.stderr)
     if a.markdown:

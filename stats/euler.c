@@ -295,21 +295,107 @@ static void budget_planes(const struct euler_config *c, const double *snap, doub
   }
 }
 
-void euler_sample(struct euler *e, const struct stats_snapshot *s) {
-  const struct euler_config *c = &e->cfg;
-  if (s->t < c->t_start) return;
-  /* close the open window when the snapshot lies past its end; an empty open window moves
-     forward to the interval holding the snapshot */
-  for (double *w = e->win + e->nwin * WIN_LEN; s->t >= w[WIN_T1]; w = e->win + e->nwin * WIN_LEN) {
+/* Close the open window when the snapshot at time t lies past its end; an empty open window
+   moves forward to the interval holding the snapshot. */
+static void advance_window(struct euler *e, double t) {
+  const double len = e->cfg.window;
+  for (double *w = e->win + e->nwin * WIN_LEN; t >= w[WIN_T1]; w = e->win + e->nwin * WIN_LEN) {
     if (w[WIN_NSNAP] > 0.0) {
       e->nwin++;
       open_row(e, w[WIN_T1]);
     } else {
-      w[WIN_T0] += floor((s->t - w[WIN_T0]) / c->window) * c->window;
-      w[WIN_T1] = w[WIN_T0] + c->window;
-      if (s->t >= w[WIN_T1]) w[WIN_T0] = w[WIN_T1], w[WIN_T1] += c->window; /* rounding */
+      w[WIN_T0] += floor((t - w[WIN_T0]) / len) * len;
+      w[WIN_T1] = w[WIN_T0] + len;
+      if (t >= w[WIN_T1]) w[WIN_T0] = w[WIN_T1], w[WIN_T1] += len; /* rounding */
     }
   }
+}
+
+/* Particle a of the snapshot into its column's per-bin partials P (EU_PART a bin). */
+static void add_particle(const struct euler *e, const struct stats_snapshot *s, size_t a,
+                         double *P) {
+  const struct euler_config *c = &e->cfg;
+  const double scale = c->nb / (c->y1 - c->y0);
+  double y = s->y[a], v = s->v[a];
+  const int upper = y > c->delta;
+  if (c->fold && upper) y = 2.0 * c->delta - y, v = -v;
+  const double smp[MOM_NQ] = {s->u[a],
+                              v,
+                              s->w[a],
+                              s->p[a],
+                              s->rho[a],
+                              y,
+                              s->nu_t ? s->nu_t[a] : 0.0,
+                              s->k_r ? s->k_r[a] : 0.0};
+  if (s->sx) { /* the momentum budget: to the bin of the particle, by side */
+    int hb = (int)floor((y - c->y0) * scale);
+    hb = hb < 0 ? 0 : hb >= c->nb ? c->nb - 1 : hb;
+    double *H = P + (size_t)hb * EU_PART + EU_PART_PL + (size_t)(!c->fold && upper) * HB_LEN;
+    const double ma = s->m ? s->m[a] : 1.0;
+    for (int k = 0; k < EULER_SX; k++) H[k] += ma * s->sx[a * EULER_SX + k];
+    H[HB_MASS] += ma;
+  }
+  if (c->method == EULER_SPH) {
+    /* Eq. 5.56 averaged over the plane y = y_i: every profile point within 2h takes the
+       sample with weight V_a W1(|y_a - y_i| / h) (a weighted one-sample merge) */
+    const double vol = s->m ? s->m[a] / s->rho[a] : 1.0, h2 = 2.0 * c->h;
+    int lo = (int)ceil((y - h2 - c->y0) * scale - 0.5),
+        hi = (int)floor((y + h2 - c->y0) * scale - 0.5);
+    lo = lo < 0 ? 0 : lo, hi = hi >= c->nb ? c->nb - 1 : hi;
+    for (int b = lo; b <= hi; b++) {
+      const double wt = vol * w1_at(e, fabs(y - euler_centre(c, b)) / c->h);
+      if (wt <= 0.0) continue;
+      double one[MOM_LEN] = {0};
+      one[MOM_N] = wt;
+      for (int q = 0; q < MOM_NQ; q++) one[MOM_MEAN + q] = smp[q];
+      double *Pb = P + (size_t)b * EU_PART;
+      mom_merge(Pb, one);
+      Pb[EU_PART_U] += wt * s->u[a], Pb[EU_PART_N] += wt;
+    }
+    return;
+  }
+  int b = (int)floor((y - c->y0) * scale);
+  b = b < 0 ? 0 : b >= c->nb ? c->nb - 1 : b; /* samples outside [y0, y1]: end bins */
+  double *Pb = P + (size_t)b * EU_PART;
+  mom_add(Pb, smp);
+  Pb[EU_PART_U] += s->u[a], Pb[EU_PART_N] += 1.0;
+}
+
+/* The partials of this rank's columns merged over the column tree on every rank: returns the
+   root record (EU_PART a bin) of the snapshot, identical on every rank. */
+static double *merge_columns(struct euler *e, struct spar *par) {
+  struct euler_work *k = e->work;
+  const size_t nb = (size_t)e->cfg.nb, ncol = (size_t)par->ncol, len = nb * EU_PART;
+  /* 2. this rank's subtrees of the column tree, merged locally */
+  int depth = 1;
+  while ((1 << (depth - 1)) < par->ncol) depth++;
+  if ((size_t)depth > k->scr_cap) {
+    k->scr = mem_realloc(k->scr, (size_t)depth * len, sizeof(double), "Eulerian statistics");
+    k->scr_cap = (size_t)depth;
+  }
+  size_t nmine = 0;
+  subtrees(k, &nmine, 0, par->ncol, par->col0, par->col1);
+  if (nmine + 1 > k->mine_cap) { /* + 1: the root record below */
+    k->mine = mem_realloc(k->mine, (nmine + 1) * len, sizeof(double), "Eulerian statistics");
+    k->mine_cap = nmine + 1;
+  }
+  for (size_t i = 0; i < nmine; i++)
+    node_record(k, nb, k->node[2 * i], k->node[2 * i + 1], NULL, 0, 0, k->mine + i * len);
+  /* 3. all subtrees on every rank (rank order is column order), merged up to the root */
+  const size_t nall = spar_gather_var(par, k->mine, nmine, len, &k->all, &k->all_cap);
+  size_t nn = 0;
+  for (int r = 0; r < par->size; r++)
+    subtrees(k, &nn, 0, par->ncol, par->range[2 * r], par->range[2 * r + 1]);
+  if (nn != nall) die("statistics: %zu column subtrees gathered, %zu expected", nall, nn);
+  node_record(k, nb, 0, (int)ncol, k->all, nn, 0, k->mine);
+  e->nsub = nn;
+  return k->mine;
+}
+
+void euler_sample(struct euler *e, const struct stats_snapshot *s) {
+  const struct euler_config *c = &e->cfg;
+  if (s->t < c->t_start) return;
+  advance_window(e, s->t);
   const size_t nb = (size_t)c->nb;
   double *row = e->mom + e->nwin * nb * MOM_LEN;
   double *srow = e->snp + e->nwin * nb * SCAL_LEN;
@@ -330,80 +416,10 @@ void euler_sample(struct euler *e, const struct stats_snapshot *s) {
   }
   double *mine = k->part + (size_t)par.col0 * len;
   memset(mine, 0, (size_t)(par.col1 - par.col0) * len * sizeof(double));
-  const double scale = c->nb / (c->y1 - c->y0), ly = 2.0 * c->delta;
-  for (size_t a = 0; a < s->n; a++) {
-    if (s->skip && s->skip[a]) continue;
-    double *P = mine + (size_t)spar_lcol(&par, s, a) * len;
-    double y = s->y[a], v = s->v[a];
-    const int upper = y > c->delta;
-    if (c->fold && upper) y = ly - y, v = -v;
-    const double smp[MOM_NQ] = {s->u[a],
-                                v,
-                                s->w[a],
-                                s->p[a],
-                                s->rho[a],
-                                y,
-                                s->nu_t ? s->nu_t[a] : 0.0,
-                                s->k_r ? s->k_r[a] : 0.0};
-    if (s->sx) { /* the momentum budget: to the bin of the particle, by side */
-      int hb = (int)floor((y - c->y0) * scale);
-      hb = hb < 0 ? 0 : hb >= c->nb ? c->nb - 1 : hb;
-      double *H = P + (size_t)hb * EU_PART + EU_PART_PL + (size_t)(!c->fold && upper) * HB_LEN;
-      const double ma = s->m ? s->m[a] : 1.0;
-      for (int k = 0; k < EULER_SX; k++) H[k] += ma * s->sx[a * EULER_SX + k];
-      H[HB_MASS] += ma;
-    }
-    if (c->method == EULER_SPH) {
-      /* Eq. 5.56 averaged over the plane y = y_i: every profile point within 2h takes the
-         sample with weight V_a W1(|y_a - y_i| / h) (a weighted one-sample merge) */
-      const double vol = s->m ? s->m[a] / s->rho[a] : 1.0, h2 = 2.0 * c->h;
-      int lo = (int)ceil((y - h2 - c->y0) * scale - 0.5),
-          hi = (int)floor((y + h2 - c->y0) * scale - 0.5);
-      lo = lo < 0 ? 0 : lo, hi = hi >= c->nb ? c->nb - 1 : hi;
-      for (int b = lo; b <= hi; b++) {
-        const double wt = vol * w1_at(e, fabs(y - euler_centre(c, b)) / c->h);
-        if (wt <= 0.0) continue;
-        double one[MOM_LEN] = {0};
-        one[MOM_N] = wt;
-        for (int q = 0; q < MOM_NQ; q++) one[MOM_MEAN + q] = smp[q];
-        double *Pb = P + (size_t)b * EU_PART;
-        mom_merge(Pb, one);
-        Pb[EU_PART_U] += wt * s->u[a], Pb[EU_PART_N] += wt;
-      }
-      continue;
-    }
-    int b = (int)floor((y - c->y0) * scale);
-    b = b < 0 ? 0 : b >= c->nb ? c->nb - 1 : b; /* samples outside [y0, y1]: end bins */
-    double *Pb = P + (size_t)b * EU_PART;
-    mom_add(Pb, smp);
-    Pb[EU_PART_U] += s->u[a], Pb[EU_PART_N] += 1.0;
-  }
-  /* 2. this rank's subtrees of the column tree, merged locally */
-  int depth = 1;
-  while ((1 << (depth - 1)) < par.ncol) depth++;
-  if ((size_t)depth > k->scr_cap) {
-    k->scr = mem_realloc(k->scr, (size_t)depth * len, sizeof(double), "Eulerian statistics");
-    k->scr_cap = (size_t)depth;
-  }
-  size_t nmine = 0;
-  subtrees(k, &nmine, 0, par.ncol, par.col0, par.col1);
-  if (nmine + 1 > k->mine_cap) { /* + 1: the root record below */
-    k->mine = mem_realloc(k->mine, (nmine + 1) * len, sizeof(double), "Eulerian statistics");
-    k->mine_cap = nmine + 1;
-  }
-  for (size_t i = 0; i < nmine; i++)
-    node_record(k, nb, k->node[2 * i], k->node[2 * i + 1], NULL, 0, 0, k->mine + i * len);
-  /* 3. all subtrees on every rank (rank order is column order), merged up to the root: one
-     record per bin for the snapshot, identical on every rank */
-  const size_t nall = spar_gather_var(&par, k->mine, nmine, len, &k->all, &k->all_cap);
-  size_t nn = 0;
-  for (int r = 0; r < par.size; r++)
-    subtrees(k, &nn, 0, par.ncol, par.range[2 * r], par.range[2 * r + 1]);
+  for (size_t a = 0; a < s->n; a++)
+    if (!s->skip || !s->skip[a]) add_particle(e, s, a, mine + (size_t)spar_lcol(&par, s, a) * len);
+  const double *snap = merge_columns(e, &par); /* 2, 3: every bin of the snapshot */
   spar_close(&par);
-  if (nn != nall) die("statistics: %zu column subtrees gathered, %zu expected", nall, nn);
-  double *snap = k->mine; /* the root record: every bin of the snapshot */
-  node_record(k, nb, 0, (int)ncol, k->all, nn, 0, snap);
-  e->nsub = nn;
   for (size_t b = 0; b < nb; b++) {
     const double *R = snap + b * EU_PART;
     mom_merge(row + b * MOM_LEN, R);
@@ -475,6 +491,61 @@ static int budget_profiles(const struct euler_config *cfg, const double *mom, co
   return any;
 }
 
+/* The profiles of bin b from its merged moment record m and the batch moments B of its 5
+   means and 6 stresses; returns 1 if the bin has samples. */
+static int bin_profiles(const struct euler_config *cfg, int b, const double *m, const double *B,
+                        struct euler_result *res) {
+  const double n = m[MOM_N], nan = NAN;
+  res->prof[EP_Y][b] = euler_centre(cfg, b);
+  res->prof[EP_N][b] = n;
+  res->prof[EP_Y_MEAN][b] = n > 0.0 ? m[MOM_MEAN + MOM_Y] : res->prof[EP_Y][b];
+  for (int q = 0; q < 5; q++) res->prof[EP_U + q][b] = n > 0.0 ? m[MOM_MEAN + q] : nan;
+  res->prof[EP_NUT][b] = n > 0.0 ? m[MOM_MEAN + MOM_NUT] : nan;
+  res->prof[EP_KR][b] = n > 0.0 ? m[MOM_MEAN + MOM_KR] : nan;
+  for (int c = 0; c < MOM_NC; c++) res->prof[EP_UU + c][b] = n > 0.0 ? m[MOM_C2 + c] / n : nan;
+  for (int i = 0; i < 3; i++) {
+    const double m2 = m[MOM_C2 + i] / n;
+    res->prof[EP_SKEW_U + i][b] = n > 0.0 && m2 > 0.0 ? m[MOM_M3 + i] / n / pow(m2, 1.5) : nan;
+    res->prof[EP_FLAT_U + i][b] = n > 0.0 && m2 > 0.0 ? m[MOM_M4 + i] / n / (m2 * m2) : nan;
+  }
+  for (int k = 0; k < 11; k++) {
+    const double *s = B + k * SCAL_LEN;
+    res->prof[EP_SE_U + k][b] =
+        s[SCAL_N] >= 2.0 ? sqrt(s[SCAL_M2] / (s[SCAL_N] - 1.0) / s[SCAL_N]) : nan;
+  }
+  return n > 0.0;
+}
+
+/* The shear-stress balance (Eq. 5.11-5.13; the momentum budget where the snapshots carried
+   the forces) and its largest error over the interior bins. */
+static void stress_balance(const struct euler_config *cfg, const double *mom, const double *pln,
+                           const int *complete, size_t r0, size_t r1, const int *ok,
+                           double tw_force, struct euler_result *res) {
+  const int nb = cfg->nb;
+  const double nan = NAN;
+  /* shear-stress balance (Eq. 5.11-5.13): nu dU/dy - <u'v'> = tau_w/rho (1 - y/delta) */
+  res->balance_error = 0.0;
+  for (int b = 0; b < nb; b++) {
+    const double dudy = ok[b] ? deriv(res->prof[EP_Y_MEAN], res->prof[EP_U], ok, nb, b) : nan;
+    const double yb = res->prof[EP_Y_MEAN][b];
+    /* with LES the modelled stress <nu_t> dU/dy joins the viscous one (Eq. 5.45) */
+    const double nu_eff = cfg->nu + (cfg->les && ok[b] ? res->prof[EP_NUT][b] : 0.0);
+    res->prof[EP_VISC][b] = nu_eff * dudy;
+    res->prof[EP_TOTAL][b] = nu_eff * dudy - res->prof[EP_UV][b];
+    res->prof[EP_TOTAL_EXPECTED][b] = tw_force * (1.0 - yb / cfg->delta);
+  }
+  res->budget = pln && budget_profiles(cfg, mom, pln, complete, r0, r1, res);
+  if (!res->budget)
+    for (int k = EP_TAU_REYNOLDS; k < EP_SE_TAU_END; k++)
+      for (int b = 0; b < nb; b++) res->prof[k][b] = nan;
+  for (int b = 0; b < nb; b++) {
+    if (b > 0 && b < nb - 1 && ok[b] && tw_force > 0.0) {
+      const double err = fabs(res->prof[EP_TOTAL][b] - res->prof[EP_TOTAL_EXPECTED][b]) / tw_force;
+      if (err > res->balance_error) res->balance_error = err;
+    }
+  }
+}
+
 void euler_finalise(const struct euler_config *cfg, const double *win, const double *mom,
                     const double *snp, const double *pln, const int *complete, size_t r0, size_t r1,
                     struct euler_result *res) {
@@ -483,15 +554,11 @@ void euler_finalise(const struct euler_config *cfg, const double *win, const dou
   res->nb = nb;
   for (int k = 0; k < EP_NPROF; k++)
     res->prof[k] = mem_alloc((size_t)nb, sizeof(double), "Eulerian statistics");
-  double *tot = mem_alloc((size_t)nb * MOM_LEN, sizeof(double), "Eulerian statistics");
-  double *bm = mem_alloc((size_t)nb * 11 * SCAL_LEN, sizeof(double),
-                         "Eulerian statistics"); /* batch moments */
-  double *sn = mem_alloc((size_t)nb * SCAL_LEN, sizeof(double), "Eulerian statistics");
-  double *within = mem_alloc((size_t)nb * 2, sizeof(double), "Eulerian statistics");
-  memset(tot, 0, (size_t)nb * MOM_LEN * sizeof(double));
-  memset(bm, 0, (size_t)nb * 11 * SCAL_LEN * sizeof(double));
-  memset(sn, 0, (size_t)nb * SCAL_LEN * sizeof(double));
-  memset(within, 0, (size_t)nb * 2 * sizeof(double));
+  const char *lbl = "Eulerian statistics";
+  double *tot = mem_calloc((size_t)nb * MOM_LEN, sizeof(double), lbl);
+  double *bm = mem_calloc((size_t)nb * 11 * SCAL_LEN, sizeof(double), lbl); /* batch moments */
+  double *sn = mem_calloc((size_t)nb * SCAL_LEN, sizeof(double), lbl);
+  double *within = mem_calloc((size_t)nb * 2, sizeof(double), lbl);
   double snaps = 0.0, sum_fx = 0.0, sum_tw = 0.0, tw_batch[SCAL_LEN] = {0, 0, 0};
   double batch_len = 0.0;
   res->t0 = r1 > r0 ? win[r0 * WIN_LEN + WIN_T0] : NAN;
@@ -525,27 +592,7 @@ void euler_finalise(const struct euler_config *cfg, const double *win, const dou
   double tau_sum = 0.0;
   int tau_n = 0;
   for (int b = 0; b < nb; b++) {
-    const double *m = tot + (size_t)b * MOM_LEN;
-    const double n = m[MOM_N];
-    ok[b] = n > 0.0;
-    res->prof[EP_Y][b] = euler_centre(cfg, b);
-    res->prof[EP_N][b] = n;
-    res->prof[EP_Y_MEAN][b] = n > 0.0 ? m[MOM_MEAN + MOM_Y] : res->prof[EP_Y][b];
-    for (int q = 0; q < 5; q++) res->prof[EP_U + q][b] = n > 0.0 ? m[MOM_MEAN + q] : nan;
-    res->prof[EP_NUT][b] = n > 0.0 ? m[MOM_MEAN + MOM_NUT] : nan;
-    res->prof[EP_KR][b] = n > 0.0 ? m[MOM_MEAN + MOM_KR] : nan;
-    for (int c = 0; c < MOM_NC; c++) res->prof[EP_UU + c][b] = n > 0.0 ? m[MOM_C2 + c] / n : nan;
-    for (int i = 0; i < 3; i++) {
-      const double m2 = m[MOM_C2 + i] / n;
-      res->prof[EP_SKEW_U + i][b] = n > 0.0 && m2 > 0.0 ? m[MOM_M3 + i] / n / pow(m2, 1.5) : nan;
-      res->prof[EP_FLAT_U + i][b] = n > 0.0 && m2 > 0.0 ? m[MOM_M4 + i] / n / (m2 * m2) : nan;
-    }
-    const double *B = bm + (size_t)b * 11 * SCAL_LEN;
-    for (int k = 0; k < 11; k++) {
-      const double *s = B + k * SCAL_LEN;
-      res->prof[EP_SE_U + k][b] =
-          s[SCAL_N] >= 2.0 ? sqrt(s[SCAL_M2] / (s[SCAL_N] - 1.0) / s[SCAL_N]) : nan;
-    }
+    ok[b] = bin_profiles(cfg, b, tot + (size_t)b * MOM_LEN, bm + (size_t)b * 11 * SCAL_LEN, res);
     /* statistical inefficiency of the per-snapshot bin means: batch variance times batch
        size over the variance within the batches; correlation time = s dt_sample / 2 */
     const double *s = sn + (size_t)b * SCAL_LEN;
@@ -570,27 +617,7 @@ void euler_finalise(const struct euler_config *cfg, const double *win, const dou
                                 (2.0 * res->u_tau_wall)
                           : nan;
   res->re_tau = res->u_tau * cfg->delta / cfg->nu;
-  /* shear-stress balance (Eq. 5.11-5.13): nu dU/dy - <u'v'> = tau_w/rho (1 - y/delta) */
-  res->balance_error = 0.0;
-  for (int b = 0; b < nb; b++) {
-    const double dudy = ok[b] ? deriv(res->prof[EP_Y_MEAN], res->prof[EP_U], ok, nb, b) : nan;
-    const double yb = res->prof[EP_Y_MEAN][b];
-    /* with LES the modelled stress <nu_t> dU/dy joins the viscous one (Eq. 5.45) */
-    const double nu_eff = cfg->nu + (cfg->les && ok[b] ? res->prof[EP_NUT][b] : 0.0);
-    res->prof[EP_VISC][b] = nu_eff * dudy;
-    res->prof[EP_TOTAL][b] = nu_eff * dudy - res->prof[EP_UV][b];
-    res->prof[EP_TOTAL_EXPECTED][b] = tw_force * (1.0 - yb / cfg->delta);
-  }
-  res->budget = pln && budget_profiles(cfg, mom, pln, complete, r0, r1, res);
-  if (!res->budget)
-    for (int k = EP_TAU_REYNOLDS; k < EP_SE_TAU_END; k++)
-      for (int b = 0; b < nb; b++) res->prof[k][b] = nan;
-  for (int b = 0; b < nb; b++) {
-    if (b > 0 && b < nb - 1 && ok[b] && tw_force > 0.0) {
-      const double err = fabs(res->prof[EP_TOTAL][b] - res->prof[EP_TOTAL_EXPECTED][b]) / tw_force;
-      if (err > res->balance_error) res->balance_error = err;
-    }
-  }
+  stress_balance(cfg, mom, pln, complete, r0, r1, ok, tw_force, res);
   if (!(tw_force > 0.0)) res->balance_error = nan;
   free(ok), free(tot), free(bm), free(sn), free(within);
 }

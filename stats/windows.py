@@ -14,15 +14,14 @@ Re_tau = 180, 0.84 at 395) with R_uv about 0.45 is sustaining resolved turbulenc
 """
 import argparse
 import math
+import os
 import sys
 
 import netCDF4
 import numpy as np
 
-# layout of a moment record (stats/moments.h)
-MOM_N, MOM_MEAN = 0, 1
-NQ = 8  # u v w p rho y nu_t k_r
-C2 = MOM_MEAN + NQ  # uu vv ww uv uw vw
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from ab_table import window_values  # noqa: E402  (the same indicators as the A/B table)
 
 
 def main():
@@ -47,28 +46,13 @@ def main():
           f"Re_tau = {ut * delta / nu:.1f}")
     print(f"# {'t0':>7} {'t1':>7} {'-uv+pk':>7} {'y+pk':>6} {'urms+pk':>7} {'vrms+pk':>7} "
           f"{'R_uv':>6} {'U_b+':>6}")
-    for r in range(0, len(win), a.every):
-        m = mom[r]
-        n = m[:, MOM_N]
-        ok = n > 0
-        if not ok.any():
-            continue
-        y = m[:, MOM_MEAN + 5]
-        u = m[:, MOM_MEAN + 0]
-        uu, vv, uv = (np.where(ok, m[:, C2 + k] / np.maximum(n, 1), np.nan) for k in (0, 1, 3))
-        if not fold:  # mirror the upper half: y -> 2 delta - y, v -> -v
-            up = y > delta
-            y = np.where(up, 2 * delta - y, y)
-            uv = np.where(up, -uv, uv)
-        yp = y * ut / nu
-        muv = -uv / ut**2
-        k = int(np.nanargmax(muv))
-        band = ok & (yp >= 30) & (yp <= 100)
-        ruv = np.nanmean(-uv[band] / np.sqrt(uu[band] * vv[band])) if band.any() else math.nan
-        ub = np.sum(u[ok] * n[ok]) / np.sum(n[ok]) / ut
-        print(f"  {win[r, 0]:7.3f} {win[r, 1]:7.3f} {muv[k]:7.3f} {yp[k]:6.1f} "
-              f"{np.nanmax(np.sqrt(uu)) / ut:7.3f} {np.nanmax(np.sqrt(vv)) / ut:7.3f} "
-              f"{ruv:6.3f} {ub:6.2f}")
+    pln = np.asarray(g["planes"][:]) if "planes" in g.variables else None
+    rows = [r for r in range(0, len(win), a.every) if win[r, 2] > 0]
+    vals = window_values(mom[rows], pln[rows] if pln is not None else [None] * len(rows),
+                         delta, fold, ut, nu)
+    for r, v in zip(rows, vals):
+        print(f"  {win[r, 0]:7.3f} {win[r, 1]:7.3f} {v['uv_peak']:7.3f} {v['y_peak']:6.1f} "
+              f"{v['urms']:7.3f} {v['vrms']:7.3f} {v['ruv']:6.3f} {v['ub']:6.2f}")
 
 
 if __name__ == "__main__":
