@@ -186,6 +186,8 @@ def read_run(path):
             return np.ma.filled(x.astype(float), np.nan)
         y, u, uu, vv, ww, uv = (v(n) for n in ("y_mean", "u_mean", "uu", "vv", "ww", "uv"))
         se = {n: v(n + "_stderr") for n in ("u_mean", "uu", "vv", "ww", "uv")}
+        budget = {n: v(n) for n in BUDGET + ("total_stress", "total_stress_expected")
+                  if n in d.variables} if "pair_stress" in d.variables else {}
     for k in ("u_tau", "nu", "delta"):
         if k not in a:
             raise InputError("%s: no global attribute '%s' (not a chansph stats.nc?)" % (path, k))
@@ -203,10 +205,34 @@ def read_run(path):
         r = np.sqrt(np.abs(s2)) / ut
         out[c + "_rms+"] = r
         out[c + "_rms+_se"] = np.where(r > 0, 0.5 * se[name] / ut ** 2 / np.where(r > 0, r, 1), np.nan)
+    for n, x in budget.items():  # the momentum budget, mirrored like -u'v' (wall units)
+        out["budget:" + n] = sign * x / ut ** 2
     out["-u'v'+"] = -sign * uv / ut ** 2
     out["-u'v'+_se"] = se["uv"] / ut ** 2
     order = np.argsort(out["yplus"], kind="stable")
     return {k: (val[order] if isinstance(val, np.ndarray) else val) for k, val in out.items()}
+
+
+BUDGET = ("reynolds_stress", "viscous_pair_stress", "model_pair_stress", "pair_stress",
+          "wall_term_stress")
+
+
+def print_budget(ours):
+    """The split of the total stress at a few heights (docs/stats-format.md, momentum budget)."""
+    names = [n for n in BUDGET if "budget:" + n in ours]
+    if not names:
+        return
+    yp = ours["yplus"]
+    print("momentum budget (shares of total_stress; total and expected in u_tau^2):")
+    print("%8s %8s " % ("y+", "y/delta") + " ".join("%10s" % n.replace("_stress", "")[:10]
+                                                  for n in names) + " %9s %9s" % ("total", "expected"))
+    rows = sorted({int(np.argmin(np.abs(yp - t))) for t in (5.0, 15.0, 30.0, 100.0,
+                                                             0.5 * ours["re_tau"])})
+    for i in rows:
+        tot = ours["budget:total_stress"][i]
+        print("%8.1f %8.3f " % (yp[i], ours["y_delta"][i]) +
+              " ".join("%9.0f%%" % (100 * ours["budget:" + n][i] / tot) for n in names) +
+              " %9.4f %9.4f" % (tot, ours["budget:total_stress_expected"][i]))
 
 
 def region_masks(yp, yd):
@@ -279,6 +305,7 @@ def compare():
             f.write("%s,%s,%d,%.6e,%.6e,%.6e,%.6e\n" % r)
     if not args.no_plots:
         plots(ours, dns, out_dir)
+    print_budget(ours)
     print("wrote %s/compare.csv%s" % (out_dir, "" if args.no_plots else " and one PNG per quantity"))
     if args.max_error is not None:
         worst = max((max(r[3], r[4]) for r in rows if r[2] > 0), default=math.nan)
