@@ -16,7 +16,7 @@
    (the weight sum with EULER_SPH) behind the per-snapshot bin mean of u, then the momentum
    budget: for each side of the channel (y < delta, y > delta; folded: the first) the sums of
    m a_x of each part of the acceleration and of m. */
-enum { HB_MASS = EULER_SX, HB_LEN };
+enum { HB_MASS = EULER_SX, HB_MU, HB_LEN };
 enum { EU_PART_U = MOM_LEN, EU_PART_N, EU_PART_PL, EU_PART = EU_PART_PL + 2 * HB_LEN };
 
 /* Scratch of euler_sample. The columns are merged over a fixed binary tree on the global
@@ -96,6 +96,10 @@ const struct euler_meta euler_prof_meta[EP_NPROF] = {
                        "per unit area and rho0 (the scheme's momentum source; zero if the pair "
                        "forces conserve momentum): the walls balance it with drag in excess of "
                        "the body force"},
+    [EP_TAU_INERTIA] = {"momentum_change", "m^2/s^2",
+                        "rate of change of the x-momentum of the fluid between the plane and the "
+                        "centre per unit area and rho0 (first to last sample; zero in a steady "
+                        "state): total_stress + momentum_change = total_stress_expected"},
     [EP_SE_TAU + 0] = {"reynolds_stress_stderr", "m^2/s^2",
                        "standard error of reynolds_stress (batch means)"},
     [EP_SE_TAU + 1] = {"viscous_pair_stress_stderr", "m^2/s^2",
@@ -260,7 +264,8 @@ static void node_record(struct euler_work *k, size_t nb, int lo, int hi, const d
    stress convention, force on the fluid below). In a steady state they balance the body force
    on that fluid. The net pair force on a whole side (zero for a momentum-conserving scheme)
    is the momentum source. */
-static void budget_planes(const struct euler_config *c, const double *snap, double fx, double *pl) {
+static void budget_planes(const struct euler_config *c, const double *snap, double fx, double t,
+                          double *pl) {
   const int nb = c->nb;
   double tot[2][HB_LEN] = {{0}}, below[2][HB_LEN] = {{0}}, prev[PL_LEN] = {0};
   for (int b = 0; b < nb; b++)
@@ -279,13 +284,17 @@ static void budget_planes(const struct euler_config *c, const double *snap, doub
         at[PL_SOURCE] += (lower ? tot[0][k] : -tot[1][k]) / norm;
       } else if (k == EULER_SX_WALL) {
         at[PL_WALL] = sum / norm;
-      } else {
+      } else if (k == HB_MASS) {
         at[PL_DRIVE] = (lower ? fx : -fx) * centre / norm;
+      } else {
+        at[PL_MU_LAST] = (lower ? centre : -centre) / norm;
       }
     }
     if (e > 0) {
       double *P = pl + (size_t)(e - 1) * PL_LEN;
-      for (int k = PL_PRESSURE; k < PL_LEN; k++) P[k] += 0.5 * (prev[k] + at[k]);
+      for (int k = PL_PRESSURE; k <= PL_SOURCE; k++) P[k] += 0.5 * (prev[k] + at[k]);
+      P[PL_MU_LAST] = 0.5 * (prev[PL_MU_LAST] + at[PL_MU_LAST]), P[PL_T_LAST] = t;
+      if (P[PL_N] == 0.0) P[PL_MU_FIRST] = P[PL_MU_LAST], P[PL_T_FIRST] = t;
       P[PL_N] += 1.0;
     }
     for (int k = 0; k < PL_LEN; k++) prev[k] = at[k];
@@ -333,7 +342,7 @@ static void add_particle(const struct euler *e, const struct stats_snapshot *s, 
     double *H = P + (size_t)hb * EU_PART + EU_PART_PL + (size_t)(!c->fold && upper) * HB_LEN;
     const double ma = s->m ? s->m[a] : 1.0;
     for (int k = 0; k < EULER_SX; k++) H[k] += ma * s->sx[a * EULER_SX + k];
-    H[HB_MASS] += ma;
+    H[HB_MASS] += ma, H[HB_MU] += ma * s->u[a];
   }
   if (c->method == EULER_SPH) {
     /* Eq. 5.56 averaged over the plane y = y_i: every profile point within 2h takes the
@@ -425,7 +434,7 @@ void euler_sample(struct euler *e, const struct stats_snapshot *s) {
     mom_merge(row + b * MOM_LEN, R);
     if (R[EU_PART_N] > 0.0) scal_add(srow + b * SCAL_LEN, R[EU_PART_U] / R[EU_PART_N]);
   }
-  if (s->sx) budget_planes(c, snap, s->fx, e->pln + e->nwin * nb * PL_LEN);
+  if (s->sx) budget_planes(c, snap, s->fx, s->t, e->pln + e->nwin * nb * PL_LEN);
   win[WIN_NSNAP] += 1.0;
   win[WIN_SUM_FX] += s->fx;
   /* wall shear stress over density: minus the wall force on the fluid per unit area */
@@ -456,9 +465,14 @@ static int budget_profiles(const struct euler_config *cfg, const double *mom, co
   int any = 0;
   for (int b = 0; b < nb; b++) {
     double sum[PL_LEN] = {0}, batch[6][SCAL_LEN] = {{0}};
+    int first = 0;
     for (size_t r = r0; r < r1; r++) {
       const double *p = pln + (r * (size_t)nb + (size_t)b) * PL_LEN;
-      for (int k = 0; k < PL_LEN; k++) sum[k] += p[k];
+      for (int k = 0; k <= PL_SOURCE; k++) sum[k] += p[k];
+      if (p[PL_N] > 0.0) { /* the unsteady term: first and last snapshots of the range */
+        if (!first) sum[PL_MU_FIRST] = p[PL_MU_FIRST], sum[PL_T_FIRST] = p[PL_T_FIRST], first = 1;
+        sum[PL_MU_LAST] = p[PL_MU_LAST], sum[PL_T_LAST] = p[PL_T_LAST];
+      }
       const double *m = mom + (r * (size_t)nb + (size_t)b) * MOM_LEN;
       if (!complete[r] || p[PL_N] <= 0.0 || m[MOM_N] <= 0.0) continue;
       double w[6] = {-m[MOM_C2 + MOM_UV] / m[MOM_N], 0, 0, 0, 0, 0};
@@ -482,6 +496,8 @@ static int budget_profiles(const struct euler_config *cfg, const double *mom, co
                       pr[EP_TAU_PAIR][b] + pr[EP_TAU_WALL][b];
     pr[EP_TOTAL_EXPECTED][b] = sum[PL_DRIVE] / n;
     pr[EP_TAU_SOURCE][b] = sum[PL_SOURCE] / n;
+    const double span = sum[PL_T_LAST] - sum[PL_T_FIRST];
+    pr[EP_TAU_INERTIA][b] = span > 0.0 ? (sum[PL_MU_LAST] - sum[PL_MU_FIRST]) / span : NAN;
     for (int k = 0; k < 6; k++)
       pr[EP_SE_TAU + k][b] =
           batch[k][SCAL_N] >= 2.0

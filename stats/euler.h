@@ -28,8 +28,22 @@ enum { EULER_SX_PRESSURE, EULER_SX_VISCOUS, EULER_SX_MODEL, EULER_SX_WALL, EULER
     through the plane y = y_i per unit area and rho0 carried by the pressure, viscous and
     eddy-viscous pair forces and the walls, the body force on the fluid between the plane and
     the centre (what the flux must balance) and the net pair force on the fluid of that side
-    (the scheme's momentum source, zero if it conserves momentum) [m^2/s^2]. */
-enum { PL_N, PL_PRESSURE, PL_VISCOUS, PL_MODEL, PL_WALL, PL_DRIVE, PL_SOURCE, PL_LEN };
+    (the scheme's momentum source, zero if it conserves momentum) [m^2/s^2]; and the momentum
+    of that fluid at the window's first and last such snapshot, for its rate of change. */
+enum {
+  PL_N,
+  PL_PRESSURE,
+  PL_VISCOUS,
+  PL_MODEL,
+  PL_WALL,
+  PL_DRIVE,
+  PL_SOURCE,
+  PL_MU_FIRST, /* not sums: the x-momentum of that fluid per unit area and rho0 [m^2/s] */
+  PL_MU_LAST,  /* at the first and the last snapshot of the window with forces, */
+  PL_T_FIRST,  /* and their times [s]: its rate of change is the unsteady term */
+  PL_T_LAST,
+  PL_LEN
+};
 
 /** Per-window scalars: nominal interval, snapshots, sums over snapshots. */
 enum { WIN_T0, WIN_T1, WIN_NSNAP, WIN_SUM_FX, WIN_SUM_TW0, WIN_SUM_TW1, WIN_LEN };
@@ -143,6 +157,7 @@ enum {
   EP_TAU_PAIR,
   EP_TAU_WALL,
   EP_TAU_SOURCE,
+  EP_TAU_INERTIA,
   EP_SE_TAU, /* stderr of the five above and of total_stress, in that order */
   EP_SE_TAU_END = EP_SE_TAU + 6,
   EP_NPROF = EP_SE_TAU_END

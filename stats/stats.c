@@ -225,10 +225,12 @@ static const char *const moment_names[MOM_LEN] = {
     "C2_vw",     "M3_u",     "M3_v",   "M3_w",   "M4_u",   "M4_v",     "M4_w"};
 static const char *const scal_names[SCAL_LEN] = {"count", "mean", "M2"};
 static const char *const plane_names[PL_LEN] = {
-    [PL_N] = "snapshots",         [PL_PRESSURE] = "sum_pair_stress",
-    [PL_VISCOUS] = "sum_viscous", [PL_MODEL] = "sum_model",
-    [PL_WALL] = "sum_wall",       [PL_DRIVE] = "sum_drive",
-    [PL_SOURCE] = "sum_source"};
+    [PL_N] = "snapshots",           [PL_PRESSURE] = "sum_pair_stress",
+    [PL_VISCOUS] = "sum_viscous",   [PL_MODEL] = "sum_model",
+    [PL_WALL] = "sum_wall",         [PL_DRIVE] = "sum_drive",
+    [PL_SOURCE] = "sum_source",     [PL_MU_FIRST] = "momentum_first",
+    [PL_MU_LAST] = "momentum_last", [PL_T_FIRST] = "time_first",
+    [PL_T_LAST] = "time_last"};
 
 /* t_reached: the time the run reached (NaN: not known); an incomplete last window ends there. */
 static int write_eulerian(const struct euler *e, double t_reached, int ncid, char *err,

@@ -1,11 +1,13 @@
 #!/usr/bin/python3
 """Check the momentum budget of a run (stats.nc, method of planes; docs/stats-format.md).
 
-usage: budget_check.py STATS.nc --tol T [--laminar]
+usage: budget_check.py STATS.nc --tol T [--laminar] [--unsteady]
 
 Asserts, in wall units of the force balance (u_tau_force^2):
   - total_stress is the sum of its parts (reynolds, viscous, model, pair, wall) to round-off;
-  - the budget closes: max over every bin |total_stress - total_stress_expected| <= T;
+  - the budget closes: max over every bin |total_stress - total_stress_expected| <= T
+    (with --unsteady: |total_stress + momentum_change - total_stress_expected|, for a run that
+    is not yet statistically steady);
   - with --laminar: the pressure pair stress and the Reynolds stress are below 0.005, and where
     no wall term acts (farther than 2h from the walls; not the end bins, where nu dU/dy is
     one-sided) the viscous pair stress equals the continuum nu dU/dy (viscous_stress) within
@@ -27,6 +29,7 @@ def main():
     ap.add_argument("stats")
     ap.add_argument("--tol", type=float, required=True)
     ap.add_argument("--laminar", action="store_true")
+    ap.add_argument("--unsteady", action="store_true")
     a = ap.parse_args()
     d = netCDF4.Dataset(a.stats)
     ut2 = float(d.u_tau_force) ** 2
@@ -35,7 +38,7 @@ def main():
         return 1
     v = {n: np.asarray(d[n][:], dtype=float) / ut2 for n in d.variables
          if n in PARTS + ("total_stress", "total_stress_expected", "viscous_stress",
-                          "pair_momentum_source")}
+                          "pair_momentum_source", "momentum_change")}
     y = np.asarray(d["y"][:])
     parts = [n for n in PARTS if n in v]
     print("  y      " + " ".join(f"{n[:12]:>12}" for n in parts + ["total_stress",
@@ -49,9 +52,10 @@ def main():
     if not dsum <= 1e-9:
         print(f"FAIL: total_stress differs from the sum of its parts by {dsum:.3g}")
         fail = 1
-    err = np.abs(v["total_stress"] - v["total_stress_expected"])
+    lhs = v["total_stress"] + (v["momentum_change"] if a.unsteady else 0.0)
+    err = np.abs(lhs - v["total_stress_expected"])
     worst = int(np.nanargmax(err))
-    print(f"closure: max |total - expected| = {err[worst]:.3g} u_tau^2 at y = {y[worst]:.4f} "
+    print(f"closure: max |total{' + momentum_change' if a.unsteady else ''} - expected| = {err[worst]:.3g} u_tau^2 at y = {y[worst]:.4f} "
           f"(tolerance {a.tol}); momentum source {np.nanmean(v['pair_momentum_source']):.4f}")
     if not err[worst] <= a.tol:
         print("FAIL: the budget does not close")

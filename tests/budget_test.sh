@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
-# budget_test.sh CHANSPH SCENE RUNS NAME TOL [--laminar] [-- chansph --set args...]
+# budget_test.sh CHANSPH SCENE RUNS NAME TOL [--laminar|--unsteady] [-- chansph --set args...]
 # Runs SCENE into RUNS/budget_NAME and checks its momentum budget (tests/budget_check.py).
 set -uo pipefail
 chansph=$1 scene=$2 runs=$3 name=$4 tol=$5
 shift 5
 check=()
-[ "${1:-}" = --laminar ] && check=(--laminar) && shift
+case "${1:-}" in --laminar | --unsteady) check=("$1") && shift ;; esac
 [ "${1:-}" = -- ] && shift
 out=$runs/budget_$name
 "$chansph" run "$scene" --out "$out" --overwrite "$@" > "$out.log" 2>&1 ||
