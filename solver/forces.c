@@ -50,7 +50,6 @@ struct fsums {
   double m1z, m2z; /*!< and z part */
   struct sym3 A;   /*!< moment matrix of the corrected gradient */
   struct v3 gc;    /*!< corrected pressure difference gradient */
-  double vmx;      /*!< LES: x part of the viscous sum with the molecular viscosity only */
 };
 
 /** Sums over the neighbours j0 .. j1-1 of particle a for the operator `visc`, the corrected
@@ -86,9 +85,8 @@ static inline __attribute__((always_inline)) void pair_sums(const struct fctx *C
   double gpx = 0, gpy = 0, gpz = 0, vx = 0, vy = 0, vz = 0, mo2 = 0, moyy = 0, mo1 = 0;
   double diff = 0, m1x = 0, m2x = 0, m1z = 0, m2z = 0;
   double axx = 0, axy = 0, axz = 0, ayy = 0, ayz = 0, azz = 0, gcx = 0, gcy = 0, gcz = 0;
-  double vmx = 0;
 #pragma omp simd reduction(+ : gpx, gpy, gpz, vx, vy, vz, mo2, moyy, mo1, diff, m1x, m2x, m1z, \
-                               m2z, axx, axy, axz, ayy, ayz, azz, gcx, gcy, gcz, vmx)
+                               m2z, axx, axy, axz, ayy, ayz, azz, gcx, gcy, gcz)
   for (int j = j0; j < j1; j++) {
     const int32_t b = gathered ? j : nl[j];
     const struct pair g = pair_geom(&K, lx, lz, d3, xa - x[b], ya - y[b], za - z[b]);
@@ -108,10 +106,8 @@ static inline __attribute__((always_inline)) void pair_sums(const struct fctx *C
       t = term_morris(&g, m[b], ira, vb, eta2, uab);
     else if (visc == VK_VIOLEAU)
       t = term_violeau(&g, vb, 0.5 * (ra + rb), np2, eta2, uab);
-    else { /* Eq. 2.100 with mu = rho (nu + nu_r); its molecular part for the budget */
+    else /* Eq. 2.100 with mu = rho (nu + nu_r) */
       t = term_violeau(&g, vb, 0.5 * (mu_a + rb * (nu + nur[b])), np2, eta2, uab);
-      vmx += term_violeau(&g, vb, 0.5 * (ra + rb) * nu, np2, eta2, uab).x;
-    }
     vx += t.x, vy += t.y, vz += t.z;
     const struct v3 mo = term_moments(&g, vb);
     mo2 += mo.x, moyy += mo.y, mo1 += mo.z;
@@ -130,8 +126,26 @@ static inline __attribute__((always_inline)) void pair_sums(const struct fctx *C
                         m1z,
                         m2z,
                         {axx, axy, axz, ayy, ayz, azz},
-                        {gcx, gcy, gcz},
-                        vmx};
+                        {gcx, gcy, gcz}};
+}
+
+/** LES: the x part of Violeau's sum over the fluid neighbours of a with the molecular viscosity
+    only (mu_ab = rho_ab nu), the same terms as pair_sums in list order. */
+static double molecular_x(const struct fctx *C, size_t a) {
+  const struct model *M = C->M;
+  const struct particles *P = C->P;
+  const int32_t *nl = C->nb->list + a * (size_t)C->nb->stride;
+  const double xa = P->x[a], ya = P->y[a], za = P->z[a], ra = P->rho[a];
+  double sum = 0.0;
+  for (int j = 0; j < C->nb->nfluid[a]; j++) {
+    const int32_t b = nl[j];
+    const struct pair g =
+        pair_geom(&M->k, M->lx, M->lz, M->dim == 3, xa - P->x[b], ya - P->y[b], za - P->z[b]);
+    const struct v3 uab = {P->u[a] - P->u[b], P->v[a] - P->v[b], P->w[a] - P->w[b]};
+    sum +=
+        term_violeau(&g, P->vol[b], 0.5 * (ra + P->rho[b]) * M->nu, M->dim + 2.0, M->eta2, uab).x;
+  }
+  return sum;
 }
 
 /** The x-acceleration of particle a by its fluid neighbours, split by term into
@@ -152,8 +166,9 @@ static void budget_parts(const struct fctx *C, size_t a, const struct fsums *s,
   } else {
     sx[SX_PRESSURE] = -s->gp.x / P->gam[a];
   }
-  /* with LES the viscous sum holds rho (nu + nu_r); vmx the same sum with rho nu */
-  sx[SX_VISCOUS] = visk * (M->les ? s->vmx : s->vis.x);
+  /* with LES the viscous sum holds rho (nu + nu_r): its part with rho nu from one more pass
+     over the fluid neighbours, on the sampled steps only (not in the hot loop) */
+  sx[SX_VISCOUS] = visk * (M->les ? molecular_x(C, a) : s->vis.x);
   sx[SX_MODEL] = M->les ? visk * s->vis.x - sx[SX_VISCOUS] : 0.0;
 }
 

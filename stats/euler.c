@@ -475,10 +475,9 @@ static int budget_profiles(const struct euler_config *cfg, const double *mom, co
       }
       const double *m = mom + (r * (size_t)nb + (size_t)b) * MOM_LEN;
       if (!complete[r] || p[PL_N] <= 0.0 || m[MOM_N] <= 0.0) continue;
-      double w[6] = {-m[MOM_C2 + MOM_UV] / m[MOM_N], 0, 0, 0, 0, 0};
-      for (int k = 0; k < 4; k++) w[1 + k] = p[PL_PRESSURE + k] / p[PL_N];
-      const double pressure = w[1];
-      w[1] = w[2], w[2] = w[3], w[3] = pressure; /* order of EP_TAU_*: viscous, model, pair */
+      /* in the order of EP_TAU_*: Reynolds, viscous, model, pair, wall; then the total */
+      double w[6] = {-m[MOM_C2 + MOM_UV] / m[MOM_N], p[PL_VISCOUS] / p[PL_N], p[PL_MODEL] / p[PL_N],
+                     p[PL_PRESSURE] / p[PL_N], p[PL_WALL] / p[PL_N]};
       w[5] = w[0] + w[1] + w[2] + w[3] + w[4];
       for (int k = 0; k < 6; k++) scal_add(batch[k], w[k]);
     }

@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "alloc.h"
 #include "moments.h"
 #include "ncout.h"
 #include "state.h"
@@ -165,8 +166,7 @@ void stats_convergence_line(const struct stats *st, char *buf, size_t len) {
   euler_result_free(&r);
   const struct euler *e = &st->eu;
   const size_t rows = euler_rows(e), r0 = e->nwin > 0 ? e->nwin - 1 : 0; /* last complete */
-  int *complete = malloc(rows * sizeof(int));
-  if (!complete) return;
+  int *complete = mem_alloc(rows, sizeof(int), "Eulerian statistics");
   for (size_t w = 0; w < rows; w++) complete[w] = w < e->nwin;
   euler_finalise(&e->cfg, e->win, e->mom, e->snp, e->pln, complete, r0, r0 + 1, &r);
   stats_turbulence(&st->cfg.eul, &r, &last);
