@@ -41,10 +41,13 @@ print("""  One eddy turnover time of a pi x 2 x pi/2 box holds few independent s
   the error bars are underestimates and the correlation time itself is uncertain).
   What the differences mean: at dr = delta/16 (Delta+ = 25) the mean profile follows the DNS to
   a few percent, but the resolved -u'v'+ stays near zero and the rms values are particle noise
-  rather than resolved eddies. The mean momentum balance must then be closed by the SPH pair
-  forces acting on the particle-scale disorder, which the stress balance in the log (mean
-  viscous + Reynolds stress) does not include; we have not measured that term yet. This is a
-  property of the resolution, not of the averaging time (docs/validation/les_vs_qdns.md).""")
+  rather than resolved eddies. The momentum budget printed above (method of planes,
+  docs/stats-format.md) shows what carries the stress instead: the pressure pair forces of the
+  disordered particles (pair_stress, about 95-100% of the total beyond y+ = 100), not the
+  resolved turbulence (reynolds_stress, about 0%). The shipped state was developed with the
+  background pressure 0.01 rho0 c0^2, which docs/validation/turbulent_channel.md shows destroys
+  resolved turbulence; a state developed without it is issue 12's next step. Longer averaging
+  would not change this (docs/validation/les_vs_qdns.md).""")
 EOF
 echo
 echo "quickstart: results in $out/"
