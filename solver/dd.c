@@ -30,6 +30,8 @@ enum {
   F_AZ,
   F_SX, /* SX_LEN parts of the x-acceleration (the momentum budget), zero unless live */
   F_SDY = F_SX + SX_LEN,
+  F_NUR, /* nu_r and k_r of the next step (les.strain_lag), zero unless live */
+  F_KR,
   F_ID,
   F_KIND,
   F_LEN
@@ -52,6 +54,7 @@ static void pack(const struct particles *P, size_t a, double *r) {
   r[F_AX] = P->ax[a], r[F_AY] = P->ay[a], r[F_AZ] = P->az[a];
   for (int k = 0; k < SX_LEN; k++) r[F_SX + k] = P->sx && P->sx_live ? P->sx[a * SX_LEN + k] : 0.0;
   r[F_SDY] = P->shift_dy ? P->shift_dy[a] : 0.0;
+  r[F_NUR] = P->nur_live ? P->nur[a] : 0.0, r[F_KR] = P->nur_live ? P->kr[a] : 0.0;
   memcpy(&r[F_ID], &P->id[a], sizeof(double));
   r[F_KIND] = P->kind[a];
 }
@@ -65,6 +68,7 @@ static void unpack(struct particles *P, size_t a, const double *r) {
   if (P->sx && P->sx_live)
     for (int k = 0; k < SX_LEN; k++) P->sx[a * SX_LEN + k] = r[F_SX + k];
   if (P->shift_dy) P->shift_dy[a] = r[F_SDY];
+  if (P->nur_live) P->nur[a] = r[F_NUR], P->kr[a] = r[F_KR];
   memcpy(&P->id[a], &r[F_ID], sizeof(double));
   P->kind[a] = (uint8_t)r[F_KIND];
 }

@@ -24,10 +24,12 @@
 #include "records.h"
 #include "sph.h"
 #include "timers.h"
+#include "turb.h"
 #include "wall.h"
 
-/** The viscous operator of a loop. */
-enum visc_kind { VK_MORRIS, VK_VIOLEAU, VK_LES, VK_N };
+/** The viscous operator of a loop; VK_LES_LAG: the LES loop that also forms the velocity-gradient
+    sums of the next step's eddy viscosity (les.strain_lag). */
+enum visc_kind { VK_MORRIS, VK_VIOLEAU, VK_LES, VK_LES_LAG, VK_N };
 
 /** What every loop reads. */
 struct fctx {
@@ -35,9 +37,10 @@ struct fctx {
   const struct particles *P;
   const struct nbr *nb;
   const struct walls *W;
-  double fx;       /*!< driving acceleration (time-step limit only) [m/s^2] */
-  double *wall_ax; /*!< x-acceleration from the walls, or NULL */
-  double *sx;      /*!< parts of the x-acceleration (enum part_sx), or NULL */
+  double fx;                  /*!< driving acceleration (time-step limit only) [m/s^2] */
+  double *wall_ax;            /*!< x-acceleration from the walls, or NULL */
+  double *sx;                 /*!< parts of the x-acceleration (enum part_sx), or NULL */
+  double *nur_next, *kr_next; /*!< VK_LES_LAG: nu_r and k_r of the next step */
 };
 
 /** Pair sums of one particle over one part of its neighbour list. */
@@ -58,12 +61,9 @@ struct fsums {
     (`gathered`: bf + REC_X * ld holds the x of neighbour j at index j, and so on) or from the
     particle arrays (neighbour j at index nl[j]). Always inlined with constant flags: one
     specialised loop per combination. */
-static inline __attribute__((always_inline)) void pair_sums(const struct fctx *C, size_t a,
-                                                            const double *bf, int ld,
-                                                            const int32_t *restrict nl, int j0,
-                                                            int j1, const int gathered,
-                                                            const int fluid, const int visc,
-                                                            const int corr, struct fsums *out) {
+static inline __attribute__((always_inline)) void pair_sums(
+    const struct fctx *C, size_t a, double *bf, int ld, const int32_t *restrict nl, int j0, int j1,
+    const int gathered, const int fluid, const int visc, const int corr, struct fsums *out) {
   const struct model *M = C->M;
   const struct particles *P = C->P;
   const struct kernel K = M->k;
@@ -81,7 +81,9 @@ static inline __attribute__((always_inline)) void pair_sums(const struct fctx *C
   const double xa = P->x[a], ya = P->y[a], za = P->z[a], ua = P->u[a], va = P->v[a];
   const double wa = P->w[a], ra = P->rho[a], pa = P->pr2[a], ca = P->c[a], ira = 1.0 / ra;
   const double pm_a = corr ? pa * ra * ra : 0.0;
-  const double mu_a = visc == VK_LES ? ra * (nu + P->nur[a]) : 0.0;
+  const int les = visc == VK_LES || visc == VK_LES_LAG, keep = visc == VK_LES_LAG;
+  double *restrict geo = bf + (size_t)PAIRBUF_RECORDS * ld; /* pair geometry kept (keep) */
+  const double mu_a = les ? ra * (nu + P->nur[a]) : 0.0;
   double gpx = 0, gpy = 0, gpz = 0, vx = 0, vy = 0, vz = 0, mo2 = 0, moyy = 0, mo1 = 0;
   double diff = 0, m1x = 0, m2x = 0, m1z = 0, m2z = 0;
   double axx = 0, axy = 0, axz = 0, ayy = 0, ayz = 0, azz = 0, gcx = 0, gcy = 0, gcz = 0;
@@ -91,6 +93,10 @@ static inline __attribute__((always_inline)) void pair_sums(const struct fctx *C
     const int32_t b = gathered ? j : nl[j];
     const struct pair g = pair_geom(&K, lx, lz, d3, xa - x[b], ya - y[b], za - z[b]);
     const double vb = vol[b], rb = rho[b];
+    if (keep) { /* for strain_sums: V_b F_ab and r_ab */
+      geo[j] = vb * g.f, geo[ld + j] = g.dx, geo[2 * (size_t)ld + j] = g.dy;
+      geo[3 * (size_t)ld + j] = g.dz;
+    }
     if (corr) {
       const struct sym3 t = term_moment(&g, vb);
       axx += t.xx, axy += t.xy, axz += t.xz, ayy += t.yy, ayz += t.yz, azz += t.zz;
@@ -127,6 +133,55 @@ static inline __attribute__((always_inline)) void pair_sums(const struct fctx *C
                         m2z,
                         {axx, axy, axz, ayy, ayz, azz},
                         {gcx, gcy, gcz}};
+}
+
+/** les.strain_lag: the corrected velocity-gradient sums of particle a over its whole list (n
+    neighbours), A = -sum_b V_b F_ab r_ab (x) r_ab and B = sum_b (v_b - v_a) (x) V_b F_ab r_ab
+    (thesis Eq. 2.88-2.90, k = 0; as turb_strain_gradient takes them), from the pair geometry
+    the pair loops kept in geo (V_b F_ab in field 0, r_ab in 1-3, ld apart) and the
+    neighbours' velocities (gathered or through the list): no distance, kernel or gather again. */
+static inline __attribute__((always_inline)) void strain_sums(const struct fctx *C, size_t a,
+                                                              const double *bf, int ld,
+                                                              const int32_t *restrict nl, int n,
+                                                              const int gathered, double A[6],
+                                                              double B[9]) {
+  const struct particles *P = C->P;
+  const double *restrict u = gathered ? bf + (size_t)REC_U * ld : P->u;
+  const double *restrict v = gathered ? bf + (size_t)REC_V * ld : P->v;
+  const double *restrict w = gathered ? bf + (size_t)REC_W * ld : P->w;
+  const double *restrict geo = bf + (size_t)PAIRBUF_RECORDS * ld;
+  const double *restrict vf = geo, *restrict dx = geo + ld, *restrict dy = geo + 2 * (size_t)ld;
+  const double *restrict dz = geo + 3 * (size_t)ld;
+  const double ua = P->u[a], va = P->v[a], wa = P->w[a];
+  double axx = 0, axy = 0, axz = 0, ayy = 0, ayz = 0, azz = 0;
+  double bxx = 0, bxy = 0, bxz = 0, byx = 0, byy = 0, byz = 0, bzx = 0, bzy = 0, bzz = 0;
+#pragma omp simd reduction(+ : axx, axy, axz, ayy, ayz, azz, bxx, bxy, bxz, byx, byy, byz, bzx, \
+                               bzy, bzz)
+  for (int j = 0; j < n; j++) {
+    const int32_t b = gathered ? j : nl[j];
+    const double qx = vf[j] * dx[j], qy = vf[j] * dy[j], qz = vf[j] * dz[j];
+    axx -= qx * dx[j], axy -= qx * dy[j], axz -= qx * dz[j];
+    ayy -= qy * dy[j], ayz -= qy * dz[j], azz -= qz * dz[j];
+    const double du = u[b] - ua, dv = v[b] - va, dw = w[b] - wa;
+    bxx += du * qx, bxy += du * qy, bxz += du * qz;
+    byx += dv * qx, byy += dv * qy, byz += dv * qz;
+    bzx += dw * qx, bzy += dw * qy, bzz += dw * qz;
+  }
+  A[0] = axx, A[1] = axy, A[2] = axz, A[3] = ayy, A[4] = ayz, A[5] = azz;
+  B[0] = bxx, B[1] = bxy, B[2] = bxz, B[3] = byx, B[4] = byy, B[5] = byz;
+  B[6] = bzx, B[7] = bzy, B[8] = bzz;
+}
+
+static CHANSPH_CLONES __attribute__((noinline)) void strain_sums_gathered(
+    const struct fctx *C, size_t a, const double *bf, int ld, const int32_t *restrict nl, int n,
+    double A[6], double B[9]) {
+  strain_sums(C, a, bf, ld, nl, n, 1, A, B);
+}
+
+static CHANSPH_CLONES __attribute__((noinline)) void strain_sums_arrays(
+    const struct fctx *C, size_t a, const double *bf, int ld, const int32_t *restrict nl, int n,
+    double A[6], double B[9]) {
+  strain_sums(C, a, bf, ld, nl, n, 0, A, B);
 }
 
 /** LES: the x part of Violeau's sum over the fluid neighbours of a with the molecular viscosity
@@ -296,7 +351,10 @@ static inline __attribute__((always_inline)) void force_range(const struct fctx 
   const int ld = nb->stride;
   double *bf = nb->pairbuf[omp_get_thread_num()];
   for (size_t a = a0; a < a1; a++) {
-    if (P->kind[a] != KIND_FLUID) continue;
+    if (P->kind[a] != KIND_FLUID) {
+      if (visc == VK_LES_LAG) C->nur_next[a] = C->kr_next[a] = 0.0;
+      continue;
+    }
     const int32_t *nl = nb->list + a * (size_t)nb->stride;
     const int nf = nb->nfluid[a], n = nb->count[a];
     if (gathered) {
@@ -307,6 +365,14 @@ static inline __attribute__((always_inline)) void force_range(const struct fctx 
     pair_sums(C, a, bf, ld, nl, 0, nf, gathered, 1, visc, corr, &s);
     pair_sums(C, a, bf, ld, nl, nf, n, gathered, 0, visc, corr, &sv);
     force_finish(C, a, &s, &sv, mx);
+    if (visc == VK_LES_LAG) { /* the strain of this state, for the next step */
+      double A[6], B[9];
+      if (gathered)
+        strain_sums_gathered(C, a, bf, ld, nl, n, A, B);
+      else
+        strain_sums_arrays(C, a, bf, ld, nl, n, A, B);
+      turb_model_gradient(C->M, P, C->W, a, A, B, &C->nur_next[a], &C->kr_next[a]);
+    }
   }
 }
 
@@ -321,21 +387,27 @@ FORCE_LOOP(forces_violeau, VK_VIOLEAU, 0, 0)
 FORCE_LOOP(forces_violeau_corrected, VK_VIOLEAU, 1, 0)
 FORCE_LOOP(forces_les, VK_LES, 0, 0)
 FORCE_LOOP(forces_les_corrected, VK_LES, 1, 0)
+FORCE_LOOP(forces_les_lag, VK_LES_LAG, 0, 0)
+FORCE_LOOP(forces_les_lag_corrected, VK_LES_LAG, 1, 0)
 FORCE_LOOP(forces_morris_rec, VK_MORRIS, 0, 1)
 FORCE_LOOP(forces_morris_corrected_rec, VK_MORRIS, 1, 1)
 FORCE_LOOP(forces_violeau_rec, VK_VIOLEAU, 0, 1)
 FORCE_LOOP(forces_violeau_corrected_rec, VK_VIOLEAU, 1, 1)
 FORCE_LOOP(forces_les_rec, VK_LES, 0, 1)
 FORCE_LOOP(forces_les_corrected_rec, VK_LES, 1, 1)
+FORCE_LOOP(forces_les_lag_rec, VK_LES_LAG, 0, 1)
+FORCE_LOOP(forces_les_lag_corrected_rec, VK_LES_LAG, 1, 1)
 
 /** The loops by data path (particle arrays, gathered records), viscous operator and
     pressure-gradient form (standard, corrected). */
 static const force_loop loops[2][VK_N][2] = {{{forces_morris, forces_morris_corrected},
                                               {forces_violeau, forces_violeau_corrected},
-                                              {forces_les, forces_les_corrected}},
+                                              {forces_les, forces_les_corrected},
+                                              {forces_les_lag, forces_les_lag_corrected}},
                                              {{forces_morris_rec, forces_morris_corrected_rec},
                                               {forces_violeau_rec, forces_violeau_corrected_rec},
-                                              {forces_les_rec, forces_les_corrected_rec}}};
+                                              {forces_les_rec, forces_les_corrected_rec},
+                                              {forces_les_lag_rec, forces_les_lag_corrected_rec}}};
 
 /** Particles per task of the force loop. */
 enum { FORCE_CHUNK = 128 };
@@ -343,9 +415,12 @@ enum { FORCE_CHUNK = 128 };
 void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb,
                 const struct walls *W, double fx, struct force_info *info) {
   timer_push("forces");
-  const int visc = M->les ? VK_LES : M->viscous == VISCOUS_VIOLEAU ? VK_VIOLEAU : VK_MORRIS;
+  const int visc = M->strain_lag                   ? VK_LES_LAG
+                   : M->les                        ? VK_LES
+                   : M->viscous == VISCOUS_VIOLEAU ? VK_VIOLEAU
+                                                   : VK_MORRIS;
   const force_loop loop = loops[records_fast()][visc][M->pgrad == PGRAD_CORRECTED];
-  const struct fctx C = {M, P, nb, W, fx, info->wall_ax, info->sx};
+  const struct fctx C = {M, P, nb, W, fx, info->wall_ax, info->sx, P->nur_next, P->kr_next};
   const size_t n = P->n, nchunk = (n + FORCE_CHUNK - 1) / FORCE_CHUNK;
   double amax2 = 0.0, gvmax = 0.0;
 #pragma omp parallel for schedule(dynamic, 4) reduction(max : amax2, gvmax)

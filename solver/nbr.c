@@ -392,7 +392,8 @@ static void nbr_scratch(struct nbr *nb) {
   const size_t bytes = (size_t)(nb->stride + NBR_ALIGN) * (sizeof(int32_t) + sizeof(double));
   for (int t = 0; t < nt; t++) {
     nb->scratch[t] = part_alloc("nbr_scratch", bytes);
-    nb->pairbuf[t] = part_alloc("pair_buffer", 16 * (size_t)nb->stride * sizeof(double));
+    nb->pairbuf[t] =
+        part_alloc("pair_buffer", PAIRBUF_FIELDS * (size_t)nb->stride * sizeof(double));
   }
   nb->scratch_threads = nt, nb->scratch_stride = nb->stride;
 }

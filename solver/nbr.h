@@ -57,7 +57,8 @@ struct nbr {
   int *nfluid;      /*!< of which fluid particles: they come first in the list, then the vertices */
   int avx512;       /*!< the candidate scan uses AVX-512 */
   double **pairbuf; /*!< per thread: the gathered records of one list (records.h),
-                         16 fields of stride values */
+                         16 fields of stride values, then PAIRBUF_GEOM fields of pair
+                         geometry the force loop keeps for the strain sums (forces.c) */
   int32_t **scratch;   /*!< per thread: a list being built and its squared distances */
   int scratch_threads; /*!< threads the scratch lists were made for */
   int scratch_stride;  /*!< stride they were made for */
@@ -140,5 +141,8 @@ void nbr_build(struct nbr *nb, const struct particles *P, const struct kernel *K
 static inline double nbr_wrap(double d, const double l) {
   return pair_wrap(d, l, 0.5 * l);
 }
+
+/** Fields of a pair buffer: 16 of gathered records, 4 of pair geometry. */
+enum { PAIRBUF_RECORDS = 16, PAIRBUF_GEOM = 4, PAIRBUF_FIELDS = PAIRBUF_RECORDS + PAIRBUF_GEOM };
 
 #endif

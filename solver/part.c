@@ -87,6 +87,8 @@ static size_t arrays(struct particles *P, struct array *t) {
                               {(void **)&P->kind, "kind", 1, 1},
                               {(void **)&P->nur, "nu_r", d, 0},
                               {(void **)&P->kr, "k_r", d, 0},
+                              {(void **)&P->nur_next, "nu_r_next", d, 0},
+                              {(void **)&P->kr_next, "k_r_next", d, 0},
                               {(void **)&P->twx, "wall_law_tx", d, 0},
                               {(void **)&P->twz, "wall_law_tz", d, 0},
                               {(void **)&P->shift_dy, "shift_dy", d, 0}};
@@ -208,6 +210,7 @@ void part_permute(struct particles *P, size_t i0, size_t n, const size_t *perm) 
       for (size_t i = 0; i < n; i++) P->sx[(i0 + i) * SX_LEN + k] = col[i];
     }
   if (P->shift_dy) permute_d(P->shift_dy, P->tmp, i0, n, perm);
+  if (P->nur_live) permute_d(P->nur, P->tmp, i0, n, perm), permute_d(P->kr, P->tmp, i0, n, perm);
   int64_t *restrict id = P->tmp_i;
   uint8_t *restrict kind = (uint8_t *)P->tmp; /* P->tmp is free after the doubles */
   for (size_t i = 0; i < n; i++) id[i] = P->id[i0 + perm[i]], kind[i] = P->kind[i0 + perm[i]];

@@ -53,9 +53,14 @@ struct particles {
   double *sx;
   int sx_live; /*!< 1: sx holds the values of the last force pass (a sampled step) */
   /* turbulence model (turb.h), allocated only when used, NULL otherwise; recomputed from the
-     state after every step, so not permuted */
-  double *nur;       /*!< eddy viscosity nu_r [m^2/s] */
-  double *kr;        /*!< residual kinetic energy k_r [m^2/s^2] */
+     state after every step and not permuted, unless nur_live */
+  double *nur; /*!< eddy viscosity nu_r [m^2/s] */
+  double *kr;  /*!< residual kinetic energy k_r [m^2/s^2] */
+  /** les.strain_lag: the force loop writes the nu_r and k_r of the next step here (turb.h) */
+  double *nur_next, *kr_next;
+  /** 1: nur and kr hold the values of the last force pass (les.strain_lag), which the next
+      step applies: permuted, migrated and checkpointed with the particles */
+  int nur_live;
   double *twx, *twz; /*!< wall-law stress rho u_tau^2 e_t of the nearest wall [Pa] */
   /** particle shifting (shift.h), allocated only when used, NULL otherwise: the wall-normal
       shift of the last step [m], the y-part of the wall-normal momentum flux m u delta y that

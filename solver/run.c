@@ -242,6 +242,7 @@ void sim_step(struct sim *S) {
                           .sx = P->sx_live ? P->sx : NULL};
   const double ub = S->drive.mode == DRIVE_FLUX ? bulk_velocity(S) : 0.0;
   sph_forces(&S->M, P, &S->nb, &S->W, S->fx, &fi);
+  if (S->M.strain_lag) turb_advance(P); /* nu_r, k_r of the next step (les.strain_lag) */
   if (wall_sample) wall_force(S);
   double maxima[2] = {fi.amax, fi.gvmax};
   reduce_global_max(maxima, 2);
@@ -304,7 +305,24 @@ int sim_done(const struct sim *S) {
 }
 
 /* The particle record of the redistribution, and the arrays of S->gather it fills. */
-enum { G_ID, G_KIND, G_X, G_Y, G_Z, G_U, G_V, G_W, G_RHO, G_P, G_M, G_GAM, G_KSUM, G_LEN };
+enum {
+  G_ID,
+  G_KIND,
+  G_X,
+  G_Y,
+  G_Z,
+  G_U,
+  G_V,
+  G_W,
+  G_RHO,
+  G_P,
+  G_M,
+  G_GAM,
+  G_KSUM,
+  G_NUR,
+  G_KR,
+  G_LEN
+};
 
 /* Send every owned particle (with the wall values of a vertex) to the rank whose id block holds
    it (MPI_Alltoallv) and place what arrives by id into S->gather: rank r then holds the ids
@@ -322,13 +340,14 @@ static void block_state(struct sim *S, size_t lo, size_t hi) {
   double *rec = part_alloc("ckpt_send", (n ? n : 1) * R * sizeof(double));
   int *fill = calloc((size_t)size, sizeof(int));
   if (!fill) die("out of memory redistributing the checkpoint state");
-  const double *f[] = {P->x, P->y, P->z, P->u, P->v, P->w, P->rho, P->p, P->m, P->gam, P->ksum};
+  const double *f[] = {P->x, P->y, P->z,   P->u,    P->v,   P->w, P->rho,
+                       P->p, P->m, P->gam, P->ksum, P->nur, P->kr};
   for (size_t a = 0; a < n; a++) {
     double *r = rec + sdisp[dest[a]] + fill[dest[a]];
     fill[dest[a]] += (int)R;
     memcpy(&r[G_ID], &P->id[a], sizeof(double));
     r[G_KIND] = P->kind[a];
-    for (int c = 0; c < G_LEN - 2; c++) r[G_X + c] = f[c][a];
+    for (int c = 0; c < G_LEN - 2; c++) r[G_X + c] = f[c] ? f[c][a] : 0.0;
     r[G_LEN] = r[G_LEN + 1] = 0.0;
     if (P->kind[a] == KIND_VERTEX) {
       const size_t slot = part_vertex_slot(P, P->id[a]);
@@ -421,6 +440,22 @@ void sim_state(struct sim *S, struct state_list *L) {
     struct state_field *fi =
         state_add(L, f[i].name, STATE_F64, 1, n, blocks ? g[f[i].g] : f[i].data + lo, f[i].units);
     fi->offset = lo, fi->total = N;
+  }
+  if (S->M.strain_lag) { /* the nu_r and k_r the next step applies (format 1.3; optional: an
+                            older checkpoint leaves nur_live 0 and the first step recomputes) */
+    struct state_field *fl = state_add(L, "les/nu_r_live", STATE_I32, 0, NULL, &P->nur_live, NULL);
+    fl->optional = 1;
+    const struct {
+      const char *name;
+      double *data;
+      int g;
+      const char *units;
+    } m[] = {{"particles/nu_r", P->nur, G_NUR, "m^2/s"}, {"particles/k_r", P->kr, G_KR, "m^2/s^2"}};
+    for (size_t i = 0; i < 2; i++) {
+      struct state_field *fi =
+          state_add(L, m[i].name, STATE_F64, 1, n, blocks ? g[m[i].g] : m[i].data + lo, m[i].units);
+      fi->offset = lo, fi->total = N, fi->optional = 1;
+    }
   }
   /* wall values: written by the blocks (the vertex slots of each id block), read whole */
   const size_t w0 = lo > P->n_fluid ? lo - P->n_fluid : 0;

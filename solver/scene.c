@@ -120,6 +120,15 @@ static const struct key keys[] = {
      "thesis Eq. 2.88-2.90) or from the Violeau-Issa estimate with its wall term (Eq. 5.48; "
      "docs/theory.md).",
      OFF(strain)},
+    {"les", "strain_lag", T_INT, "1", 0, 1, 0, NULL, "-",
+     "With strain = gradient: 1 forms the strain sums of the eddy viscosity and k_r inside the "
+     "force loop, from the neighbours and pair geometry it has already gathered, and applies "
+     "them at the next step (one time step of lag, as in codes that update nu_r from the "
+     "previous velocity field; the LES step then costs about as much as the quasi-DNS step; "
+     "docs/performance.md); the first step of a run, and of a resumed run whose checkpoint "
+     "lacks the values, computes them at the current state. 0: a separate pass at the current "
+     "state every step.",
+     OFF(strain_lag)},
     {"les", "van_driest", T_INT, "1", 0, 1, 0, NULL, "-",
      "van Driest damping l_S = C_S Delta_G (1 - exp(-y+/A+)) (thesis Eq. 5.50 with the sign "
      "corrected), y+ from the local friction velocity of the nearest wall; also damps k_r.",

@@ -63,6 +63,7 @@ struct scene {
   double cs;       /*!< Smagorinsky constant C_S [-] */
   double filter_h; /*!< filter width Delta_G over h [-] */
   int strain;      /*!< enum les_strain */
+  int strain_lag;  /*!< strain sums in the force loop, applied one step later (1) or not (0) */
   int van_driest;  /*!< van Driest damping on (1) or off (0) */
   double a_plus;   /*!< A+ of the damping [-] */
   double cy;       /*!< Yoshizawa constant C_Y [-]; 0 = no residual kinetic energy */

@@ -37,6 +37,7 @@ void sph_model_init(struct model *M, const struct scene *s) {
   M->pgrad = s->pgrad;
   M->les = s->les != LES_NONE;
   M->strain = s->strain;
+  M->strain_lag = M->les && s->strain == STRAIN_GRADIENT && s->strain_lag;
   M->van_driest = s->van_driest;
   M->cs = s->cs, M->delta_g = s->filter_h * M->h, M->a_plus = s->a_plus;
   M->cy = s->cy;

@@ -17,24 +17,25 @@ enum { LATTICE_KNOTS = 16, VIOLEAU_KNOTS = 128 };
 
 /** Constants of the discretisation, derived once from the scene. */
 struct model {
-  int dim;                    /*!< 2 or 3 */
-  int viscous;                /*!< enum viscous_form */
-  struct kernel k;            /*!< Wendland kernel */
-  struct eos e;               /*!< Tait equation of state */
-  double lx, ly, lz;          /*!< domain [m]; ly = 2 delta */
-  double dr, h;               /*!< spacing and smoothing length [m] */
-  double nu;                  /*!< kinematic viscosity [m^2/s] */
-  double inv_xi;              /*!< 1 / xi of the volume diffusion [-] */
-  double gy;                  /*!< wall-normal body acceleration [m/s^2] */
-  double wall_dmin;           /*!< delta r of Eq. 2.148 [m] */
-  double eta2;                /*!< regularisation of r^2 in the viscous term [m^2] */
-  int lap_norm;               /*!< enum laplacian_norm */
-  int wall_weight;            /*!< enum wall_weight: weight of the wall shear term */
-  int wall_pressure;          /*!< enum wall_pressure: weight of the pressure wall term */
-  int pgrad;                  /*!< enum pressure_gradient */
-  int les;                    /*!< eddy viscosity on (enum les_model) */
-  int strain;                 /*!< enum les_strain */
-  int van_driest;             /*!< damping on */
+  int dim;           /*!< 2 or 3 */
+  int viscous;       /*!< enum viscous_form */
+  struct kernel k;   /*!< Wendland kernel */
+  struct eos e;      /*!< Tait equation of state */
+  double lx, ly, lz; /*!< domain [m]; ly = 2 delta */
+  double dr, h;      /*!< spacing and smoothing length [m] */
+  double nu;         /*!< kinematic viscosity [m^2/s] */
+  double inv_xi;     /*!< 1 / xi of the volume diffusion [-] */
+  double gy;         /*!< wall-normal body acceleration [m/s^2] */
+  double wall_dmin;  /*!< delta r of Eq. 2.148 [m] */
+  double eta2;       /*!< regularisation of r^2 in the viscous term [m^2] */
+  int lap_norm;      /*!< enum laplacian_norm */
+  int wall_weight;   /*!< enum wall_weight: weight of the wall shear term */
+  int wall_pressure; /*!< enum wall_pressure: weight of the pressure wall term */
+  int pgrad;         /*!< enum pressure_gradient */
+  int les;           /*!< eddy viscosity on (enum les_model) */
+  int strain;        /*!< enum les_strain */
+  int strain_lag;    /*!< 1: the force loop forms the strain sums; nu_r, k_r apply one step later */
+  int van_driest;    /*!< damping on */
   double cs, delta_g, a_plus; /*!< C_S [-], Delta_G [m], A+ [-] */
   double cy;                  /*!< Yoshizawa C_Y [-]; 0 = off */
   struct wall_law_def law;    /*!< wall law of the wall shear term */

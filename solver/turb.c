@@ -16,11 +16,15 @@ void turb_init(const struct model *M, struct particles *P, struct walls *W) {
   P->twx = part_alloc("wall_law_tx", nd), P->twz = part_alloc("wall_law_tz", nd);
   W->tx = part_alloc("wall_tau_x", nv), W->tz = part_alloc("wall_tau_z", nv);
   if (M->les) P->nur = part_alloc("nu_r", nd), P->kr = part_alloc("k_r", nd);
+  if (M->strain_lag)
+    P->nur_next = part_alloc("nu_r_next", nd), P->kr_next = part_alloc("k_r_next", nd);
+  P->nur_live = 0;
 }
 
 void turb_free(struct particles *P, struct walls *W) {
-  double **d[] = {&P->twx, &P->twz, &P->nur, &P->kr, &W->tx, &W->tz};
+  double **d[] = {&P->twx, &P->twz, &P->nur, &P->kr, &P->nur_next, &P->kr_next, &W->tx, &W->tz};
   for (size_t i = 0; i < sizeof d / sizeof d[0]; i++) part_free(*d[i]), *d[i] = NULL;
+  P->nur_live = 0;
 }
 
 double turb_van_driest(double yplus, double a_plus) {
@@ -62,6 +66,45 @@ static inline double nearest_wall(const struct model *M, double y, int *wall) {
   const double top = M->ly - y;
   *wall = top < y;
   return *wall ? top : y;
+}
+
+/** The damped Smagorinsky length squared l_S^2 = (C_S Delta_G D)^2 of fluid particle a and the
+    damping D (thesis Eq. 5.47, 5.50), with y+ from the local friction velocity at the foot on
+    the nearest wall; *d and *utau2: its wall distance and u_tau^2 there. */
+static double smagorinsky_length2(const struct model *M, const struct particles *P,
+                                  const struct walls *W, size_t a, double *damp_out, double *d,
+                                  double *utau2) {
+  int wall;
+  *d = nearest_wall(M, P->y[a], &wall);
+  double damp = 1.0, rs, tsx, tsz;
+  sph_wall_stress(M, W, wall, P->x[a], P->z[a], &rs, &tsx, &tsz);
+  *utau2 = sqrt(tsx * tsx + tsz * tsz) / rs;
+  if (M->van_driest) damp = turb_van_driest(*d * sqrt(*utau2) / M->nu, M->a_plus);
+  *damp_out = damp;
+  const double dg2 = M->delta_g * M->delta_g;
+  return M->cs * M->cs * dg2 * damp * damp; /* l_S^2 */
+}
+
+/** nu_r = l_S^2 S and k_r = 2 C_Y (Delta_G D S)^2 (thesis Eq. 5.47, 5.49) of strain S. */
+static inline void smagorinsky(const struct model *M, double ls2, double damp, double S,
+                               double *nur, double *kr) {
+  const double dg2 = M->delta_g * M->delta_g;
+  *nur = ls2 * S;
+  *kr = M->cy > 0.0 ? 2.0 * M->cy * dg2 * damp * damp * S * S : 0.0;
+}
+
+void turb_model_gradient(const struct model *M, const struct particles *P, const struct walls *W,
+                         size_t a, const double A[6], const double B[9], double *nur, double *kr) {
+  double damp, d, utau2;
+  const double ls2 = smagorinsky_length2(M, P, W, a, &damp, &d, &utau2);
+  smagorinsky(M, ls2, damp, turb_strain_gradient(M->dim, A, B), nur, kr);
+}
+
+void turb_advance(struct particles *P) {
+  double *t = P->nur;
+  P->nur = P->nur_next, P->nur_next = t;
+  t = P->kr, P->kr = P->kr_next, P->kr_next = t;
+  P->nur_live = 1;
 }
 
 /** Shepard sums at vertex s over its fluid neighbours (the first nfluid of its list): returns
@@ -171,9 +214,8 @@ double turb_update(const struct model *M, struct particles *P, const struct nbr 
                    struct walls *W, struct dd *dd) {
   if (!M->wall_tau) return M->nu;
   timer_push("wall_law");
-  const struct kernel *K = &M->k;
   const double two_h = 2.0 * M->h, nu = M->nu;
-  const double *restrict x = P->x, *restrict y = P->y, *restrict z = P->z;
+  const double *restrict y = P->y;
   const double *restrict u = P->u, *restrict w = P->w, *restrict rho = P->rho;
   const uint8_t *restrict kind = P->kind;
   double *restrict twx = P->twx, *restrict twz = P->twz;
@@ -210,43 +252,45 @@ double turb_update(const struct model *M, struct particles *P, const struct nbr 
   if (dd) dd_update_walls(dd, P, 2, wt);
   if (!M->les) return nu;
   timer_push("les");
-  records_pack(P, P->n + P->n_ghost); /* positions, velocities, volumes for the gradient */
-  /* 3. rate of strain, damping, eddy viscosity and residual kinetic energy */
+  if (!P->nur_live) /* positions, velocities, volumes for the gradient */
+    records_pack(P, P->n + P->n_ghost);
+  const double ih = M->k.inv_h;
+  /* 3. rate of strain, damping, eddy viscosity and residual kinetic energy; with
+        les.strain_lag the last force pass has formed them (except on a run's first step) */
   double *restrict nur = P->nur, *restrict kr = P->kr;
-  const double ih = K->inv_h, dg2 = M->delta_g * M->delta_g;
   double numax = nu;
+  if (P->nur_live) {
+#pragma omp parallel for schedule(static) reduction(max : numax)
+    for (size_t a = 0; a < P->n; a++)
+      if (kind[a] == KIND_FLUID && nu + nur[a] > numax) numax = nu + nur[a];
+  } else {
 #pragma omp parallel for schedule(dynamic, 256) reduction(max : numax)
-  for (size_t a = 0; a < P->n; a++) {
-    nur[a] = kr[a] = 0.0;
-    if (kind[a] != KIND_FLUID) continue;
-    /* local friction velocity at the foot on the nearest wall, y+ and the damped length */
-    int wall;
-    const double d = nearest_wall(M, y[a], &wall);
-    double damp = 1.0, rs, tsx, tsz;
-    sph_wall_stress(M, W, wall, x[a], z[a], &rs, &tsx, &tsz);
-    const double utau2 = sqrt(tsx * tsx + tsz * tsz) / rs;
-    if (M->van_driest) damp = turb_van_driest(d * sqrt(utau2) / nu, M->a_plus);
-    const double ls2 = M->cs * M->cs * dg2 * damp * damp; /* l_S^2 */
-    double S;
-    if (M->strain == STRAIN_GRADIENT) {
-      double A[6], B[9];
-      if (records_fast())
-        gradient_sums_rec(M, P, nb, a, A, B);
-      else
-        gradient_sums(M, P, nb, a, A, B);
-      S = turb_strain_gradient(M->dim, A, B);
-    } else { /* Violeau-Issa, Eq. 5.48 with nu_r,b = nu_r,a: S^3 - sum S - W / l_S^2 = 0 */
-      const double ig = 1.0 / P->gam[a];
-      const double sum = violeau_issa_sum(M, P, nb, a) * ig / rho[a];
-      double wterm = 0.0; /* power of the wall shear: 2/gamma sum_s u_tau,s^2 |v_t| |grad gamma| */
-      if (d < two_h)
-        wterm =
-            2.0 * ig * utau2 * sqrt(u[a] * u[a] + w[a] * w[a]) * wall_dgamma(M->dim, d * ih) * ih;
-      S = ls2 > 0.0 ? strain_cubic(sum, wterm / ls2) : sqrt(sum);
+    for (size_t a = 0; a < P->n; a++) {
+      nur[a] = kr[a] = 0.0;
+      if (kind[a] != KIND_FLUID) continue;
+      double damp, d, utau2;
+      const double ls2 = smagorinsky_length2(M, P, W, a, &damp, &d, &utau2);
+      double S;
+      if (M->strain == STRAIN_GRADIENT) {
+        double A[6], B[9];
+        if (records_fast())
+          gradient_sums_rec(M, P, nb, a, A, B);
+        else
+          gradient_sums(M, P, nb, a, A, B);
+        S = turb_strain_gradient(M->dim, A, B);
+      } else { /* Violeau-Issa, Eq. 5.48 with nu_r,b = nu_r,a: S^3 - sum S - W / l_S^2 = 0 */
+        const double ig = 1.0 / P->gam[a];
+        const double sum = violeau_issa_sum(M, P, nb, a) * ig / rho[a];
+        double wterm =
+            0.0; /* power of the wall shear: 2/gamma sum_s u_tau,s^2 |v_t| |grad gamma| */
+        if (d < two_h)
+          wterm =
+              2.0 * ig * utau2 * sqrt(u[a] * u[a] + w[a] * w[a]) * wall_dgamma(M->dim, d * ih) * ih;
+        S = ls2 > 0.0 ? strain_cubic(sum, wterm / ls2) : sqrt(sum);
+      }
+      smagorinsky(M, ls2, damp, S, &nur[a], &kr[a]);
+      if (nu + nur[a] > numax) numax = nu + nur[a];
     }
-    nur[a] = ls2 * S;
-    if (M->cy > 0.0) kr[a] = 2.0 * M->cy * dg2 * damp * damp * S * S;
-    if (nu + nur[a] > numax) numax = nu + nur[a];
   }
   double *const nk[2] = {nur, kr};
   if (dd) dd_update(dd, P, 2, nk); /* read at neighbours by the forces and by step 4 */

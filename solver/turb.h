@@ -10,7 +10,9 @@
  *  2. the wall stress rho_s u_tau u_tau of the vertices by Shepard interpolation (Ferrand
  *     Eq. 38),
  *  3. with LES: the rate of strain S, the local y+ from the wall stress at the foot of the
- *     nearest wall, nu_r = l_S^2 S and k_r,
+ *     nearest wall, nu_r = l_S^2 S and k_r; with les.strain_lag (the default) the force loop
+ *     of the previous step formed them from the strain of its state (turb_model_gradient,
+ *     turb_advance), one time step of lag, and this step only takes their maximum,
  *  4. with C_Y > 0: k_r of the vertices (Shepard), and the pressure of fluid and vertex
  *     particles as seen by the forces becomes p + 2/3 rho k_r (Eq. 5.42: pr2 and the wall
  *     pressure; P->p stays the equation-of-state pressure).
@@ -44,6 +46,21 @@ void turb_free(struct particles *P, struct walls *W);
  */
 double turb_update(const struct model *M, struct particles *P, const struct nbr *nb,
                    struct walls *W, struct dd *dd);
+
+/**
+ * @brief nu_r and k_r of fluid particle a from its corrected velocity-gradient sums A and B (as
+ *        turb_strain_gradient takes them), with the damping of the current wall stresses: what
+ *        the force loop computes for the next step under les.strain_lag.
+ */
+void turb_model_gradient(const struct model *M, const struct particles *P, const struct walls *W,
+                         size_t a, const double A[6], const double B[9], double *nur, double *kr);
+
+/**
+ * @brief les.strain_lag, after the force pass: the nu_r and k_r it formed (P->nur_next,
+ *        P->kr_next) become those of the next step (P->nur_live = 1), which turb_update then
+ *        only refreshes at the ghosts and adds to the pressure.
+ */
+void turb_advance(struct particles *P);
 
 /**
  * @brief Rate of strain from the first-order corrected velocity gradient of one particle
