@@ -93,11 +93,49 @@ static inline void smagorinsky(const struct model *M, double ls2, double damp, d
   *kr = M->cy > 0.0 ? 2.0 * M->cy * dg2 * damp * damp * S * S : 0.0;
 }
 
+/** S of turb_strain_gradient with L_a = A^-1 formed once (one division instead of a solve per
+    row; the same fallback for a degenerate A): the force loop's per-particle cost. */
+static double strain_gradient_inverse(int dim, const double A[6], const double B[9]) {
+  double L[3][3] = {{0}};
+  if (dim == 2) {
+    const double det = A[0] * A[3] - A[1] * A[1], tr = A[0] + A[3];
+    if (!(fabs(det) > 1e-12 * tr * tr)) {
+      L[0][0] = L[1][1] = tr > 0 ? 2.0 / tr : 0.0;
+    } else {
+      const double id = 1.0 / det;
+      L[0][0] = A[3] * id, L[0][1] = L[1][0] = -A[1] * id, L[1][1] = A[0] * id;
+    }
+  } else {
+    const double a = A[0], b = A[1], c = A[2], d = A[3], e = A[4], f = A[5];
+    const double c0 = d * f - e * e, c1 = c * e - b * f, c2 = b * e - c * d;
+    const double det = a * c0 + b * c1 + c * c2, tr = a + d + f;
+    if (!(fabs(det) > 1e-12 * tr * tr * tr)) {
+      L[0][0] = L[1][1] = L[2][2] = tr > 0 ? 3.0 / tr : 0.0;
+    } else {
+      const double id = 1.0 / det;
+      L[0][0] = c0 * id, L[0][1] = L[1][0] = c1 * id, L[0][2] = L[2][0] = c2 * id;
+      L[1][1] = (a * f - c * c) * id, L[1][2] = L[2][1] = (b * c - a * e) * id;
+      L[2][2] = (a * d - b * b) * id;
+    }
+  }
+  double G[3][3];
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++)
+      G[i][j] = B[3 * i] * L[0][j] + B[3 * i + 1] * L[1][j] + B[3 * i + 2] * L[2][j];
+  double s2 = 0.0;
+  for (int i = 0; i < dim; i++)
+    for (int j = 0; j < dim; j++) {
+      const double sij = 0.5 * (G[i][j] + G[j][i]);
+      s2 += 2.0 * sij * sij;
+    }
+  return sqrt(s2);
+}
+
 void turb_model_gradient(const struct model *M, const struct particles *P, const struct walls *W,
                          size_t a, const double A[6], const double B[9], double *nur, double *kr) {
   double damp, d, utau2;
   const double ls2 = smagorinsky_length2(M, P, W, a, &damp, &d, &utau2);
-  smagorinsky(M, ls2, damp, turb_strain_gradient(M->dim, A, B), nur, kr);
+  smagorinsky(M, ls2, damp, strain_gradient_inverse(M->dim, A, B), nur, kr);
 }
 
 void turb_advance(struct particles *P) {
