@@ -1,0 +1,196 @@
+#!/usr/bin/python3
+"""Error against run time: how far a turbulent channel run is from the DNS, window by window.
+
+usage: python3 stats/error_vs_time.py --dns FILE [--dns FILE2] [--group T] [--out DIR]
+                                      LABEL=RUN_DIR[+RUN_DIR...] ...
+
+Each series is one or more run directories (stats.nc, log.txt), the later ones continuing the
+earlier (a run started from an earlier one's particles with its time restarting at 0 is shifted
+to follow it). The averaging windows of stats.nc are grouped into consecutive groups of length T
+in delta/u_tau (default 0.25); for each group the profiles of U+, u_rms+, v_rms+, w_rms+ and
+-u'v'+ are formed from the raw window sums (upper half mirrored when not folded; wall units from
+the force balance u_tau^2 = delta f) and compared with each DNS file over the bins inside its y+
+range: relative L2 error = rms(ours - DNS) / rms(DNS). The x axes are the particle-steps spent
+since the start of the series (from the log's step lines and the fluid-particle count) and the
+wall seconds (from the log's particle-steps/s of each interval: what the machine delivered,
+shared or not).
+
+Writes DIR/error_vs_time.csv (one row per series, group and DNS set) and
+DIR/error_vs_time.png (one panel per quantity, error against particle-steps), and prints the
+last group of each series. DNS files: those `chansph compare` reads (stats/compare.py).
+"""
+import argparse
+import math
+import os
+import re
+import sys
+
+import netCDF4
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from compare import QUANTITIES, InputError, read_dns  # noqa: E402
+
+MOM_N, MEAN = 0, 1
+C2 = MEAN + 8
+
+
+def log_cost(run):
+    """Arrays (t, cumulative particle-steps, cumulative wall seconds) at the log's step lines."""
+    try:
+        log = open(os.path.join(run, "log.txt"), encoding="utf-8").read()
+    except OSError as e:
+        raise InputError(f"{run}/log.txt: {e.strerror}")
+    nfl = re.search(r"(\d+) fluid", log)
+    rows = re.findall(r"^step\s+(\d+)\s+t\s+(\S+)\s+dt.*?(\S+) p-steps/s", log, re.M)
+    if not nfl or len(rows) < 2:
+        raise InputError(f"{run}/log.txt: no step lines with particle-steps/s")
+    n = int(nfl.group(1))
+    step = np.array([int(r[0]) for r in rows], float)
+    t = np.array([float(r[1]) for r in rows])
+    rate = np.array([float(r[2]) for r in rows])
+    keep = np.concatenate(([True], np.diff(step) > 0))  # a resumed run repeats a step line
+    step, t, rate = step[keep], t[keep], rate[keep]
+    psteps = (step - step[0]) * n
+    dwall = np.where(rate[1:] > 0, np.diff(psteps) / np.maximum(rate[1:], 1e-300), 0.0)
+    return t, psteps, np.concatenate(([0.0], np.cumsum(dwall)))
+
+
+def group_profiles(run, group):
+    """[(t0, t1, profiles dict)] of the window groups of a run."""
+    try:
+        nc = netCDF4.Dataset(os.path.join(run, "stats.nc"))
+    except OSError as e:
+        raise InputError(f"{run}/stats.nc: {e}")
+    g = nc.groups.get("eulerian")
+    if g is None:
+        raise InputError(f"{run}/stats.nc: no group 'eulerian'")
+    delta, nu, fold = float(nc.delta), float(nc.nu), int(nc.fold)
+    win = np.asarray(g["windows"][:])
+    mom = np.asarray(g["moments"][:])
+    done = win[:, 2] > 0
+    ut = math.sqrt(max(delta * win[done, 3].sum() / max(win[done, 2].sum(), 1), 0.0))
+    out = []
+    t_start = win[0, 0]
+    k = 0
+    while k < len(win):
+        t_lo = t_start + math.floor((win[k, 0] - t_start) / group + 1e-9) * group
+        sel = [i for i in range(k, len(win)) if win[i, 0] < t_lo + group - 1e-9]
+        k = sel[-1] + 1
+        sel = [i for i in sel if done[i]]
+        if not sel:
+            continue
+        # merge the windows' records (counts, means, co-moments; Chan et al. 1979)
+        n = mom[sel][:, :, MOM_N].sum(axis=0)
+        ok = n > 0
+        nn = np.maximum(n, 1)
+        mean = sum(mom[i][:, MEAN:MEAN + 8] * mom[i][:, [MOM_N]] for i in sel) / nn[:, None]
+        pairs = ((0, 0), (1, 1), (2, 2), (0, 1))  # uu vv ww uv
+        c2 = np.zeros((len(n), len(pairs)))
+        for i in sel:
+            d = mom[i][:, MEAN:MEAN + 3] - mean[:, :3]
+            for c, (p, q) in enumerate(pairs):
+                c2[:, c] += mom[i][:, C2 + c] + mom[i][:, MOM_N] * d[:, p] * d[:, q]
+        y = np.where(ok, mean[:, 5], np.nan)
+        u = np.where(ok, mean[:, 0], np.nan)
+        uu, vv, ww, uv = (np.where(ok, c2[:, c] / nn, np.nan) for c in range(4))
+        if not fold:
+            up = y > delta
+            y = np.where(up, 2 * delta - y, y)
+            uv = np.where(up, -uv, uv)
+        yp = y * ut / nu
+        prof = {"yplus": yp, "y_delta": y / delta, "U+": u / ut, "u_rms+": np.sqrt(uu) / ut,
+                "v_rms+": np.sqrt(vv) / ut, "w_rms+": np.sqrt(ww) / ut, "-u'v'+": -uv / ut**2}
+        out.append((win[sel[0], 0], win[sel[-1], 1], prof))
+    return out
+
+
+def rel_l2(prof, dns, q):
+    yp = prof["yplus"]
+    inside = (yp >= dns["yplus"][0]) & (yp <= dns["yplus"][-1]) & np.isfinite(prof[q])
+    if not inside.any() or dns.get(q) is None:
+        return math.nan
+    ref = np.interp(yp[inside], dns["yplus"], dns[q])
+    return math.sqrt(np.mean((prof[q][inside] - ref) ** 2)) / math.sqrt(np.mean(ref**2))
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("series", nargs="+", help="LABEL=RUN_DIR[+RUN_DIR...]")
+    ap.add_argument("--dns", action="append", required=True)
+    ap.add_argument("--group", type=float, default=0.25, help="window group length [delta/u_tau]")
+    ap.add_argument("--out", default=".")
+    a = ap.parse_args()
+    try:
+        dns = [read_dns(p) for p in a.dns]
+        rows = []
+        for spec in a.series:
+            label, _, dirs = spec.partition("=")
+            if not dirs:
+                raise InputError(f"{spec}: expected LABEL=RUN_DIR[+RUN_DIR...]")
+            t_off = ps_off = wall_off = 0.0
+            for run in dirs.split("+"):
+                t, ps, wall = log_cost(run)
+                groups = group_profiles(run, a.group)
+                for t0, t1, prof in groups:
+                    p1, w1 = np.interp(t1, t, ps), np.interp(t1, t, wall)
+                    errs = [[rel_l2(prof, d, q) for q in QUANTITIES] for d in dns]
+                    rows.append((label, t_off + t0, t_off + t1, ps_off + p1, wall_off + w1, errs))
+                t_off += groups[-1][1] if groups else t[-1]
+                ps_off += ps[-1]
+                wall_off += wall[-1]
+    except InputError as e:
+        sys.exit(f"error: {e}")
+    os.makedirs(a.out, exist_ok=True)
+    csv = os.path.join(a.out, "error_vs_time.csv")
+    with open(csv, "w") as f:
+        f.write("series,dns,t0,t1,particle_steps,wall_seconds," +
+                ",".join("rel_L2_" + q.replace("'", "").replace("+", "p").replace("-", "m")
+                         for q in QUANTITIES) + "\n")
+        for lab, t0, t1, ps, wall, errs in rows:
+            for d, e in zip(dns, errs):
+                f.write(f"{lab},{d['name']},{t0:.4f},{t1:.4f},{ps:.6e},{wall:.1f}," +
+                        ",".join(f"{x:.4f}" for x in e) + "\n")
+    print(f"# relative L2 errors of the last window group of each series against {dns[0]['name']}")
+    print(f"# {'series':<14} {'t':>11} {'Gp-steps':>9} {'wall s':>8} " +
+          " ".join(f"{q:>7}" for q in QUANTITIES))
+    last = {}
+    for r in rows:
+        last[r[0]] = r
+    for lab, t0, t1, ps, wall, errs in last.values():
+        print(f"  {lab:<14} {t0:5.2f}-{t1:5.2f} {ps / 1e9:9.3f} {wall:8.0f} " +
+              " ".join(f"{x:7.3f}" for x in errs[0]))
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        print(f"wrote {csv} (no matplotlib: no plot)")
+        return
+    nq = len(QUANTITIES)
+    fig, axes = plt.subplots(2, nq, figsize=(4 * nq, 6.8))
+    for k, q in enumerate(QUANTITIES):
+        for row, (col, xlabel) in enumerate(((3, "particle-steps since the start"),
+                                              (2, "t u_tau / delta (end of the window group)"))):
+            ax = axes[row][k]
+            for lab in dict.fromkeys(r[0] for r in rows):
+                rr = [r for r in rows if r[0] == lab]
+                for j, d in enumerate(dns):
+                    ax.plot([r[col] for r in rr], [r[5][j][k] for r in rr],
+                            "o-" if j == 0 else "x--", ms=3,
+                            label=f"{lab} vs {d['name'][:14]}" if k == 0 and row == 0 else None)
+            if row == 0:
+                ax.set_xscale("log")
+            ax.set_xlabel(xlabel)
+            ax.set_title(f"{q}: relative L2 error")
+            ax.set_ylim(bottom=0)
+            ax.grid(alpha=0.3)
+    fig.legend(loc="lower center", ncol=4, fontsize=7)
+    fig.tight_layout(rect=(0, 0.07, 1, 1))
+    png = os.path.join(a.out, "error_vs_time.png")
+    fig.savefig(png, dpi=110)
+    print(f"wrote {csv} and {png}")
+
+
+if __name__ == "__main__":
+    main()
