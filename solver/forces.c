@@ -227,58 +227,27 @@ static void budget_parts(const struct fctx *C, size_t a, const struct fsums *s,
   sx[SX_MODEL] = M->les ? visk * s->vis.x - sx[SX_VISCOUS] : 0.0;
 }
 
-/** Acceleration of fluid particle a from its pair sums (fluid part s, vertex part sv): the
-    normalisation of the viscous sum, the wall terms, the body force; the time-step maxima go to
-    mx[0] (max |a|^2) and mx[1] (max |grad gamma . v|). */
-static void force_finish(const struct fctx *C, size_t a, const struct fsums *s,
-                         const struct fsums *sv, double mx[2]) {
+/** What the wall terms of force_finish take from it. */
+struct wall_ctx {
+  double ig, ira, pa;    /*!< 1/gamma_a, 1/rho_a, p_a/rho_a^2 */
+  double lap, kx, kz;    /*!< nu/gamma_a normalised; the normalisations of x and z */
+  double m1x, m1z, mom1; /*!< first moments: Violeau's x and z parts, the full one */
+};
+
+/** The wall terms of fluid particle a added to acc = {ax, ay, az, ax from the walls}: the
+    pressure wall term (Eq. 3.17, k = 1) and the wall shear (Eq. 2.147-2.148, or the wall law);
+    returns max over the walls of |grad gamma_as . v_a| for the time step. */
+static double wall_terms(const struct fctx *C, size_t a, const struct wall_ctx *wc, double acc[4]) {
   const struct model *M = C->M;
   const struct particles *P = C->P;
   const struct walls *W = C->W;
-  const double ih = M->k.inv_h, nu = M->nu, ra = P->rho[a], ira = 1.0 / ra, pa = P->pr2[a];
-  const double ya = P->y[a], ua = P->u[a], va = P->v[a], wa = P->w[a];
-  const int violeau = M->viscous == VISCOUS_VIOLEAU, les = M->les;
+  const double ih = M->k.inv_h, nu = M->nu, ig = wc->ig, ira = wc->ira, pa = wc->pa;
+  const double lap = wc->lap, kx = wc->kx, kz = wc->kz, m1x = wc->m1x, m1z = wc->m1z;
+  const double mom1 = wc->mom1, ya = P->y[a], ua = P->u[a], va = P->v[a], wa = P->w[a];
+  const int violeau = M->viscous == VISCOUS_VIOLEAU;
   const int corrected = M->pgrad == PGRAD_CORRECTED;
   const int discrete = M->wall_weight == WALL_WEIGHT_DISCRETE;
-  const double ig = 1.0 / P->gam[a];
-  const double mom2 = s->mom.x + sv->mom.x, momyy = s->mom.y + sv->mom.y;
-  const double mom1 = s->mom.z + sv->mom.z;
-  const double m1x = s->m1x + sv->m1x, m2x = s->m2x + sv->m2x;
-  const double m1z = s->m1z + sv->m1z, m2z = s->m2z + sv->m2z;
-  const double vx = s->vis.x + sv->vis.x, vy = s->vis.y + sv->vis.y, vz = s->vis.z + sv->vis.z;
-  double axa, aya, aza;
-  if (corrected) { /* -(1/rho_a) L_a g, L_a = A^-1 (Eq. 2.88, 2.90 with k = 0) */
-    const double A[6] = {s->A.xx + sv->A.xx, s->A.xy + sv->A.xy, s->A.xz + sv->A.xz,
-                         s->A.yy + sv->A.yy, s->A.yz + sv->A.yz, s->A.zz + sv->A.zz};
-    const double gc[3] = {s->gc.x + sv->gc.x, s->gc.y + sv->gc.y, s->gc.z + sv->gc.z};
-    double gr[3];
-    sph_solve_sym(M->dim, A, gc, gr);
-    axa = -gr[0] * ira, aya = -gr[1] * ira, aza = -gr[2] * ira;
-  } else {
-    axa = -ig * (s->gp.x + sv->gp.x), aya = -ig * (s->gp.y + sv->gp.y);
-    aza = -ig * (s->gp.z + sv->gp.z);
-  }
-  double kappa = 1.0, kx = 1.0, kz = 1.0; /* normalisation; Violeau: of the x and z parts */
-  if (M->lap_norm != LAPNORM_NONE) {      /* discrete + analytic part behind the walls */
-    const double qb = ya * ih, qt = (M->ly - ya) * ih;
-    if (M->lap_norm == LAPNORM_TRACE) {
-      kappa = -M->dim / (mom2 + wall_moment2(M->dim, qb) + wall_moment2(M->dim, qt));
-      kx = kz = kappa;
-    } else if (violeau) { /* its own y-y moments: -2 in the full space */
-      const double wm = sph_violeau_moment(M, qb) + sph_violeau_moment(M, qt);
-      kx = -2.0 / (m2x + wm);
-      kz = M->dim == 3 ? -2.0 / (m2z + wm) : kx;
-      kappa = 0.5 * (kx + kz);
-    } else {
-      kappa = -1.0 / (momyy + wall_moment_yy(M->dim, qb) + wall_moment_yy(M->dim, qt));
-      kx = kz = kappa;
-    }
-  }
-  const double lap = nu * ig * kappa; /* nu / gamma_a, normalised */
-  const double vis = les ? ig / ra : violeau ? nu * ig / ra : nu * ig;
-  axa += vis * kx * vx, aya += vis * kappa * vy, aza += vis * kz * vz;
-  double awall = vis * kx * sv->vis.x; /* x-acceleration from the walls, for the statistics */
-  /* wall terms: pressure (Eq. 3.17, k = 1) and wall shear (Eq. 2.147-2.148) */
+  double axa = acc[0], aya = acc[1], aza = acc[2], awall = acc[3];
   double gv = 0.0;
   for (int wall = 0; wall < 2; wall++) {
     const double d = wall ? M->ly - ya : ya;
@@ -324,6 +293,64 @@ static void force_finish(const struct fctx *C, size_t a, const struct fsums *s,
     const double g = fabs(dg * va);
     if (g > gv) gv = g;
   }
+  acc[0] = axa, acc[1] = aya, acc[2] = aza, acc[3] = awall;
+  return gv;
+}
+
+/** Acceleration of fluid particle a from its pair sums (fluid part s, vertex part sv): the
+    normalisation of the viscous sum, the wall terms, the body force; the time-step maxima go to
+    mx[0] (max |a|^2) and mx[1] (max |grad gamma . v|). */
+static void force_finish(const struct fctx *C, size_t a, const struct fsums *s,
+                         const struct fsums *sv, double mx[2]) {
+  const struct model *M = C->M;
+  const struct particles *P = C->P;
+  const double ih = M->k.inv_h, nu = M->nu, ra = P->rho[a], ira = 1.0 / ra, pa = P->pr2[a];
+  const double ya = P->y[a];
+  const int violeau = M->viscous == VISCOUS_VIOLEAU, les = M->les;
+  const int corrected = M->pgrad == PGRAD_CORRECTED;
+  const double ig = 1.0 / P->gam[a];
+  const double mom2 = s->mom.x + sv->mom.x, momyy = s->mom.y + sv->mom.y;
+  const double mom1 = s->mom.z + sv->mom.z;
+  const double m1x = s->m1x + sv->m1x, m2x = s->m2x + sv->m2x;
+  const double m1z = s->m1z + sv->m1z, m2z = s->m2z + sv->m2z;
+  const double vx = s->vis.x + sv->vis.x, vy = s->vis.y + sv->vis.y, vz = s->vis.z + sv->vis.z;
+  double axa, aya, aza;
+  if (corrected) { /* -(1/rho_a) L_a g, L_a = A^-1 (Eq. 2.88, 2.90 with k = 0) */
+    const double A[6] = {s->A.xx + sv->A.xx, s->A.xy + sv->A.xy, s->A.xz + sv->A.xz,
+                         s->A.yy + sv->A.yy, s->A.yz + sv->A.yz, s->A.zz + sv->A.zz};
+    const double gc[3] = {s->gc.x + sv->gc.x, s->gc.y + sv->gc.y, s->gc.z + sv->gc.z};
+    double gr[3];
+    sph_solve_sym(M->dim, A, gc, gr);
+    axa = -gr[0] * ira, aya = -gr[1] * ira, aza = -gr[2] * ira;
+  } else {
+    axa = -ig * (s->gp.x + sv->gp.x), aya = -ig * (s->gp.y + sv->gp.y);
+    aza = -ig * (s->gp.z + sv->gp.z);
+  }
+  double kappa = 1.0, kx = 1.0, kz = 1.0; /* normalisation; Violeau: of the x and z parts */
+  if (M->lap_norm != LAPNORM_NONE) {      /* discrete + analytic part behind the walls */
+    const double qb = ya * ih, qt = (M->ly - ya) * ih;
+    if (M->lap_norm == LAPNORM_TRACE) {
+      kappa = -M->dim / (mom2 + wall_moment2(M->dim, qb) + wall_moment2(M->dim, qt));
+      kx = kz = kappa;
+    } else if (violeau) { /* its own y-y moments: -2 in the full space */
+      const double wm = sph_violeau_moment(M, qb) + sph_violeau_moment(M, qt);
+      kx = -2.0 / (m2x + wm);
+      kz = M->dim == 3 ? -2.0 / (m2z + wm) : kx;
+      kappa = 0.5 * (kx + kz);
+    } else {
+      kappa = -1.0 / (momyy + wall_moment_yy(M->dim, qb) + wall_moment_yy(M->dim, qt));
+      kx = kz = kappa;
+    }
+  }
+  const double lap = nu * ig * kappa; /* nu / gamma_a, normalised */
+  const double vis = les ? ig / ra : violeau ? nu * ig / ra : nu * ig;
+  axa += vis * kx * vx, aya += vis * kappa * vy, aza += vis * kz * vz;
+  double awall = vis * kx * sv->vis.x; /* x-acceleration from the walls, for the statistics */
+  /* wall terms: pressure (Eq. 3.17, k = 1) and wall shear (Eq. 2.147-2.148) */
+  const struct wall_ctx wc = {ig, ira, pa, lap, kx, kz, m1x, m1z, mom1};
+  double acc[4] = {axa, aya, aza, awall};
+  const double gv = wall_terms(C, a, &wc, acc);
+  axa = acc[0], aya = acc[1], aza = acc[2], awall = acc[3];
   aya += M->gy;
   if (C->sx) budget_parts(C, a, s, sv, vis * kx, C->sx + a * SX_LEN);
   P->ax[a] = axa, P->ay[a] = aya, P->az[a] = aza;

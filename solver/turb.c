@@ -248,17 +248,17 @@ static CHANSPH_CLONES double violeau_issa_sum(const struct model *M, const struc
   return sum;
 }
 
-double turb_update(const struct model *M, struct particles *P, const struct nbr *nb,
-                   struct walls *W, struct dd *dd) {
-  if (!M->wall_tau) return M->nu;
-  timer_push("wall_law");
+/* Steps 1-2 of turb_update: the wall-law stress of the near-wall fluid particles (from each
+   particle's own values: the ghosts compute theirs too) and its Shepard interpolation to the
+   vertices, rho_s u_tau u_tau = (1/alpha) sum_b V_b rho_b u_tau,b u_tau,b w_bs (Ferrand
+   Eq. 38). */
+static void wall_law_stresses(const struct model *M, struct particles *P, const struct nbr *nb,
+                              struct walls *W) {
   const double two_h = 2.0 * M->h, nu = M->nu;
   const double *restrict y = P->y;
   const double *restrict u = P->u, *restrict w = P->w, *restrict rho = P->rho;
   const uint8_t *restrict kind = P->kind;
   double *restrict twx = P->twx, *restrict twz = P->twz;
-  /* 1. wall-law stress of the near-wall particles: rho u_tau^2 along their tangential velocity
-        (from the particle's own values: the ghosts compute theirs too) */
   const size_t n_all = P->n + P->n_ghost;
 #pragma omp parallel for schedule(static)
   for (size_t a = 0; a < n_all; a++) {
@@ -273,8 +273,6 @@ double turb_update(const struct model *M, struct particles *P, const struct nbr 
     const double s = rho[a] * utau * utau / ut; /* rho_a u_tau,a u_tau,a of Ferrand Eq. 38 */
     twx[a] = s * u[a], twz[a] = s * w[a];
   }
-  /* 2. vertex values rho_s u_tau u_tau = (1/alpha) sum_b V_b rho_b u_tau,b u_tau,b w_bs
-        (Ferrand Eq. 38) */
   const double *tw[2] = {P->twx, P->twz};
 #pragma omp parallel for schedule(static)
   for (size_t s = 0; s < P->n; s++) {
@@ -285,69 +283,91 @@ double turb_update(const struct model *M, struct particles *P, const struct nbr 
     W->tx[slot] = alpha > 0.0 ? sum[0] / alpha : 0.0;
     W->tz[slot] = alpha > 0.0 ? sum[1] / alpha : 0.0;
   }
+}
+
+/* Step 3 at the current state (not les.strain_lag, or a run's first step): rate of strain,
+   damping, nu_r and k_r of every owned particle; returns the largest nu + nu_r. */
+static double eddy_viscosity(const struct model *M, struct particles *P, const struct nbr *nb,
+                             const struct walls *W) {
+  const double two_h = 2.0 * M->h, nu = M->nu, ih = M->k.inv_h;
+  const double *restrict u = P->u, *restrict w = P->w, *restrict rho = P->rho;
+  const uint8_t *restrict kind = P->kind;
+  double *restrict nur = P->nur, *restrict kr = P->kr;
+  records_pack(P, P->n + P->n_ghost); /* positions, velocities, volumes for the gradient */
+  double numax = nu;
+#pragma omp parallel for schedule(dynamic, 256) reduction(max : numax)
+  for (size_t a = 0; a < P->n; a++) {
+    nur[a] = kr[a] = 0.0;
+    if (kind[a] != KIND_FLUID) continue;
+    double damp, d, utau2;
+    const double ls2 = smagorinsky_length2(M, P, W, a, &damp, &d, &utau2);
+    double S;
+    if (M->strain == STRAIN_GRADIENT) {
+      double A[6], B[9];
+      if (records_fast())
+        gradient_sums_rec(M, P, nb, a, A, B);
+      else
+        gradient_sums(M, P, nb, a, A, B);
+      S = turb_strain_gradient(M->dim, A, B);
+    } else { /* Violeau-Issa, Eq. 5.48 with nu_r,b = nu_r,a: S^3 - sum S - W / l_S^2 = 0 */
+      const double ig = 1.0 / P->gam[a];
+      const double sum = violeau_issa_sum(M, P, nb, a) * ig / rho[a];
+      double wterm = 0.0; /* power of the wall shear: 2/gamma sum_s u_tau,s^2 |v_t| |grad gamma| */
+      if (d < two_h)
+        wterm =
+            2.0 * ig * utau2 * sqrt(u[a] * u[a] + w[a] * w[a]) * wall_dgamma(M->dim, d * ih) * ih;
+      S = ls2 > 0.0 ? strain_cubic(sum, wterm / ls2) : sqrt(sum);
+    }
+    smagorinsky(M, ls2, damp, S, &nur[a], &kr[a]);
+    if (nu + nur[a] > numax) numax = nu + nur[a];
+  }
+  return numax;
+}
+
+/* Step 4: the residual kinetic energy in the pressure, p + 2/3 rho k_r, for fluid and vertex
+   particles (k_r of a vertex by Shepard interpolation) and the wall pressure. */
+static void kr_pressure(const struct model *M, struct particles *P, const struct nbr *nb,
+                        struct walls *W) {
+  const double *restrict rho = P->rho, *restrict kr = P->kr;
+#pragma omp parallel for schedule(static)
+  for (size_t s = 0; s < P->n; s++) {
+    if (P->kind[s] == KIND_FLUID) {
+      P->pr2[s] += 2.0 / 3.0 * kr[s] / rho[s];
+      continue;
+    }
+    const double *krf[1] = {kr};
+    double sk;
+    const double alpha = vertex_sums(M, P, nb, s, 1, krf, &sk);
+    const double ks = alpha > 0.0 ? sk / alpha : 0.0, extra = 2.0 / 3.0 * rho[s] * ks;
+    P->pr2[s] += extra / (rho[s] * rho[s]);
+    W->p[part_vertex_slot(P, P->id[s])] += extra;
+  }
+}
+
+double turb_update(const struct model *M, struct particles *P, const struct nbr *nb,
+                   struct walls *W, struct dd *dd) {
+  if (!M->wall_tau) return M->nu;
+  timer_push("wall_law");
+  wall_law_stresses(M, P, nb, W); /* 1-2 */
   timer_pop();
   double *const wt[2] = {W->tx, W->tz};
   if (dd) dd_update_walls(dd, P, 2, wt);
-  if (!M->les) return nu;
+  if (!M->les) return M->nu;
   timer_push("les");
-  if (!P->nur_live) /* positions, velocities, volumes for the gradient */
-    records_pack(P, P->n + P->n_ghost);
-  const double ih = M->k.inv_h;
-  /* 3. rate of strain, damping, eddy viscosity and residual kinetic energy; with
-        les.strain_lag the last force pass has formed them (except on a run's first step) */
-  double *restrict nur = P->nur, *restrict kr = P->kr;
-  double numax = nu;
+  /* 3. with les.strain_lag the last force pass has formed nu_r and k_r (except on a run's first
+        step): only their maximum is taken here */
+  double numax = M->nu;
   if (P->nur_live) {
+    const double nu = M->nu, *restrict nur = P->nur;
 #pragma omp parallel for schedule(static) reduction(max : numax)
     for (size_t a = 0; a < P->n; a++)
-      if (kind[a] == KIND_FLUID && nu + nur[a] > numax) numax = nu + nur[a];
+      if (P->kind[a] == KIND_FLUID && nu + nur[a] > numax) numax = nu + nur[a];
   } else {
-#pragma omp parallel for schedule(dynamic, 256) reduction(max : numax)
-    for (size_t a = 0; a < P->n; a++) {
-      nur[a] = kr[a] = 0.0;
-      if (kind[a] != KIND_FLUID) continue;
-      double damp, d, utau2;
-      const double ls2 = smagorinsky_length2(M, P, W, a, &damp, &d, &utau2);
-      double S;
-      if (M->strain == STRAIN_GRADIENT) {
-        double A[6], B[9];
-        if (records_fast())
-          gradient_sums_rec(M, P, nb, a, A, B);
-        else
-          gradient_sums(M, P, nb, a, A, B);
-        S = turb_strain_gradient(M->dim, A, B);
-      } else { /* Violeau-Issa, Eq. 5.48 with nu_r,b = nu_r,a: S^3 - sum S - W / l_S^2 = 0 */
-        const double ig = 1.0 / P->gam[a];
-        const double sum = violeau_issa_sum(M, P, nb, a) * ig / rho[a];
-        double wterm =
-            0.0; /* power of the wall shear: 2/gamma sum_s u_tau,s^2 |v_t| |grad gamma| */
-        if (d < two_h)
-          wterm =
-              2.0 * ig * utau2 * sqrt(u[a] * u[a] + w[a] * w[a]) * wall_dgamma(M->dim, d * ih) * ih;
-        S = ls2 > 0.0 ? strain_cubic(sum, wterm / ls2) : sqrt(sum);
-      }
-      smagorinsky(M, ls2, damp, S, &nur[a], &kr[a]);
-      if (nu + nur[a] > numax) numax = nu + nur[a];
-    }
+    numax = eddy_viscosity(M, P, nb, W);
   }
-  double *const nk[2] = {nur, kr};
-  if (dd) dd_update(dd, P, 2, nk); /* read at neighbours by the forces and by step 4 */
-  /* 4. residual kinetic energy in the pressure: p + 2/3 rho k_r for fluid and vertices */
-  if (M->cy > 0.0) {
-#pragma omp parallel for schedule(static)
-    for (size_t s = 0; s < P->n; s++) {
-      if (kind[s] == KIND_FLUID) {
-        P->pr2[s] += 2.0 / 3.0 * kr[s] / rho[s];
-        continue;
-      }
-      const double *krf[1] = {kr};
-      double sk;
-      const double alpha = vertex_sums(M, P, nb, s, 1, krf, &sk);
-      const double ks = alpha > 0.0 ? sk / alpha : 0.0, extra = 2.0 / 3.0 * rho[s] * ks;
-      P->pr2[s] += extra / (rho[s] * rho[s]);
-      W->p[part_vertex_slot(P, P->id[s])] += extra;
-    }
-  }
+  double *const nk[2] = {P->nur, P->kr};
+  if (dd) dd_update(dd, P, 2, nk);           /* read at neighbours by the forces and by step 4 */
+  if (M->cy > 0.0) kr_pressure(M, P, nb, W); /* 4 */
   timer_pop();
   if (dd && M->cy > 0.0) {
     double *const pr[1] = {P->pr2}, *const wp[1] = {W->p};
