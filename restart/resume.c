@@ -130,6 +130,36 @@ struct candidate {
   char run_id[CKPT_RUN_ID_MAX]; /* the file's identity, once read */
 };
 
+/* Read the candidate's header (info) and check its identity: readable, the step its name says,
+   the directory's run. Returns 1 with the reason in err if the file is to be skipped. */
+static int check_identity(const char *dir, const struct candidate *cd, struct ckpt_info *ip,
+                          char *err, size_t errlen) {
+  const char *path = cd->path;
+  struct ckpt_info info;
+  int bad_file = ckpt_agree(ckpt_info(path, &info, err, errlen), err, errlen);
+  if (!bad_file && info.step != cd->name_step) {
+    snprintf(err, errlen,
+             "%.1900s: the file name says step %ld but the checkpoint holds step %ld (a renamed "
+             "or copied file)",
+             path, cd->name_step, info.step);
+    bad_file = 1;
+  } else if (!bad_file && cd->dir_id[0] && strcmp(info.run_id, cd->dir_id)) {
+    if (info.run_id[0])
+      snprintf(err, errlen,
+               "%.1900s: a checkpoint of another run (run_id %s; this directory's run is %s, "
+               "see %s/run_id)",
+               path, info.run_id, cd->dir_id, dir);
+    else
+      snprintf(err, errlen,
+               "%.1900s: a checkpoint without a run identity (format %d.%d) in the directory "
+               "of run %s",
+               path, info.major, info.minor, cd->dir_id);
+    bad_file = 1;
+  }
+  *ip = info;
+  return bad_file;
+}
+
 /* Read one candidate; on failure everything it set up is released. */
 static int try_one(const char *dir, struct candidate *cd, int n_set, char *const *set,
                    struct scene *sc, struct sim *S, struct output *o, struct skipped *sk,
@@ -137,26 +167,7 @@ static int try_one(const char *dir, struct candidate *cd, int n_set, char *const
   const char *path = cd->path;
   char err[2048];
   struct ckpt_info info;
-  int bad_file = ckpt_agree(ckpt_info(path, &info, err, sizeof err), err, sizeof err);
-  if (!bad_file && info.step != cd->name_step) {
-    snprintf(err, sizeof err,
-             "%.1900s: the file name says step %ld but the checkpoint holds step %ld (a renamed "
-             "or copied file)",
-             path, cd->name_step, info.step);
-    bad_file = 1;
-  } else if (!bad_file && cd->dir_id[0] && strcmp(info.run_id, cd->dir_id)) {
-    if (info.run_id[0])
-      snprintf(err, sizeof err,
-               "%.1900s: a checkpoint of another run (run_id %s; this directory's run is %s, "
-               "see %s/run_id)",
-               path, info.run_id, cd->dir_id, dir);
-    else
-      snprintf(err, sizeof err,
-               "%.1900s: a checkpoint without a run identity (format %d.%d) in the directory "
-               "of run %s",
-               path, info.major, info.minor, cd->dir_id);
-    bad_file = 1;
-  }
+  const int bad_file = check_identity(dir, cd, &info, err, sizeof err);
   if (bad_file) {
     free(info.scene);
     skip(sk, path, err);

@@ -401,79 +401,86 @@ int output_takes_state(const struct output *o, const struct sim *S) {
   return sample_due(o, S) || S->step % S->sc->series_every == 0 || S->t >= o->next_write;
 }
 
+void output_sample(struct output *o, struct sim *S) {
+  if (!sample_due(o, S)) return;
+  const struct scene *sc = S->sc;
+  timer_push("stats");
+  const struct particles *P = &S->P;
+  /* the engine merges per global column in a fixed order: rank-independent results */
+  if (P->n > o->col_cap) {
+    free(o->col);
+    o->col_cap = P->n + P->n / 2;
+    o->col = malloc(o->col_cap * sizeof *o->col);
+    if (!o->col) die("out of memory for the statistics snapshot");
+  }
+  for (size_t a = 0; a < P->n; a++) o->col[a] = nbr_column(&S->nb, P->x[a]);
+  const struct stats_snapshot snap = {.n = P->n,
+                                      .x = P->x,
+                                      .y = P->y,
+                                      .z = P->z,
+                                      .u = P->u,
+                                      .v = P->v,
+                                      .w = P->w,
+                                      .p = P->p,
+                                      .rho = P->rho,
+                                      .nu_t = P->nur,
+                                      .k_r = P->kr,
+                                      .m = P->m,
+                                      .ax = P->ax,
+                                      .ay = P->ay,
+                                      .az = P->az,
+                                      .sx = P->sx_live ? P->sx : NULL,
+                                      .id = P->id,
+                                      .skip = P->kind,
+                                      .t = S->t,
+                                      .fx = S->fx,
+                                      .step = S->step,
+                                      .wall_fx = {S->wall_fx[0], S->wall_fx[1]},
+                                      .col = o->col,
+                                      .ncol = S->dd.ncol,
+                                      .col0 = S->dd.first[S->dd.rank],
+                                      .col1 = S->dd.first[S->dd.rank + 1],
+                                      .comm = MPI_COMM_WORLD};
+  stats_sample(&o->st, &snap);
+  timer_pop();
+  struct stats_target tg;
+  if (target_of(sc, &tg) && o->st.eu.nwin != o->target_nwin) { /* a window closed */
+    o->target_nwin = o->st.eu.nwin;
+    struct stats_progress p;
+    stats_progress(&o->st, &tg, &p);
+    if (agree(p.met)) {
+      char line[1024];
+      stats_convergence_line(&o->st, line, sizeof line);
+      output_log(o, "%s", line);
+      log_target(o, S, &p);
+      output_log(o,
+                 "converged: the statistics meet stats.target_stderr = %g at step %ld, t = "
+                 "%.9g s; the run ends here\n",
+                 sc->target_stderr, S->step, S->t);
+      o->converged = 1;
+    }
+  }
+}
+
+/* The log line of a load rebalance of the decomposition (dd_balance), once per rebalance. */
+static void log_rebalance(struct output *o, const struct sim *S) {
+  if (S->dd.rebalances == o->rebalances) return;
+  const struct dd *dd = &S->dd;
+  char cols[256] = "";
+  for (int r = 0, k = 0; r < dd->size && k < (int)sizeof cols - 16; r++)
+    k += snprintf(cols + k, sizeof cols - (size_t)k, "%s%d", r ? " " : "",
+                  dd->first[r + 1] - dd->first[r]);
+  output_log(o,
+             "load balance: step %ld, imbalance %.3f (max / mean particles per rank): "
+             "columns per rank now %s\n",
+             S->step, dd->imbalance, cols);
+  o->rebalances = dd->rebalances;
+}
+
 int output_step(struct output *o, struct sim *S) {
   const struct scene *sc = S->sc;
-  if (sample_due(o, S)) {
-    timer_push("stats");
-    const struct particles *P = &S->P;
-    /* the engine merges per global column in a fixed order: rank-independent results */
-    if (P->n > o->col_cap) {
-      free(o->col);
-      o->col_cap = P->n + P->n / 2;
-      o->col = malloc(o->col_cap * sizeof *o->col);
-      if (!o->col) die("out of memory for the statistics snapshot");
-    }
-    for (size_t a = 0; a < P->n; a++) o->col[a] = nbr_column(&S->nb, P->x[a]);
-    const struct stats_snapshot snap = {.n = P->n,
-                                        .x = P->x,
-                                        .y = P->y,
-                                        .z = P->z,
-                                        .u = P->u,
-                                        .v = P->v,
-                                        .w = P->w,
-                                        .p = P->p,
-                                        .rho = P->rho,
-                                        .nu_t = P->nur,
-                                        .k_r = P->kr,
-                                        .m = P->m,
-                                        .ax = P->ax,
-                                        .ay = P->ay,
-                                        .az = P->az,
-                                        .sx = P->sx_live ? P->sx : NULL,
-                                        .id = P->id,
-                                        .skip = P->kind,
-                                        .t = S->t,
-                                        .fx = S->fx,
-                                        .step = S->step,
-                                        .wall_fx = {S->wall_fx[0], S->wall_fx[1]},
-                                        .col = o->col,
-                                        .ncol = S->dd.ncol,
-                                        .col0 = S->dd.first[S->dd.rank],
-                                        .col1 = S->dd.first[S->dd.rank + 1],
-                                        .comm = MPI_COMM_WORLD};
-    stats_sample(&o->st, &snap);
-    timer_pop();
-    struct stats_target tg;
-    if (target_of(sc, &tg) && o->st.eu.nwin != o->target_nwin) { /* a window closed */
-      o->target_nwin = o->st.eu.nwin;
-      struct stats_progress p;
-      stats_progress(&o->st, &tg, &p);
-      if (agree(p.met)) {
-        char line[1024];
-        stats_convergence_line(&o->st, line, sizeof line);
-        output_log(o, "%s", line);
-        log_target(o, S, &p);
-        output_log(o,
-                   "converged: the statistics meet stats.target_stderr = %g at step %ld, t = "
-                   "%.9g s; the run ends here\n",
-                   sc->target_stderr, S->step, S->t);
-        o->converged = 1;
-      }
-    }
-  }
   timer_push("output");
-  if (S->dd.rebalances != o->rebalances) {
-    const struct dd *dd = &S->dd;
-    char cols[256] = "";
-    for (int r = 0, k = 0; r < dd->size && k < (int)sizeof cols - 16; r++)
-      k += snprintf(cols + k, sizeof cols - (size_t)k, "%s%d", r ? " " : "",
-                    dd->first[r + 1] - dd->first[r]);
-    output_log(o,
-               "load balance: step %ld, imbalance %.3f (max / mean particles per rank): "
-               "columns per rank now %s\n",
-               S->step, dd->imbalance, cols);
-    o->rebalances = dd->rebalances;
-  }
+  log_rebalance(o, S);
   struct diag d;
   int have = 0;
   if (S->step % sc->series_every == 0) record(o, S, &d), have = 1;

@@ -84,9 +84,16 @@ void output_begin(struct output *o, struct sim *S);
 int output_takes_state(const struct output *o, const struct sim *S);
 
 /**
- * @brief After each step: sample statistics, record the series, log, rewrite stats.nc; when a
- *        window closes, check the convergence target (stats.target_stderr) and set
- *        o->converged if it is met (the caller then ends the run).
+ * @brief Statistics sample of the current state when one is due (output.stats_every), and the
+ *        convergence check when an averaging window has closed (sets o->converged when
+ *        stats.target_stderr is met). Call after the health check of the state, before
+ *        output_step.
+ */
+void output_sample(struct output *o, struct sim *S);
+
+/**
+ * @brief After each step and output_sample: record the series, log, rewrite stats.nc when
+ *        due (the statistics sample is output_sample's).
  * @return CHANSPH_OK, or CHANSPH_ERR after a message when stats.nc cannot be written (the
  *         previous stats.nc and the checkpoints are kept)
  */

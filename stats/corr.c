@@ -222,38 +222,13 @@ void corr_results(const struct corr *c, double *rx, double *rz, double *ex, doub
 
 #define CK(call) NC_TRY(call, done)
 
-int corr_nc_write(const struct corr *c, int ncid, char *err, size_t errlen) {
-  const int nl = c->cfg.n_levels, nx = c->cfg.nx, nz = c->cfg.nz, nzh = c->nzh;
-  const int nxh = nx / 2 + 1;
-  double *rx = malloc((size_t)nl * 4 * nx * sizeof(double));
-  double *rz = malloc((size_t)nl * 4 * nz * sizeof(double));
-  double *ex = malloc((size_t)nl * 3 * nxh * sizeof(double));
-  double *ez = malloc((size_t)nl * 3 * nzh * sizeof(double));
-  double *tmp = malloc((size_t)(nx > nz ? nx : nz) * 4 * sizeof(double));
-  int rc = NC_NOERR, g, dl, dx, dz, dkx, dkz, dkk, dsl, v;
-  corr_results(c, rx, rz, ex, ez);
-  CK(nc_def_grp(ncid, "correlations", &g));
-  static const char desc[] =
-      "two-point correlations and 1-D spectra in wall-parallel planes (thesis Eq. "
-      "5.57-5.59); a level and its mirror 2 delta - y (v -> -v) are both sampled";
-  CK(nc_put_att_text(g, NC_GLOBAL, "description", strlen(desc), desc));
-  CK(nc_def_dim(g, "level", (size_t)nl, &dl));
-  CK(nc_def_dim(g, "separation_x", (size_t)nx, &dx));
-  CK(nc_def_dim(g, "separation_z", (size_t)nz, &dz));
-  CK(nc_def_dim(g, "kx", (size_t)nxh, &dkx));
-  CK(nc_def_dim(g, "kz", (size_t)nzh, &dkz));
-  CK(nc_def_dim(g, "k_index", (size_t)nx * (size_t)nzh, &dkk));
-  CK(nc_def_dim(g, "spectrum_slot", CS_LEN, &dsl));
-  CK(ncout_def(g, "level", NC_DOUBLE, 1, &dl, "m", "height of the plane above the lower wall", &v));
-  CK(nc_put_var_double(g, v, c->cfg.y));
-  CK(ncout_def(g, "y_plus", NC_DOUBLE, 1, &dl, "1", "level in wall units of stats.u_tau_ref", &v));
-  CK(nc_put_var_double(g, v, c->cfg.y_plus));
-  CK(ncout_def(g, "samples", NC_DOUBLE, 1, &dl, "1", "planes accumulated", &v));
-  CK(nc_put_var_double(g, v, c->samples));
-  CK(ncout_def(g, "empty_cells", NC_DOUBLE, 1, &dl, "1",
-               "grid cells without a particle, summed over the planes (set to zero fluctuation)",
-               &v));
-  CK(nc_put_var_double(g, v, c->empty));
+/* The coordinate variables of the correlations group: separations, wavenumbers and the
+   flattened r2c index with its wavenumbers. d: dimension ids {x, z, kx, kz, k_index}. */
+static int write_axes(const struct corr *c, int g, const int d[5], double *tmp, char *err,
+                      size_t errlen) {
+  const int nx = c->cfg.nx, nz = c->cfg.nz, nzh = c->nzh, nxh = nx / 2 + 1;
+  const int dx = d[0], dz = d[1], dkx = d[2], dkz = d[3], dkk = d[4];
+  int rc = NC_NOERR, v;
   for (int i = 0; i < nx; i++) tmp[i] = i * c->cfg.lx / nx;
   CK(ncout_def(g, "separation_x", NC_DOUBLE, 1, &dx, "m", "streamwise separation l_x", &v));
   CK(nc_put_var_double(g, v, tmp));
@@ -296,6 +271,16 @@ int corr_nc_write(const struct corr *c, int ncid, char *err, size_t errlen) {
     free(ki), free(kk);
     CK(rc);
   }
+done:
+  return rc;
+}
+
+/* R_ij and rho_ij along x and z at every level (Eq. 5.57, 5.58) and the spectrum slot labels. */
+static int write_correlations(const struct corr *c, int g, const int d[4], const double *rx,
+                              const double *rz, double *tmp, char *err, size_t errlen) {
+  const int nl = c->cfg.n_levels, nx = c->cfg.nx, nz = c->cfg.nz;
+  const int dl = d[0], dx = d[1], dz = d[2], dsl = d[3];
+  int rc = NC_NOERR, v;
   static const char *const slots[CS_LEN] = {"uu", "vv", "ww", "Re_uv", "Im_uv"};
   CK(ncout_labels(g, "spectrum_slot", dsl, "component of the summed spectra", slots));
   static const char *const comp[4] = {"uu", "vv", "ww", "uv"};
@@ -328,6 +313,17 @@ int corr_nc_write(const struct corr *c, int ncid, char *err, size_t errlen) {
       }
     }
   }
+done:
+  return rc;
+}
+
+/* The one-sided 1-D spectra E_ii over kx and kz at every level (Eq. 5.59). */
+static int write_spectra(const struct corr *c, int g, const int d[3], const double *ex,
+                         const double *ez, char *err, size_t errlen) {
+  const int nl = c->cfg.n_levels, nzh = c->nzh, nxh = c->cfg.nx / 2 + 1;
+  const int dl = d[0], dkx = d[1], dkz = d[2];
+  static const char *const comp[4] = {"uu", "vv", "ww", "uv"};
+  int rc = NC_NOERR, v;
   for (int q = 0; q < 3; q++) {
     char name[32], ln[160];
     for (int dir = 0; dir < 2; dir++) {
@@ -344,6 +340,50 @@ int corr_nc_write(const struct corr *c, int ncid, char *err, size_t errlen) {
         CK(ncout_put_filled(g, v, st, ct, (dir ? ez : ex) + ((size_t)l * 3 + q) * n, (size_t)n));
       }
     }
+  }
+done:
+  return rc;
+}
+
+int corr_nc_write(const struct corr *c, int ncid, char *err, size_t errlen) {
+  const int nl = c->cfg.n_levels, nx = c->cfg.nx, nz = c->cfg.nz, nzh = c->nzh;
+  const int nxh = nx / 2 + 1;
+  double *rx = malloc((size_t)nl * 4 * nx * sizeof(double));
+  double *rz = malloc((size_t)nl * 4 * nz * sizeof(double));
+  double *ex = malloc((size_t)nl * 3 * nxh * sizeof(double));
+  double *ez = malloc((size_t)nl * 3 * nzh * sizeof(double));
+  double *tmp = malloc((size_t)(nx > nz ? nx : nz) * 4 * sizeof(double));
+  int rc = NC_NOERR, g, dl, dx, dz, dkx, dkz, dkk, dsl, v;
+  corr_results(c, rx, rz, ex, ez);
+  CK(nc_def_grp(ncid, "correlations", &g));
+  static const char desc[] =
+      "two-point correlations and 1-D spectra in wall-parallel planes (thesis Eq. "
+      "5.57-5.59); a level and its mirror 2 delta - y (v -> -v) are both sampled";
+  CK(nc_put_att_text(g, NC_GLOBAL, "description", strlen(desc), desc));
+  CK(nc_def_dim(g, "level", (size_t)nl, &dl));
+  CK(nc_def_dim(g, "separation_x", (size_t)nx, &dx));
+  CK(nc_def_dim(g, "separation_z", (size_t)nz, &dz));
+  CK(nc_def_dim(g, "kx", (size_t)nxh, &dkx));
+  CK(nc_def_dim(g, "kz", (size_t)nzh, &dkz));
+  CK(nc_def_dim(g, "k_index", (size_t)nx * (size_t)nzh, &dkk));
+  CK(nc_def_dim(g, "spectrum_slot", CS_LEN, &dsl));
+  CK(ncout_def(g, "level", NC_DOUBLE, 1, &dl, "m", "height of the plane above the lower wall", &v));
+  CK(nc_put_var_double(g, v, c->cfg.y));
+  CK(ncout_def(g, "y_plus", NC_DOUBLE, 1, &dl, "1", "level in wall units of stats.u_tau_ref", &v));
+  CK(nc_put_var_double(g, v, c->cfg.y_plus));
+  CK(ncout_def(g, "samples", NC_DOUBLE, 1, &dl, "1", "planes accumulated", &v));
+  CK(nc_put_var_double(g, v, c->samples));
+  CK(ncout_def(g, "empty_cells", NC_DOUBLE, 1, &dl, "1",
+               "grid cells without a particle, summed over the planes (set to zero fluctuation)",
+               &v));
+  CK(nc_put_var_double(g, v, c->empty));
+  {
+    const int da[5] = {dx, dz, dkx, dkz, dkk}, dc[4] = {dl, dx, dz, dsl}, ds[3] = {dl, dkx, dkz};
+    /* each names its own failing call in err */
+    if ((rc = write_axes(c, g, da, tmp, err, errlen)) != NC_NOERR ||
+        (rc = write_correlations(c, g, dc, rx, rz, tmp, err, errlen)) != NC_NOERR ||
+        (rc = write_spectra(c, g, ds, ex, ez, err, errlen)) != NC_NOERR)
+      goto done;
   }
   {
     const int d3[3] = {dl, dkk, dsl};

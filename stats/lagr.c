@@ -418,6 +418,88 @@ static int put_rows(int g, int v, int level, size_t n, const double *src) {
   return rc;
 }
 
+/* T_L of each level and component: from the merged releases, the mean over the releases and
+   its standard error. */
+static int write_integral_times(const struct lagr *g, int gr, int dl, int dc, const double *tl,
+                                char *err, size_t errlen) {
+  const int nl = g->cfg.n_levels;
+  int rc = NC_NOERR, v;
+  const int dlc[2] = {dl, dc};
+  double *a = malloc((size_t)nl * 9 * sizeof(double));
+  for (int l = 0; l < nl; l++)
+    for (int i = 0; i < 3; i++) {
+      const double *W = g->tl + ((size_t)l * 3 + (size_t)i) * SCAL_LEN;
+      a[l * 3 + i] = isfinite(tl[3 * l + i]) ? tl[3 * l + i] : NC_FILL_DOUBLE;
+      a[3 * nl + l * 3 + i] = W[SCAL_N] > 0 ? W[SCAL_MEAN] : NC_FILL_DOUBLE;
+      a[6 * nl + l * 3 + i] =
+          W[SCAL_N] >= 2 ? sqrt(W[SCAL_M2] / (W[SCAL_N] - 1) / W[SCAL_N]) : NC_FILL_DOUBLE;
+    }
+  static const char *const nm[3] = {"T_L", "T_L_release_mean", "T_L_stderr"};
+  static const char *const lnm[3] = {
+      "Lagrangian integral time of u, v, w (Eq. 5.61) from the merged releases",
+      "mean over the releases of their own T_L", "standard error of T_L over the releases"};
+  for (int j = 0; j < 3 && rc == NC_NOERR; j++) {
+    rc = ncout_def(gr, nm[j], NC_DOUBLE, 2, dlc, "s", lnm[j], &v);
+    if (rc == NC_NOERR) rc = ncout_fill(gr, v);
+    if (rc == NC_NOERR) rc = nc_put_var_double(gr, v, a + (size_t)j * 3 * nl);
+  }
+  free(a);
+  CK(rc);
+done:
+  return rc;
+}
+
+/* The PDFs of the track heights at the stations, their mean and variance (Eq. 5.67-5.68). */
+static int write_pdfs(const struct lagr *g, int gr, int dl, double *tmp, char *err, size_t errlen) {
+  const struct lagr_config *c = &g->cfg;
+  const int nl = c->n_levels, ns = c->n_stations, nb = c->pdf_bins;
+  int rc = NC_NOERR, v;
+  int dst, db;
+  CK(nc_def_dim(gr, "station", (size_t)ns, &dst));
+  CK(nc_def_dim(gr, "pdf_bin", (size_t)nb, &db));
+  CK(ncout_def(gr, "station", NC_DOUBLE, 1, &dst, "m", "downstream distance x - x0", &v));
+  CK(nc_put_var_double(gr, v, c->station));
+  for (int b = 0; b < nb; b++) tmp[b] = (b + 0.5) * 2.0 * c->delta / nb;
+  CK(ncout_def(gr, "pdf_bin", NC_DOUBLE, 1, &db, "m", "y at the centre of the PDF bin", &v));
+  {
+    double *lo = malloc(2 * (size_t)nb * sizeof *lo), *hi = lo + nb;
+    rc = lo ? NC_NOERR : NC_ENOMEM;
+    for (int b = 0; b < nb && lo; b++)
+      lo[b] = b * 2.0 * c->delta / nb, hi[b] = (b + 1) * 2.0 * c->delta / nb;
+    if (rc == NC_NOERR)
+      rc = ncout_bounds(gr, "pdf_bin", v, db, "m", "limits of the PDF bin", lo, hi, (size_t)nb);
+    free(lo);
+    CK(rc);
+  }
+  CK(nc_put_var_double(gr, v, tmp));
+  const int d3[3] = {dl, dst, db}, dls[2] = {dl, dst};
+  int vp, vmu, vvar, vn;
+  CK(ncout_def(gr, "pdf_y", NC_DOUBLE, 3, d3, "1/m",
+               "PDF P(y; x) of the heights where the tracks cross the station", &vp));
+  CK(ncout_def(gr, "pdf_mu_y", NC_DOUBLE, 2, dls, "m", "mean height mu_y (Eq. 5.67)", &vmu));
+  CK(ncout_fill(gr, vmu));
+  CK(ncout_def(gr, "pdf_var_y", NC_DOUBLE, 2, dls, "m^2",
+               "variance of the height about mu_y (Eq. 5.68, printed there as sigma_y)", &vvar));
+  CK(ncout_fill(gr, vvar));
+  CK(ncout_def(gr, "pdf_count", NC_DOUBLE, 2, dls, "1", "tracks that crossed the station", &vn));
+  const double width = 2.0 * c->delta / nb;
+  for (int l = 0; l < nl; l++)
+    for (int s = 0; s < ns; s++) {
+      const double *P = g->pdf + ((size_t)l * ns + (size_t)s) * (size_t)(nb + 3);
+      const double n = P[nb], mu = n > 0 ? P[nb + 1] / n : NC_FILL_DOUBLE;
+      const double var = n > 0 ? P[nb + 2] / n - mu * mu : NC_FILL_DOUBLE;
+      for (int b = 0; b < nb; b++) tmp[b] = n > 0 ? P[b] / (n * width) : 0.0;
+      const size_t st3[3] = {(size_t)l, (size_t)s, 0}, ct3[3] = {1, 1, (size_t)nb};
+      const size_t st2[2] = {(size_t)l, (size_t)s};
+      CK(nc_put_vara_double(gr, vp, st3, ct3, tmp));
+      CK(nc_put_var1_double(gr, vmu, st2, &mu));
+      CK(nc_put_var1_double(gr, vvar, st2, &var));
+      CK(nc_put_var1_double(gr, vn, st2, &n));
+    }
+done:
+  return rc;
+}
+
 int lagr_nc_write(const struct lagr *g, int ncid, char *err, size_t errlen) {
   const struct lagr_config *c = &g->cfg;
   const int nl = c->n_levels, ns = c->n_stations, nb = c->pdf_bins;
@@ -477,73 +559,10 @@ int lagr_nc_write(const struct lagr *g, int ncid, char *err, size_t errlen) {
   CK(ncout_def(gr, "n_tracks", NC_DOUBLE, 2, d2, "1", "particle samples at each lag", &v));
   for (int l = 0; l < nl; l++)
     CK(put_rows(gr, v, l, nlag, fn + ((size_t)l * LF_LEN + LF_N) * nlag));
-  {
-    const int dlc[2] = {dl, dc};
-    double *a = malloc((size_t)nl * 9 * sizeof(double));
-    for (int l = 0; l < nl; l++)
-      for (int i = 0; i < 3; i++) {
-        const double *W = g->tl + ((size_t)l * 3 + (size_t)i) * SCAL_LEN;
-        a[l * 3 + i] = isfinite(tl[3 * l + i]) ? tl[3 * l + i] : NC_FILL_DOUBLE;
-        a[3 * nl + l * 3 + i] = W[SCAL_N] > 0 ? W[SCAL_MEAN] : NC_FILL_DOUBLE;
-        a[6 * nl + l * 3 + i] =
-            W[SCAL_N] >= 2 ? sqrt(W[SCAL_M2] / (W[SCAL_N] - 1) / W[SCAL_N]) : NC_FILL_DOUBLE;
-      }
-    static const char *const nm[3] = {"T_L", "T_L_release_mean", "T_L_stderr"};
-    static const char *const lnm[3] = {
-        "Lagrangian integral time of u, v, w (Eq. 5.61) from the merged releases",
-        "mean over the releases of their own T_L", "standard error of T_L over the releases"};
-    for (int j = 0; j < 3 && rc == NC_NOERR; j++) {
-      rc = ncout_def(gr, nm[j], NC_DOUBLE, 2, dlc, "s", lnm[j], &v);
-      if (rc == NC_NOERR) rc = ncout_fill(gr, v);
-      if (rc == NC_NOERR) rc = nc_put_var_double(gr, v, a + (size_t)j * 3 * nl);
-    }
-    free(a);
-    CK(rc);
-  }
-  if (ns > 0) {
-    int dst, db;
-    CK(nc_def_dim(gr, "station", (size_t)ns, &dst));
-    CK(nc_def_dim(gr, "pdf_bin", (size_t)nb, &db));
-    CK(ncout_def(gr, "station", NC_DOUBLE, 1, &dst, "m", "downstream distance x - x0", &v));
-    CK(nc_put_var_double(gr, v, c->station));
-    for (int b = 0; b < nb; b++) tmp[b] = (b + 0.5) * 2.0 * c->delta / nb;
-    CK(ncout_def(gr, "pdf_bin", NC_DOUBLE, 1, &db, "m", "y at the centre of the PDF bin", &v));
-    {
-      double *lo = malloc(2 * (size_t)nb * sizeof *lo), *hi = lo + nb;
-      rc = lo ? NC_NOERR : NC_ENOMEM;
-      for (int b = 0; b < nb && lo; b++)
-        lo[b] = b * 2.0 * c->delta / nb, hi[b] = (b + 1) * 2.0 * c->delta / nb;
-      if (rc == NC_NOERR)
-        rc = ncout_bounds(gr, "pdf_bin", v, db, "m", "limits of the PDF bin", lo, hi, (size_t)nb);
-      free(lo);
-      CK(rc);
-    }
-    CK(nc_put_var_double(gr, v, tmp));
-    const int d3[3] = {dl, dst, db}, dls[2] = {dl, dst};
-    int vp, vmu, vvar, vn;
-    CK(ncout_def(gr, "pdf_y", NC_DOUBLE, 3, d3, "1/m",
-                 "PDF P(y; x) of the heights where the tracks cross the station", &vp));
-    CK(ncout_def(gr, "pdf_mu_y", NC_DOUBLE, 2, dls, "m", "mean height mu_y (Eq. 5.67)", &vmu));
-    CK(ncout_fill(gr, vmu));
-    CK(ncout_def(gr, "pdf_var_y", NC_DOUBLE, 2, dls, "m^2",
-                 "variance of the height about mu_y (Eq. 5.68, printed there as sigma_y)", &vvar));
-    CK(ncout_fill(gr, vvar));
-    CK(ncout_def(gr, "pdf_count", NC_DOUBLE, 2, dls, "1", "tracks that crossed the station", &vn));
-    const double width = 2.0 * c->delta / nb;
-    for (int l = 0; l < nl; l++)
-      for (int s = 0; s < ns; s++) {
-        const double *P = g->pdf + ((size_t)l * ns + (size_t)s) * (size_t)(nb + 3);
-        const double n = P[nb], mu = n > 0 ? P[nb + 1] / n : NC_FILL_DOUBLE;
-        const double var = n > 0 ? P[nb + 2] / n - mu * mu : NC_FILL_DOUBLE;
-        for (int b = 0; b < nb; b++) tmp[b] = n > 0 ? P[b] / (n * width) : 0.0;
-        const size_t st3[3] = {(size_t)l, (size_t)s, 0}, ct3[3] = {1, 1, (size_t)nb};
-        const size_t st2[2] = {(size_t)l, (size_t)s};
-        CK(nc_put_vara_double(gr, vp, st3, ct3, tmp));
-        CK(nc_put_var1_double(gr, vmu, st2, &mu));
-        CK(nc_put_var1_double(gr, vvar, st2, &var));
-        CK(nc_put_var1_double(gr, vn, st2, &n));
-      }
-  }
+  /* each names its own failing call in err */
+  if ((rc = write_integral_times(g, gr, dl, dc, tl, err, errlen)) != NC_NOERR ||
+      (ns > 0 && (rc = write_pdfs(g, gr, dl, tmp, err, errlen)) != NC_NOERR))
+    goto done;
 done:
   free(fn), free(tl), free(tmp);
   return rc;

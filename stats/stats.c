@@ -232,18 +232,13 @@ static const char *const plane_names[PL_LEN] = {
     [PL_MU_LAST] = "momentum_last", [PL_T_FIRST] = "time_first",
     [PL_T_LAST] = "time_last"};
 
-/* t_reached: the time the run reached (NaN: not known); an incomplete last window ends there. */
-static int write_eulerian(const struct euler *e, double t_reached, int ncid, char *err,
-                          size_t errlen) {
-  int rc = NC_NOERR, dy, vid;
-  struct euler_result r;
-  eulerian_result(e, &r);
-  const size_t nb = (size_t)e->cfg.nb, rows = euler_rows(e);
-  double *lo = malloc(2 * nb * sizeof *lo), *hi = lo + nb;
-  if (!lo) return NC_ENOMEM;
-  bin_bounds(&e->cfg, lo, hi);
-  CK(nc_def_dim(ncid, "y", nb, &dy));
-  CK(def_y(&e->cfg, ncid, dy, r.prof[EP_Y], lo, hi));
+/* The root's profiles on dimension dy and the run's scalars as global attributes; t_reached:
+   the time the run reached (NaN: not known), where an incomplete last window ends. */
+static int write_profiles(const struct euler *e, const struct euler_result *rp, double t_reached,
+                          int ncid, int dy, char *err, size_t errlen) {
+  const struct euler_result r = *rp;
+  const size_t nb = (size_t)e->cfg.nb;
+  int rc = NC_NOERR, vid;
   for (int k = 0; k < EP_NPROF; k++) {
     const int model = k == EP_NUT || k == EP_KR || k == EP_TAU_MODEL || k == EP_SE_TAU + 2;
     if (k == EP_Y || (model && !e->cfg.les)) continue;
@@ -279,7 +274,41 @@ static int write_eulerian(const struct euler *e, double t_reached, int ncid, cha
     } else {
       CK(put_att_d(ncid, NC_GLOBAL, scal[i].name, scal[i].v));
     }
-  /* the raw windows: the complete accumulator state, re-averaged by chansph extract */
+  return NC_NOERR;
+fail:
+  return rc ? rc : NC_EINVAL;
+}
+
+/* The coordinate variable of the windows: their middle times, with start and end as bounds. */
+static int def_window_axis(const struct euler *e, int g, int dw, char *err, size_t errlen) {
+  const size_t rows = euler_rows(e);
+  int rc = NC_NOERR;
+  double *mid = malloc(3 * (rows ? rows : 1) * sizeof *mid), *t0 = mid + rows, *t1 = t0 + rows;
+  if (!mid) CK(NC_ENOMEM);
+  for (size_t w = 0; w < rows; w++) {
+    t0[w] = e->win[w * WIN_LEN + WIN_T0], t1[w] = e->win[w * WIN_LEN + WIN_T1];
+    mid[w] = 0.5 * (t0[w] + t1[w]);
+  }
+  int vt;
+  rc = ncout_def(g, "window", NC_DOUBLE, 1, &dw, "s", "middle of the averaging window", &vt);
+  if (rc == NC_NOERR)
+    rc =
+        ncout_bounds(g, "window", vt, dw, "s", "nominal start and end of the window", t0, t1, rows);
+  if (rc == NC_NOERR && rows) rc = nc_put_var_double(g, vt, mid);
+  free(mid);
+  CK(rc);
+  return NC_NOERR;
+fail:
+  return rc ? rc : NC_EINVAL;
+}
+
+/* The group eulerian: the raw per-window records (the complete accumulator state, which
+   chansph extract re-averages), with a coordinate variable for every dimension. */
+static int write_raw_windows(const struct euler *e, const struct euler_result *rp, int ncid,
+                             const double *lo, const double *hi, char *err, size_t errlen) {
+  const struct euler_result r = *rp;
+  const size_t nb = (size_t)e->cfg.nb, rows = euler_rows(e);
+  int rc = NC_NOERR, dy;
   int g, dw, dwf, dm, ds, dp, vw, vm, vs, vp, vc, v0, v1;
   CK(nc_def_grp(ncid, "eulerian", &g));
   static const char desc[] =
@@ -297,22 +326,7 @@ static int write_eulerian(const struct euler *e, double t_reached, int ncid, cha
   CK(nc_def_dim(g, "snapshot_moment", SCAL_LEN, &ds));
   CK(nc_def_dim(g, "plane_field", PL_LEN, &dp));
   CK(def_y(&e->cfg, g, dy, r.prof[EP_Y], lo, hi));
-  {
-    double *mid = malloc(3 * (rows ? rows : 1) * sizeof *mid), *t0 = mid + rows, *t1 = t0 + rows;
-    if (!mid) CK(NC_ENOMEM);
-    for (size_t w = 0; w < rows; w++) {
-      t0[w] = e->win[w * WIN_LEN + WIN_T0], t1[w] = e->win[w * WIN_LEN + WIN_T1];
-      mid[w] = 0.5 * (t0[w] + t1[w]);
-    }
-    int vt;
-    rc = ncout_def(g, "window", NC_DOUBLE, 1, &dw, "s", "middle of the averaging window", &vt);
-    if (rc == NC_NOERR)
-      rc = ncout_bounds(g, "window", vt, dw, "s", "nominal start and end of the window", t0, t1,
-                        rows);
-    if (rc == NC_NOERR && rows) rc = nc_put_var_double(g, vt, mid);
-    free(mid);
-    CK(rc);
-  }
+  if ((rc = def_window_axis(e, g, dw, err, errlen)) != NC_NOERR) goto fail; /* names its call */
   CK(ncout_labels(g, "window_field", dwf, "fields of the window records", window_fields));
   CK(ncout_labels(g, "moment", dm,
                   "fields of the moment records: count, means, co-moments C2 (sums of products "
@@ -355,6 +369,27 @@ static int write_eulerian(const struct euler *e, double t_reached, int ncid, cha
     CK(nc_put_var_double(g, vs, e->snp));
     CK(nc_put_var_double(g, vp, e->pln));
   }
+  return NC_NOERR;
+fail:
+  return rc ? rc : NC_EINVAL;
+}
+
+/* t_reached: the time the run reached (NaN: not known); an incomplete last window ends there. */
+static int write_eulerian(const struct euler *e, double t_reached, int ncid, char *err,
+                          size_t errlen) {
+  int rc = NC_NOERR, dy;
+  struct euler_result r;
+  eulerian_result(e, &r);
+  const size_t nb = (size_t)e->cfg.nb;
+  double *lo = malloc(2 * nb * sizeof *lo), *hi = lo + nb;
+  if (!lo) return NC_ENOMEM;
+  bin_bounds(&e->cfg, lo, hi);
+  CK(nc_def_dim(ncid, "y", nb, &dy));
+  CK(def_y(&e->cfg, ncid, dy, r.prof[EP_Y], lo, hi));
+  /* each names its own failing call in err */
+  if ((rc = write_profiles(e, &r, t_reached, ncid, dy, err, errlen)) != NC_NOERR ||
+      (rc = write_raw_windows(e, &r, ncid, lo, hi, err, errlen)) != NC_NOERR)
+    goto fail;
   euler_result_free(&r);
   free(lo);
   return NC_NOERR;

@@ -47,7 +47,52 @@ static int unhealthy(struct output *out, struct sim *S, long *checked) {
   return 0;
 }
 
-/** Run a scene, or resume a run, in a directory; returns the process exit code. */
+/** Open the run: resume it from DIR's checkpoints, or build the scene's initial state and
+    create DIR; returns 0 or EXIT_INPUT (message printed, nothing left allocated). */
+static int open_run(struct scene *sc, const struct cli *c, struct sim *S, struct output *out) {
+  if (c->cmd == CMD_RESUME) {
+    /* the directory is locked for the life of the process (DIR/.lock) */
+    if (rundir_lock(c->out, 0) || restart_resume(c->out, c->n_set, c->set, sc, S, out))
+      return EXIT_INPUT;
+    output_resume(out, S);
+    return 0;
+  }
+  if (sim_init(S, sc)) return EXIT_INPUT; /* before the run directory exists */
+  if (rundir_lock(c->out, 1) || restart_prepare_new(c->out, c->overwrite) ||
+      output_open(out, c->out, sc, c->overwrite)) {
+    sim_free(S);
+    return EXIT_INPUT;
+  }
+  if (rundir_new_id(c->out, out->run_id)) {
+    output_close(out);
+    sim_free(S);
+    return EXIT_INPUT;
+  }
+  output_begin(out, S);
+  return 0;
+}
+
+/** End the run with exit code rc: a finished run is checked, checkpointed and its files written;
+    a stopped one (EXIT_RESUBMIT) says how to continue. Returns the final exit code. */
+static int close_run(struct output *out, struct sim *S, struct trigger *T, int why, int rc,
+                     long *checked) {
+  if (rc == EXIT_DONE && unhealthy(out, S, checked)) rc = EXIT_NUMERICAL;
+  if (rc == EXIT_DONE && T->last_step != S->step && save(out, S, T)) rc = EXIT_IOERR;
+  if (rc == EXIT_DONE && output_finish(out, S)) rc = EXIT_IOERR;
+  if (rc == EXIT_RESUBMIT) {
+    if (output_stop(out, S, trigger_text(T, why)))
+      rc = EXIT_IOERR;
+    else
+      output_log(out, "checkpointed: continue with `chansph resume %s` (exit code %d)\n", out->dir,
+                 EXIT_RESUBMIT);
+  }
+  output_close(out);
+  sim_free(S);
+  return rc;
+}
+
+/** Run a scene, or resume a run, in a directory; returns the process exit code. The loop is the
+    whole life of a step: advance, check, sample the statistics, write, checkpoint. */
 static int run(struct scene *sc, const struct cli *c) {
   double walltime = 0.0;
   if (c->walltime && trigger_parse_walltime(c->walltime, &walltime)) {
@@ -56,25 +101,7 @@ static int run(struct scene *sc, const struct cli *c) {
   }
   struct output out;
   struct sim S;
-  if (c->cmd == CMD_RESUME) {
-    /* the directory is locked for the life of the process (DIR/.lock) */
-    if (rundir_lock(c->out, 0) || restart_resume(c->out, c->n_set, c->set, sc, &S, &out))
-      return EXIT_INPUT;
-    output_resume(&out, &S);
-  } else {
-    if (sim_init(&S, sc)) return EXIT_INPUT; /* before the run directory exists */
-    if (rundir_lock(c->out, 1) || restart_prepare_new(c->out, c->overwrite) ||
-        output_open(&out, c->out, sc, c->overwrite)) {
-      sim_free(&S);
-      return EXIT_INPUT;
-    }
-    if (rundir_new_id(c->out, out.run_id)) {
-      output_close(&out);
-      sim_free(&S);
-      return EXIT_INPUT;
-    }
-    output_begin(&out, &S);
-  }
+  if (open_run(sc, c, &S, &out)) return EXIT_INPUT;
   if (sc->threads > 0) omp_set_num_threads(sc->threads);
   out.history =
       rundir_history(c->out, c->cmdline, c->cmd == CMD_RUN, S.dd.size, omp_get_max_threads());
@@ -102,6 +129,7 @@ static int run(struct scene *sc, const struct cli *c) {
       rc = EXIT_NUMERICAL;
       break;
     }
+    output_sample(&out, &S); /* statistics (stats/), when due */
     if (output_step(&out, &S)) {
       output_log(&out, "stopped at step %ld: cannot write stats.nc (the checkpoints are intact)\n",
                  S.step);
@@ -128,19 +156,7 @@ static int run(struct scene *sc, const struct cli *c) {
       break;
     }
   }
-  if (rc == EXIT_DONE && unhealthy(&out, &S, &checked)) rc = EXIT_NUMERICAL;
-  if (rc == EXIT_DONE && T.last_step != S.step && save(&out, &S, &T)) rc = EXIT_IOERR;
-  if (rc == EXIT_DONE && output_finish(&out, &S)) rc = EXIT_IOERR;
-  if (rc == EXIT_RESUBMIT) {
-    if (output_stop(&out, &S, trigger_text(&T, why)))
-      rc = EXIT_IOERR;
-    else
-      output_log(&out, "checkpointed: continue with `chansph resume %s` (exit code %d)\n", out.dir,
-                 EXIT_RESUBMIT);
-  }
-  output_close(&out);
-  sim_free(&S);
-  return rc;
+  return close_run(&out, &S, &T, why, rc, &checked);
 }
 
 int main(int argc, char **argv) {
