@@ -1,10 +1,13 @@
 /** @file corr.c @brief Implementation of corr.h. */
 #include "corr.h"
+#include "engine.h"
 #include "ncutil.h"
+#include "stats.h"
 
 #include <fftw3.h>
 #include <math.h>
 #include <netcdf.h>
+#include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -399,3 +402,48 @@ done:
   free(rx), free(rz), free(ex), free(ez), free(tmp);
   return rc;
 }
+
+/* The engine's table of operations (engine.h). */
+static int engine_wanted(const struct stats_config *cfg) {
+  return cfg->corr.n_levels > 0;
+}
+
+static void engine_init(void *self, const struct stats_config *cfg) {
+  corr_init(self, &cfg->corr);
+}
+
+static void engine_free(void *self) {
+  corr_free(self);
+}
+
+static void engine_sample(void *self, const struct stats_snapshot *s) {
+  corr_sample(self, s);
+}
+
+static void engine_state(void *self, struct state_list *L) {
+  corr_state(self, L);
+}
+
+static size_t engine_bytes(const void *self) {
+  const struct corr *c = self;
+  const size_t d = sizeof(double);
+  const size_t nk = (size_t)c->cfg.nx * (size_t)c->nzh, np = (size_t)c->cfg.nx * c->cfg.nz;
+  return (size_t)c->cfg.n_levels * (nk * CS_LEN + 2) * d + 4 * np * d + 3 * nk * 2 * d +
+         (c->ent_cap + c->all_cap) * CORR_ENT * d + c->hits_cap * (4 * d + sizeof(size_t));
+}
+
+static int engine_write(const void *self, double t_reached, int ncid, char *err, size_t errlen) {
+  (void)t_reached;
+  return corr_nc_write(self, ncid, err, errlen);
+}
+
+const struct stats_engine corr_engine = {"two-point correlations",
+                                         offsetof(struct stats, co),
+                                         engine_wanted,
+                                         engine_init,
+                                         engine_free,
+                                         engine_sample,
+                                         engine_state,
+                                         engine_bytes,
+                                         engine_write,
+                                         NULL};

@@ -230,6 +230,10 @@ void euler_result_free(struct euler_result *res);
 /** @brief Rows holding data (closed windows plus the open one if it has samples). */
 size_t euler_rows(const struct euler *e);
 
+/** @brief The running result of the accumulators: every row with data, the closed windows as
+    the batches (free with euler_result_free). */
+void euler_running_result(const struct euler *e, struct euler_result *res);
+
 /** @brief Expose the complete state (rows 0..nwin, open window included) to a state list. */
 void euler_state(struct euler *e, struct state_list *L);
 

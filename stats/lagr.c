@@ -1,9 +1,12 @@
 /** @file lagr.c @brief Implementation of lagr.h. */
 #include "lagr.h"
+#include "engine.h"
 #include "ncutil.h"
+#include "stats.h"
 
 #include <math.h>
 #include <netcdf.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -567,3 +570,54 @@ done:
   free(fn), free(tl), free(tmp);
   return rc;
 }
+
+/* The engine's table of operations (engine.h). */
+static int engine_wanted(const struct stats_config *cfg) {
+  return cfg->lagr.n_levels > 0;
+}
+
+static void engine_init(void *self, const struct stats_config *cfg) {
+  lagr_init(self, &cfg->lagr);
+}
+
+static void engine_free(void *self) {
+  lagr_free(self);
+}
+
+static void engine_sample(void *self, const struct stats_snapshot *s) {
+  lagr_sample(self, s);
+}
+
+static void engine_state(void *self, struct state_list *L) {
+  lagr_state(self, L);
+}
+
+static size_t engine_bytes(const void *self) {
+  const struct lagr *g = self;
+  const size_t d = sizeof(double);
+  const size_t nl = (size_t)g->cfg.n_levels, ns = (size_t)g->n_slots;
+  const size_t nst = (size_t)(g->cfg.n_stations ? g->cfg.n_stations : 1);
+  return nl * g->nlag * LG_LEN * d * (1 + ns) + ns * SL_LEN * d + nl * 3 * SCAL_LEN * d +
+         nl * nst * ((size_t)g->cfg.pdf_bins + 3) * d + g->cap * TR_LEN * d +
+         g->index_len * sizeof(long) + (g->mine_cap + g->all_cap) * LAGR_REC * d;
+}
+
+static int engine_write(const void *self, double t_reached, int ncid, char *err, size_t errlen) {
+  (void)t_reached;
+  return lagr_nc_write(self, ncid, err, errlen);
+}
+
+static int engine_warnings(const void *self, char *buf, size_t len) {
+  return lagr_warnings(self, buf, len);
+}
+
+const struct stats_engine lagr_engine = {"Lagrangian statistics",
+                                         offsetof(struct stats, la),
+                                         engine_wanted,
+                                         engine_init,
+                                         engine_free,
+                                         engine_sample,
+                                         engine_state,
+                                         engine_bytes,
+                                         engine_write,
+                                         engine_warnings};

@@ -1,0 +1,280 @@
+/**
+ * @file euler_nc.c
+ * @brief The Eulerian engine's stats.nc writer (root profiles with units and standard errors,
+ *        the run's scalars, the raw per-window records in group eulerian) and its table of
+ *        operations (engine.h).
+ */
+#include <math.h>
+#include <netcdf.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "engine.h"
+#include "euler.h"
+#include "moments.h"
+#include "ncout.h"
+#include "ncutil.h"
+#include "stats.h"
+
+void euler_running_result(const struct euler *e, struct euler_result *res) {
+  const size_t rows = euler_rows(e);
+  int *complete = calloc(rows ? rows : 1, sizeof *complete);
+  for (size_t r = 0; r < rows; r++) complete[r] = r < e->nwin;
+  euler_finalise(&e->cfg, e->win, e->mom, e->snp, e->pln, complete, 0, rows, res);
+  free(complete);
+}
+
+#define CK(call) NC_TRY(call, fail)
+
+static int put_att_d(int ncid, int var, const char *name, double v) {
+  return nc_put_att_double(ncid, var, name, NC_DOUBLE, 1, &v);
+}
+
+/* The limits of the wall-normal bins: uniform between cfg->y0 and y1, the first reaching down to
+   the wall and the last up to the other wall (the centre when folded), as the samples outside
+   [y0, y1] go to the end bins. */
+static void bin_bounds(const struct euler_config *c, double *lo, double *hi) {
+  const double w = (c->y1 - c->y0) / c->nb;
+  for (int b = 0; b < c->nb; b++) {
+    lo[b] = b == 0 ? 0.0 : c->y0 + b * w;
+    hi[b] = b == c->nb - 1 ? (c->fold ? 1.0 : 2.0) * c->delta : c->y0 + (b + 1) * w;
+  }
+}
+
+/* The bin coordinate y (centres, with bounds) on dimension dy of group ncid. */
+static int def_y(const struct euler_config *c, int ncid, int dy, const double *centre,
+                 const double *lo, const double *hi) {
+  int v, rc = ncout_def(ncid, "y", NC_DOUBLE, 1, &dy, "m", euler_prof_meta[EP_Y].long_name, &v);
+  if (rc == NC_NOERR) rc = nc_put_att_text(ncid, v, "axis", 1, "Y");
+  if (rc == NC_NOERR)
+    rc =
+        ncout_bounds(ncid, "y", v, dy, "m", "wall-normal limits of the bin", lo, hi, (size_t)c->nb);
+  if (rc == NC_NOERR) rc = nc_put_var_double(ncid, v, centre);
+  return rc;
+}
+
+static const char *const window_fields[WIN_LEN] = {
+    [WIN_T0] = "t_start",     [WIN_T1] = "t_end",           [WIN_NSNAP] = "snapshots",
+    [WIN_SUM_FX] = "sum_f_x", [WIN_SUM_TW0] = "sum_tau_w0", [WIN_SUM_TW1] = "sum_tau_w1"};
+static const char *const moment_names[MOM_LEN] = {
+    "count",     "mean_u",   "mean_v", "mean_w", "mean_p", "mean_rho", "mean_y",
+    "mean_nu_t", "mean_k_r", "C2_uu",  "C2_vv",  "C2_ww",  "C2_uv",    "C2_uw",
+    "C2_vw",     "M3_u",     "M3_v",   "M3_w",   "M4_u",   "M4_v",     "M4_w"};
+static const char *const scal_names[SCAL_LEN] = {"count", "mean", "M2"};
+static const char *const plane_names[PL_LEN] = {
+    [PL_N] = "snapshots",           [PL_PRESSURE] = "sum_pair_stress",
+    [PL_VISCOUS] = "sum_viscous",   [PL_MODEL] = "sum_model",
+    [PL_WALL] = "sum_wall",         [PL_DRIVE] = "sum_drive",
+    [PL_SOURCE] = "sum_source",     [PL_MU_FIRST] = "momentum_first",
+    [PL_MU_LAST] = "momentum_last", [PL_T_FIRST] = "time_first",
+    [PL_T_LAST] = "time_last"};
+
+/* The root's profiles on dimension dy and the run's scalars as global attributes; t_reached:
+   the time the run reached (NaN: not known), where an incomplete last window ends. */
+static int write_profiles(const struct euler *e, const struct euler_result *rp, double t_reached,
+                          int ncid, int dy, char *err, size_t errlen) {
+  const struct euler_result r = *rp;
+  const size_t nb = (size_t)e->cfg.nb;
+  int rc = NC_NOERR, vid;
+  for (int k = 0; k < EP_NPROF; k++) {
+    const int model = k == EP_NUT || k == EP_KR || k == EP_TAU_MODEL || k == EP_SE_TAU + 2;
+    if (k == EP_Y || (model && !e->cfg.les)) continue;
+    const struct euler_meta *m = &euler_prof_meta[k];
+    CK(ncout_def(ncid, m->name, NC_DOUBLE, 1, &dy, m->units, m->long_name, &vid));
+    CK(ncout_fill(ncid, vid));
+    CK(ncout_put_filled(ncid, vid, NULL, NULL, r.prof[k], nb));
+  }
+  const struct {
+    const char *name;
+    double v;
+    int integer; /* a count or flag: int64 */
+  } scal[] = {{"u_tau", r.u_tau, 0},
+              {"u_tau_stderr", r.u_tau_stderr, 0},
+              {"u_tau_wall", r.u_tau_wall, 0},
+              {"u_tau_force", r.u_tau_force, 0},
+              {"re_tau", r.re_tau, 0},
+              {"correlation_time", r.corr_time, 0},
+              {"stress_balance_error", r.balance_error, 0},
+              {"average_start", r.t0, 0},
+              {"average_end", isnan(t_reached) ? r.t1 : fmin(r.t1, t_reached), 0},
+              {"n_windows", (double)r.n_batches, 1},
+              {"window_length", e->cfg.window, 0},
+              {"bin_lower", e->cfg.y0, 0},
+              {"bin_upper", e->cfg.y1, 0},
+              {"wall_area", e->cfg.area, 0},
+              {"fold", (double)e->cfg.fold, 1},
+              {"les", (double)e->cfg.les, 1}};
+  for (size_t i = 0; i < sizeof scal / sizeof scal[0]; i++)
+    if (scal[i].integer) {
+      const long long v = (long long)scal[i].v;
+      CK(nc_put_att_longlong(ncid, NC_GLOBAL, scal[i].name, NC_INT64, 1, &v));
+    } else {
+      CK(put_att_d(ncid, NC_GLOBAL, scal[i].name, scal[i].v));
+    }
+  return NC_NOERR;
+fail:
+  return rc ? rc : NC_EINVAL;
+}
+
+/* The coordinate variable of the windows: their middle times, with start and end as bounds. */
+static int def_window_axis(const struct euler *e, int g, int dw, char *err, size_t errlen) {
+  const size_t rows = euler_rows(e);
+  int rc = NC_NOERR;
+  double *mid = malloc(3 * (rows ? rows : 1) * sizeof *mid), *t0 = mid + rows, *t1 = t0 + rows;
+  if (!mid) CK(NC_ENOMEM);
+  for (size_t w = 0; w < rows; w++) {
+    t0[w] = e->win[w * WIN_LEN + WIN_T0], t1[w] = e->win[w * WIN_LEN + WIN_T1];
+    mid[w] = 0.5 * (t0[w] + t1[w]);
+  }
+  int vt;
+  rc = ncout_def(g, "window", NC_DOUBLE, 1, &dw, "s", "middle of the averaging window", &vt);
+  if (rc == NC_NOERR)
+    rc =
+        ncout_bounds(g, "window", vt, dw, "s", "nominal start and end of the window", t0, t1, rows);
+  if (rc == NC_NOERR && rows) rc = nc_put_var_double(g, vt, mid);
+  free(mid);
+  CK(rc);
+  return NC_NOERR;
+fail:
+  return rc ? rc : NC_EINVAL;
+}
+
+/* The group eulerian: the raw per-window records (the complete accumulator state, which
+   chansph extract re-averages), with a coordinate variable for every dimension. */
+static int write_raw_windows(const struct euler *e, const struct euler_result *rp, int ncid,
+                             const double *lo, const double *hi, char *err, size_t errlen) {
+  const struct euler_result r = *rp;
+  const size_t nb = (size_t)e->cfg.nb, rows = euler_rows(e);
+  int rc = NC_NOERR, dy;
+  int g, dw, dwf, dm, ds, dp, vw, vm, vs, vp, vc, v0, v1;
+  CK(nc_def_grp(ncid, "eulerian", &g));
+  static const char desc[] =
+      "raw per-window moment records of the wall-normal bins; re-average any range of windows "
+      "with chansph extract --window T0:T1 (docs/stats-format.md)";
+  CK(nc_put_att_text(g, NC_GLOBAL, "description", strlen(desc), desc));
+  /* every dimension of the group has its coordinate variable here, so that xarray's
+     open_dataset(group="eulerian") has labelled axes: the bins again (a dimension y of the
+     group, the same as the root's), the windows by their middle time (bounds: start, end) and
+     the fields of the records by name */
+  CK(nc_def_dim(g, "window", rows, &dw));
+  CK(nc_def_dim(g, "y", nb, &dy));
+  CK(nc_def_dim(g, "window_field", WIN_LEN, &dwf));
+  CK(nc_def_dim(g, "moment", MOM_LEN, &dm));
+  CK(nc_def_dim(g, "snapshot_moment", SCAL_LEN, &ds));
+  CK(nc_def_dim(g, "plane_field", PL_LEN, &dp));
+  CK(def_y(&e->cfg, g, dy, r.prof[EP_Y], lo, hi));
+  if ((rc = def_window_axis(e, g, dw, err, errlen)) != NC_NOERR) goto fail; /* names its call */
+  CK(ncout_labels(g, "window_field", dwf, "fields of the window records", window_fields));
+  CK(ncout_labels(g, "moment", dm,
+                  "fields of the moment records: count, means, co-moments C2 (sums of products "
+                  "of deviations), third and fourth central moments M3, M4 (sums)",
+                  moment_names));
+  CK(ncout_labels(g, "snapshot_moment", ds,
+                  "fields of the records of per-snapshot bin means of u: count, mean, M2",
+                  scal_names));
+  CK(ncout_labels(g, "plane_field", dp, "fields of the momentum-budget records", plane_names));
+  CK(ncout_def(g, "window_start", NC_DOUBLE, 1, &dw, "s", "start of the averaging window", &v0));
+  CK(ncout_def(g, "window_end", NC_DOUBLE, 1, &dw, "s", "end of the averaging window", &v1));
+  CK(ncout_def(g, "window_complete", NC_INT, 1, &dw, "1", "1: closed window, 0: still open", &vc));
+  const int d2[2] = {dw, dwf}, d3m[3] = {dw, dy, dm}, d3s[3] = {dw, dy, ds}, d3p[3] = {dw, dy, dp};
+  CK(ncout_def(g, "windows", NC_DOUBLE, 2, d2, NULL,
+               "per window: t_start [s], t_end [s], snapshots, sum of body force [m/s^2], sums "
+               "of tau_w/rho at y=0 and y=2delta [m^2/s^2]",
+               &vw));
+  CK(ncout_def(g, "moments", NC_DOUBLE, 3, d3m, NULL,
+               "per window and bin: count, means of u v w p rho y nu_t k_r, co-moments uu vv ww "
+               "uv uw vw, third and fourth central moments of u v w (sums, not divided by count)",
+               &vm));
+  CK(ncout_def(g, "snapshot_u", NC_DOUBLE, 3, d3s, NULL,
+               "per window and bin: count, mean and M2 of the per-snapshot bin means of u", &vs));
+  CK(ncout_def(g, "planes", NC_DOUBLE, 3, d3p, NULL,
+               "per window and plane y (bin centre): snapshots with forces, sums over them of the "
+               "momentum flux through the plane by the pressure, viscous and eddy-viscous pair "
+               "forces and the walls, of the body force it balances and of the momentum source, "
+               "per unit area and rho0 [m^2/s^2] (docs/stats-format.md, momentum budget)",
+               &vp));
+  for (size_t w = 0; w < rows; w++) {
+    const size_t st[1] = {w}, ct[1] = {1};
+    const int cpl = w < e->nwin;
+    CK(nc_put_vara_double(g, v0, st, ct, &e->win[w * WIN_LEN + WIN_T0]));
+    CK(nc_put_vara_double(g, v1, st, ct, &e->win[w * WIN_LEN + WIN_T1]));
+    CK(nc_put_vara_int(g, vc, st, ct, &cpl));
+  }
+  if (rows) {
+    CK(nc_put_var_double(g, vw, e->win));
+    CK(nc_put_var_double(g, vm, e->mom));
+    CK(nc_put_var_double(g, vs, e->snp));
+    CK(nc_put_var_double(g, vp, e->pln));
+  }
+  return NC_NOERR;
+fail:
+  return rc ? rc : NC_EINVAL;
+}
+
+/* t_reached: the time the run reached (NaN: not known); an incomplete last window ends there. */
+static int write_eulerian(const struct euler *e, double t_reached, int ncid, char *err,
+                          size_t errlen) {
+  int rc = NC_NOERR, dy;
+  struct euler_result r;
+  euler_running_result(e, &r);
+  const size_t nb = (size_t)e->cfg.nb;
+  double *lo = malloc(2 * nb * sizeof *lo), *hi = lo + nb;
+  if (!lo) return NC_ENOMEM;
+  bin_bounds(&e->cfg, lo, hi);
+  CK(nc_def_dim(ncid, "y", nb, &dy));
+  CK(def_y(&e->cfg, ncid, dy, r.prof[EP_Y], lo, hi));
+  /* each names its own failing call in err */
+  if ((rc = write_profiles(e, &r, t_reached, ncid, dy, err, errlen)) != NC_NOERR ||
+      (rc = write_raw_windows(e, &r, ncid, lo, hi, err, errlen)) != NC_NOERR)
+    goto fail;
+  euler_result_free(&r);
+  free(lo);
+  return NC_NOERR;
+fail:
+  euler_result_free(&r);
+  free(lo);
+  return rc ? rc : NC_EINVAL;
+}
+
+static int wanted(const struct stats_config *cfg) {
+  return cfg->eulerian;
+}
+
+static void init(void *self, const struct stats_config *cfg) {
+  euler_init(self, &cfg->eul);
+}
+
+static void release(void *self) {
+  euler_free(self);
+}
+
+static void sample(void *self, const struct stats_snapshot *s) {
+  euler_sample(self, s);
+}
+
+static void state(void *self, struct state_list *L) {
+  euler_state(self, L);
+}
+
+static size_t bytes(const void *self) {
+  const struct euler *e = self;
+  const size_t nb = (size_t)e->cfg.nb;
+  return e->cap * (WIN_LEN + nb * (MOM_LEN + SCAL_LEN)) * sizeof(double) + euler_work_bytes(e);
+}
+
+static int write(const void *self, double t_reached, int ncid, char *err, size_t errlen) {
+  return write_eulerian(self, t_reached, ncid, err, errlen);
+}
+
+const struct stats_engine euler_engine = {"Eulerian profiles",
+                                          offsetof(struct stats, eu),
+                                          wanted,
+                                          init,
+                                          release,
+                                          sample,
+                                          state,
+                                          bytes,
+                                          write,
+                                          NULL};
