@@ -12,30 +12,20 @@
 #include "reduce.h"
 #include "timers.h"
 
-/* A particle on the wire: the permuted arrays of part.h (shift_dy when in use), id and kind. */
-enum {
-  F_X,
-  F_Y,
-  F_Z,
-  F_U,
-  F_V,
-  F_W,
-  F_RHO,
-  F_M,
-  F_GAM,
-  F_KSUM,
-  F_DDIFF,
-  F_AX,
-  F_AY,
-  F_AZ,
-  F_SX, /* SX_LEN parts of the x-acceleration (the momentum budget), zero unless live */
-  F_SDY = F_SX + SX_LEN,
-  F_NUR, /* nu_r and k_r of the next step (les.strain_lag), zero unless live */
-  F_KR,
-  F_ID,
-  F_KIND,
-  F_LEN
-};
+/* A particle on the wire: its PF_MIGRATE fields (part.h) in table order, width values each (an
+   id's bytes in one double, a kind as a double); a field not in use or not live travels as
+   zeros and is not unpacked. F_LEN bounds the record. */
+enum { F_LEN = 48 };
+
+static int record_len(void) {
+  static int len = 0;
+  if (len) return len;
+  int n = 0;
+  for (int i = 0; i < part_n_fields; i++)
+    if (part_fields[i].roles & PF_MIGRATE) n += part_fields[i].width;
+  if (n > F_LEN) die("a migrated particle record of %d values exceeds F_LEN (dd.c)", n);
+  return len = n;
+}
 
 /* tags: a message going to the left neighbour, one going to the right */
 enum { TAG_LEFT = 11, TAG_RIGHT = 12 };
@@ -47,30 +37,33 @@ static void reserve_buf(double **buf, size_t *cap, size_t n) {
 }
 
 static void pack(const struct particles *P, size_t a, double *r) {
-  r[F_X] = P->x[a], r[F_Y] = P->y[a], r[F_Z] = P->z[a];
-  r[F_U] = P->u[a], r[F_V] = P->v[a], r[F_W] = P->w[a];
-  r[F_RHO] = P->rho[a], r[F_M] = P->m[a], r[F_GAM] = P->gam[a];
-  r[F_KSUM] = P->ksum[a], r[F_DDIFF] = P->ddiff[a];
-  r[F_AX] = P->ax[a], r[F_AY] = P->ay[a], r[F_AZ] = P->az[a];
-  for (int k = 0; k < SX_LEN; k++) r[F_SX + k] = P->sx && P->sx_live ? P->sx[a * SX_LEN + k] : 0.0;
-  r[F_SDY] = P->shift_dy ? P->shift_dy[a] : 0.0;
-  r[F_NUR] = P->nur_live ? P->nur[a] : 0.0, r[F_KR] = P->nur_live ? P->kr[a] : 0.0;
-  memcpy(&r[F_ID], &P->id[a], sizeof(double));
-  r[F_KIND] = P->kind[a];
+  for (int i = 0; i < part_n_fields; i++) {
+    const struct part_field *f = &part_fields[i];
+    if (!(f->roles & PF_MIGRATE)) continue;
+    const void *arr = part_field_live(P, f) ? part_field_ptr(P, f) : NULL;
+    if (f->type == PT_I64)
+      memcpy(r, (const int64_t *)arr + a, sizeof(double));
+    else if (f->type == PT_U8)
+      r[0] = ((const uint8_t *)arr)[a];
+    else
+      for (int k = 0; k < f->width; k++) r[k] = arr ? ((const double *)arr)[a * f->width + k] : 0.0;
+    r += f->width;
+  }
 }
 
 static void unpack(struct particles *P, size_t a, const double *r) {
-  P->x[a] = r[F_X], P->y[a] = r[F_Y], P->z[a] = r[F_Z];
-  P->u[a] = r[F_U], P->v[a] = r[F_V], P->w[a] = r[F_W];
-  P->rho[a] = r[F_RHO], P->m[a] = r[F_M], P->gam[a] = r[F_GAM];
-  P->ksum[a] = r[F_KSUM], P->ddiff[a] = r[F_DDIFF];
-  P->ax[a] = r[F_AX], P->ay[a] = r[F_AY], P->az[a] = r[F_AZ];
-  if (P->sx && P->sx_live)
-    for (int k = 0; k < SX_LEN; k++) P->sx[a * SX_LEN + k] = r[F_SX + k];
-  if (P->shift_dy) P->shift_dy[a] = r[F_SDY];
-  if (P->nur_live) P->nur[a] = r[F_NUR], P->kr[a] = r[F_KR];
-  memcpy(&P->id[a], &r[F_ID], sizeof(double));
-  P->kind[a] = (uint8_t)r[F_KIND];
+  for (int i = 0; i < part_n_fields; i++) {
+    const struct part_field *f = &part_fields[i];
+    if (!(f->roles & PF_MIGRATE)) continue;
+    void *arr = part_field_live(P, f) ? part_field_ptr(P, f) : NULL;
+    if (f->type == PT_I64)
+      memcpy((int64_t *)arr + a, r, sizeof(double));
+    else if (f->type == PT_U8)
+      ((uint8_t *)arr)[a] = (uint8_t)r[0];
+    else if (arr)
+      for (int k = 0; k < f->width; k++) ((double *)arr)[a * f->width + k] = r[k];
+    r += f->width;
+  }
 }
 
 static void copy_slot(struct particles *P, size_t to, size_t from) {
@@ -174,7 +167,7 @@ void dd_migrate(struct dd *d, struct particles *P, const struct nbr *nb) {
     nbr_wrap_position(nb, &P->x[a], &P->z[a]);
     const int col = nbr_column(nb, P->x[a]);
     dest[a] = owned(d, col) ? -1 : dd_owner(d, col);
-    if (dest[a] >= 0) scount[dest[a]] += F_LEN, leaving++;
+    if (dest[a] >= 0) scount[dest[a]] += record_len(), leaving++;
   }
   for (int r = 0; r < np; r++) sdisp[r + 1] = sdisp[r] + scount[r];
   reserve_buf(&d->sbuf, &d->cap_sbuf, (size_t)sdisp[np]);
@@ -189,7 +182,7 @@ void dd_migrate(struct dd *d, struct particles *P, const struct nbr *nb) {
       continue;
     }
     pack(P, a, d->sbuf + sdisp[dest[a]] + fill[dest[a]]);
-    fill[dest[a]] += F_LEN;
+    fill[dest[a]] += record_len();
   }
   P->n = k;
   CHECK_MPI(MPI_Alltoall(scount, 1, MPI_INT, rcount, 1, MPI_INT, MPI_COMM_WORLD));
@@ -197,9 +190,9 @@ void dd_migrate(struct dd *d, struct particles *P, const struct nbr *nb) {
   reserve_buf(&d->rbuf, &d->cap_rbuf, (size_t)rdisp[np]);
   CHECK_MPI(MPI_Alltoallv(d->sbuf, scount, sdisp, MPI_DOUBLE, d->rbuf, rcount, rdisp, MPI_DOUBLE,
                           MPI_COMM_WORLD));
-  const size_t arriving = (size_t)rdisp[np] / F_LEN;
+  const size_t arriving = (size_t)rdisp[np] / (size_t)record_len();
   d->reserve(d->ctx, P->n + arriving);
-  for (size_t i = 0; i < arriving; i++) unpack(P, P->n + i, d->rbuf + i * F_LEN);
+  for (size_t i = 0; i < arriving; i++) unpack(P, P->n + i, d->rbuf + i * (size_t)record_len());
   P->n += arriving;
   for (int r = 0; r < np; r++)
     if (scount[r]) d->messages++;

@@ -5,6 +5,7 @@
 #include <math.h>
 #include <mpi.h>
 #include <stdarg.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -509,10 +510,18 @@ int output_step(struct output *o, struct sim *S) {
 static int write_particles(struct output *o, const struct sim *S) {
   const struct particles *P = &S->P;
   const size_t n = P->n_fluid;
-  enum { NC = 10 };
-  const double *src[NC] = {P->x, P->y, P->z, P->u, P->v, P->w, P->rho, P->p, P->gam, P->m};
+  enum { NC_MAX = 32 };
+  const double *src[NC_MAX];
+  const char *names[NC_MAX], *long_names[NC_MAX], *units[NC_MAX];
+  int NC = 0; /* the PF_WRITE fields of the table (part.h), in its order */
+  for (int i = 0; i < part_n_fields && NC < NC_MAX; i++) {
+    const struct part_field *f = &part_fields[i];
+    if (!(f->roles & PF_WRITE) || !part_field_ptr(P, f)) continue;
+    src[NC] = part_field_ptr(P, f), names[NC] = f->name, long_names[NC] = f->long_name;
+    units[NC++] = f->off == offsetof(struct particles, m) && S->sc->dim == 2 ? "kg/m" : f->units;
+  }
   const int root = rank0();
-  double *buf = root ? malloc(n * NC * sizeof *buf) : NULL;
+  double *buf = root ? malloc(n * (size_t)NC * sizeof *buf) : NULL;
   if (root && !buf) die("out of memory writing particles.nc");
   dd_gather_fluid(&S->dd, P, NC, src, buf); /* rank 0: by id */
   int rc = CHANSPH_OK;
@@ -520,24 +529,10 @@ static int write_particles(struct output *o, const struct sim *S) {
     long long *ids = malloc(n * sizeof *ids);
     if (!ids) die("out of memory writing particles.nc");
     for (size_t r = 0; r < n; r++) ids[r] = (long long)r;
-    static const char *const names[NC] = {"x", "y",   "z", "u",     "v",
-                                          "w", "rho", "p", "gamma", "mass"};
-    const char *const units[NC] = {"m",   "m",      "m",  "m/s", "m/s",
-                                   "m/s", "kg/m^3", "Pa", "1",   S->sc->dim == 2 ? "kg/m" : "kg"};
-    const double *cols[NC];
+    const double *cols[NC_MAX];
     for (int c = 0; c < NC; c++) cols[c] = buf + (size_t)c * n;
     char date[32];
     date_now(date, sizeof date);
-    static const char *const long_names[NC] = {"position x (streamwise)",
-                                               "position y (wall-normal)",
-                                               "position z (spanwise)",
-                                               "velocity u (streamwise)",
-                                               "velocity v (wall-normal)",
-                                               "velocity w (spanwise)",
-                                               "density",
-                                               "pressure",
-                                               "wall renormalisation factor",
-                                               "mass (per metre of span in 2-D)"};
     const struct nc_attr attrs[] = {
         {"time", NULL, S->t, 0}, {"step", NULL, (double)S->step, 1}, PROVENANCE_ATTRS(o, S, date)};
     char path[4096], err[4096];

@@ -2,6 +2,7 @@
 #include "part.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -50,8 +51,58 @@ void part_memory_report(FILE *f) {
   fprintf(f, "  %-12s %10.2f MB\n", "total", total / 1048576.0);
 }
 
-/* Every per-particle array of part.h with its label and element size; `core` arrays exist in
-   every run, the others (turbulence model) only when turb_init allocated them. */
+#define F(member) offsetof(struct particles, member)
+#define ALL (PF_PERMUTE | PF_MIGRATE | PF_CKPT | PF_WRITE | PF_HEALTH)
+/* Every per-particle array of part.h: what it takes part in (enum part_role), in the order of
+   the files (particles.nc, checkpoint) and of the memory report. */
+const struct part_field part_fields[] = {
+    {F(x), "x", "x", PT_F64, 1, ALL, 1, 0, 0, "m", "position x (streamwise)"},
+    {F(y), "y", "y", PT_F64, 1, ALL, 1, 0, 0, "m", "position y (wall-normal)"},
+    {F(z), "z", "z", PT_F64, 1, ALL, 1, 0, 0, "m", "position z (spanwise)"},
+    {F(u), "u", "u", PT_F64, 1, ALL, 1, 0, 0, "m/s", "velocity u (streamwise)"},
+    {F(v), "v", "v", PT_F64, 1, ALL, 1, 0, 0, "m/s", "velocity v (wall-normal)"},
+    {F(w), "w", "w", PT_F64, 1, ALL, 1, 0, 0, "m/s", "velocity w (spanwise)"},
+    {F(rho), "rho", "rho", PT_F64, 1, ALL, 1, 0, 0, "kg/m^3", "density"},
+    {F(p), "pressure", "p", PT_F64, 1, PF_CKPT | PF_WRITE | PF_HEALTH, 1, 0, 0, "Pa", "pressure"},
+    {F(gam), "gamma", "gamma", PT_F64, 1, ALL, 1, 0, 0, "1", "wall renormalisation factor"},
+    {F(m), "mass", "mass", PT_F64, 1, ALL, 1, 0, 0, "kg", "mass (per metre of span in 2-D)"},
+    {F(ksum), "kernel_sum", "kernel_sum", PT_F64, 1, ALL & ~PF_WRITE, 1, 0, 0, "kg/m^dim",
+     "kernel sum S of the continuity equation"},
+    {F(ddiff), "diffusion", NULL, PT_F64, 1, PF_PERMUTE | PF_MIGRATE, 1, 0, 0, NULL, NULL},
+    {F(c), "sound", NULL, PT_F64, 1, 0, 1, 0, 0, NULL, NULL},
+    {F(pr2), "p_over_rho2", NULL, PT_F64, 1, 0, 1, 0, 0, NULL, NULL},
+    {F(vol), "volume", NULL, PT_F64, 1, 0, 1, 0, 0, NULL, NULL},
+    {F(rec), "pair_records", NULL, PT_F64, 16, 0, 1, 0, 0, NULL, NULL},
+    {F(ax), "ax", "ax", PT_F64, 1, PF_PERMUTE | PF_MIGRATE | PF_HEALTH, 1, 0, 0, NULL, NULL},
+    {F(ay), "ay", "ay", PT_F64, 1, PF_PERMUTE | PF_MIGRATE | PF_HEALTH, 1, 0, 0, NULL, NULL},
+    {F(az), "az", "az", PT_F64, 1, PF_PERMUTE | PF_MIGRATE | PF_HEALTH, 1, 0, 0, NULL, NULL},
+    {F(sx), "stress_ax", NULL, PT_F64, SX_LEN, PF_PERMUTE | PF_MIGRATE, 0, F(sx_live), 0, NULL,
+     NULL},
+    {F(tmp), "sort_scratch", NULL, PT_F64, 1, 0, 1, 0, 0, NULL, NULL},
+    {F(id), "id", NULL, PT_I64, 1, PF_PERMUTE | PF_MIGRATE, 1, 0, 0, NULL, NULL},
+    {F(tmp_i), "sort_scratch_i", NULL, PT_I64, 1, 0, 1, 0, 0, NULL, NULL},
+    {F(kind), "kind", NULL, PT_U8, 1, PF_PERMUTE | PF_MIGRATE, 1, 0, 0, NULL, NULL},
+    {F(nur), "nu_r", "nu_r", PT_F64, 1, PF_PERMUTE | PF_MIGRATE | PF_CKPT | PF_HEALTH, 0,
+     F(nur_live), 1, "m^2/s", "eddy viscosity of the next step"},
+    {F(kr), "k_r", "k_r", PT_F64, 1, PF_PERMUTE | PF_MIGRATE | PF_CKPT | PF_HEALTH, 0, F(nur_live),
+     1, "m^2/s^2", "residual kinetic energy of the next step"},
+    {F(nur_next), "nu_r_next", NULL, PT_F64, 1, 0, 0, 0, 0, NULL, NULL},
+    {F(kr_next), "k_r_next", NULL, PT_F64, 1, 0, 0, 0, 0, NULL, NULL},
+    {F(twx), "wall_law_tx", NULL, PT_F64, 1, 0, 0, 0, 0, NULL, NULL},
+    {F(twz), "wall_law_tz", NULL, PT_F64, 1, 0, 0, 0, 0, NULL, NULL},
+    {F(shift_dy), "shift_dy", NULL, PT_F64, 1, PF_PERMUTE | PF_MIGRATE, 0, 0, 0, NULL, NULL},
+};
+#undef ALL
+#undef F
+const int part_n_fields = sizeof part_fields / sizeof part_fields[0];
+
+static size_t elem_size(const struct part_field *f) {
+  return (size_t)f->width * (f->type == PT_F64   ? sizeof(double)
+                             : f->type == PT_I64 ? sizeof(int64_t)
+                                                 : sizeof(uint8_t));
+}
+
+/* The table as the allocation helpers below use it: pointer, label, bytes per particle, core. */
 struct array {
   void **p;
   const char *label;
@@ -60,44 +111,13 @@ struct array {
 };
 
 static size_t arrays(struct particles *P, struct array *t) {
-  const size_t d = sizeof(double);
-  const struct array all[] = {{(void **)&P->x, "x", d, 1},
-                              {(void **)&P->y, "y", d, 1},
-                              {(void **)&P->z, "z", d, 1},
-                              {(void **)&P->u, "u", d, 1},
-                              {(void **)&P->v, "v", d, 1},
-                              {(void **)&P->w, "w", d, 1},
-                              {(void **)&P->rho, "rho", d, 1},
-                              {(void **)&P->m, "mass", d, 1},
-                              {(void **)&P->gam, "gamma", d, 1},
-                              {(void **)&P->ksum, "kernel_sum", d, 1},
-                              {(void **)&P->ddiff, "diffusion", d, 1},
-                              {(void **)&P->p, "pressure", d, 1},
-                              {(void **)&P->c, "sound", d, 1},
-                              {(void **)&P->pr2, "p_over_rho2", d, 1},
-                              {(void **)&P->vol, "volume", d, 1},
-                              {(void **)&P->rec, "pair_records", 16 * d, 1},
-                              {(void **)&P->ax, "ax", d, 1},
-                              {(void **)&P->ay, "ay", d, 1},
-                              {(void **)&P->az, "az", d, 1},
-                              {(void **)&P->sx, "stress_ax", SX_LEN * d, 0},
-                              {(void **)&P->tmp, "sort_scratch", d, 1},
-                              {(void **)&P->id, "id", sizeof(int64_t), 1},
-                              {(void **)&P->tmp_i, "sort_scratch_i", sizeof(int64_t), 1},
-                              {(void **)&P->kind, "kind", 1, 1},
-                              {(void **)&P->nur, "nu_r", d, 0},
-                              {(void **)&P->kr, "k_r", d, 0},
-                              {(void **)&P->nur_next, "nu_r_next", d, 0},
-                              {(void **)&P->kr_next, "k_r_next", d, 0},
-                              {(void **)&P->twx, "wall_law_tx", d, 0},
-                              {(void **)&P->twz, "wall_law_tz", d, 0},
-                              {(void **)&P->shift_dy, "shift_dy", d, 0}};
-  const size_t n = sizeof all / sizeof all[0];
-  memcpy(t, all, sizeof all);
-  return n;
+  for (int i = 0; i < part_n_fields; i++)
+    t[i] = (struct array){(void **)((char *)P + part_fields[i].off), part_fields[i].label,
+                          elem_size(&part_fields[i]), part_fields[i].core};
+  return (size_t)part_n_fields;
 }
 
-enum { N_ARRAYS_MAX = 32 };
+enum { N_ARRAYS_MAX = 64 };
 
 int part_check_memory(const struct scene *s) {
   const double nx = floor(s->lx / s->dr + 0.5), ny = floor(2.0 * s->delta / s->dr + 0.5);
@@ -199,18 +219,21 @@ static void permute_d(double *arr, double *tmp, size_t i0, size_t n, const size_
 }
 
 void part_permute(struct particles *P, size_t i0, size_t n, const size_t *perm) {
-  /* the accelerations too: the statistics sample them after the re-sort */
-  double *arrs[] = {P->x, P->y,   P->z,    P->u,     P->v,  P->w,  P->rho,
-                    P->m, P->gam, P->ksum, P->ddiff, P->ax, P->ay, P->az};
-  for (size_t i = 0; i < sizeof arrs / sizeof arrs[0]; i++) permute_d(arrs[i], P->tmp, i0, n, perm);
-  if (P->sx && P->sx_live) /* the budget parts of a sampled step, one column at a time */
-    for (int k = 0; k < SX_LEN; k++) {
-      double *restrict col = P->tmp;
-      for (size_t i = 0; i < n; i++) col[i] = P->sx[(i0 + perm[i]) * SX_LEN + k];
-      for (size_t i = 0; i < n; i++) P->sx[(i0 + i) * SX_LEN + k] = col[i];
+  /* the doubles first (P->tmp is their scratch), then ids and kinds */
+  for (int i = 0; i < part_n_fields; i++) {
+    const struct part_field *f = &part_fields[i];
+    if (!(f->roles & PF_PERMUTE) || f->type != PT_F64 || !part_field_live(P, f)) continue;
+    double *arr = part_field_ptr(P, f);
+    if (f->width == 1) {
+      permute_d(arr, P->tmp, i0, n, perm);
+      continue;
     }
-  if (P->shift_dy) permute_d(P->shift_dy, P->tmp, i0, n, perm);
-  if (P->nur_live) permute_d(P->nur, P->tmp, i0, n, perm), permute_d(P->kr, P->tmp, i0, n, perm);
+    for (int k = 0; k < f->width; k++) { /* one column at a time */
+      double *restrict col = P->tmp;
+      for (size_t j = 0; j < n; j++) col[j] = arr[(i0 + perm[j]) * f->width + k];
+      for (size_t j = 0; j < n; j++) arr[(i0 + j) * f->width + k] = col[j];
+    }
+  }
   int64_t *restrict id = P->tmp_i;
   uint8_t *restrict kind = (uint8_t *)P->tmp; /* P->tmp is free after the doubles */
   for (size_t i = 0; i < n; i++) id[i] = P->id[i0 + perm[i]], kind[i] = P->kind[i0 + perm[i]];

@@ -91,6 +91,48 @@ struct walls {
  * @param[in] bytes size
  * @return the memory (dies on failure, naming the label)
  */
+/** What a per-particle field takes part in (struct part_field.roles). */
+enum part_role {
+  PF_PERMUTE = 1, /*!< moves with its particle when the particles are re-sorted */
+  PF_MIGRATE = 2, /*!< travels with its particle to another MPI rank */
+  PF_CKPT = 4,    /*!< in the checkpoint as particles/NAME (by id; docs/checkpoint-format.md) */
+  PF_WRITE = 8,   /*!< in particles.nc */
+  PF_HEALTH = 16  /*!< must be finite: health.c checks it before a state is written or sampled */
+};
+
+enum part_type { PT_F64, PT_I64, PT_U8 };
+
+/** One per-particle array of struct particles. Adding a field: the member in struct particles
+    and one line in part_fields (part.c); allocation, growth, sort, migration, checkpoint,
+    particles.nc and the health check follow from the roles. */
+struct part_field {
+  size_t off;            /*!< offsetof(struct particles, the pointer member) */
+  const char *label;     /*!< in the memory report */
+  const char *name;      /*!< in files and messages (PF_CKPT, PF_WRITE, PF_HEALTH) */
+  enum part_type type;   /*!< element type */
+  int width;             /*!< values per particle */
+  int roles;             /*!< enum part_role */
+  int core;              /*!< allocated for every run; else by the module that uses it */
+  size_t live;           /*!< offsetof an int of struct particles that must be set for the
+                              array to hold particle values (permute, migrate), or 0 */
+  int optional;          /*!< PF_CKPT: added in a later checkpoint format (may be absent) */
+  const char *units;     /*!< PF_CKPT, PF_WRITE */
+  const char *long_name; /*!< PF_WRITE */
+};
+
+extern const struct part_field part_fields[]; /*!< every per-particle array (part.c) */
+extern const int part_n_fields;
+
+/** The array of field f (NULL if not allocated). */
+static inline void *part_field_ptr(const struct particles *P, const struct part_field *f) {
+  return *(void *const *)((const char *)P + f->off);
+}
+
+/** 1 if field f is allocated and holds particle values (its live flag, if any, is set). */
+static inline int part_field_live(const struct particles *P, const struct part_field *f) {
+  return part_field_ptr(P, f) && (!f->live || *(const int *)((const char *)P + f->live));
+}
+
 void *part_alloc(const char *label, size_t bytes);
 
 /** @brief Free memory from part_alloc(). */

@@ -304,25 +304,20 @@ int sim_done(const struct sim *S) {
   return S->t >= S->sc->t_end * (1.0 - 1e-12);
 }
 
-/* The particle record of the redistribution, and the arrays of S->gather it fills. */
-enum {
-  G_ID,
-  G_KIND,
-  G_X,
-  G_Y,
-  G_Z,
-  G_U,
-  G_V,
-  G_W,
-  G_RHO,
-  G_P,
-  G_M,
-  G_GAM,
-  G_KSUM,
-  G_NUR,
-  G_KR,
-  G_LEN
-};
+/* The checkpoint's particle datasets: id and kind, then the allocated PF_CKPT fields of the
+   table (part.h) in its order; S->gather holds them in that order (G_FIELDS onwards), then the
+   wall values. Returns the number of fields, their table indices in idx. */
+enum { G_ID, G_KIND, G_FIELDS };
+
+static int ckpt_fields(const struct particles *P, int idx[SIM_GATHER]) {
+  int n = 0;
+  for (int i = 0; i < part_n_fields; i++)
+    if ((part_fields[i].roles & PF_CKPT) && part_field_ptr(P, &part_fields[i])) {
+      if (G_FIELDS + n + 1 >= SIM_GATHER) die("more checkpointed particle fields than SIM_GATHER");
+      idx[n++] = i;
+    }
+  return n;
+}
 
 /* Send every owned particle (with the wall values of a vertex) to the rank whose id block holds
    it (MPI_Alltoallv) and place what arrives by id into S->gather: rank r then holds the ids
@@ -330,7 +325,9 @@ enum {
    max(lo, n_fluid) - n_fluid onwards). Collective. */
 static void block_state(struct sim *S, size_t lo, size_t hi) {
   const struct particles *P = &S->P;
-  const size_t n = P->n, N = P->n_fluid + P->n_vertex, nb = hi - lo, R = G_LEN + 2;
+  int idx[SIM_GATHER];
+  const int nf = ckpt_fields(P, idx), wall_col = G_FIELDS + nf;
+  const size_t n = P->n, N = P->n_fluid + P->n_vertex, nb = hi - lo, R = (size_t)wall_col + 2;
   const int size = S->dd.size;
   int *cnt = calloc(4 * (size_t)size + 2, sizeof(int)), *dest = malloc((n ? n : 1) * sizeof(int));
   if (!cnt || !dest) die("out of memory redistributing the checkpoint state");
@@ -340,18 +337,18 @@ static void block_state(struct sim *S, size_t lo, size_t hi) {
   double *rec = part_alloc("ckpt_send", (n ? n : 1) * R * sizeof(double));
   int *fill = calloc((size_t)size, sizeof(int));
   if (!fill) die("out of memory redistributing the checkpoint state");
-  const double *f[] = {P->x, P->y, P->z,   P->u,    P->v,   P->w, P->rho,
-                       P->p, P->m, P->gam, P->ksum, P->nur, P->kr};
+  const double *f[SIM_GATHER];
+  for (int c = 0; c < nf; c++) f[c] = part_field_ptr(P, &part_fields[idx[c]]);
   for (size_t a = 0; a < n; a++) {
     double *r = rec + sdisp[dest[a]] + fill[dest[a]];
     fill[dest[a]] += (int)R;
     memcpy(&r[G_ID], &P->id[a], sizeof(double));
     r[G_KIND] = P->kind[a];
-    for (int c = 0; c < G_LEN - 2; c++) r[G_X + c] = f[c] ? f[c][a] : 0.0;
-    r[G_LEN] = r[G_LEN + 1] = 0.0;
+    for (int c = 0; c < nf; c++) r[G_FIELDS + c] = f[c][a];
+    r[wall_col] = r[wall_col + 1] = 0.0;
     if (P->kind[a] == KIND_VERTEX) {
       const size_t slot = part_vertex_slot(P, P->id[a]);
-      r[G_LEN] = S->W.rho[slot], r[G_LEN + 1] = S->W.p[slot];
+      r[wall_col] = S->W.rho[slot], r[wall_col + 1] = S->W.p[slot];
     }
   }
   CHECK_MPI(MPI_Alltoall(cnt, 1, MPI_INT, rcnt, 1, MPI_INT, MPI_COMM_WORLD));
@@ -369,8 +366,8 @@ static void block_state(struct sim *S, size_t lo, size_t hi) {
   uint8_t *kind = malloc(nb ? nb : 1);
   double *wr = malloc(2 * (nw ? nw : 1) * sizeof(double));
   if (!id || !kind || !wr) die("out of memory redistributing the checkpoint state");
-  S->gather[G_ID] = id, S->gather[G_KIND] = kind, S->gather[G_LEN] = wr;
-  for (int c = G_X; c < G_LEN; c++)
+  S->gather[G_ID] = id, S->gather[G_KIND] = kind, S->gather[wall_col] = wr;
+  for (int c = G_FIELDS; c < wall_col; c++)
     if (!(S->gather[c] = malloc((nb ? nb : 1) * sizeof(double))))
       die("out of memory redistributing the checkpoint state");
   for (size_t i = 0; i < nb; i++) { /* by id: the same file on any rank count */
@@ -382,9 +379,9 @@ static void block_state(struct sim *S, size_t lo, size_t hi) {
           hi - 1);
     const size_t k = (size_t)pid - lo;
     id[k] = pid, kind[k] = (uint8_t)r[G_KIND];
-    for (int c = G_X; c < G_LEN; c++) ((double *)S->gather[c])[k] = r[c];
+    for (int c = G_FIELDS; c < wall_col; c++) ((double *)S->gather[c])[k] = r[c];
     if (r[G_KIND] == KIND_VERTEX)
-      wr[(size_t)pid - w0] = r[G_LEN], wr[nw + (size_t)pid - w0] = r[G_LEN + 1];
+      wr[(size_t)pid - w0] = r[wall_col], wr[nw + (size_t)pid - w0] = r[wall_col + 1];
   }
   part_free(buf);
 }
@@ -392,7 +389,6 @@ static void block_state(struct sim *S, size_t lo, size_t hi) {
 void sim_state(struct sim *S, struct state_list *L) {
   _Static_assert(sizeof(long) == sizeof(int64_t), "long must be 64-bit");
   _Static_assert(sizeof(int) == sizeof(int32_t), "int must be 32-bit");
-  _Static_assert(G_LEN + 1 <= SIM_GATHER, "SIM_GATHER too small");
   struct particles *P = &S->P;
   state_add(L, "sim/step", STATE_I64, 0, NULL, &S->step, NULL);
   state_add(L, "sim/time", STATE_F64, 0, NULL, &S->t, "s");
@@ -420,47 +416,26 @@ void sim_state(struct sim *S, struct state_list *L) {
   fid = state_add(L, "particles/id", STATE_I64, 1, n, blocks ? g[G_ID] : P->id + lo, NULL);
   fkind = state_add(L, "particles/kind", STATE_U8, 1, n, blocks ? g[G_KIND] : P->kind + lo, NULL);
   fid->offset = fkind->offset = lo, fid->total = fkind->total = N;
-  struct {
-    const char *name;
-    double *data;
-    int g;
-    const char *units;
-  } const f[] = {{"particles/x", P->x, G_X, "m"},
-                 {"particles/y", P->y, G_Y, "m"},
-                 {"particles/z", P->z, G_Z, "m"},
-                 {"particles/u", P->u, G_U, "m/s"},
-                 {"particles/v", P->v, G_V, "m/s"},
-                 {"particles/w", P->w, G_W, "m/s"},
-                 {"particles/rho", P->rho, G_RHO, "kg/m^3"},
-                 {"particles/p", P->p, G_P, "Pa"},
-                 {"particles/mass", P->m, G_M, "kg"},
-                 {"particles/gamma", P->gam, G_GAM, "1"},
-                 {"particles/kernel_sum", P->ksum, G_KSUM, "kg/m^dim"}};
-  for (size_t i = 0; i < sizeof f / sizeof f[0]; i++) {
+  int idx[SIM_GATHER];
+  const int nf = ckpt_fields(P, idx);
+  for (int c = 0; c < nf; c++) {
+    const struct part_field *pf = &part_fields[idx[c]];
+    char name[96];
+    snprintf(name, sizeof name, "particles/%s", pf->name);
+    double *data = part_field_ptr(P, pf);
     struct state_field *fi =
-        state_add(L, f[i].name, STATE_F64, 1, n, blocks ? g[f[i].g] : f[i].data + lo, f[i].units);
-    fi->offset = lo, fi->total = N;
+        state_add(L, name, STATE_F64, 1, n, blocks ? g[G_FIELDS + c] : data + lo, pf->units);
+    fi->offset = lo, fi->total = N, fi->optional = pf->optional;
   }
-  if (S->M.strain_lag) { /* the nu_r and k_r the next step applies (format 1.3; optional: an
-                            older checkpoint leaves nur_live 0 and the first step recomputes) */
+  if (S->M.strain_lag) { /* whether nu_r and k_r hold the values the next step applies (format
+                            1.3; an older checkpoint leaves it 0 and the first step recomputes) */
     struct state_field *fl = state_add(L, "les/nu_r_live", STATE_I32, 0, NULL, &P->nur_live, NULL);
     fl->optional = 1;
-    const struct {
-      const char *name;
-      double *data;
-      int g;
-      const char *units;
-    } m[] = {{"particles/nu_r", P->nur, G_NUR, "m^2/s"}, {"particles/k_r", P->kr, G_KR, "m^2/s^2"}};
-    for (size_t i = 0; i < 2; i++) {
-      struct state_field *fi =
-          state_add(L, m[i].name, STATE_F64, 1, n, blocks ? g[m[i].g] : m[i].data + lo, m[i].units);
-      fi->offset = lo, fi->total = N, fi->optional = 1;
-    }
   }
   /* wall values: written by the blocks (the vertex slots of each id block), read whole */
   const size_t w0 = lo > P->n_fluid ? lo - P->n_fluid : 0;
   const size_t nw[1] = {blocks ? (hi > P->n_fluid ? hi - P->n_fluid : 0) - w0 : nv};
-  double *wr = blocks ? S->gather[G_LEN] : NULL;
+  double *wr = blocks ? S->gather[G_FIELDS + nf] : NULL;
   struct state_field *wrho, *wp;
   wrho = state_add(L, "walls/rho", STATE_F64, 1, nw, blocks ? wr : S->W.rho, "kg/m^3");
   wp = state_add(L, "walls/p", STATE_F64, 1, nw, blocks ? wr + nw[0] : S->W.p, "Pa");
