@@ -27,13 +27,32 @@ struct key {
   const char *def; /*!< default as text; NULL for required keys */
   double lo, hi;   /*!< allowed range (inclusive unless LO_OPEN) */
   int flags;
-  const char *choices; /*!< "a|b|c" for T_CHOICE; the value stored is the index */
+  const char *const *choices; /*!< T_CHOICE: the names, NULL-terminated; the value is the index */
   const char *unit, *help;
   size_t offset;
 };
 
 #define OFF(f) offsetof(struct scene, f)
 #define BIG 1e300
+
+/* The names of the choice keys, in the order of their enums (scene.h): the value stored is
+   the index. */
+static const char *const names_sph_viscous[] = {"morris", "violeau", NULL};
+static const char *const names_sph_laplacian_norm[] = {"wall_normal", "trace", "none", NULL};
+static const char *const names_sph_wall_shear_weight[] = {"discrete", "analytic", NULL};
+static const char *const names_sph_wall_pressure_weight[] = {"lattice", "consistent", "analytic",
+                                                             NULL};
+static const char *const names_sph_pressure_gradient[] = {"standard", "corrected", NULL};
+static const char *const names_sph_shifting[] = {"none", "fickian", NULL};
+static const char *const names_les_model[] = {"none", "smagorinsky", NULL};
+static const char *const names_les_strain[] = {"gradient", "violeau_issa", NULL};
+static const char *const names_wall_law[] = {"laminar", "log", "reichardt", NULL};
+static const char *const names_drive_mode[] = {"force", "flux", NULL};
+static const char *const names_drive_controller[] = {"eq3.43", "eq3.38", NULL};
+static const char *const names_init_profile[] = {"rest", "laminar",   "reichardt",
+                                                 "wave", "synthetic", NULL};
+static const char *const names_stats_method[] = {"bins", "sph", NULL};
+static const char *const names_stats_target_profiles[] = {"both", "u_mean", "uv_peak", NULL};
 
 static const struct key keys[] = {
     {"domain", "dimension", T_INT, NULL, 2, 3, REQUIRED, NULL, "-",
@@ -52,23 +71,23 @@ static const struct key keys[] = {
      "Volume-diffusion constant xi of thesis Eq. 3.34; 0 selects the mixing-length value "
      "1000 dr / (2 delta) (thesis Sec. 3.2, 6.1.1).",
      OFF(xi)},
-    {"sph", "viscous", T_CHOICE, "morris", 0, 0, 0, "morris|violeau", "-",
+    {"sph", "viscous", T_CHOICE, "morris", 0, 0, 0, names_sph_viscous, "-",
      "Viscous operator: Morris (thesis Eq. 2.147) or Violeau (Eq. 2.100), both with the wall "
      "shear term.",
      OFF(viscous)},
-    {"sph", "laplacian_norm", T_CHOICE, "wall_normal", 0, 0, 0, "wall_normal|trace|none", "-",
+    {"sph", "laplacian_norm", T_CHOICE, "wall_normal", 0, 0, 0, names_sph_laplacian_norm, "-",
      "Normalisation of the viscous particle sum by its discrete second moment (plus the "
      "analytic part behind the walls): wall_normal uses the y-y moment, exact for the mean "
      "flow of a channel; trace uses the isotropic part; none is the plain operator of the "
      "thesis (2.6% lattice error at h/dr = 1.3, docs/theory.md).",
      OFF(lap_norm)},
-    {"sph", "wall_shear_weight", T_CHOICE, "discrete", 0, 0, 0, "discrete|analytic", "-",
+    {"sph", "wall_shear_weight", T_CHOICE, "discrete", 0, 0, 0, names_sph_wall_shear_weight, "-",
      "Weight of the wall shear term of the Morris operator: |grad gamma_as| (analytic, thesis "
      "Eq. 2.147) or the discrete first moment sum_b V_b (r_ab . n) F_ab, which makes the "
      "operator exact for a linear velocity profile (docs/theory.md). Violeau always uses "
      "the analytic weight.",
      OFF(wall_weight)},
-    {"sph", "wall_pressure_weight", T_CHOICE, "lattice", 0, 0, 0, "lattice|consistent|analytic",
+    {"sph", "wall_pressure_weight", T_CHOICE, "lattice", 0, 0, 0, names_sph_wall_pressure_weight,
      "-",
      "Weight of the pressure wall term: |grad gamma_as| (analytic, thesis Eq. 3.17); "
      "max(|grad gamma_as|, sum_b V_b (r_ab . n) F_ab) of the current particles (consistent), "
@@ -77,13 +96,13 @@ static const struct key keys[] = {
      "lattice, as a function of the wall distance (lattice): the same equilibrium, but a "
      "uniform pressure still resists wall-normal disorder (docs/theory.md).",
      OFF(wall_pressure)},
-    {"sph", "pressure_gradient", T_CHOICE, "standard", 0, 0, 0, "standard|corrected", "-",
+    {"sph", "pressure_gradient", T_CHOICE, "standard", 0, 0, 0, names_sph_pressure_gradient, "-",
      "Pressure gradient: the symmetric Grad^{gamma,1} with its wall term (thesis Eq. 3.17), or "
      "the first-order corrected difference form Eq. 2.90 (k = 0) with the matrix L of Eq. "
      "2.88 built from fluid and vertex neighbours, exact for linear pressure fields and without "
      "a wall term (Sec. 6.2.2-6.2.3; docs/theory.md).",
      OFF(pgrad)},
-    {"sph", "shifting", T_CHOICE, "none", 0, 0, 0, "none|fickian", "-",
+    {"sph", "shifting", T_CHOICE, "none", 0, 0, 0, names_sph_shifting, "-",
      "Particle shifting after each position update: none, or the Fickian shift "
      "delta r_a = -C h^2 grad C_a of Lind et al. (2012) with the anti-clustering term of "
      "Skillen et al. (2013) / Sun et al. (2017, 2018) and the walls' part of grad C_a taken "
@@ -103,7 +122,7 @@ static const struct key keys[] = {
     {"sph", "eta2", T_DOUBLE, "1e-4", 0, 1, 0, NULL, "h^2",
      "Regularisation added to r^2 in the viscous term (thesis Sec. 2.3.3), in units of h^2.",
      OFF(eta2)},
-    {"les", "model", T_CHOICE, "none", 0, 0, 0, "none|smagorinsky", "-",
+    {"les", "model", T_CHOICE, "none", 0, 0, 0, names_les_model, "-",
      "Sub-grid model: none (quasi-DNS: no model term is computed) or the Smagorinsky eddy "
      "viscosity nu_r = l_S^2 S (thesis Eq. 5.45-5.47); needs sph.viscous = violeau (Eq. 2.100 "
      "with variable viscosity).",
@@ -115,7 +134,7 @@ static const struct key keys[] = {
     {"les", "filter_width", T_DOUBLE, "2", 0, 10, LO_OPEN, NULL, "h",
      "Filter width Delta_G in units of h (thesis Sec. 5.2.2.1: 2h for the Wendland kernel).",
      OFF(filter_h)},
-    {"les", "strain", T_CHOICE, "gradient", 0, 0, 0, "gradient|violeau_issa", "-",
+    {"les", "strain", T_CHOICE, "gradient", 0, 0, 0, names_les_strain, "-",
      "Rate of strain S = (2 S:S)^(1/2) from the full velocity gradient (first-order corrected, "
      "thesis Eq. 2.88-2.90) or from the Violeau-Issa estimate with its wall term (Eq. 5.48; "
      "docs/theory.md).",
@@ -139,7 +158,7 @@ static const struct key keys[] = {
      "Yoshizawa constant C_Y of the residual kinetic energy k_r = 2 C_Y (Delta_G S)^2 (thesis "
      "Eq. 5.49), added to the pressure as 2/3 rho k_r (Eq. 5.42); 0 leaves it out.",
      OFF(cy)},
-    {"wall", "law", T_CHOICE, "laminar", 0, 0, 0, "laminar|log|reichardt", "-",
+    {"wall", "law", T_CHOICE, "laminar", 0, 0, 0, names_wall_law, "-",
      "Wall law of the wall shear term: laminar (thesis Eq. 2.146-2.148, the particle's own "
      "velocity), log law (Eq. 5.51, linear below y+ = 11.06) or Reichardt (Eq. 5.53); the "
      "turbulent laws are solved for u_tau per near-wall particle and carried to the wall "
@@ -177,7 +196,7 @@ static const struct key keys[] = {
      OFF(nu_ramp_begin)},
     {"fluid", "nu_ramp_end", T_DOUBLE, "0", 0, BIG, 0, NULL, "s",
      "End of the viscosity ramp (at least nu_ramp_begin).", OFF(nu_ramp_end)},
-    {"drive", "mode", T_CHOICE, "force", 0, 0, 0, "force|flux", "-",
+    {"drive", "mode", T_CHOICE, "force", 0, 0, 0, names_drive_mode, "-",
      "Drive the flow by a constant body force or by a controlled volume flux.", OFF(drive_mode)},
     {"drive", "force", T_DOUBLE, "0", -BIG, BIG, 0, NULL, "m/s^2",
      "Streamwise body acceleration in force mode (tau_w = rho delta force, thesis Eq. 5.14); "
@@ -185,7 +204,7 @@ static const struct key keys[] = {
      OFF(force)},
     {"drive", "u_bulk", T_DOUBLE, "0", -BIG, BIG, 0, NULL, "m/s",
      "Target bulk velocity in flux mode.", OFF(u_bulk)},
-    {"drive", "controller", T_CHOICE, "eq3.43", 0, 0, 0, "eq3.43|eq3.38", "-",
+    {"drive", "controller", T_CHOICE, "eq3.43", 0, 0, 0, names_drive_controller, "-",
      "Flux controller: thesis Eq. 3.43 (new, generalised to variable dt by Eq. 3.42) or the "
      "older Eq. 3.38.",
      OFF(controller)},
@@ -207,7 +226,7 @@ static const struct key keys[] = {
      OFF(c_gamma)},
     {"time", "max_steps", T_LONG, "0", 0, 1e18, 0, NULL, "-",
      "Stop after this many steps even if t_end is not reached (0 = no limit).", OFF(max_steps)},
-    {"init", "profile", T_CHOICE, "rest", 0, 0, 0, "rest|laminar|reichardt|wave|synthetic", "-",
+    {"init", "profile", T_CHOICE, "rest", 0, 0, 0, names_init_profile, "-",
      "Initial mean velocity: at rest; the laminar Poiseuille profile of the force (force mode) "
      "or of the target bulk velocity (flux mode); or Reichardt's turbulent profile (thesis Eq. "
      "5.53) with u_tau = (force delta)^(1/2) (force mode) or the u_tau whose profile has the "
@@ -293,7 +312,7 @@ static const struct key keys[] = {
      "Fold the upper half onto the lower one (y -> 2 delta - y, v -> -v) before binning; the "
      "bins then cover 0 .. delta.",
      OFF(stats_fold)},
-    {"stats", "method", T_CHOICE, "bins", 0, 0, 0, "bins|sph", "-",
+    {"stats", "method", T_CHOICE, "bins", 0, 0, 0, names_stats_method, "-",
      "How particles make the profiles: bin sampling (thesis Eq. 5.54-5.55), or SPH "
      "interpolation (Eq. 5.56) at the bin centres averaged over the plane, each particle "
      "weighted by V_a times the plane integral of the kernel; the means are Eq. 5.56, the "
@@ -311,7 +330,7 @@ static const struct key keys[] = {
      "window closes; every convergence line of the log gives the projected simulated and wall "
      "time to reach it. 0 = off.",
      OFF(target_stderr)},
-    {"stats", "target_profiles", T_CHOICE, "both", 0, 0, 0, "both|u_mean|uv_peak", "-",
+    {"stats", "target_profiles", T_CHOICE, "both", 0, 0, 0, names_stats_target_profiles, "-",
      "Profiles of the convergence target: u_mean and the -u'v' peak, or one of them (a laminar "
      "flow has no -u'v' to converge).",
      OFF(target_profiles)},
@@ -446,18 +465,11 @@ static const char *set_value(struct scene *s, int k, const char *text) {
     return NULL;
   }
   if (K->type == T_CHOICE) {
-    const size_t len = strlen(text);
-    int idx = 0;
-    for (const char *c = K->choices; *c; idx++) {
-      const char *bar = strchr(c, '|');
-      const size_t clen = bar ? (size_t)(bar - c) : strlen(c);
-      if (clen == len && !strncmp(c, text, len)) {
+    for (int idx = 0; K->choices[idx]; idx++)
+      if (!strcmp(K->choices[idx], text)) {
         *(int *)field = idx;
         return NULL;
       }
-      if (!bar) break;
-      c = bar + 1;
-    }
     return "is not one of the allowed choices";
   }
   if (K->type == T_LIST) {
@@ -499,8 +511,11 @@ static void range_text(const struct key *K, char *buf, size_t n) {
     snprintf(buf, n, "text");
     return;
   }
-  if (K->type == T_CHOICE) {
-    snprintf(buf, n, "%s", K->choices);
+  if (K->type == T_CHOICE) { /* "a|b|c" */
+    size_t m = 0;
+    buf[0] = '\0';
+    for (int i = 0; K->choices[i] && m < n; i++)
+      m += (size_t)snprintf(buf + m, n - m, "%s%s", i ? "|" : "", K->choices[i]);
     return;
   }
   char lo[32] = "-inf", hi[32] = "inf";
@@ -828,21 +843,14 @@ int scene_bins(const struct scene *s) {
 }
 
 const char *scene_choice(const char *key, int value) {
-  static char buf[64];
   const char *dot = strchr(key, '.');
   char sec[32];
   snprintf(sec, sizeof sec, "%.*s", (int)(dot - key), key);
   const int k = find_key(sec, dot + 1);
-  if (k < 0 || keys[k].type != T_CHOICE) return "?";
-  const char *c = keys[k].choices;
-  for (int i = 0; i < value && c; i++) {
-    c = strchr(c, '|');
-    if (c) c++;
-  }
-  if (!c) return "?";
-  const char *bar = strchr(c, '|');
-  snprintf(buf, sizeof buf, "%.*s", bar ? (int)(bar - c) : (int)strlen(c), c);
-  return buf;
+  if (k < 0 || keys[k].type != T_CHOICE || value < 0) return "?";
+  for (int i = 0; keys[k].choices[i]; i++)
+    if (i == value) return keys[k].choices[i];
+  return "?";
 }
 
 static void value_text(const struct scene *s, int k, char *buf, size_t n) {
