@@ -1,5 +1,6 @@
 /** @file ckpt.c @brief Implementation of ckpt.h (serial and parallel HDF5). */
 #include "ckpt.h"
+#include "alloc.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -447,7 +448,7 @@ static int get_attr_text(hid_t obj, const char *name, char *buf, size_t n) {
   int rc = -1;
   if (H5Tget_class(ft) == H5T_STRING && !H5Tis_variable_str(ft)) {
     const size_t sz = H5Tget_size(ft);
-    char *tmp = calloc(sz + 1, 1);
+    char *tmp = mem_calloc(sz + 1, 1, "checkpoint");
     const hid_t mt = H5Tcopy(H5T_C_S1);
     CHECK_H5(H5Tset_size(mt, sz));
     if (tmp && H5Aread(a, mt, tmp) >= 0) {
@@ -507,7 +508,7 @@ static char *read_text(hid_t file, const char *name, const char *path, char *err
     snprintf(err, errlen, "%s: dataset /%s is not a fixed-length string", path, name);
   } else {
     const size_t sz = H5Tget_size(ft);
-    text = calloc(sz + 1, 1);
+    text = mem_calloc(sz + 1, 1, "checkpoint");
     const hid_t mt = H5Tcopy(H5T_C_S1);
     CHECK_H5(H5Tset_size(mt, sz));
     if (!text || H5Dread(ds, mt, H5S_ALL, H5S_ALL, H5P_DEFAULT, text) < 0) {

@@ -12,6 +12,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "alloc.h"
 #include "ckpt.h"
 #include "error.h"
 #include "restart.h"
@@ -49,8 +50,7 @@ int rotate_list(const char *dir, long **steps) {
     if (s < 0) continue;
     if (n == cap) {
       cap = cap ? 2 * cap : 16;
-      long *t = realloc(*steps, (size_t)cap * sizeof *t);
-      if (!t) die("out of memory listing %s", path);
+      long *t = mem_realloc(*steps, (size_t)cap, sizeof *t, "checkpoint list");
       *steps = t;
     }
     (*steps)[n++] = s;

@@ -15,6 +15,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "alloc.h"
 #include "ckpt.h"
 #include "error.h"
 #include "restart.h"
@@ -141,14 +142,13 @@ char *rundir_history(const char *dir, const char *cmdline, int fresh, int ranks,
   FILE *f = fresh ? NULL : fopen(path, "r");
   if (f) {
     if (fseek(f, 0, SEEK_END) == 0 && (n = (size_t)ftell(f)) > 0 && fseek(f, 0, SEEK_SET) == 0 &&
-        (old = malloc(n + 1)))
+        (old = mem_alloc(1, n + 1, "run directory")))
       n = fread(old, 1, n, f), old[n] = '\0';
     fclose(f);
   }
   while (old && n > 0 && old[n - 1] == '\n') old[--n] = '\0';
   const size_t len = strlen(entry) + (old ? n + 1 : 0) + 1;
-  char *text = malloc(len);
-  if (!text) die("out of memory recording the history");
+  char *text = mem_alloc(1, len, "run directory");
   snprintf(text, len, "%s%s%s", entry, old && n ? "\n" : "", old && n ? old : "");
   free(old);
   FILE *w = fopen(tmp, "w");

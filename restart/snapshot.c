@@ -1,5 +1,6 @@
 /** @file snapshot.c @brief Implementation of snapshot.h. */
 #include "snapshot.h"
+#include "alloc.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -58,8 +59,7 @@ static int write_xdmf(const char *sdir, size_t n, int les) {
     if (strncmp(e->d_name, "snap_", 5) || len < 9 || strcmp(e->d_name + len - 3, ".h5")) continue;
     if (nn == cap) {
       cap = cap ? 2 * cap : 64;
-      char **t = realloc(names, cap * sizeof *t);
-      if (!t) die("out of memory");
+      char **t = mem_realloc(names, cap, sizeof *t, "snapshot list");
       names = t;
     }
     names[nn++] = strdup(e->d_name);
@@ -127,14 +127,14 @@ int snapshot_write(const char *dir, const struct sim *S) {
   enum { NC_MAX = 9 };
   const int NC = les ? 9 : 8;
   const double *src[NC_MAX] = {P->x, P->y, P->z, P->u, P->v, P->w, P->p, P->rho, P->nur};
-  double *g = root ? malloc((size_t)NC * n * sizeof *g) : NULL;
+  double *g = root ? mem_alloc(1, (size_t)NC * n * sizeof *g, "particle snapshot") : NULL;
   if (root && !g) die("out of memory writing a snapshot");
   dd_gather_fluid(&S->dd, P, NC, src, g);
   int rc = CHANSPH_OK;
   if (root) {
-    double *pos = malloc(3 * n * sizeof *pos), *vel = malloc(3 * n * sizeof *vel);
-    int64_t *id = malloc(n * sizeof *id);
-    if (!pos || !vel || !id) die("out of memory writing a snapshot");
+    double *pos = mem_alloc(1, 3 * n * sizeof *pos, "particle snapshot"),
+           *vel = mem_alloc(1, 3 * n * sizeof *vel, "particle snapshot");
+    int64_t *id = mem_alloc(1, n * sizeof *id, "particle snapshot");
     for (size_t r = 0; r < n; r++) {
       for (int k = 0; k < 3; k++)
         pos[3 * r + k] = g[k * n + r], vel[3 * r + k] = g[(3 + k) * n + r];

@@ -158,10 +158,11 @@ void dd_migrate(struct dd *d, struct particles *P, const struct nbr *nb) {
   timer_push("halo");
   const double t0 = MPI_Wtime();
   const int np = d->size;
-  int *scount = calloc((size_t)np, sizeof(int)), *rcount = calloc((size_t)np, sizeof(int));
-  int *sdisp = calloc((size_t)np + 1, sizeof(int)), *rdisp = calloc((size_t)np + 1, sizeof(int));
-  int *dest = malloc((P->n ? P->n : 1) * sizeof(int));
-  if (!scount || !rcount || !sdisp || !rdisp || !dest) die("out of memory in dd_migrate");
+  int *scount = mem_calloc((size_t)np, sizeof(int), "domain decomposition"),
+      *rcount = mem_calloc((size_t)np, sizeof(int), "domain decomposition");
+  int *sdisp = mem_calloc((size_t)np + 1, sizeof(int), "domain decomposition"),
+      *rdisp = mem_calloc((size_t)np + 1, sizeof(int), "domain decomposition");
+  int *dest = mem_alloc(1, (P->n ? P->n : 1) * sizeof(int), "domain decomposition");
   size_t leaving = 0;
   for (size_t a = 0; a < P->n; a++) {
     nbr_wrap_position(nb, &P->x[a], &P->z[a]);
@@ -172,8 +173,7 @@ void dd_migrate(struct dd *d, struct particles *P, const struct nbr *nb) {
   for (int r = 0; r < np; r++) sdisp[r + 1] = sdisp[r] + scount[r];
   reserve_buf(&d->sbuf, &d->cap_sbuf, (size_t)sdisp[np]);
   /* pack the leaving particles by destination and compact the staying ones in order */
-  int *fill = calloc((size_t)np, sizeof(int));
-  if (!fill) die("out of memory in dd_migrate");
+  int *fill = mem_calloc((size_t)np, sizeof(int), "domain decomposition");
   size_t k = 0;
   for (size_t a = 0; a < P->n; a++) {
     if (dest[a] < 0) {
@@ -455,8 +455,7 @@ size_t dd_check_ids(const struct dd *d, const struct particles *P, size_t n_tota
   long long bad = -1;
   int dup = 0;
   if (d->rank == 0) {
-    unsigned char *seen = calloc(n_total ? n_total : 1, 1);
-    if (!seen) die("out of memory checking the particle ids");
+    unsigned char *seen = mem_calloc(n_total ? n_total : 1, 1, "domain decomposition");
     for (size_t i = 0; i < total && bad < 0; i++) {
       const int64_t id = all[i];
       if (id < 0 || (size_t)id >= n_total || seen[id])

@@ -1,5 +1,6 @@
 /** @file init.c @brief Implementation of init.h. */
 #include "init.h"
+#include "alloc.h"
 
 #include <Random123/philox.h>
 #include <math.h>
@@ -108,18 +109,18 @@ static int read_source(const char *path, const struct scene *sc, struct source *
   int ok = !nc_inq_dimid(nc, "particle", &dimid) && !nc_inq_dimlen(nc, dimid, &n) &&
            !nc_inq_attlen(nc, NC_GLOBAL, "scene", &alen);
   if (ok) {
-    text = calloc(alen + 1, 1);
+    text = mem_calloc(alen + 1, 1, "initial state");
     ok = text && !nc_get_att_text(nc, NC_GLOBAL, "scene", text);
   }
   src->n = n;
   for (int c = 0; ok && c < 8; c++) {
-    src->col[c] = malloc((n ? n : 1) * sizeof(double));
+    src->col[c] = mem_alloc(1, (n ? n : 1) * sizeof(double), "initial state");
     ok = src->col[c] && !nc_inq_varid(nc, names[c], &vid) &&
          !nc_get_var_double(nc, vid, src->col[c]);
     if (!ok) error_input("%s (init.from): variable '%s' missing or unreadable", path, names[c]);
   }
   if (ok) {
-    src->id = malloc((n ? n : 1) * sizeof(long long));
+    src->id = mem_alloc(1, (n ? n : 1) * sizeof(long long), "initial state");
     ok = src->id && !nc_inq_varid(nc, "id", &vid) && !nc_get_var_longlong(nc, vid, src->id);
   }
   CHECK_NC(nc_close(nc));
@@ -212,10 +213,10 @@ static void interpolate(const struct source *src, struct particles *P) {
   const int nx = (int)fmax(1.0, floor(src->lx / cell)), ny = (int)fmax(1.0, floor(src->ly / cell));
   const int nz = src->dim == 3 ? (int)fmax(1.0, floor(src->lz / cell)) : 1;
   const size_t ncell = (size_t)nx * ny * nz;
-  size_t *start = calloc(ncell + 1, sizeof *start), *fill = malloc(ncell * sizeof *fill);
-  size_t *order = malloc((src->n ? src->n : 1) * sizeof *order);
-  int *cellof = malloc((src->n ? src->n : 1) * sizeof *cellof);
-  if (!start || !fill || !order || !cellof) die("out of memory interpolating init.from");
+  size_t *start = mem_calloc(ncell + 1, sizeof *start, "initial state"),
+         *fill = mem_alloc(1, ncell * sizeof *fill, "initial state");
+  size_t *order = mem_alloc(1, (src->n ? src->n : 1) * sizeof *order, "initial state");
+  int *cellof = mem_alloc(1, (src->n ? src->n : 1) * sizeof *cellof, "initial state");
   const double *sx = src->col[0], *sy = src->col[1], *sz = src->col[2];
 #define CELL_OF(X, Y, Z)                                         \
   (((int)fmin(nz - 1, fmax(0, floor((Z) / src->lz * nz))) * ny + \
@@ -341,12 +342,12 @@ int init_sem_make(struct init_sem *E, const struct scene *sc) {
   if (E->nx < 3) E->nx = 1;
   if (E->nz < 3) E->nz = 1;
   const size_t ncell = (size_t)E->nx * E->ny * E->nz;
-  E->pos = malloc(E->n * 3 * sizeof(double));
-  E->eps = malloc(E->n * 3 * sizeof(double));
-  E->start = calloc(ncell + 1, sizeof(size_t));
-  E->order = malloc(E->n * sizeof(size_t));
-  size_t *fill = malloc(ncell * sizeof(size_t));
-  int *cellof = malloc(E->n * sizeof(int));
+  E->pos = mem_alloc(1, E->n * 3 * sizeof(double), "initial state");
+  E->eps = mem_alloc(1, E->n * 3 * sizeof(double), "initial state");
+  E->start = mem_calloc(ncell + 1, sizeof(size_t), "initial state");
+  E->order = mem_alloc(1, E->n * sizeof(size_t), "initial state");
+  size_t *fill = mem_alloc(1, ncell * sizeof(size_t), "initial state");
+  int *cellof = mem_alloc(1, E->n * sizeof(int), "initial state");
   if (!E->pos || !E->eps || !E->start || !E->order || !fill || !cellof)
     die("out of memory for %zu synthetic eddies", E->n);
   const double lo[3] = {0.0, E->y0, 0.0}, len[3] = {E->lx, E->ly, E->lz};

@@ -1,5 +1,6 @@
 /** @file nbr.c @brief Implementation of nbr.h. */
 #include "nbr.h"
+#include "alloc.h"
 
 #include <math.h>
 #include <omp.h>
@@ -386,8 +387,8 @@ static void nbr_scratch(struct nbr *nb) {
   for (int t = 0; t < nb->scratch_threads; t++)
     part_free(nb->scratch[t]), part_free(nb->pairbuf[t]);
   free(nb->scratch), free(nb->pairbuf);
-  nb->scratch = calloc((size_t)nt, sizeof *nb->scratch);
-  nb->pairbuf = calloc((size_t)nt, sizeof *nb->pairbuf);
+  nb->scratch = mem_calloc((size_t)nt, sizeof *nb->scratch, "neighbour lists");
+  nb->pairbuf = mem_calloc((size_t)nt, sizeof *nb->pairbuf, "neighbour lists");
   if (!nb->scratch || !nb->pairbuf) die("out of memory for the neighbour scratch lists");
   const size_t bytes = (size_t)(nb->stride + NBR_ALIGN) * (sizeof(int32_t) + sizeof(double));
   for (int t = 0; t < nt; t++) {

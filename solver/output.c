@@ -1,5 +1,6 @@
 /** @file output.c @brief Implementation of output.h. */
 #include "output.h"
+#include "alloc.h"
 
 #include <errno.h>
 #include <math.h>
@@ -201,8 +202,8 @@ static void *series_reserve(void *owner, int rank, const size_t *dims) {
   struct series *ts = owner;
   if (rank != 2 || dims[1] != (size_t)ts->ncol) return NULL;
   if (dims[0] > ts->cap) {
-    double *d = realloc(ts->data, (dims[0] ? dims[0] : 1) * (size_t)ts->ncol * sizeof *d);
-    if (!d) return NULL;
+    double *d =
+        mem_realloc(ts->data, dims[0] ? dims[0] : 1, (size_t)ts->ncol * sizeof *d, "time series");
     ts->data = d, ts->cap = dims[0] ? dims[0] : 1;
   }
   ts->n = dims[0];
@@ -411,7 +412,7 @@ void output_sample(struct output *o, struct sim *S) {
   if (P->n > o->col_cap) {
     free(o->col);
     o->col_cap = P->n + P->n / 2;
-    o->col = malloc(o->col_cap * sizeof *o->col);
+    o->col = mem_alloc(1, o->col_cap * sizeof *o->col, "output");
     if (!o->col) die("out of memory for the statistics snapshot");
   }
   for (size_t a = 0; a < P->n; a++) o->col[a] = nbr_column(&S->nb, P->x[a]);
@@ -521,13 +522,12 @@ static int write_particles(struct output *o, const struct sim *S) {
     units[NC++] = f->off == offsetof(struct particles, m) && S->sc->dim == 2 ? "kg/m" : f->units;
   }
   const int root = rank0();
-  double *buf = root ? malloc(n * (size_t)NC * sizeof *buf) : NULL;
+  double *buf = root ? mem_alloc(1, n * (size_t)NC * sizeof *buf, "output") : NULL;
   if (root && !buf) die("out of memory writing particles.nc");
   dd_gather_fluid(&S->dd, P, NC, src, buf); /* rank 0: by id */
   int rc = CHANSPH_OK;
   if (root) {
-    long long *ids = malloc(n * sizeof *ids);
-    if (!ids) die("out of memory writing particles.nc");
+    long long *ids = mem_alloc(1, n * sizeof *ids, "output");
     for (size_t r = 0; r < n; r++) ids[r] = (long long)r;
     const double *cols[NC_MAX];
     for (int c = 0; c < NC; c++) cols[c] = buf + (size_t)c * n;

@@ -1,5 +1,6 @@
 /** @file run.c @brief Implementation of run.h. */
 #include "run.h"
+#include "alloc.h"
 
 #include <math.h>
 #include <mpi.h>
@@ -329,14 +330,13 @@ static void block_state(struct sim *S, size_t lo, size_t hi) {
   const int nf = ckpt_fields(P, idx), wall_col = G_FIELDS + nf;
   const size_t n = P->n, N = P->n_fluid + P->n_vertex, nb = hi - lo, R = (size_t)wall_col + 2;
   const int size = S->dd.size;
-  int *cnt = calloc(4 * (size_t)size + 2, sizeof(int)), *dest = malloc((n ? n : 1) * sizeof(int));
-  if (!cnt || !dest) die("out of memory redistributing the checkpoint state");
+  int *cnt = mem_calloc(4 * (size_t)size + 2, sizeof(int), "checkpoint state"),
+      *dest = mem_alloc(1, (n ? n : 1) * sizeof(int), "checkpoint state");
   int *sdisp = cnt + size, *rcnt = sdisp + size + 1, *rdisp = rcnt + size;
   for (size_t a = 0; a < n; a++) dest[a] = id_block_owner(P->id[a], size, N), cnt[dest[a]] += R;
   for (int r = 0; r < size; r++) sdisp[r + 1] = sdisp[r] + cnt[r];
   double *rec = part_alloc("ckpt_send", (n ? n : 1) * R * sizeof(double));
-  int *fill = calloc((size_t)size, sizeof(int));
-  if (!fill) die("out of memory redistributing the checkpoint state");
+  int *fill = mem_calloc((size_t)size, sizeof(int), "checkpoint state");
   const double *f[SIM_GATHER];
   for (int c = 0; c < nf; c++) f[c] = part_field_ptr(P, &part_fields[idx[c]]);
   for (size_t a = 0; a < n; a++) {
@@ -362,13 +362,12 @@ static void block_state(struct sim *S, size_t lo, size_t hi) {
   part_free(rec), free(fill), free(dest), free(cnt);
   for (int k = 0; k < SIM_GATHER; k++) free(S->gather[k]), S->gather[k] = NULL;
   const size_t w0 = lo > P->n_fluid ? lo : P->n_fluid, nw = hi > w0 ? hi - w0 : 0;
-  int64_t *id = malloc((nb ? nb : 1) * sizeof *id);
-  uint8_t *kind = malloc(nb ? nb : 1);
-  double *wr = malloc(2 * (nw ? nw : 1) * sizeof(double));
-  if (!id || !kind || !wr) die("out of memory redistributing the checkpoint state");
+  int64_t *id = mem_alloc(1, (nb ? nb : 1) * sizeof *id, "checkpoint state");
+  uint8_t *kind = mem_alloc(1, nb ? nb : 1, "checkpoint state");
+  double *wr = mem_alloc(1, 2 * (nw ? nw : 1) * sizeof(double), "checkpoint state");
   S->gather[G_ID] = id, S->gather[G_KIND] = kind, S->gather[wall_col] = wr;
   for (int c = G_FIELDS; c < wall_col; c++)
-    if (!(S->gather[c] = malloc((nb ? nb : 1) * sizeof(double))))
+    if (!(S->gather[c] = mem_alloc(1, (nb ? nb : 1) * sizeof(double), "checkpoint state")))
       die("out of memory redistributing the checkpoint state");
   for (size_t i = 0; i < nb; i++) { /* by id: the same file on any rank count */
     const double *r = buf + i * R;

@@ -4,6 +4,7 @@
  */
 #define _XOPEN_SOURCE 700 /* realpath */
 #include "scene.h"
+#include "alloc.h"
 
 #include <ctype.h>
 #include <ini.h>
@@ -892,8 +893,7 @@ static void value_text(const struct scene *s, int k, char *buf, size_t n) {
 
 char *scene_text(const struct scene *s) {
   size_t cap = 8192, len = 0;
-  char *out = malloc(cap);
-  if (!out) die("out of memory");
+  char *out = mem_alloc(1, cap, "scene text");
   out[0] = '\0';
   const char *section = "";
   for (int k = 0; k < N_KEYS; k++) {
@@ -907,8 +907,7 @@ char *scene_text(const struct scene *s) {
     m += snprintf(line + m, sizeof line - m, "%s = %s\n", keys[k].name, val);
     if (len + (size_t)m + 1 > cap) {
       cap *= 2;
-      out = realloc(out, cap);
-      if (!out) die("out of memory");
+      out = mem_realloc(out, cap, 1, "scene text");
     }
     memcpy(out + len, line, (size_t)m + 1);
     len += (size_t)m;

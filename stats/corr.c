@@ -248,8 +248,8 @@ static int write_axes(const struct corr *c, int g, const int d[5], double *tmp, 
      for ix > nx/2) as auxiliary coordinates of spectra */
   {
     const size_t nk = (size_t)nx * (size_t)nzh;
-    long long *ki = malloc(nk * sizeof *ki);
-    double *kk = malloc(2 * nk * sizeof *kk);
+    long long *ki = mem_alloc(1, nk * sizeof *ki, "correlations");
+    double *kk = mem_alloc(1, 2 * nk * sizeof *kk, "correlations");
     int vk, vkx, vkz;
     rc = ki && kk ? NC_NOERR : NC_ENOMEM;
     for (int i = 0; i < nx && rc == NC_NOERR; i++)
@@ -351,11 +351,11 @@ done:
 int corr_nc_write(const struct corr *c, int ncid, char *err, size_t errlen) {
   const int nl = c->cfg.n_levels, nx = c->cfg.nx, nz = c->cfg.nz, nzh = c->nzh;
   const int nxh = nx / 2 + 1;
-  double *rx = malloc((size_t)nl * 4 * nx * sizeof(double));
-  double *rz = malloc((size_t)nl * 4 * nz * sizeof(double));
-  double *ex = malloc((size_t)nl * 3 * nxh * sizeof(double));
-  double *ez = malloc((size_t)nl * 3 * nzh * sizeof(double));
-  double *tmp = malloc((size_t)(nx > nz ? nx : nz) * 4 * sizeof(double));
+  double *rx = mem_alloc(1, (size_t)nl * 4 * nx * sizeof(double), "correlations");
+  double *rz = mem_alloc(1, (size_t)nl * 4 * nz * sizeof(double), "correlations");
+  double *ex = mem_alloc(1, (size_t)nl * 3 * nxh * sizeof(double), "correlations");
+  double *ez = mem_alloc(1, (size_t)nl * 3 * nzh * sizeof(double), "correlations");
+  double *tmp = mem_alloc(1, (size_t)(nx > nz ? nx : nz) * 4 * sizeof(double), "correlations");
   int rc = NC_NOERR, g, dl, dx, dz, dkx, dkz, dkk, dsl, v;
   corr_results(c, rx, rz, ex, ez);
   CK(nc_def_grp(ncid, "correlations", &g));

@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "alloc.h"
 #include "engine.h"
 #include "euler.h"
 #include "moments.h"
@@ -20,7 +21,7 @@
 
 void euler_running_result(const struct euler *e, struct euler_result *res) {
   const size_t rows = euler_rows(e);
-  int *complete = calloc(rows ? rows : 1, sizeof *complete);
+  int *complete = mem_calloc(rows ? rows : 1, sizeof *complete, "Eulerian statistics");
   for (size_t r = 0; r < rows; r++) complete[r] = r < e->nwin;
   euler_finalise(&e->cfg, e->win, e->mom, e->snp, e->pln, complete, 0, rows, res);
   free(complete);
@@ -122,7 +123,8 @@ fail:
 static int def_window_axis(const struct euler *e, int g, int dw, char *err, size_t errlen) {
   const size_t rows = euler_rows(e);
   int rc = NC_NOERR;
-  double *mid = malloc(3 * (rows ? rows : 1) * sizeof *mid), *t0 = mid + rows, *t1 = t0 + rows;
+  double *mid = mem_alloc(1, 3 * (rows ? rows : 1) * sizeof *mid, "Eulerian statistics"),
+         *t0 = mid + rows, *t1 = t0 + rows;
   if (!mid) CK(NC_ENOMEM);
   for (size_t w = 0; w < rows; w++) {
     t0[w] = e->win[w * WIN_LEN + WIN_T0], t1[w] = e->win[w * WIN_LEN + WIN_T1];
@@ -220,7 +222,7 @@ static int write_eulerian(const struct euler *e, double t_reached, int ncid, cha
   struct euler_result r;
   euler_running_result(e, &r);
   const size_t nb = (size_t)e->cfg.nb;
-  double *lo = malloc(2 * nb * sizeof *lo), *hi = lo + nb;
+  double *lo = mem_alloc(1, 2 * nb * sizeof *lo, "Eulerian statistics"), *hi = lo + nb;
   if (!lo) return NC_ENOMEM;
   bin_bounds(&e->cfg, lo, hi);
   CK(nc_def_dim(ncid, "y", nb, &dy));

@@ -1,5 +1,6 @@
 /** @file extract.c @brief Implementation of extract.h. */
 #include "extract.h"
+#include "alloc.h"
 
 #include <errno.h>
 #include <getopt.h>
@@ -98,10 +99,10 @@ static int read_stored(const char *path, struct stored *s) {
   if (!bad) {
     s->cfg.nb = (int)nb;
     const size_t r = s->rows ? s->rows : 1;
-    s->win = malloc(r * WIN_LEN * sizeof(double));
-    s->mom = malloc(r * nb * MOM_LEN * sizeof(double));
-    s->snp = malloc(r * nb * SCAL_LEN * sizeof(double));
-    s->complete = malloc(r * sizeof(int));
+    s->win = mem_alloc(1, r * WIN_LEN * sizeof(double), "chansph extract");
+    s->mom = mem_alloc(1, r * nb * MOM_LEN * sizeof(double), "chansph extract");
+    s->snp = mem_alloc(1, r * nb * SCAL_LEN * sizeof(double), "chansph extract");
+    s->complete = mem_alloc(1, r * sizeof(int), "chansph extract");
     if (s->rows && (nc_get_var_double(g, vw, s->win) || nc_get_var_double(g, vm, s->mom) ||
                     nc_get_var_double(g, vs, s->snp) || nc_get_var_int(g, vc, s->complete))) {
       fprintf(stderr, "error: %s: cannot read the raw windows\n", path);
@@ -109,7 +110,7 @@ static int read_stored(const char *path, struct stored *s) {
     }
     int vp; /* the momentum budget: absent in files of earlier versions */
     if (!bad && s->rows && nc_inq_varid(g, "planes", &vp) == NC_NOERR) {
-      s->pln = malloc(r * nb * PL_LEN * sizeof(double));
+      s->pln = mem_alloc(1, r * nb * PL_LEN * sizeof(double), "chansph extract");
       if (!s->pln || nc_get_var_double(g, vp, s->pln)) {
         fprintf(stderr, "error: %s: cannot read the raw windows (planes)\n", path);
         bad = 1;
@@ -342,7 +343,7 @@ int compare_main(int argc, char **argv, const char *stats_dir) {
      in PATH); the Debian one by default */
   const char *env = getenv("CHANSPH_PYTHON");
   const char *py = env && env[0] ? env : "/usr/bin/python3";
-  char **args = calloc((size_t)argc + 3, sizeof *args);
+  char **args = mem_calloc((size_t)argc + 3, sizeof *args, "chansph extract");
   if (!args) return 1;
   args[0] = (char *)py, args[1] = script;
   for (int i = 0; i < argc; i++) args[2 + i] = argv[i];

@@ -375,7 +375,7 @@ int lagr_warnings(const struct lagr *g, char *buf, size_t len) {
                           c->horizon);
     return 1;
   }
-  double *fn = malloc(LF_LEN * nlag * sizeof(double));
+  double *fn = mem_alloc(1, LF_LEN * nlag * sizeof(double), "Lagrangian statistics");
   if (!fn) return 0;
   for (int l = 0; l < c->n_levels && m < len; l++) {
     double tl[3];
@@ -413,7 +413,7 @@ int lagr_warnings(const struct lagr *g, char *buf, size_t len) {
 #define CK(call) NC_TRY(call, done)
 
 static int put_rows(int g, int v, int level, size_t n, const double *src) {
-  double *tmp = malloc(n * sizeof *tmp);
+  double *tmp = mem_alloc(1, n * sizeof *tmp, "Lagrangian statistics");
   for (size_t i = 0; i < n; i++) tmp[i] = isfinite(src[i]) ? src[i] : NC_FILL_DOUBLE;
   const size_t st[2] = {(size_t)level, 0}, ct[2] = {1, n};
   const int rc = nc_put_vara_double(g, v, st, ct, tmp);
@@ -428,7 +428,7 @@ static int write_integral_times(const struct lagr *g, int gr, int dl, int dc, co
   const int nl = g->cfg.n_levels;
   int rc = NC_NOERR, v;
   const int dlc[2] = {dl, dc};
-  double *a = malloc((size_t)nl * 9 * sizeof(double));
+  double *a = mem_alloc(1, (size_t)nl * 9 * sizeof(double), "Lagrangian statistics");
   for (int l = 0; l < nl; l++)
     for (int i = 0; i < 3; i++) {
       const double *W = g->tl + ((size_t)l * 3 + (size_t)i) * SCAL_LEN;
@@ -465,7 +465,7 @@ static int write_pdfs(const struct lagr *g, int gr, int dl, double *tmp, char *e
   for (int b = 0; b < nb; b++) tmp[b] = (b + 0.5) * 2.0 * c->delta / nb;
   CK(ncout_def(gr, "pdf_bin", NC_DOUBLE, 1, &db, "m", "y at the centre of the PDF bin", &v));
   {
-    double *lo = malloc(2 * (size_t)nb * sizeof *lo), *hi = lo + nb;
+    double *lo = mem_alloc(1, 2 * (size_t)nb * sizeof *lo, "Lagrangian statistics"), *hi = lo + nb;
     rc = lo ? NC_NOERR : NC_ENOMEM;
     for (int b = 0; b < nb && lo; b++)
       lo[b] = b * 2.0 * c->delta / nb, hi[b] = (b + 1) * 2.0 * c->delta / nb;
@@ -507,9 +507,9 @@ int lagr_nc_write(const struct lagr *g, int ncid, char *err, size_t errlen) {
   const struct lagr_config *c = &g->cfg;
   const int nl = c->n_levels, ns = c->n_stations, nb = c->pdf_bins;
   const size_t nlag = g->nlag;
-  double *fn = malloc((size_t)nl * LF_LEN * nlag * sizeof(double));
-  double *tl = malloc((size_t)nl * 3 * sizeof(double));
-  double *tmp = malloc((nlag + (size_t)nb + 16) * sizeof(double));
+  double *fn = mem_alloc(1, (size_t)nl * LF_LEN * nlag * sizeof(double), "Lagrangian statistics");
+  double *tl = mem_alloc(1, (size_t)nl * 3 * sizeof(double), "Lagrangian statistics");
+  double *tmp = mem_alloc(nlag + (size_t)nb + 16, sizeof(double), "Lagrangian statistics");
   int rc = NC_NOERR, gr, dl, dk, dc, v;
   for (int l = 0; l < nl; l++) lagr_functions(g, l, fn + (size_t)l * LF_LEN * nlag, tl + 3 * l);
   CK(nc_def_grp(ncid, "lagrangian", &gr));

@@ -1,5 +1,6 @@
 /** @file ncout.c @brief Implementation of ncout.h. */
 #include "ncout.h"
+#include "alloc.h"
 
 #include "stats.h"
 
@@ -101,7 +102,7 @@ int ncout_fill(int ncid, int varid) {
 
 int ncout_put_filled(int ncid, int varid, const size_t *start, const size_t *count, const double *v,
                      size_t n) {
-  double *tmp = malloc((n ? n : 1) * sizeof *tmp);
+  double *tmp = mem_alloc(1, (n ? n : 1) * sizeof *tmp, "netCDF output");
   if (!tmp) return NC_ENOMEM;
   for (size_t i = 0; i < n; i++) tmp[i] = isfinite(v[i]) ? v[i] : NCOUT_FILL;
   const int rc = start ? nc_put_vara_double(ncid, varid, start, count, tmp)
@@ -129,7 +130,7 @@ int ncout_bounds(int ncid, const char *name, int varid, int dimid, const char *u
   const int dims[2] = {dimid, db};
   if (rc == NC_NOERR) rc = nc_put_att_text(ncid, varid, "bounds", strlen(bname), bname);
   if (rc == NC_NOERR) rc = def_var(ncid, bname, NC_DOUBLE, 2, dims, units, long_name, &v);
-  double *b = malloc((n ? 2 * n : 1) * sizeof *b);
+  double *b = mem_alloc(1, (n ? 2 * n : 1) * sizeof *b, "netCDF output");
   if (!b) return NC_ENOMEM;
   for (size_t i = 0; i < n; i++) b[2 * i] = lo[i], b[2 * i + 1] = hi[i];
   if (rc == NC_NOERR && n) rc = nc_put_var_double(ncid, v, b);
@@ -157,8 +158,8 @@ int ncout_stats(const char *path, const struct stats *st, const struct series *t
   }
   /* time series, column by column, on the unlimited dimension time */
   NC(nc_def_dim(ncid, "time", NC_UNLIMITED, &dt));
-  int *vts = malloc((size_t)ts->ncol * sizeof *vts);
-  double *col = malloc((ts->n ? ts->n : 1) * sizeof *col);
+  int *vts = mem_alloc(1, (size_t)ts->ncol * sizeof *vts, "netCDF output");
+  double *col = mem_alloc(1, (ts->n ? ts->n : 1) * sizeof *col, "netCDF output");
   int rc = vts && col ? NC_NOERR : NC_ENOMEM;
   for (int c = 0; c < ts->ncol && rc == NC_NOERR; c++) {
     rc = def_var(ncid, ts->names[c], NC_DOUBLE, 1, &dt, ts->units[c],
@@ -197,7 +198,7 @@ int ncout_columns(const char *path, const char *title, const char *dim, size_t n
   NC(nc_put_att_text(ncid, NC_GLOBAL, "source", 7, "chansph"));
   NC(nc_def_dim(ncid, dim, n, &d));
   if (ids) NC(def_var(ncid, "id", NC_INT64, 1, &d, "1", "particle id", &vid));
-  int *v = malloc((size_t)ncol * sizeof *v);
+  int *v = mem_alloc(1, (size_t)ncol * sizeof *v, "netCDF output");
   if (!v) {
     snprintf(err, errlen, "out of memory writing %s", path);
     nc_close(ncid), remove(tmp);
