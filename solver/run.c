@@ -22,10 +22,29 @@ double sim_viscosity(const struct scene *sc, double t) {
   return sc->nu_start + f * (sc->nu - sc->nu_start);
 }
 
-/* Model terms of the current state, at the viscosity of the schedule. */
+/* Model terms of the current state, at the viscosity of the schedule (turb.h), with the ghosts'
+   copies refreshed after each pass whose results the next one reads at neighbours. */
 static void model_update(struct sim *S) {
+  const struct model *M = &S->M;
+  struct particles *P = &S->P;
   S->M.nu = sim_viscosity(S->sc, S->t);
-  S->nu_max = turb_update(&S->M, &S->P, &S->nb, &S->W, &S->dd);
+  S->nu_max = M->nu;
+  if (M->wall_tau) {
+    turb_wall_law(M, P, &S->nb, &S->W);
+    double *const wt[2] = {S->W.tx, S->W.tz};
+    dd_update_walls(&S->dd, P, 2, wt);
+  }
+  if (M->les) {
+    S->nu_max = turb_eddy_viscosity(M, P, &S->nb, &S->W);
+    double *const nk[2] = {P->nur, P->kr};
+    dd_update(&S->dd, P, 2, nk); /* read at neighbours by the forces and by turb_kr_pressure */
+    if (M->cy > 0.0) {
+      turb_kr_pressure(M, P, &S->nb, &S->W);
+      double *const pr[1] = {P->pr2}, *const wp[1] = {S->W.p};
+      dd_update(&S->dd, P, 1, pr);
+      dd_update_walls(&S->dd, P, 1, wp);
+    }
+  }
   reduce_global_max(&S->nu_max, 1);
 }
 

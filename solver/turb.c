@@ -248,7 +248,7 @@ static CHANSPH_CLONES double violeau_issa_sum(const struct model *M, const struc
   return sum;
 }
 
-/* Steps 1-2 of turb_update: the wall-law stress of the near-wall fluid particles (from each
+/* turb_wall_law: the wall-law stress of the near-wall fluid particles (from each
    particle's own values: the ghosts compute theirs too) and its Shepard interpolation to the
    vertices, rho_s u_tau u_tau = (1/alpha) sum_b V_b rho_b u_tau,b u_tau,b w_bs (Ferrand
    Eq. 38). */
@@ -285,8 +285,8 @@ static void wall_law_stresses(const struct model *M, struct particles *P, const 
   }
 }
 
-/* Step 3 at the current state (not les.strain_lag, or a run's first step): rate of strain,
-   damping, nu_r and k_r of every owned particle; returns the largest nu + nu_r. */
+/* turb_eddy_viscosity at the current state (not les.strain_lag, or a run's first step): rate of
+   strain, damping, nu_r and k_r of every owned particle; returns the largest nu + nu_r. */
 static double eddy_viscosity(const struct model *M, struct particles *P, const struct nbr *nb,
                              const struct walls *W) {
   const double two_h = 2.0 * M->h, nu = M->nu, ih = M->k.inv_h;
@@ -324,8 +324,8 @@ static double eddy_viscosity(const struct model *M, struct particles *P, const s
   return numax;
 }
 
-/* Step 4: the residual kinetic energy in the pressure, p + 2/3 rho k_r, for fluid and vertex
-   particles (k_r of a vertex by Shepard interpolation) and the wall pressure. */
+/* turb_kr_pressure: the residual kinetic energy in the pressure, p + 2/3 rho k_r, for fluid and
+   vertex particles (k_r of a vertex by Shepard interpolation) and the wall pressure. */
 static void kr_pressure(const struct model *M, struct particles *P, const struct nbr *nb,
                         struct walls *W) {
   const double *restrict rho = P->rho, *restrict kr = P->kr;
@@ -344,18 +344,18 @@ static void kr_pressure(const struct model *M, struct particles *P, const struct
   }
 }
 
-double turb_update(const struct model *M, struct particles *P, const struct nbr *nb,
-                   struct walls *W, struct dd *dd) {
-  if (!M->wall_tau) return M->nu;
+void turb_wall_law(const struct model *M, struct particles *P, const struct nbr *nb,
+                   struct walls *W) {
   timer_push("wall_law");
-  wall_law_stresses(M, P, nb, W); /* 1-2 */
+  wall_law_stresses(M, P, nb, W);
   timer_pop();
-  double *const wt[2] = {W->tx, W->tz};
-  if (dd) dd_update_walls(dd, P, 2, wt);
-  if (!M->les) return M->nu;
+}
+
+double turb_eddy_viscosity(const struct model *M, struct particles *P, const struct nbr *nb,
+                           const struct walls *W) {
   timer_push("les");
-  /* 3. with les.strain_lag the last force pass has formed nu_r and k_r (except on a run's first
-        step): only their maximum is taken here */
+  /* with les.strain_lag the last force pass has formed nu_r and k_r (except on a run's first
+     step): only their maximum is taken here */
   double numax = M->nu;
   if (P->nur_live) {
     const double nu = M->nu, *restrict nur = P->nur;
@@ -365,14 +365,13 @@ double turb_update(const struct model *M, struct particles *P, const struct nbr 
   } else {
     numax = eddy_viscosity(M, P, nb, W);
   }
-  double *const nk[2] = {P->nur, P->kr};
-  if (dd) dd_update(dd, P, 2, nk);           /* read at neighbours by the forces and by step 4 */
-  if (M->cy > 0.0) kr_pressure(M, P, nb, W); /* 4 */
   timer_pop();
-  if (dd && M->cy > 0.0) {
-    double *const pr[1] = {P->pr2}, *const wp[1] = {W->p};
-    dd_update(dd, P, 1, pr);
-    dd_update_walls(dd, P, 1, wp);
-  }
   return numax;
+}
+
+void turb_kr_pressure(const struct model *M, struct particles *P, const struct nbr *nb,
+                      struct walls *W) {
+  timer_push("les");
+  kr_pressure(M, P, nb, W);
+  timer_pop();
 }

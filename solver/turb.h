@@ -4,8 +4,9 @@
  *        Smagorinsky eddy viscosity with van Driest damping and Yoshizawa's residual kinetic
  *        energy (thesis Sec. 5.2.2). Quasi-DNS with the laminar wall law never calls it.
  *
- * Order within a step (run.c): after the density and the wall values of the new positions,
- * turb_update computes
+ * Order within a step (run.c, model_update, which also refreshes the ghosts between the
+ * passes: as for sph.h, the passes never exchange halos themselves): after the density and
+ * the wall values of the new positions,
  *  1. the wall-law stress rho u_tau^2 e_t of every fluid particle within 2h of a wall (walllaw.h),
  *  2. the wall stress rho_s u_tau u_tau of the vertices by Shepard interpolation (Ferrand
  *     Eq. 38),
@@ -34,18 +35,30 @@ void turb_init(const struct model *M, struct particles *P, struct walls *W);
 void turb_free(struct particles *P, struct walls *W);
 
 /**
- * @brief Model terms of the current state (see the file comment).
- * @param[in] M model (M->nu is the viscosity of the schedule at this time)
- * @param[in,out] P particles (twx, twz, nur, kr, pr2)
- * @param[in] nb neighbour list of the current positions
- * @param[in,out] W wall lattice (tx, tz; p gains 2/3 rho k_r)
- * @param[in,out] dd decomposition: the ghosts' copies of what the next pass reads are refreshed
- *                   after each pass (NULL: one rank, no ghosts)
- * @return the largest nu + nu_r over this rank's fluid particles [m^2/s], for the viscous
- *         time step (the caller takes the maximum over the ranks)
+ * @brief Steps 1-2: the wall-law stress of the near-wall fluid particles (ghosts included: they
+ *        compute their own) and its Shepard interpolation to the vertices (W->tx, W->tz); the
+ *        caller then refreshes the vertex ghosts' wall values.
  */
-double turb_update(const struct model *M, struct particles *P, const struct nbr *nb,
-                   struct walls *W, struct dd *dd);
+void turb_wall_law(const struct model *M, struct particles *P, const struct nbr *nb,
+                   struct walls *W);
+
+/**
+ * @brief Step 3 (LES): nu_r and k_r of the owned particles at the current state, or, with
+ *        les.strain_lag after the first step, those the last force pass formed; the caller
+ *        then refreshes them at the ghosts.
+ * @return the largest nu + nu_r over this rank's fluid particles [m^2/s] (M->nu is the
+ *         viscosity of the schedule; the caller takes the maximum over the ranks)
+ */
+double turb_eddy_viscosity(const struct model *M, struct particles *P, const struct nbr *nb,
+                           const struct walls *W);
+
+/**
+ * @brief Step 4 (LES, C_Y > 0): p/rho^2 of fluid and vertex particles and the wall pressure
+ *        gain 2/3 rho k_r (k_r of a vertex by Shepard); the caller then refreshes pr2 and the
+ *        wall pressure at the ghosts.
+ */
+void turb_kr_pressure(const struct model *M, struct particles *P, const struct nbr *nb,
+                      struct walls *W);
 
 /**
  * @brief nu_r and k_r of fluid particle a from its corrected velocity-gradient sums A and B (as
@@ -57,8 +70,8 @@ void turb_model_gradient(const struct model *M, const struct particles *P, const
 
 /**
  * @brief les.strain_lag, after the force pass: the nu_r and k_r it formed (P->nur_next,
- *        P->kr_next) become those of the next step (P->nur_live = 1), which turb_update then
- *        only refreshes at the ghosts and adds to the pressure.
+ *        P->kr_next) become those of the next step (P->nur_live = 1), which model_update (run.c)
+ *        then only refreshes at the ghosts and adds to the pressure.
  */
 void turb_advance(struct particles *P);
 
