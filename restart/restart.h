@@ -8,8 +8,8 @@
 #define CHANSPH_RESTART_H
 
 #include "output.h"
-#include "run.h"
 #include "scene.h"
+#include "sim.h"
 
 /** Exit codes of chansph (also in `chansph --help` and docs/batch-jobs.md). */
 enum exit_code {

@@ -7,7 +7,7 @@
 #ifndef CHANSPH_SNAPSHOT_H
 #define CHANSPH_SNAPSHOT_H
 
-#include "run.h"
+#include "sim.h"
 
 /**
  * @brief Is a snapshot due after this step? True when the step crossed a multiple of

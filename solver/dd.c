@@ -508,3 +508,25 @@ void dd_gather_fluid(const struct dd *d, const struct particles *P, int nf, cons
     }
   free(buf), free(cnts), free(disp), free(all);
 }
+
+double *dd_exchange(int size, const int *dest, size_t n, const double *rec, size_t R, size_t *got) {
+  int *cnt = mem_calloc(4 * (size_t)size + 2, sizeof(int), "record exchange");
+  int *sdisp = cnt + size, *rcnt = sdisp + size + 1, *rdisp = rcnt + size;
+  for (size_t a = 0; a < n; a++) cnt[dest[a]] += (int)R;
+  for (int r = 0; r < size; r++) sdisp[r + 1] = sdisp[r] + cnt[r];
+  double *send = part_alloc("exchange_send", (n ? n : 1) * R * sizeof(double));
+  int *fill = mem_calloc((size_t)size, sizeof(int), "record exchange");
+  for (size_t a = 0; a < n; a++) { /* by destination, each in the order given */
+    memcpy(send + sdisp[dest[a]] + fill[dest[a]], rec + a * R, R * sizeof(double));
+    fill[dest[a]] += (int)R;
+  }
+  CHECK_MPI(MPI_Alltoall(cnt, 1, MPI_INT, rcnt, 1, MPI_INT, MPI_COMM_WORLD));
+  rdisp[0] = 0;
+  for (int r = 1; r < size; r++) rdisp[r] = rdisp[r - 1] + rcnt[r - 1];
+  *got = (size_t)(rdisp[size - 1] + rcnt[size - 1]) / R;
+  double *buf = part_alloc("exchange_recv", (*got ? *got : 1) * R * sizeof(double));
+  CHECK_MPI(
+      MPI_Alltoallv(send, cnt, sdisp, MPI_DOUBLE, buf, rcnt, rdisp, MPI_DOUBLE, MPI_COMM_WORLD));
+  part_free(send), free(fill), free(cnt);
+  return buf;
+}

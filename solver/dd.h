@@ -129,4 +129,13 @@ size_t dd_check_ids(const struct dd *d, const struct particles *P, size_t n_tota
  */
 int dd_balance(struct dd *d, struct nbr *nb, double threshold);
 
+/**
+ * @brief Send record a (R doubles at rec + a R) of this rank's n records to rank dest[a] and
+ *        receive what every rank sends here: by source rank, each rank's records in the order
+ *        it gave them. Collective over MPI_COMM_WORLD (the checkpoint's id blocks use it).
+ * @param[out] got the number of records received
+ * @return the received records (free with part_free)
+ */
+double *dd_exchange(int size, const int *dest, size_t n, const double *rec, size_t R, size_t *got);
+
 #endif

@@ -9,8 +9,8 @@
 #include <stdio.h>
 
 #include "health.h"
-#include "run.h"
 #include "series.h"
+#include "sim.h"
 #include "state.h"
 #include "stats.h"
 

@@ -4,7 +4,7 @@
  *        Smagorinsky eddy viscosity with van Driest damping and Yoshizawa's residual kinetic
  *        energy (thesis Sec. 5.2.2). Quasi-DNS with the laminar wall law never calls it.
  *
- * Order within a step (run.c, model_update, which also refreshes the ghosts between the
+ * Order within a step (sim.c, model_update, which also refreshes the ghosts between the
  * passes: as for sph.h, the passes never exchange halos themselves): after the density and
  * the wall values of the new positions,
  *  1. the wall-law stress rho u_tau^2 e_t of every fluid particle within 2h of a wall (walllaw.h),
@@ -70,7 +70,7 @@ void turb_model_gradient(const struct model *M, const struct particles *P, const
 
 /**
  * @brief les.strain_lag, after the force pass: the nu_r and k_r it formed (P->nur_next,
- *        P->kr_next) become those of the next step (P->nur_live = 1), which model_update (run.c)
+ *        P->kr_next) become those of the next step (P->nur_live = 1), which model_update (sim.c)
  *        then only refreshes at the ghosts and adds to the pressure.
  */
 void turb_advance(struct particles *P);

@@ -20,7 +20,7 @@
 #include <string.h>
 
 #include "health.h"
-#include "run.h"
+#include "sim.h"
 
 /** Internal energy per unit mass of the Tait equation with background pressure pb. */
 static double internal_energy(const struct eos *e, double rho) {

@@ -14,8 +14,8 @@
 #include <stdint.h>
 #include <stdio.h>
 
-#include "run.h"
 #include "shift.h"
+#include "sim.h"
 
 /* A number in [-1, 1) from (id, component): splitmix64. */
 static double hash_unit(int64_t id, int c) {

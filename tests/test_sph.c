@@ -8,7 +8,7 @@
 #include <mpi.h>
 #include <stdio.h>
 
-#include "run.h"
+#include "sim.h"
 #include "wall.h"
 
 static int check(const char *name, char **set, int nset) {

@@ -21,7 +21,7 @@
 #include <mpi.h>
 #include <stdio.h>
 
-#include "run.h"
+#include "sim.h"
 #include "turb.h"
 #include "wall.h"
 

@@ -17,7 +17,7 @@
 #include "health.h"
 #include "output.h"
 #include "restart.h"
-#include "run.h"
+#include "sim.h"
 #include "snapshot.h"
 
 /** Write a checkpoint and tell the triggers how long it took. */

@@ -10,7 +10,7 @@
 
 #include "alloc.h"
 #include "error.h"
-#include "run.h"
+#include "sim.h"
 #include "timers.h"
 
 /* One entry per command: its name and its usage lines (cli_usage prints them all, and

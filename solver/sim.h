@@ -1,10 +1,10 @@
 /**
- * @file run.h
+ * @file sim.h
  * @brief The simulation state and one time step (thesis Eq. 2.159 with the continuity
  *        equation 3.64), plus diagnostics. The step loop itself is in chansph.c.
  */
-#ifndef CHANSPH_RUN_H
-#define CHANSPH_RUN_H
+#ifndef CHANSPH_SIM_H
+#define CHANSPH_SIM_H
 
 #include "dd.h"
 #include "forcing.h"

@@ -1,5 +1,5 @@
-/** @file run.c @brief Implementation of run.h. */
-#include "run.h"
+/** @file sim.c @brief Implementation of sim.h. */
+#include "sim.h"
 #include "alloc.h"
 
 #include <math.h>
@@ -349,18 +349,13 @@ static void block_state(struct sim *S, size_t lo, size_t hi) {
   const int nf = ckpt_fields(P, idx), wall_col = G_FIELDS + nf;
   const size_t n = P->n, N = P->n_fluid + P->n_vertex, nb = hi - lo, R = (size_t)wall_col + 2;
   const int size = S->dd.size;
-  int *cnt = mem_calloc(4 * (size_t)size + 2, sizeof(int), "checkpoint state"),
-      *dest = mem_alloc(1, (n ? n : 1) * sizeof(int), "checkpoint state");
-  int *sdisp = cnt + size, *rcnt = sdisp + size + 1, *rdisp = rcnt + size;
-  for (size_t a = 0; a < n; a++) dest[a] = id_block_owner(P->id[a], size, N), cnt[dest[a]] += R;
-  for (int r = 0; r < size; r++) sdisp[r + 1] = sdisp[r] + cnt[r];
+  int *dest = mem_alloc(n ? n : 1, sizeof(int), "checkpoint state");
   double *rec = part_alloc("ckpt_send", (n ? n : 1) * R * sizeof(double));
-  int *fill = mem_calloc((size_t)size, sizeof(int), "checkpoint state");
   const double *f[SIM_GATHER];
   for (int c = 0; c < nf; c++) f[c] = part_field_ptr(P, &part_fields[idx[c]]);
   for (size_t a = 0; a < n; a++) {
-    double *r = rec + sdisp[dest[a]] + fill[dest[a]];
-    fill[dest[a]] += (int)R;
+    dest[a] = id_block_owner(P->id[a], size, N);
+    double *r = rec + a * R;
     memcpy(&r[G_ID], &P->id[a], sizeof(double));
     r[G_KIND] = P->kind[a];
     for (int c = 0; c < nf; c++) r[G_FIELDS + c] = f[c][a];
@@ -370,15 +365,10 @@ static void block_state(struct sim *S, size_t lo, size_t hi) {
       r[wall_col] = S->W.rho[slot], r[wall_col + 1] = S->W.p[slot];
     }
   }
-  CHECK_MPI(MPI_Alltoall(cnt, 1, MPI_INT, rcnt, 1, MPI_INT, MPI_COMM_WORLD));
-  rdisp[0] = 0;
-  for (int r = 1; r < size; r++) rdisp[r] = rdisp[r - 1] + rcnt[r - 1];
-  const size_t got = (size_t)(rdisp[size - 1] + rcnt[size - 1]) / R;
+  size_t got;
+  double *buf = dd_exchange(size, dest, n, rec, R, &got);
   if (got != nb) die("checkpoint blocks: %zu particles arrived for the %zu ids %zu..", got, nb, lo);
-  double *buf = part_alloc("ckpt_recv", (nb ? nb : 1) * R * sizeof(double));
-  CHECK_MPI(
-      MPI_Alltoallv(rec, cnt, sdisp, MPI_DOUBLE, buf, rcnt, rdisp, MPI_DOUBLE, MPI_COMM_WORLD));
-  part_free(rec), free(fill), free(dest), free(cnt);
+  part_free(rec), free(dest);
   for (int k = 0; k < SIM_GATHER; k++) free(S->gather[k]), S->gather[k] = NULL;
   const size_t w0 = lo > P->n_fluid ? lo : P->n_fluid, nw = hi > w0 ? hi - w0 : 0;
   int64_t *id = mem_alloc(1, (nb ? nb : 1) * sizeof *id, "checkpoint state");
