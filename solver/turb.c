@@ -31,9 +31,8 @@ double turb_van_driest(double yplus, double a_plus) {
   return -expm1(-yplus / a_plus); /* 1 - exp(-y+/A+) */
 }
 
-double turb_strain_gradient(int dim, const double A[6], const double B[9]) {
-  double G[3][3];
-  for (int i = 0; i < 3; i++) sph_solve_sym(dim, A, B + 3 * i, G[i]); /* row i of B L */
+/** S = (2 S:S)^(1/2) of the velocity gradient G, S = (G + G^T)/2. */
+static double strain_rate(int dim, const double G[3][3]) {
   double s2 = 0.0;
   for (int i = 0; i < dim; i++)
     for (int j = 0; j < dim; j++) {
@@ -41,6 +40,12 @@ double turb_strain_gradient(int dim, const double A[6], const double B[9]) {
       s2 += 2.0 * sij * sij;
     }
   return sqrt(s2);
+}
+
+double turb_strain_gradient(int dim, const double A[6], const double B[9]) {
+  double G[3][3];
+  for (int i = 0; i < 3; i++) sph_solve_sym(dim, A, B + 3 * i, G[i]); /* row i of B L */
+  return strain_rate(dim, G);
 }
 
 /** Positive root of S^3 - a S - b = 0 (a, b >= 0): the Violeau-Issa estimate solved for S
@@ -122,13 +127,7 @@ static double strain_gradient_inverse(int dim, const double A[6], const double B
   for (int i = 0; i < 3; i++)
     for (int j = 0; j < 3; j++)
       G[i][j] = B[3 * i] * L[0][j] + B[3 * i + 1] * L[1][j] + B[3 * i + 2] * L[2][j];
-  double s2 = 0.0;
-  for (int i = 0; i < dim; i++)
-    for (int j = 0; j < dim; j++) {
-      const double sij = 0.5 * (G[i][j] + G[j][i]);
-      s2 += 2.0 * sij * sij;
-    }
-  return sqrt(s2);
+  return strain_rate(dim, G);
 }
 
 void turb_model_gradient(const struct model *M, const struct particles *P, const struct walls *W,
