@@ -32,7 +32,7 @@ double turb_van_driest(double yplus, double a_plus) {
 }
 
 /** S = (2 S:S)^(1/2) of the velocity gradient G, S = (G + G^T)/2. */
-static double strain_rate(int dim, const double G[3][3]) {
+static double strain_rate(int dim, double G[3][3]) {
   double s2 = 0.0;
   for (int i = 0; i < dim; i++)
     for (int j = 0; j < dim; j++) {
