@@ -251,7 +251,7 @@ static int write_axes(const struct corr *c, int g, const int d[5], double *tmp, 
     long long *ki = mem_alloc(1, nk * sizeof *ki, "correlations");
     double *kk = mem_alloc(1, 2 * nk * sizeof *kk, "correlations");
     int vk, vkx, vkz;
-    rc = ki && kk ? NC_NOERR : NC_ENOMEM;
+    rc = NC_NOERR;
     for (int i = 0; i < nx && rc == NC_NOERR; i++)
       for (int k = 0; k < nzh; k++) {
         const size_t j = (size_t)i * (size_t)nzh + (size_t)k;

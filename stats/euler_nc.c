@@ -125,7 +125,6 @@ static int def_window_axis(const struct euler *e, int g, int dw, char *err, size
   int rc = NC_NOERR;
   double *mid = mem_alloc(1, 3 * (rows ? rows : 1) * sizeof *mid, "Eulerian statistics"),
          *t0 = mid + rows, *t1 = t0 + rows;
-  if (!mid) CK(NC_ENOMEM);
   for (size_t w = 0; w < rows; w++) {
     t0[w] = e->win[w * WIN_LEN + WIN_T0], t1[w] = e->win[w * WIN_LEN + WIN_T1];
     mid[w] = 0.5 * (t0[w] + t1[w]);
@@ -223,7 +222,6 @@ static int write_eulerian(const struct euler *e, double t_reached, int ncid, cha
   euler_running_result(e, &r);
   const size_t nb = (size_t)e->cfg.nb;
   double *lo = mem_alloc(1, 2 * nb * sizeof *lo, "Eulerian statistics"), *hi = lo + nb;
-  if (!lo) return NC_ENOMEM;
   bin_bounds(&e->cfg, lo, hi);
   CK(nc_def_dim(ncid, "y", nb, &dy));
   CK(def_y(&e->cfg, ncid, dy, r.prof[EP_Y], lo, hi));

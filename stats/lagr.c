@@ -466,8 +466,8 @@ static int write_pdfs(const struct lagr *g, int gr, int dl, double *tmp, char *e
   CK(ncout_def(gr, "pdf_bin", NC_DOUBLE, 1, &db, "m", "y at the centre of the PDF bin", &v));
   {
     double *lo = mem_alloc(1, 2 * (size_t)nb * sizeof *lo, "Lagrangian statistics"), *hi = lo + nb;
-    rc = lo ? NC_NOERR : NC_ENOMEM;
-    for (int b = 0; b < nb && lo; b++)
+    rc = NC_NOERR;
+    for (int b = 0; b < nb; b++)
       lo[b] = b * 2.0 * c->delta / nb, hi[b] = (b + 1) * 2.0 * c->delta / nb;
     if (rc == NC_NOERR)
       rc = ncout_bounds(gr, "pdf_bin", v, db, "m", "limits of the PDF bin", lo, hi, (size_t)nb);

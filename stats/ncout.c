@@ -103,7 +103,6 @@ int ncout_fill(int ncid, int varid) {
 int ncout_put_filled(int ncid, int varid, const size_t *start, const size_t *count, const double *v,
                      size_t n) {
   double *tmp = mem_alloc(1, (n ? n : 1) * sizeof *tmp, "netCDF output");
-  if (!tmp) return NC_ENOMEM;
   for (size_t i = 0; i < n; i++) tmp[i] = isfinite(v[i]) ? v[i] : NCOUT_FILL;
   const int rc = start ? nc_put_vara_double(ncid, varid, start, count, tmp)
                        : nc_put_var_double(ncid, varid, tmp);
@@ -131,7 +130,6 @@ int ncout_bounds(int ncid, const char *name, int varid, int dimid, const char *u
   if (rc == NC_NOERR) rc = nc_put_att_text(ncid, varid, "bounds", strlen(bname), bname);
   if (rc == NC_NOERR) rc = def_var(ncid, bname, NC_DOUBLE, 2, dims, units, long_name, &v);
   double *b = mem_alloc(1, (n ? 2 * n : 1) * sizeof *b, "netCDF output");
-  if (!b) return NC_ENOMEM;
   for (size_t i = 0; i < n; i++) b[2 * i] = lo[i], b[2 * i + 1] = hi[i];
   if (rc == NC_NOERR && n) rc = nc_put_var_double(ncid, v, b);
   free(b);
@@ -160,7 +158,7 @@ int ncout_stats(const char *path, const struct stats *st, const struct series *t
   NC(nc_def_dim(ncid, "time", NC_UNLIMITED, &dt));
   int *vts = mem_alloc(1, (size_t)ts->ncol * sizeof *vts, "netCDF output");
   double *col = mem_alloc(1, (ts->n ? ts->n : 1) * sizeof *col, "netCDF output");
-  int rc = vts && col ? NC_NOERR : NC_ENOMEM;
+  int rc = NC_NOERR;
   for (int c = 0; c < ts->ncol && rc == NC_NOERR; c++) {
     rc = def_var(ncid, ts->names[c], NC_DOUBLE, 1, &dt, ts->units[c],
                  ts->long_names ? ts->long_names[c] : NULL, &vts[c]);
