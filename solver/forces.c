@@ -55,85 +55,18 @@ struct fsums {
   struct v3 gc;    /*!< corrected pressure difference gradient */
 };
 
-/** Sums over the neighbours j0 .. j1-1 of particle a for the operator `visc`, the corrected
-    (`corr`) or symmetric pressure gradient, with (`fluid`) or without the volume diffusion.
-    The neighbours' values are read either from the buffers their records were gathered into
-    (`gathered`: bf + REC_X * ld holds the x of neighbour j at index j, and so on) or from the
-    particle arrays (neighbour j at index nl[j]). Always inlined with constant flags: one
-    specialised loop per combination. */
-static inline __attribute__((always_inline)) void pair_sums(
-    const struct fctx *C, size_t a, double *bf, int ld, const int32_t *restrict nl, int j0, int j1,
-    const int gathered, const int fluid, const int visc, const int corr, struct fsums *out) {
-  const struct model *M = C->M;
-  const struct particles *P = C->P;
-  const struct kernel K = M->k;
-#define FIELD(k, arr) (gathered ? bf + (size_t)(k)*ld : P->arr)
-  const double *restrict x = FIELD(REC_X, x), *restrict y = FIELD(REC_Y, y);
-  const double *restrict z = FIELD(REC_Z, z), *restrict u = FIELD(REC_U, u);
-  const double *restrict v = FIELD(REC_V, v), *restrict w = FIELD(REC_W, w);
-  const double *restrict vol = FIELD(REC_VOL, vol), *restrict rho = FIELD(REC_RHO, rho);
-  const double *restrict m = FIELD(REC_M, m), *restrict pr2 = FIELD(REC_PR2, pr2);
-  const double *restrict c = FIELD(REC_C, c), *restrict nur = FIELD(REC_NUR, nur);
-#undef FIELD
-  const double lx = M->lx, lz = M->lz, eta2 = M->eta2, nu = M->nu, np2 = M->dim + 2.0;
-  const int d3 = M->dim == 3;
-  const double dgrav = M->e.rho0 / (M->e.c0 * M->e.c0) * M->gy; /* Eq. 3.61 */
-  const double xa = P->x[a], ya = P->y[a], za = P->z[a], ua = P->u[a], va = P->v[a];
-  const double wa = P->w[a], ra = P->rho[a], pa = P->pr2[a], ca = P->c[a], ira = 1.0 / ra;
-  const double pm_a = corr ? pa * ra * ra : 0.0;
-  const int les = visc == VK_LES || visc == VK_LES_LAG, keep = visc == VK_LES_LAG;
-  double *restrict geo = bf + (size_t)PAIRBUF_RECORDS * ld; /* pair geometry kept (keep) */
-  const double mu_a = les ? ra * (nu + P->nur[a]) : 0.0;
-  double gpx = 0, gpy = 0, gpz = 0, vx = 0, vy = 0, vz = 0, mo2 = 0, moyy = 0, mo1 = 0;
-  double diff = 0, m1x = 0, m2x = 0, m1z = 0, m2z = 0;
-  double axx = 0, axy = 0, axz = 0, ayy = 0, ayz = 0, azz = 0, gcx = 0, gcy = 0, gcz = 0;
-#pragma omp simd reduction(+ : gpx, gpy, gpz, vx, vy, vz, mo2, moyy, mo1, diff, m1x, m2x, m1z, \
-                               m2z, axx, axy, axz, ayy, ayz, azz, gcx, gcy, gcz)
-  for (int j = j0; j < j1; j++) {
-    const int32_t b = gathered ? j : nl[j];
-    const struct pair g = pair_geom(&K, lx, lz, d3, xa - x[b], ya - y[b], za - z[b]);
-    const double vb = vol[b], rb = rho[b];
-    if (keep) { /* for strain_sums: V_b F_ab and r_ab */
-      geo[j] = vb * g.f, geo[ld + j] = g.dx, geo[2 * (size_t)ld + j] = g.dy;
-      geo[3 * (size_t)ld + j] = g.dz;
-    }
-    if (corr) {
-      const struct sym3 t = term_moment(&g, vb);
-      axx += t.xx, axy += t.xy, axz += t.xz, ayy += t.yy, ayz += t.yz, azz += t.zz;
-      const struct v3 d = term_difference(&g, vb, pr2[b] * rb * rb - pm_a);
-      gcx += d.x, gcy += d.y, gcz += d.z;
-    } else {
-      const struct v3 t = term_pressure(&g, m[b], pa, pr2[b]);
-      gpx += t.x, gpy += t.y, gpz += t.z;
-    }
-    const struct v3 uab = {ua - u[b], va - v[b], wa - w[b]};
-    struct v3 t;
-    if (visc == VK_MORRIS)
-      t = term_morris(&g, m[b], ira, vb, eta2, uab);
-    else if (visc == VK_VIOLEAU)
-      t = term_violeau(&g, vb, 0.5 * (ra + rb), np2, eta2, uab);
-    else /* Eq. 2.100 with mu = rho (nu + nu_r) */
-      t = term_violeau(&g, vb, 0.5 * (mu_a + rb * (nu + nur[b])), np2, eta2, uab);
-    vx += t.x, vy += t.y, vz += t.z;
-    const struct v3 mo = term_moments(&g, vb);
-    mo2 += mo.x, moyy += mo.y, mo1 += mo.z;
-    if (visc != VK_MORRIS) {
-      const struct v3 vm = term_violeau_moments(&g, vb, np2, eta2);
-      m1x += vm.x, m2x += vm.x * g.dy, m1z += vm.y, m2z += vm.y * g.dy;
-    }
-    if (fluid) diff += term_diffusion(&g, vb, ca, c[b], ra, rb, dgrav);
-  }
-  *out = (struct fsums){{gpx, gpy, gpz},
-                        {vx, vy, vz},
-                        {mo2, moyy, mo1},
-                        diff,
-                        m1x,
-                        m2x,
-                        m1z,
-                        m2z,
-                        {axx, axy, axz, ayy, ayz, azz},
-                        {gcx, gcy, gcz}};
-}
+/* pair_sums (double) and pair_sums_f (sph.precision = mixed: float pair terms, double sums),
+   one source: forces_pair.h. */
+#define R double
+#define PF(name) name
+#include "forces_pair.h"
+#undef R
+#undef PF
+#define R float
+#define PF(name) name##_f
+#include "forces_pair.h"
+#undef R
+#undef PF
 
 /** les.strain_lag: the corrected velocity-gradient sums of particle a over its whole list (n
     neighbours), A = -sum_b V_b F_ab r_ab (x) r_ab and B = sum_b (v_b - v_a) (x) V_b F_ab r_ab
@@ -368,11 +301,12 @@ static void force_finish(const struct fctx *C, size_t a, const struct fsums *s,
 typedef void (*force_loop)(const struct fctx *C, size_t a0, size_t a1, double mx[2]);
 
 /* The loop over particles a0 .. a1-1 for one combination; `gathered`: read the neighbours'
-   gathered records (AVX-512), else the particle arrays through the list. */
+   gathered records (AVX-512), else the particle arrays through the list; `sp`: float pair
+   terms (sph.precision = mixed). */
 static inline __attribute__((always_inline)) void force_range(const struct fctx *C, size_t a0,
                                                               size_t a1, double mx[2],
                                                               const int visc, const int corr,
-                                                              const int gathered) {
+                                                              const int gathered, const int sp) {
   const struct nbr *nb = C->nb;
   const struct particles *P = C->P;
   const int ld = nb->stride;
@@ -389,8 +323,13 @@ static inline __attribute__((always_inline)) void force_range(const struct fctx 
       records_gather(P->rec, nl, n, 1, bf + 8 * (size_t)ld, ld);
     }
     struct fsums s, sv;
-    pair_sums(C, a, bf, ld, nl, 0, nf, gathered, 1, visc, corr, &s);
-    pair_sums(C, a, bf, ld, nl, nf, n, gathered, 0, visc, corr, &sv);
+    if (sp) {
+      pair_sums_f(C, a, bf, ld, nl, 0, nf, gathered, 1, visc, corr, &s);
+      pair_sums_f(C, a, bf, ld, nl, nf, n, gathered, 0, visc, corr, &sv);
+    } else {
+      pair_sums(C, a, bf, ld, nl, 0, nf, gathered, 1, visc, corr, &s);
+      pair_sums(C, a, bf, ld, nl, nf, n, gathered, 0, visc, corr, &sv);
+    }
     force_finish(C, a, &s, &sv, mx);
     if (visc == VK_LES_LAG) { /* the strain of this state, for the next step */
       double A[6], B[9];
@@ -403,38 +342,39 @@ static inline __attribute__((always_inline)) void force_range(const struct fctx 
   }
 }
 
-/* One function per combination, each built for several instruction sets (pair.h). */
-#define FORCE_LOOP(name, visc, corr, gathered)                                                \
+/* One function per combination, each built for several instruction sets (pair.h): for one
+   precision (suffix, sp) and data path (gathered), the four viscous operators by the two
+   pressure-gradient forms, and their row of the table `loops`. */
+#define FORCE_LOOP(name, visc, corr, gathered, sp)                                            \
   static CHANSPH_CLONES void name(const struct fctx *C, size_t a0, size_t a1, double mx[2]) { \
-    force_range(C, a0, a1, mx, visc, corr, gathered);                                         \
+    force_range(C, a0, a1, mx, visc, corr, gathered, sp);                                     \
   }
-FORCE_LOOP(forces_morris, VK_MORRIS, 0, 0)
-FORCE_LOOP(forces_morris_corrected, VK_MORRIS, 1, 0)
-FORCE_LOOP(forces_violeau, VK_VIOLEAU, 0, 0)
-FORCE_LOOP(forces_violeau_corrected, VK_VIOLEAU, 1, 0)
-FORCE_LOOP(forces_les, VK_LES, 0, 0)
-FORCE_LOOP(forces_les_corrected, VK_LES, 1, 0)
-FORCE_LOOP(forces_les_lag, VK_LES_LAG, 0, 0)
-FORCE_LOOP(forces_les_lag_corrected, VK_LES_LAG, 1, 0)
-FORCE_LOOP(forces_morris_rec, VK_MORRIS, 0, 1)
-FORCE_LOOP(forces_morris_corrected_rec, VK_MORRIS, 1, 1)
-FORCE_LOOP(forces_violeau_rec, VK_VIOLEAU, 0, 1)
-FORCE_LOOP(forces_violeau_corrected_rec, VK_VIOLEAU, 1, 1)
-FORCE_LOOP(forces_les_rec, VK_LES, 0, 1)
-FORCE_LOOP(forces_les_corrected_rec, VK_LES, 1, 1)
-FORCE_LOOP(forces_les_lag_rec, VK_LES_LAG, 0, 1)
-FORCE_LOOP(forces_les_lag_corrected_rec, VK_LES_LAG, 1, 1)
+#define FORCE_LOOPS(sfx, gathered, sp)                                   \
+  FORCE_LOOP(forces_morris##sfx, VK_MORRIS, 0, gathered, sp)             \
+  FORCE_LOOP(forces_morris_corrected##sfx, VK_MORRIS, 1, gathered, sp)   \
+  FORCE_LOOP(forces_violeau##sfx, VK_VIOLEAU, 0, gathered, sp)           \
+  FORCE_LOOP(forces_violeau_corrected##sfx, VK_VIOLEAU, 1, gathered, sp) \
+  FORCE_LOOP(forces_les##sfx, VK_LES, 0, gathered, sp)                   \
+  FORCE_LOOP(forces_les_corrected##sfx, VK_LES, 1, gathered, sp)         \
+  FORCE_LOOP(forces_les_lag##sfx, VK_LES_LAG, 0, gathered, sp)           \
+  FORCE_LOOP(forces_les_lag_corrected##sfx, VK_LES_LAG, 1, gathered, sp)
+#define FORCE_ROW(sfx)                                        \
+  {                                                           \
+    {forces_morris##sfx, forces_morris_corrected##sfx},       \
+        {forces_violeau##sfx, forces_violeau_corrected##sfx}, \
+        {forces_les##sfx, forces_les_corrected##sfx}, {       \
+      forces_les_lag##sfx, forces_les_lag_corrected##sfx      \
+    }                                                         \
+  }
+FORCE_LOOPS(, 0, 0)
+FORCE_LOOPS(_rec, 1, 0)
+FORCE_LOOPS(_sp, 0, 1)
+FORCE_LOOPS(_rec_sp, 1, 1)
 
-/** The loops by data path (particle arrays, gathered records), viscous operator and
-    pressure-gradient form (standard, corrected). */
-static const force_loop loops[2][VK_N][2] = {{{forces_morris, forces_morris_corrected},
-                                              {forces_violeau, forces_violeau_corrected},
-                                              {forces_les, forces_les_corrected},
-                                              {forces_les_lag, forces_les_lag_corrected}},
-                                             {{forces_morris_rec, forces_morris_corrected_rec},
-                                              {forces_violeau_rec, forces_violeau_corrected_rec},
-                                              {forces_les_rec, forces_les_corrected_rec},
-                                              {forces_les_lag_rec, forces_les_lag_corrected_rec}}};
+/** The loops by precision (double, mixed), data path (particle arrays, gathered records),
+    viscous operator and pressure-gradient form (standard, corrected). */
+static const force_loop loops[2][2][VK_N][2] = {{FORCE_ROW(), FORCE_ROW(_rec)},
+                                                {FORCE_ROW(_sp), FORCE_ROW(_rec_sp)}};
 
 /** Particles per task of the force loop. */
 enum { FORCE_CHUNK = 128 };
@@ -446,7 +386,8 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
                    : M->les                        ? VK_LES
                    : M->viscous == VISCOUS_VIOLEAU ? VK_VIOLEAU
                                                    : VK_MORRIS;
-  const force_loop loop = loops[records_fast()][visc][M->pgrad == PGRAD_CORRECTED];
+  const force_loop loop =
+      loops[M->precision == PRECISION_MIXED][records_fast()][visc][M->pgrad == PGRAD_CORRECTED];
   const struct fctx C = {M, P, nb, W, fx, info->wall_ax, info->sx, P->nur_next, P->kr_next};
   const size_t n = P->n, nchunk = (n + FORCE_CHUNK - 1) / FORCE_CHUNK;
   double amax2 = 0.0, gvmax = 0.0;

@@ -45,6 +45,7 @@ static const char *const names_sph_wall_pressure_weight[] = {"lattice", "consist
                                                              NULL};
 static const char *const names_sph_pressure_gradient[] = {"standard", "corrected", NULL};
 static const char *const names_sph_shifting[] = {"none", "fickian", NULL};
+static const char *const names_sph_precision[] = {"double", "mixed", NULL};
 static const char *const names_les_model[] = {"none", "smagorinsky", NULL};
 static const char *const names_les_strain[] = {"gradient", "violeau_issa", NULL};
 static const char *const names_wall_law[] = {"laminar", "log", "reichardt", NULL};
@@ -103,6 +104,12 @@ static const struct key keys[] = {
      "2.88 built from fluid and vertex neighbours, exact for linear pressure fields and without "
      "a wall term (Sec. 6.2.2-6.2.3; docs/theory.md).",
      OFF(pgrad)},
+    {"sph", "precision", T_CHOICE, "double", 0, 0, 0, names_sph_precision, "-",
+     "Arithmetic of the force pair loops: double, or mixed (each pair's geometry and terms in "
+     "single precision from separations and differences formed in double, the sums over "
+     "neighbours in double; docs/performance.md, \"Precision\"). The density, the neighbour "
+     "search, the time integration and every other pass stay in double.",
+     OFF(precision)},
     {"sph", "shifting", T_CHOICE, "none", 0, 0, 0, names_sph_shifting, "-",
      "Particle shifting after each position update: none, or the Fickian shift "
      "delta r_a = -C h^2 grad C_a of Lind et al. (2012) with the anti-clustering term of "

@@ -35,6 +35,7 @@ void sph_model_init(struct model *M, const struct scene *s) {
   M->wall_weight = s->wall_weight;
   M->wall_pressure = s->wall_pressure;
   M->pgrad = s->pgrad;
+  M->precision = s->precision;
   M->les = s->les != LES_NONE;
   M->strain = s->strain;
   M->strain_lag = M->les && s->strain == STRAIN_GRADIENT && s->strain_lag;

@@ -19,6 +19,7 @@ enum { LATTICE_KNOTS = 16, VIOLEAU_KNOTS = 128 };
 struct model {
   int dim;           /*!< 2 or 3 */
   int viscous;       /*!< enum viscous_form */
+  int precision;     /*!< enum precision: arithmetic of the force pair loops */
   struct kernel k;   /*!< Wendland kernel */
   struct eos e;      /*!< Tait equation of state */
   double lx, ly, lz; /*!< domain [m]; ly = 2 delta */

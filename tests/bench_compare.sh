@@ -2,11 +2,14 @@
 # Compare the speed of two builds of chansph on the benchmark cases, interleaved in one go.
 #
 # usage: tests/bench_compare.sh OLD_COMMIT [NEW] [--reps N] [--threads N] [--set key=value]
+#                               [--new-set key=value]
 #   OLD_COMMIT  a commit to build (generic Release build, as jobs/setup.sh makes it)
 #   NEW         a commit, or "." (default) for the working tree's build/chansph
 #   --reps N    runs of each build on each case (default 3); medians are printed
 #   --threads N OpenMP threads (default 2)
 #   --set k=v   passed to every bench run (e.g. --set sph.precision=double)
+#   --new-set k=v  passed to the new build's runs only (e.g. HEAD against the working tree with
+#               --new-set sph.precision=mixed: one build, two settings)
 #
 # Cases: the default bench case, jobs/scenes/les395_small.ini (LES), the same scene without
 # the model (les.model=none: the LES / quasi-DNS cost ratio) and jobs/scenes/qdns180_small.ini.
@@ -16,13 +19,14 @@
 # new / old of particle-steps/s. Run it on an idle machine.
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
-old="" new="." reps=3 threads=2 sets=()
+old="" new="." reps=3 threads=2 sets=() new_sets=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --reps) reps=$2; shift 2 ;;
     --threads) threads=$2; shift 2 ;;
     --set) sets+=(--set "$2"); shift 2 ;;
-    -h|--help) sed -n '2,17p' "$0"; exit 0 ;;
+    --new-set) new_sets+=(--set "$2"); shift 2 ;;
+    -h|--help) sed -n '2,20p' "$0"; exit 0 ;;
     *) if [ -z "$old" ]; then old=$1; else new=$1; fi; shift ;;
   esac
 done
@@ -66,9 +70,10 @@ for ((r = 1; r <= reps; r++)); do
   for i in "${!cases[@]}"; do
     name=${cases[$i]%%|*} args=${cases[$i]#*|}
     for which in old new; do
-      bin=$old_bin; [ $which = new ] && bin=$new_bin
+      bin=$old_bin extra=()
+      [ $which = new ] && bin=$new_bin extra=("${new_sets[@]}")
       # shellcheck disable=SC2086
-      out=$("$bin" bench $args --steps "${steps[$i]}" "${sets[@]}" 2>&1)
+      out=$("$bin" bench $args --steps "${steps[$i]}" "${sets[@]}" "${extra[@]}" 2>&1)
       ps=$(echo "$out" | awk '/^particle-steps\/s:/ {print $2}')
       ms=$(echo "$out" | sed -n 's/.*(\([0-9.]*\) ms\/step).*/\1/p')
       [ -n "$ps" ] || { echo "$out" | tail -5; echo "bench_compare: $which failed on $name" >&2; exit 1; }
@@ -78,7 +83,7 @@ for ((r = 1; r <= reps; r++)); do
   done
 done
 
-echo "old: $(git -C "$here" rev-parse --short "$old")  new: $new_name  threads: $threads  reps: $reps ${sets[*]}"
+echo "old: $(git -C "$here" rev-parse --short "$old")  new: $new_name  threads: $threads  reps: $reps ${sets[*]} new: ${new_sets[*]}"
 /usr/bin/python3 - "$log" <<'EOF'
 import sys, statistics as st
 rows = [l.split() for l in open(sys.argv[1]) if l.strip()]

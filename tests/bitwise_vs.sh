@@ -6,6 +6,9 @@
 # without the provenance attributes, tests/nc_content.sh, and without `source`, which names
 # the git commit) and every checkpoint and particle snapshot (h5diff, which compares every dataset and attribute;
 # the only attribute allowed to differ is `source`).
+# BITWISE_NEW_KEYS="sec.key=value ...": scene keys the new build added, at their defaults (e.g.
+# sph.precision=double): the new runs' scene text, which lists every key, is compared with those
+# lines removed.
 # usage: tests/bitwise_vs.sh OLD_COMMIT [NEW_CHANSPH (default build/chansph)]
 set -u
 here=$(cd "$(dirname "$0")/.." && pwd)
@@ -20,7 +23,16 @@ if [ ! -x "$ref/build/chansph" ]; then
 fi
 export CHANSPH_RUN_ID=bitwise-vs OMP_NUM_THREADS=${OMP_NUM_THREADS:-2}
 runs=$(mktemp -d /tmp/bitwise_vs.XXXXXX)
-content() { "$here/tests/nc_content.sh" "$1" | awk '/^\t\t:source = /{skip=1} skip{if (/ ;$/) skip=0; next} 1'; }
+drop_keys() { # remove the lines "key = value" of BITWISE_NEW_KEYS from a scene text (ncdump
+  # writes its newlines as \n, h5dump as line breaks)
+  local kv args=(-e '')
+  for kv in ${BITWISE_NEW_KEYS:-}; do
+    local k=${kv%%=*} v=${kv#*=}
+    args+=(-e "s/\\\\n${k#*.} = $v\\\\n/\\\\n/" -e "/^ *${k#*.} = $v\$/d")
+  done
+  sed "${args[@]}"
+}
+content() { "$here/tests/nc_content.sh" "$1" | awk '/^\t\t:source = /{skip=1} skip{if (/ ;$/) skip=0; next} 1' | drop_keys; }
 status=0
 compare() { # NAME RANKS SCENE ARGS...
   local name=$1 np=$2 scene=$3
@@ -52,10 +64,11 @@ compare() { # NAME RANKS SCENE ARGS...
     # (e.g. no Lagrangian track in flight): their headers (shape, type, attributes) are.
     local report empty=""
     report=$(h5diff -v "$c" "$d" 2>&1)
-    if [ -f "$d" ] && printf '%s\n' "$report" | awk '
+    if [ -f "$d" ] && printf '%s\n' "$report" | awk -v newkeys="${BITWISE_NEW_KEYS:+1}" '
         /^ +x +\// { if ($2 != "x") bad = 1 } # an object in one file only
         /^(attribute|dataset|group|datatype): / { obj = $0 }
-        /^[0-9]+ differences? found/ { if ($1 > 0 && obj !~ /^attribute: <source of/) bad = 1 }
+        /^[0-9]+ differences? found/ { if ($1 > 0 && obj !~ /^attribute: <source of/ &&
+                                       !(newkeys && obj ~ /^dataset: <\/scene>/)) bad = 1 }
         /[Nn]ot comparable/ && !/is an empty dataset/ && !/^Some objects/ { bad = 1 }
         END { exit bad }'; then
       empty=$(printf '%s\n' "$report" | sed -n 's/^Not comparable: <\([^>]*\)> or .* is an empty dataset$/\1/p')
@@ -63,6 +76,10 @@ compare() { # NAME RANKS SCENE ARGS...
         cmp -s <(h5dump -H -d "$e" "$c" | tail -n +2) <(h5dump -H -d "$e" "$d" | tail -n +2) ||
           { echo "$name $(basename "$c") $e: DIFFERENT header"; status=1; }
       done
+      # with new keys the scene texts differ by those lines only (h5dump, the size line aside)
+      [ -n "${BITWISE_NEW_KEYS:-}" ] && ! cmp -s <(h5dump -d /scene "$c" 2>/dev/null | tail -n +2 | grep -v STRSIZE | drop_keys) \
+        <(h5dump -d /scene "$d" 2>/dev/null | tail -n +2 | grep -v STRSIZE | drop_keys) &&
+        { echo "$name $(basename "$c") /scene: DIFFERENT"; status=1; }
       n=$((n + 1))
     else
       echo "$name $(basename "$c"): DIFFERENT"; status=1
