@@ -163,4 +163,15 @@ int rundir_valid_id(const char *id);
 /** @brief State size in bytes of a run (for the write-time estimate and reports). */
 double restart_state_bytes(struct output *o, struct sim *S);
 
+/**
+ * @brief (layout.c) Append the state a continuation needs to a list (particles by id with their
+ * ids, wall values, step, time, last dt and force, flux-controller history). The particle and wall
+ * fields are distributed (state.h): rank r of P names the ids [r N / P, (r+1) N / P). After
+ * sim_init the particles are first sent to the ranks of their blocks (collective); after sim_create
+ * the fields are those slots of the full arrays, to read a block into.
+ * @param[in] S simulation (the fields point into its memory)
+ * @param[in,out] L list
+ */
+void sim_state(struct sim *S, struct state_list *L);
+
 #endif

@@ -82,16 +82,12 @@ void sim_free(struct sim *S);
  */
 void sim_step(struct sim *S);
 
-/**
- * @brief Append the state a continuation needs to a list (particles by id with their ids, wall
- *        values, step, time, last dt and force, flux-controller history). The particle and
- *        wall fields are distributed (state.h): rank r of P names the ids [r N / P, (r+1) N / P).
- *        After sim_init the particles are first sent to the ranks of their blocks (collective);
- *        after sim_create the fields are those slots of the full arrays, to read a block into.
- * @param[in] S simulation (the fields point into its memory)
- * @param[in,out] L list
- */
-void sim_state(struct sim *S, struct state_list *L);
+/** Checkpoint id blocks: rank r of size holds the ids [r N / size, (r+1) N / size) of the
+    particle datasets (restart/layout.c). */
+static inline void sim_id_block(int r, int size, size_t N, size_t *lo, size_t *hi) {
+  *lo = (size_t)((unsigned long long)r * N / (unsigned)size);
+  *hi = (size_t)((unsigned long long)(r + 1) * N / (unsigned)size);
+}
 
 /**
  * @brief After the fields of sim_state() were filled from a checkpoint (into sim_create()'s
