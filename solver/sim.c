@@ -37,9 +37,9 @@ static void model_update(struct sim *S) {
   if (M->les) {
     S->nu_max = turb_eddy_viscosity(M, P, &S->nb, &S->W);
     double *const nk[2] = {P->nur, P->kr};
-    dd_update(&S->dd, P, 2, nk); /* read at neighbours by the forces and by turb_kr_pressure */
+    dd_update(&S->dd, P, 2, nk); /* read at neighbours by the forces and by sph_kr_pressure */
     if (M->cy > 0.0) {
-      turb_kr_pressure(M, P, &S->nb, &S->W);
+      sph_kr_pressure(M, P, &S->nb, &S->W);
       double *const pr[1] = {P->pr2}, *const wp[1] = {S->W.p};
       dd_update(&S->dd, P, 1, pr);
       dd_update_walls(&S->dd, P, 1, wp);

@@ -197,6 +197,49 @@ void sph_walls(const struct model *M, struct particles *P, const struct nbr *nb,
   timer_pop();
 }
 
+/* sph.h; the wall law (turb.c) and sph_kr_pressure use it. */
+CHANSPH_CLONES double sph_vertex_sums(const struct model *M, const struct particles *P,
+                                      const struct nbr *nb, size_t s, int nf,
+                                      const double *const *f, double *out) {
+  const struct kernel K = M->k;
+  const double *restrict x = P->x, *restrict y = P->y, *restrict z = P->z;
+  const double *restrict vol = P->vol, *restrict f0 = f[0], *restrict f1 = nf > 1 ? f[1] : f[0];
+  const int32_t *restrict nl = nb->list + s * (size_t)nb->stride;
+  const double xs = x[s], ys = y[s], zs = z[s], lx = M->lx, lz = M->lz;
+  const int d3 = M->dim == 3;
+  double alpha = 0.0, s0 = 0.0, s1 = 0.0;
+#pragma omp simd reduction(+ : alpha, s0, s1)
+  for (int j = 0; j < nb->nfluid[s]; j++) {
+    const int32_t b = nl[j];
+    const struct pair g = pair_geom(&K, lx, lz, d3, xs - x[b], ys - y[b], zs - z[b]);
+    const double vw = vol[b] * pair_w(&K, g.r);
+    alpha += vw, s0 += vw * f0[b], s1 += vw * f1[b];
+  }
+  out[0] = s0;
+  if (nf > 1) out[1] = s1;
+  return alpha;
+}
+
+void sph_kr_pressure(const struct model *M, struct particles *P, const struct nbr *nb,
+                     struct walls *W) {
+  timer_push("les");
+  const double *restrict rho = P->rho, *restrict kr = P->kr;
+#pragma omp parallel for schedule(static)
+  for (size_t s = 0; s < P->n; s++) {
+    if (P->kind[s] == KIND_FLUID) {
+      P->pr2[s] += 2.0 / 3.0 * kr[s] / rho[s];
+      continue;
+    }
+    const double *krf[1] = {kr};
+    double sk;
+    const double alpha = sph_vertex_sums(M, P, nb, s, 1, krf, &sk);
+    const double ks = alpha > 0.0 ? sk / alpha : 0.0, extra = 2.0 / 3.0 * rho[s] * ks;
+    P->pr2[s] += extra / (rho[s] * rho[s]);
+    W->p[part_vertex_slot(P, P->id[s])] += extra;
+  }
+  timer_pop();
+}
+
 void sph_wall_values(const struct model *M, const struct walls *W, int wall, double x, double z,
                      double *rho, double *p) {
   const struct foot f = sph_foot(M, W, wall, x, z);

@@ -127,6 +127,24 @@ void sph_density(const struct model *M, struct particles *P, const double *ksum_
 void sph_walls(const struct model *M, struct particles *P, const struct nbr *nb, struct walls *W);
 
 /**
+ * @brief LES with C_Y > 0 (turb.h, step 4): the pressure the forces read becomes p + 2/3 rho k_r
+ *        (thesis Eq. 5.42): p/rho^2 of fluid and vertex particles (k_r of a vertex by Shepard
+ *        interpolation) and the wall pressure; P->p stays the equation-of-state pressure. With
+ *        sph_density() and sph_walls() this is every place that sets a pressure. The caller then
+ *        refreshes pr2 and the wall pressure at the ghosts.
+ */
+void sph_kr_pressure(const struct model *M, struct particles *P, const struct nbr *nb,
+                     struct walls *W);
+
+/**
+ * @brief Shepard sums at vertex s over its fluid neighbours (the first nfluid of its list):
+ *        returns alpha = sum_b V_b w_bs and sets out[k] = sum_b V_b w_bs f_k,b for the nf <= 2
+ *        fields f (Ferrand Eq. 38 without the 1/alpha).
+ */
+double sph_vertex_sums(const struct model *M, const struct particles *P, const struct nbr *nb,
+                       size_t s, int nf, const double *const *f, double *out);
+
+/**
  * @brief Accelerations of the fluid particles (pressure gradient Grad^{gamma,1} of thesis
  *        Eq. 3.17, viscous term Eq. 2.147 or 2.100 with the wall shear term, wall-normal body
  *        force) and the volume-diffusion sum D of Eq. 3.64.

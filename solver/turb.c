@@ -144,31 +144,6 @@ void turb_advance(struct particles *P) {
   P->nur_live = 1;
 }
 
-/** Shepard sums at vertex s over its fluid neighbours (the first nfluid of its list): returns
-    alpha = sum_b V_b w_bs and sets out[k] = sum_b V_b w_bs f_k,b for the nf <= 2 fields f
-    (Ferrand Eq. 38 without the 1/alpha). */
-static CHANSPH_CLONES double vertex_sums(const struct model *M, const struct particles *P,
-                                         const struct nbr *nb, size_t s, int nf,
-                                         const double *const *f, double *out) {
-  const struct kernel K = M->k;
-  const double *restrict x = P->x, *restrict y = P->y, *restrict z = P->z;
-  const double *restrict vol = P->vol, *restrict f0 = f[0], *restrict f1 = nf > 1 ? f[1] : f[0];
-  const int32_t *restrict nl = nb->list + s * (size_t)nb->stride;
-  const double xs = x[s], ys = y[s], zs = z[s], lx = M->lx, lz = M->lz;
-  const int d3 = M->dim == 3;
-  double alpha = 0.0, s0 = 0.0, s1 = 0.0;
-#pragma omp simd reduction(+ : alpha, s0, s1)
-  for (int j = 0; j < nb->nfluid[s]; j++) {
-    const int32_t b = nl[j];
-    const struct pair g = pair_geom(&K, lx, lz, d3, xs - x[b], ys - y[b], zs - z[b]);
-    const double vw = vol[b] * pair_w(&K, g.r);
-    alpha += vw, s0 += vw * f0[b], s1 += vw * f1[b];
-  }
-  out[0] = s0;
-  if (nf > 1) out[1] = s1;
-  return alpha;
-}
-
 /** Corrected velocity-gradient sums of particle a over its whole list (fluid and vertices):
     A = -sum_b V_b F_ab r_ab (x) r_ab and B = sum_b V_b (v_b - v_a) (x) F_ab r_ab (thesis
     Eq. 2.88-2.90, k = 0), as turb_strain_gradient takes them. The neighbours' positions,
@@ -277,7 +252,7 @@ static void wall_law_stresses(const struct model *M, struct particles *P, const 
   for (size_t s = 0; s < P->n; s++) {
     if (kind[s] != KIND_VERTEX) continue;
     double sum[2];
-    const double alpha = vertex_sums(M, P, nb, s, 2, tw, sum);
+    const double alpha = sph_vertex_sums(M, P, nb, s, 2, tw, sum);
     const size_t slot = part_vertex_slot(P, P->id[s]);
     W->tx[slot] = alpha > 0.0 ? sum[0] / alpha : 0.0;
     W->tz[slot] = alpha > 0.0 ? sum[1] / alpha : 0.0;
@@ -323,26 +298,6 @@ static double eddy_viscosity(const struct model *M, struct particles *P, const s
   return numax;
 }
 
-/* turb_kr_pressure: the residual kinetic energy in the pressure, p + 2/3 rho k_r, for fluid and
-   vertex particles (k_r of a vertex by Shepard interpolation) and the wall pressure. */
-static void kr_pressure(const struct model *M, struct particles *P, const struct nbr *nb,
-                        struct walls *W) {
-  const double *restrict rho = P->rho, *restrict kr = P->kr;
-#pragma omp parallel for schedule(static)
-  for (size_t s = 0; s < P->n; s++) {
-    if (P->kind[s] == KIND_FLUID) {
-      P->pr2[s] += 2.0 / 3.0 * kr[s] / rho[s];
-      continue;
-    }
-    const double *krf[1] = {kr};
-    double sk;
-    const double alpha = vertex_sums(M, P, nb, s, 1, krf, &sk);
-    const double ks = alpha > 0.0 ? sk / alpha : 0.0, extra = 2.0 / 3.0 * rho[s] * ks;
-    P->pr2[s] += extra / (rho[s] * rho[s]);
-    W->p[part_vertex_slot(P, P->id[s])] += extra;
-  }
-}
-
 void turb_wall_law(const struct model *M, struct particles *P, const struct nbr *nb,
                    struct walls *W) {
   timer_push("wall_law");
@@ -366,11 +321,4 @@ double turb_eddy_viscosity(const struct model *M, struct particles *P, const str
   }
   timer_pop();
   return numax;
-}
-
-void turb_kr_pressure(const struct model *M, struct particles *P, const struct nbr *nb,
-                      struct walls *W) {
-  timer_push("les");
-  kr_pressure(M, P, nb, W);
-  timer_pop();
 }

@@ -14,10 +14,12 @@
  *     nearest wall, nu_r = l_S^2 S and k_r; with les.strain_lag (the default) the force loop
  *     of the previous step formed them from the strain of its state (turb_model_gradient,
  *     turb_advance), one time step of lag, and this step only takes their maximum,
- *  4. with C_Y > 0: k_r of the vertices (Shepard), and the pressure of fluid and vertex
- *     particles as seen by the forces becomes p + 2/3 rho k_r (Eq. 5.42: pr2 and the wall
- *     pressure; P->p stays the equation-of-state pressure).
+ *  4. with C_Y > 0, sph_kr_pressure (sph.h, which sets every pressure the forces read): k_r
+ *     of the vertices (Shepard), and the pressure of fluid and vertex particles as seen by the
+ *     forces becomes p + 2/3 rho k_r (Eq. 5.42: pr2 and the wall pressure; P->p stays the
+ *     equation-of-state pressure).
  * Everything is a gather over the neighbour list: bitwise independent of the thread count.
+ * The model terms change no pressure here: turb.c computes tau_w, nu_r and k_r only.
  * Phases: steps 1-2 are timed as `wall_law`, steps 3-4 as `les`.
  */
 #ifndef CHANSPH_TURB_H
@@ -51,14 +53,6 @@ void turb_wall_law(const struct model *M, struct particles *P, const struct nbr 
  */
 double turb_eddy_viscosity(const struct model *M, struct particles *P, const struct nbr *nb,
                            const struct walls *W);
-
-/**
- * @brief Step 4 (LES, C_Y > 0): p/rho^2 of fluid and vertex particles and the wall pressure
- *        gain 2/3 rho k_r (k_r of a vertex by Shepard); the caller then refreshes pr2 and the
- *        wall pressure at the ghosts.
- */
-void turb_kr_pressure(const struct model *M, struct particles *P, const struct nbr *nb,
-                      struct walls *W);
 
 /**
  * @brief nu_r and k_r of fluid particle a from its corrected velocity-gradient sums A and B (as

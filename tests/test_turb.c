@@ -96,7 +96,7 @@ static int check_channel(int damping, int strain) {
   pr2_before = P->pr2[probe];
   turb_wall_law(M, P, &S.nb, &S.W); /* one rank: no ghosts to refresh */
   turb_eddy_viscosity(M, P, &S.nb, &S.W);
-  if (M->cy > 0.0) turb_kr_pressure(M, P, &S.nb, &S.W);
+  if (M->cy > 0.0) sph_kr_pressure(M, P, &S.nb, &S.W);
   double worst_nu = 0.0, worst_k = 0.0, worst_tau = 0.0;
   int n_inner = 0, n_wall = 0;
   const struct wall_law_def *L = &M->law;
