@@ -18,6 +18,7 @@
 #include "git_commit.h"
 #include "ncout.h"
 #include "timers.h"
+#include "turb.h"
 
 /** The `source` attribute of the output files: version and git commit of the build. */
 #define CHANSPH_SOURCE "chansph " CHANSPH_VERSION " (git " CHANSPH_GIT_COMMIT ")"
@@ -508,8 +509,9 @@ int output_step(struct output *o, struct sim *S) {
   return CHANSPH_OK;
 }
 
-static int write_particles(struct output *o, const struct sim *S) {
+static int write_particles(struct output *o, struct sim *S) {
   const struct particles *P = &S->P;
+  if (P->qcrit) turb_q_criterion(&S->M, &S->P, &S->nb, S->P.qcrit); /* output.q_criterion */
   const size_t n = P->n_fluid;
   enum { NC_MAX = 32 };
   const double *src[NC_MAX];

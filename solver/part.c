@@ -91,6 +91,8 @@ const struct part_field part_fields[] = {
     {F(twx), "wall_law_tx", NULL, PT_F64, 1, 0, 0, 0, 0, NULL, NULL},
     {F(twz), "wall_law_tz", NULL, PT_F64, 1, 0, 0, 0, 0, NULL, NULL},
     {F(shift_dy), "shift_dy", NULL, PT_F64, 1, PF_PERMUTE | PF_MIGRATE, 0, 0, 0, NULL, NULL},
+    {F(qcrit), "q_criterion", "q_criterion", PT_F64, 1, PF_WRITE, 0, 0, 0, "1/s^2",
+     "Q criterion (|Omega|^2 - |S|^2)/2 of the corrected velocity gradient"},
 };
 #undef ALL
 #undef F

@@ -67,6 +67,9 @@ struct particles {
       shifting adds (docs/theory.md); computed before the re-sort, so permuted and migrated
       with the particles; not checkpointed (every step sets it before anything reads it) */
   double *shift_dy;
+  /** output.q_criterion: Q = (|Omega|^2 - |S|^2)/2 of the corrected velocity gradient, set just
+      before particles.nc is written (turb_q_criterion) [1/s^2]; NULL otherwise */
+  double *qcrit;
   /* sort scratch */
   double *tmp;
   int64_t *tmp_i;

@@ -116,6 +116,7 @@ struct scene {
   double t_average_start; /*!< start of the averaging window [s] */
   int n_bins;             /*!< wall-normal bins; 0 = 2 delta / dr - 1 */
   int particles;          /*!< write the final particle state to particles.nc (1) or not (0) */
+  int q_criterion;        /*!< add the Q criterion to particles.nc (1) or not (0) */
   /* [stats] */
   int stats_eulerian;       /*!< Eulerian profiles on (1) or off (0) */
   double stats_window;      /*!< averaging window (batch) length [s]; 0 = a tenth of the average */

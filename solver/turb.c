@@ -48,6 +48,14 @@ double turb_strain_gradient(int dim, const double A[6], const double B[9]) {
   return strain_rate(dim, G);
 }
 
+double turb_q_gradient(int dim, const double A[6], const double B[9]) {
+  double G[3][3], q = 0.0;
+  for (int i = 0; i < 3; i++) sph_solve_sym(dim, A, B + 3 * i, G[i]); /* row i of B L */
+  for (int i = 0; i < dim; i++)
+    for (int j = 0; j < dim; j++) q -= 0.5 * G[i][j] * G[j][i]; /* (W:W - S:S) / 2 */
+  return q;
+}
+
 /** Positive root of S^3 - a S - b = 0 (a, b >= 0): the Violeau-Issa estimate solved for S
     (docs/theory.md). It lies in [max(sqrt(a), cbrt(b)), sqrt(a) + cbrt(b)]; Newton from the
     upper end decreases monotonically (the cubic is convex and increasing there). */
@@ -256,6 +264,18 @@ static void wall_law_stresses(const struct model *M, struct particles *P, const 
     const size_t slot = part_vertex_slot(P, P->id[s]);
     W->tx[slot] = alpha > 0.0 ? sum[0] / alpha : 0.0;
     W->tz[slot] = alpha > 0.0 ? sum[1] / alpha : 0.0;
+  }
+}
+
+void turb_q_criterion(const struct model *M, const struct particles *P, const struct nbr *nb,
+                      double *q) {
+#pragma omp parallel for schedule(dynamic, 256)
+  for (size_t a = 0; a < P->n; a++) {
+    q[a] = 0.0;
+    if (P->kind[a] != KIND_FLUID) continue;
+    double A[6], B[9];
+    gradient_sums(M, P, nb, a, A, B); /* the particle arrays: the records may be older */
+    q[a] = turb_q_gradient(M->dim, A, B);
   }
 }
 

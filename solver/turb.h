@@ -81,6 +81,21 @@ void turb_advance(struct particles *P);
 double turb_strain_gradient(int dim, const double A[6], const double B[9]);
 
 /**
+ * @brief The Q criterion (|Omega|^2 - |S|^2)/2 = -G_ij G_ji / 2 of the corrected velocity
+ *        gradient G = B L from the sums of turb_strain_gradient. Exposed for the unit tests.
+ * @return Q [1/s^2]
+ */
+double turb_q_gradient(int dim, const double A[6], const double B[9]);
+
+/**
+ * @brief Q (turb_q_gradient) of every owned fluid particle at the current state into q (0 for
+ *        vertices), from the neighbour list and the ghosts' current velocities; for
+ *        particles.nc (output.q_criterion).
+ */
+void turb_q_criterion(const struct model *M, const struct particles *P, const struct nbr *nb,
+                      double *q);
+
+/**
  * @brief van Driest damping 1 - exp(-y+/A+) (thesis Eq. 5.50, sign corrected).
  */
 double turb_van_driest(double yplus, double a_plus);

@@ -3,7 +3,8 @@
  * hand (closed forms) on small particle sets:
  *  - rate of strain from the first-order corrected gradient (thesis Eq. 2.88-2.90) on a random
  *    cloud of 40 neighbours is exact for a linear velocity field: S = (2 S:S)^(1/2) of the
- *    field's gradient to 1e-12 (2-D and 3-D, including compressible and rotational parts);
+ *    field's gradient to 1e-12 (2-D and 3-D, including compressible and rotational parts), and
+ *    so is the Q criterion (|Omega|^2 - |S|^2)/2 = -C_ij C_ji / 2;
  *  - van Driest damping (Eq. 5.50, sign corrected) at y+ = 0, A+, 10^6;
  *  - in a 3-D channel with the linear shear u = g (y - delta), away from the walls (d >= 2h):
  *    Smagorinsky nu_r = (C_S Delta_G)^2 |g| and Yoshizawa k_r = 2 C_Y (Delta_G g)^2 (Eq. 5.46-
@@ -57,7 +58,12 @@ static int check_strain_cloud(int dim) {
   const double err = fabs(got - want) / want;
   printf("strain, corrected gradient, %d-D cloud of 40: S = %.15g, exact %.15g, rel. error %.2e\n",
          dim, got, want, err);
-  return err > 1e-12;
+  double qwant = 0.0; /* Q = (W:W - S:S)/2 = -C_ij C_ji / 2 */
+  for (int i = 0; i < dim; i++)
+    for (int k = 0; k < dim; k++) qwant -= 0.5 * C[i][k] * C[k][i];
+  const double qgot = turb_q_gradient(dim, A, B), qerr = fabs(qgot - qwant) / fabs(qwant);
+  printf("Q criterion, same cloud: Q = %.15g, exact %.15g, rel. error %.2e\n", qgot, qwant, qerr);
+  return err > 1e-12 || qerr > 1e-12;
 }
 
 static int check_channel(int damping, int strain) {
