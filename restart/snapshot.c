@@ -1,6 +1,7 @@
 /** @file snapshot.c @brief Implementation of snapshot.h. */
 #include "snapshot.h"
 #include "alloc.h"
+#include "turb.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -49,7 +50,14 @@ static void item(FILE *x, const char *file, const char *ds, size_t n, int cols, 
 
 /* Rewrite DIR/snapshots/particles.xdmf from the snapshot files present. les: the files hold
    the eddy viscosity. */
-static int write_xdmf(const char *sdir, size_t n, int les) {
+/** The per-particle scalars of a snapshot after position and velocity: name, units, and the
+    particle array (NULL: this run has none, e.g. no eddy viscosity without LES). */
+struct snap_scalar {
+  const char *name, *units;
+  const double *src;
+};
+
+static int write_xdmf(const char *sdir, size_t n, const struct snap_scalar *sc, int ns) {
   DIR *d = opendir(sdir);
   if (!d) return -1;
   char **names = NULL;
@@ -94,15 +102,14 @@ static int write_xdmf(const char *sdir, size_t n, int les) {
       fprintf(x, "        </Topology>\n        <Geometry GeometryType=\"XYZ\">\n");
       item(x, names[i], "position", n, 3, "Float", 8);
       fprintf(x, "        </Geometry>\n");
-      static const char *const attr[5][2] = {{"velocity", "Vector"},
-                                             {"pressure", "Scalar"},
-                                             {"density", "Scalar"},
-                                             {"id", "Scalar"},
-                                             {"eddy_viscosity", "Scalar"}};
-      for (int k = 0; k < (les ? 5 : 4); k++) {
-        fprintf(x, "        <Attribute Name=\"%s\" AttributeType=\"%s\" Center=\"Node\">\n",
-                attr[k][0], attr[k][1]);
-        item(x, names[i], attr[k][0], n, k == 0 ? 3 : 1, k == 3 ? "Int" : "Float", 8);
+      /* velocity, the scalars in their order with id after the first two (the order of
+         earlier files), each an attribute of the points */
+      for (int k = -1; k <= ns; k++) {
+        const int id = k == 2, vec = k == -1, j = k > 2 ? k - 1 : k;
+        const char *name = vec ? "velocity" : id ? "id" : sc[j].name;
+        fprintf(x, "        <Attribute Name=\"%s\" AttributeType=\"%s\" Center=\"Node\">\n", name,
+                vec ? "Vector" : "Scalar");
+        item(x, names[i], name, n, vec ? 3 : 1, id ? "Int" : "Float", 8);
         fprintf(x, "        </Attribute>\n");
       }
       fprintf(x, "      </Grid>\n");
@@ -116,17 +123,26 @@ static int write_xdmf(const char *sdir, size_t n, int les) {
   return rc;
 }
 
-int snapshot_write(const char *dir, const struct sim *S) {
+int snapshot_write(const char *dir, struct sim *S) {
   timer_push("snapshot");
   const struct particles *P = &S->P;
   const size_t n = P->n_fluid;
   const int root = S->dd.rank == 0;
+  if (P->qcrit) turb_q_criterion(&S->M, &S->P, &S->nb, S->P.qcrit); /* output.q_criterion */
+  /* the scalars this run has (every rank has the same arrays) */
+  const struct snap_scalar all[] = {{"pressure", "Pa", P->p},
+                                    {"density", "kg/m^3", P->rho},
+                                    {"eddy_viscosity", "m^2/s", P->nur},
+                                    {"q_criterion", "1/s^2", P->qcrit}};
+  enum { NS_MAX = sizeof all / sizeof all[0], NC_MAX = 6 + NS_MAX };
+  struct snap_scalar sc[NS_MAX];
+  int ns = 0;
+  for (int k = 0; k < NS_MAX; k++)
+    if (all[k].src) sc[ns++] = all[k];
   /* gathered on rank 0 by id, which writes the file */
-  /* with LES the eddy viscosity too (every rank has nu_r, or none has) */
-  const int les = P->nur != NULL;
-  enum { NC_MAX = 9 };
-  const int NC = les ? 9 : 8;
-  const double *src[NC_MAX] = {P->x, P->y, P->z, P->u, P->v, P->w, P->p, P->rho, P->nur};
+  const int NC = 6 + ns;
+  const double *src[NC_MAX] = {P->x, P->y, P->z, P->u, P->v, P->w};
+  for (int k = 0; k < ns; k++) src[6 + k] = sc[k].src;
   double *g = root ? mem_alloc(1, (size_t)NC * n * sizeof *g, "particle snapshot") : NULL;
   if (root && !g) die("out of memory writing a snapshot");
   dd_gather_fluid(&S->dd, P, NC, src, g);
@@ -145,9 +161,8 @@ int snapshot_write(const char *dir, const struct sim *S) {
     state_add(&L, "id", STATE_I64, 1, d1, id, NULL);
     state_add(&L, "position", STATE_F64, 2, d2, pos, "m");
     state_add(&L, "velocity", STATE_F64, 2, d2, vel, "m/s");
-    state_add(&L, "pressure", STATE_F64, 1, d1, g + 6 * n, "Pa");
-    state_add(&L, "density", STATE_F64, 1, d1, g + 7 * n, "kg/m^3");
-    if (les) state_add(&L, "eddy_viscosity", STATE_F64, 1, d1, g + 8 * n, "m^2/s");
+    for (int k = 0; k < ns; k++)
+      state_add(&L, sc[k].name, STATE_F64, 1, d1, g + (size_t)(6 + k) * n, sc[k].units);
     char sdir[4096], path[4200], err[2048];
     snprintf(sdir, sizeof sdir, "%s/snapshots", dir);
     snprintf(path, sizeof path, "%s/snap_%010ld.h5", sdir, S->step);
@@ -158,7 +173,7 @@ int snapshot_write(const char *dir, const struct sim *S) {
                                  sizeof err)) {
       error_input("%s", err);
       rc = CHANSPH_ERR;
-    } else if (write_xdmf(sdir, n, les)) {
+    } else if (write_xdmf(sdir, n, sc, ns)) {
       error_input("%s/particles.xdmf: cannot write (%s)", sdir, strerror(errno));
       rc = CHANSPH_ERR;
     }

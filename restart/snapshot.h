@@ -18,9 +18,9 @@ int snapshot_due(const struct sim *S);
 /**
  * @brief Write the snapshot of the current step atomically and rewrite the XDMF index.
  * @param[in] dir run directory
- * @param[in] S simulation
+ * @param[in,out] S simulation (with output.q_criterion the Q criterion is computed first)
  * @return CHANSPH_OK, or CHANSPH_ERR with a message naming the file
  */
-int snapshot_write(const char *dir, const struct sim *S);
+int snapshot_write(const char *dir, struct sim *S);
 
 #endif

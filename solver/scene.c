@@ -305,10 +305,11 @@ static const struct key keys[] = {
     {"output", "particles", T_INT, "1", 0, 1, 0, NULL, "-",
      "Write the final particle state to DIR/particles.nc (1) or not (0).", OFF(particles)},
     {"output", "q_criterion", T_INT, "0", 0, 1, 0, NULL, "-",
-     "Add q_criterion to particles.nc: Q = (|Omega|^2 - |S|^2)/2 [1/s^2] of each fluid "
+     "Add q_criterion to particles.nc and the snapshots: Q = (|Omega|^2 - |S|^2)/2 [1/s^2] of each "
+     "fluid "
      "particle's first-order corrected velocity gradient (thesis Eq. 2.88-2.90), for vortex "
      "identification (Hunt, Wray & Moin 1988: Q > 0 where rotation exceeds strain; an iso-surface "
-     "of Q in ParaView shows the vortices). Computed only when particles.nc is written.",
+     "of Q in ParaView shows the vortices). Computed only when one of them is written.",
      OFF(q_criterion)},
     {"stats", "eulerian", T_INT, "1", 0, 1, 0, NULL, "-",
      "Eulerian statistics: wall-normal profiles of means, Reynolds stresses, skewness, "

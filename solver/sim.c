@@ -101,8 +101,7 @@ int sim_create(struct sim *S, const struct scene *sc) {
     S->P.sx = part_alloc("stress_ax", S->P.cap * SX_LEN * sizeof(double));
   }
   if (sc->shifting != SHIFT_NONE) S->P.shift_dy = part_alloc("shift_dy", S->P.cap * sizeof(double));
-  if (sc->particles && sc->q_criterion)
-    S->P.qcrit = part_alloc("q_criterion", S->P.cap * sizeof(double));
+  if (sc->q_criterion) S->P.qcrit = part_alloc("q_criterion", S->P.cap * sizeof(double));
   S->wall_fx[0] = S->wall_fx[1] = NAN;
   drive_init(&S->drive, sc);
   S->fx = S->drive.force;
