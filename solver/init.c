@@ -485,7 +485,7 @@ int init_fields(const struct scene *sc, struct particles *P) {
       if (sc->dim == 3) P->w[a] += sc->init_noise * init_noise(sc->init_seed, id, 2);
     }
   }
-  if (ut > 0.0 && sc->init_profile == INIT_REICHARDT)
+  if (ut > 0.0 && sc->init_profile == INIT_REICHARDT && !sc->init_from[0]) /* else from the file */
     msg("init: Reichardt profile with u_tau = %.6g m/s\n", ut);
   return CHANSPH_OK;
 }
