@@ -146,6 +146,11 @@ void output_stats_config(const struct scene *sc, struct stats_config *cfg) {
   c->nz = sc->dim == 2 ? 1 : sc->corr_nz > 0 ? sc->corr_nz : (int)floor(sc->lz / sc->dr + 0.5);
   c->lx = sc->lx, c->lz = sc->lz, c->delta = sc->delta, c->t_start = sc->t_average_start;
   c->half = 0.5 * sc->corr_thickness * sc->dr;
+  struct quad_config *qc = &cfg->quad;
+  qc->n_levels = sc->quad_y_plus.n;
+  for (int l = 0; l < qc->n_levels; l++)
+    qc->y_plus[l] = sc->quad_y_plus.v[l], qc->y[l] = qc->y_plus[l] * sc->nu / u_tau;
+  qc->half = 0.5 * sc->dr, qc->delta = sc->delta, qc->t_start = sc->t_average_start;
   struct lagr_config *g = &cfg->lagr;
   g->n_levels = sc->lagr_y_plus.n;
   for (int l = 0; l < g->n_levels; l++)

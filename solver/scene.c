@@ -367,6 +367,13 @@ static const struct key keys[] = {
     {"correlations", "thickness", T_DOUBLE, "1", 0, 100, LO_OPEN, NULL, "dr",
      "Thickness of the slab of particles binned onto each plane, in units of dr.",
      OFF(corr_thickness)},
+    {"quadrants", "y_plus", T_LIST, "", 0, BIG, 0, NULL, "-",
+     "Comma-separated y+ levels (up to 8) of the quadrant analysis of u'v' (Wallace et al. "
+     "1972, Willmarth & Lu 1972): in a slab of one dr at each level and its mirror, the "
+     "fluctuations about the plane average of each instant sorted into Q1 (outward), Q2 "
+     "(ejections), Q3 (inward) and Q4 (sweeps); stats.nc group quadrants (docs/stats-format.md). "
+     "Ejections and sweeps dominate in wall turbulence, not in particle noise. Empty = off.",
+     OFF(quad_y_plus)},
     {"lagrangian", "y_plus", T_LIST, "", 0, BIG, 0, NULL, "-",
      "Comma-separated y+ release levels (up to 8) of the Lagrangian statistics (thesis Sec. "
      "5.2.3.2, 6.1.3): fluid particles within dr/2 of each level (and of its mirror) and "
@@ -726,7 +733,7 @@ static void validate(struct parse_state *ps) {
   if (s->t_average_start > s->t_end)
     inconsistent(ps, "output.t_average_start", "averaging start %g is after t_end = %g",
                  s->t_average_start, s->t_end);
-  if ((s->corr_y_plus.n || s->lagr_y_plus.n) && s->u_tau_ref == 0.0 &&
+  if ((s->corr_y_plus.n || s->lagr_y_plus.n || s->quad_y_plus.n) && s->u_tau_ref == 0.0 &&
       (s->drive_mode == DRIVE_FLUX || s->force <= 0.0))
     inconsistent(ps, "stats.u_tau_ref",
                  "y+ levels need stats.u_tau_ref > 0 unless a positive drive.force gives it "

@@ -129,6 +129,7 @@ struct scene {
   int target_windows;       /*!< minimum complete windows for the target */
   /* [correlations] */
   struct scene_list corr_y_plus; /*!< y+ levels of the two-point correlations (empty = off) */
+  struct scene_list quad_y_plus; /*!< y+ levels of the quadrant analysis (empty = off) */
   int corr_nx, corr_nz;          /*!< plane grid; 0 = lx/dr, lz/dr */
   double corr_thickness;         /*!< slab thickness around each level [dr] */
   /* [lagrangian] */

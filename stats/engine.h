@@ -41,5 +41,6 @@ struct stats_engine {
 extern const struct stats_engine euler_engine; /* euler_nc.c */
 extern const struct stats_engine corr_engine;  /* corr.c */
 extern const struct stats_engine lagr_engine;  /* lagr.c */
+extern const struct stats_engine quad_engine;  /* quad.c */
 
 #endif

@@ -15,7 +15,8 @@
 #include "state.h"
 
 /* The engines, in the order they are initialised, sampled, checkpointed and written. */
-static const struct stats_engine *const engines[] = {&euler_engine, &corr_engine, &lagr_engine};
+static const struct stats_engine *const engines[] = {&euler_engine, &corr_engine, &lagr_engine,
+                                                     &quad_engine};
 enum { N_ENGINES = sizeof engines / sizeof engines[0] };
 
 static void *self_of(struct stats *st, const struct stats_engine *e) {

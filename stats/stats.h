@@ -16,6 +16,7 @@
 #include "corr.h"
 #include "euler.h"
 #include "lagr.h"
+#include "quad.h"
 
 struct state_list;
 
@@ -25,6 +26,7 @@ struct stats_config {
   struct euler_config eul; /*!< their bins and windows */
   struct corr_config corr; /*!< two-point correlations (off if corr.n_levels == 0) */
   struct lagr_config lagr; /*!< Lagrangian statistics (off if lagr.n_levels == 0) */
+  struct quad_config quad; /*!< quadrant analysis (off if quad.n_levels == 0) */
 };
 
 /** The engine. */
@@ -33,6 +35,7 @@ struct stats {
   struct euler eu;  /*!< Eulerian profiles (if cfg.eulerian) */
   struct corr co;   /*!< correlations and spectra (if cfg.corr.n_levels) */
   struct lagr la;   /*!< Lagrangian statistics (if cfg.lagr.n_levels) */
+  struct quad qu;   /*!< quadrant analysis (if cfg.quad.n_levels) */
   int64_t samples;  /*!< snapshots handed to the engine */
   double t_reached; /*!< simulated time reached, set before a write (NaN: not known); the
                          average_end written is at most this */

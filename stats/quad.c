@@ -1,0 +1,209 @@
+/** @file quad.c @brief Implementation of quad.h. */
+#include "quad.h"
+#include "engine.h"
+#include "ncutil.h"
+#include "stats.h"
+
+#include <math.h>
+#include <netcdf.h>
+#include <stddef.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "alloc.h"
+#include "ncout.h"
+#include "spar.h"
+#include "state.h"
+
+void quad_init(struct quad *q, const struct quad_config *cfg) {
+  memset(q, 0, sizeof *q);
+  q->cfg = *cfg;
+  if (cfg->n_levels <= 0) return;
+  q->acc = mem_calloc((size_t)cfg->n_levels * QS_LEN, sizeof(double), "quadrant engine");
+  q->samples = mem_calloc((size_t)cfg->n_levels, sizeof(double), "quadrant engine");
+}
+
+void quad_free(struct quad *q) {
+  free(q->acc), free(q->samples), free(q->ent), free(q->all);
+  memset(q, 0, sizeof *q);
+}
+
+/* The planes of a snapshot: each level, and its mirror (v -> -v) if the slabs do not overlap. */
+static int planes(const struct quad_config *c, int lev[], int mir[], double yp[]) {
+  int npl = 0;
+  for (int l = 0; l < c->n_levels; l++) {
+    const double yl = c->y[l], ym = 2.0 * c->delta - yl;
+    lev[npl] = l, mir[npl] = 0, yp[npl++] = yl;
+    if (fabs(ym - yl) >= 2.0 * c->half) lev[npl] = l, mir[npl] = 1, yp[npl++] = ym;
+  }
+  return npl;
+}
+
+/* Per (local column, plane) partial sums, QS_LEN slots, of this rank's slab particles, each
+   column's particles in memory order (m = NULL: u, v and the count in slots 0-2; else the
+   quadrant slots about the plane means m[plane][2]); gathered to every rank in column order,
+   then summed over the columns in that order into out[plane][QS_LEN]. */
+static void plane_sums(struct quad *q, const struct stats_snapshot *s, struct spar *par, int npl,
+                       const int mir[], const double yp[], const double *m, double *out) {
+  const size_t ncl = (size_t)(par->col1 - par->col0), rec = (size_t)npl * QS_LEN;
+  q->rec = rec;
+  if (ncl * rec > q->ent_cap) {
+    q->ent_cap = ncl * rec;
+    q->ent = mem_realloc(q->ent, q->ent_cap, sizeof(double), "quadrant engine");
+  }
+  memset(q->ent, 0, ncl * rec * sizeof(double));
+  for (size_t a = 0; a < s->n; a++) {
+    if (s->skip && s->skip[a]) continue;
+    for (int pl = 0; pl < npl; pl++) {
+      if (fabs(s->y[a] - yp[pl]) >= q->cfg.half) continue;
+      double *e = q->ent + (size_t)spar_lcol(par, s, a) * rec + (size_t)pl * QS_LEN;
+      const double u = s->u[a], v = mir[pl] ? -s->v[a] : s->v[a];
+      if (!m) {
+        e[0] += u, e[1] += v, e[2] += 1.0;
+        continue;
+      }
+      const double du = u - m[2 * pl], dv = v - m[2 * pl + 1];
+      const int k = dv >= 0.0 ? (du >= 0.0 ? 0 : 1) : (du < 0.0 ? 2 : 3); /* Q1 .. Q4 */
+      e[QS_UV + k] += du * dv, e[QS_N + k] += 1.0;
+    }
+  }
+  const size_t ncol = spar_gather_var(par, q->ent, ncl, rec, &q->all, &q->all_cap);
+  memset(out, 0, rec * sizeof(double));
+  for (size_t c = 0; c < ncol; c++)
+    for (size_t i = 0; i < rec; i++) out[i] += q->all[c * rec + i];
+}
+
+void quad_sample(struct quad *q, const struct stats_snapshot *s) {
+  if (q->cfg.n_levels <= 0 || s->t < q->cfg.t_start) return;
+  int lev[2 * QUAD_MAX_LEVELS] = {0}, mir[2 * QUAD_MAX_LEVELS] = {0};
+  double yp[2 * QUAD_MAX_LEVELS] = {0}, mean[2 * 2 * QUAD_MAX_LEVELS] = {0};
+  double s0[QS_LEN * 2 * QUAD_MAX_LEVELS], s1[QS_LEN * 2 * QUAD_MAX_LEVELS];
+  const int npl = planes(&q->cfg, lev, mir, yp);
+  struct spar par;
+  spar_open(&par, s);
+  plane_sums(q, s, &par, npl, mir, yp, NULL, s0); /* the plane means of this instant */
+  for (int pl = 0; pl < npl; pl++) {
+    const double *t = s0 + QS_LEN * pl, n = t[2];
+    mean[2 * pl] = n > 0 ? t[0] / n : 0.0, mean[2 * pl + 1] = n > 0 ? t[1] / n : 0.0;
+  }
+  plane_sums(q, s, &par, npl, mir, yp, mean, s1);
+  spar_close(&par);
+  for (int pl = 0; pl < npl; pl++) {
+    if (!(s0[QS_LEN * pl + 2] > 0)) continue;
+    double *acc = q->acc + (size_t)lev[pl] * QS_LEN;
+    for (int k = 0; k < QS_LEN; k++) acc[k] += s1[QS_LEN * pl + k];
+    q->samples[lev[pl]] += 1.0;
+  }
+}
+
+void quad_state(struct quad *q, struct state_list *L) {
+  if (q->cfg.n_levels <= 0) return;
+  const size_t d2[2] = {(size_t)q->cfg.n_levels, QS_LEN}, d1[1] = {d2[0]};
+  state_add(L, "stats/quadrants/sums", STATE_F64, 2, d2, q->acc, NULL);
+  state_add(L, "stats/quadrants/samples", STATE_F64, 1, d1, q->samples, NULL);
+}
+
+/* [level][4] from the sums: each quadrant's part of <u'v'> (sum over the quadrant / all
+   samples), its share of the whole u'v', and its share of the samples. */
+static void quad_results(const struct quad *q, double *uv, double *share, double *time) {
+  for (int l = 0; l < q->cfg.n_levels; l++) {
+    const double *a = q->acc + (size_t)l * QS_LEN;
+    const double n = a[QS_N] + a[QS_N + 1] + a[QS_N + 2] + a[QS_N + 3];
+    const double tot = a[QS_UV] + a[QS_UV + 1] + a[QS_UV + 2] + a[QS_UV + 3];
+    for (int k = 0; k < 4; k++) {
+      uv[4 * l + k] = n > 0 ? a[QS_UV + k] / n : NAN;
+      share[4 * l + k] = n > 0 && tot != 0.0 ? a[QS_UV + k] / tot : NAN;
+      time[4 * l + k] = n > 0 ? a[QS_N + k] / n : NAN;
+    }
+  }
+}
+
+int quad_nc_write(const struct quad *q, int ncid, char *err, size_t errlen) {
+  const size_t nl = (size_t)q->cfg.n_levels;
+  double *r = mem_alloc(3 * 4 * nl, sizeof(double), "quadrants");
+  int rc = NC_NOERR, g, dl, dq, d2[2], d3[2], v;
+  quad_results(q, r, r + 4 * nl, r + 8 * nl);
+  NC_TRY(nc_def_grp(ncid, "quadrants", &g), done);
+  static const char desc[] =
+      "quadrant analysis of u'v' (Wallace et al. 1972, Willmarth & Lu 1972): fluctuations about "
+      "the plane average of each instant in a slab of one dr at each level and its mirror "
+      "(v -> -v); quadrant 1..4 = Q1 (u'>0, v'>0), Q2 ejections (u'<0, v'>0), Q3 (u'<0, v'<0), "
+      "Q4 sweeps (u'>0, v'<0)";
+  NC_TRY(nc_put_att_text(g, NC_GLOBAL, "description", strlen(desc), desc), done);
+  NC_TRY(nc_def_dim(g, "level", nl, &dl), done);
+  NC_TRY(nc_def_dim(g, "quadrant", 4, &dq), done);
+  NC_TRY(
+      ncout_def(g, "level", NC_DOUBLE, 1, &dl, "m", "height of the plane above the lower wall", &v),
+      done);
+  NC_TRY(nc_put_var_double(g, v, q->cfg.y), done);
+  NC_TRY(
+      ncout_def(g, "y_plus", NC_DOUBLE, 1, &dl, "1", "level in wall units of stats.u_tau_ref", &v),
+      done);
+  NC_TRY(nc_put_var_double(g, v, q->cfg.y_plus), done);
+  NC_TRY(ncout_def(g, "samples", NC_DOUBLE, 1, &dl, "1", "planes accumulated", &v), done);
+  NC_TRY(nc_put_var_double(g, v, q->samples), done);
+  d2[0] = d3[0] = dl, d2[1] = dq;
+  static const char *const name[3] = {"uv", "uv_fraction", "time_fraction"};
+  static const char *const units[3] = {"m^2/s^2", "1", "1"};
+  static const char *const lname[3] = {
+      "part of <u'v'> from each quadrant (the four add up to <u'v'>)",
+      "share of u'v' carried by each quadrant (the four add up to 1)",
+      "share of the samples in each quadrant"};
+  for (int k = 0; k < 3; k++) {
+    NC_TRY(ncout_def(g, name[k], NC_DOUBLE, 2, d2, units[k], lname[k], &v), done);
+    NC_TRY(nc_put_var_double(g, v, r + (size_t)k * 4 * nl), done);
+  }
+  d3[1] = 0; /* the raw sums, re-averageable: [level][u'v' Q1..Q4, count Q1..Q4] */
+  {
+    int ds;
+    NC_TRY(nc_def_dim(g, "sum_slot", QS_LEN, &ds), done);
+    d3[1] = ds;
+    NC_TRY(ncout_def(g, "sums", NC_DOUBLE, 2, d3, "1",
+                     "raw sums over the planes: u'v' of Q1..Q4 [m^2/s^2], then the sample counts "
+                     "of Q1..Q4",
+                     &v),
+           done);
+    NC_TRY(nc_put_var_double(g, v, q->acc), done);
+  }
+done:
+  free(r);
+  return rc;
+}
+
+/* The engine's table of operations (engine.h). */
+static int engine_wanted(const struct stats_config *cfg) {
+  return cfg->quad.n_levels > 0;
+}
+
+static void engine_init(void *self, const struct stats_config *cfg) {
+  quad_init(self, &cfg->quad);
+}
+
+static void engine_free(void *self) {
+  quad_free(self);
+}
+
+static void engine_sample(void *self, const struct stats_snapshot *s) {
+  quad_sample(self, s);
+}
+
+static void engine_state(void *self, struct state_list *L) {
+  quad_state(self, L);
+}
+
+static size_t engine_bytes(const void *self) {
+  const struct quad *q = self;
+  return ((size_t)q->cfg.n_levels * (QS_LEN + 1) + q->ent_cap + q->all_cap * q->rec) *
+         sizeof(double);
+}
+
+static int engine_write(const void *self, double t_reached, int ncid, char *err, size_t errlen) {
+  (void)t_reached;
+  return quad_nc_write(self, ncid, err, errlen);
+}
+
+const struct stats_engine quad_engine = {"quadrant analysis", offsetof(struct stats, qu),
+                                         engine_wanted,       engine_init,
+                                         engine_free,         engine_sample,
+                                         engine_state,        engine_bytes,
+                                         engine_write,        NULL};
