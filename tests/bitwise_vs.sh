@@ -8,7 +8,8 @@
 # the only attribute allowed to differ is `source`).
 # BITWISE_NEW_KEYS="sec.key=value ...": scene keys the new build added, at their defaults (e.g.
 # sph.precision=double): the new runs' scene text, which lists every key, is compared with those
-# lines removed.
+# lines removed; BITWISE_NEW_SECTIONS="sec ...": whole sections the new build added (e.g.
+# quadrants), removed likewise.
 # usage: tests/bitwise_vs.sh OLD_COMMIT [NEW_CHANSPH (default build/chansph)]
 set -u
 here=$(cd "$(dirname "$0")/.." && pwd)
@@ -30,7 +31,12 @@ drop_keys() { # remove the lines "key = value" of BITWISE_NEW_KEYS from a scene 
     local k=${kv%%=*} v=${kv#*=}
     args+=(-e "s/\\\\n${k#*.} = $v\\\\n/\\\\n/" -e "/^ *${k#*.} = $v\$/d")
   done
-  sed "${args[@]}"
+  local sec
+  for sec in ${BITWISE_NEW_SECTIONS:-}; do # a whole new section, up to its blank line
+    args+=(-e "/^ *\\[$sec\\]\$/,/^ *\$/d")
+  done
+  sed "${args[@]}" | perl -pe 'for my $s (split " ", $ENV{BITWISE_NEW_SECTIONS} // "") {
+    s/\\n\[\Q$s\E\]\\n.*?\\n\\n/\\n/g }'
 }
 content() { "$here/tests/nc_content.sh" "$1" | awk '/^\t\t:source = /{skip=1} skip{if (/ ;$/) skip=0; next} 1' | drop_keys; }
 status=0
@@ -64,7 +70,7 @@ compare() { # NAME RANKS SCENE ARGS...
     # (e.g. no Lagrangian track in flight): their headers (shape, type, attributes) are.
     local report empty=""
     report=$(h5diff -v "$c" "$d" 2>&1)
-    if [ -f "$d" ] && printf '%s\n' "$report" | awk -v newkeys="${BITWISE_NEW_KEYS:+1}" '
+    if [ -f "$d" ] && printf '%s\n' "$report" | awk -v newkeys="${BITWISE_NEW_KEYS:+1}${BITWISE_NEW_SECTIONS:+1}" '
         /^ +x +\// { if ($2 != "x") bad = 1 } # an object in one file only
         /^(attribute|dataset|group|datatype): / { obj = $0 }
         /^[0-9]+ differences? found/ { if ($1 > 0 && obj !~ /^attribute: <source of/ &&
@@ -77,7 +83,7 @@ compare() { # NAME RANKS SCENE ARGS...
           { echo "$name $(basename "$c") $e: DIFFERENT header"; status=1; }
       done
       # with new keys the scene texts differ by those lines only (h5dump, the size line aside)
-      [ -n "${BITWISE_NEW_KEYS:-}" ] && ! cmp -s <(h5dump -d /scene "$c" 2>/dev/null | tail -n +2 | grep -v STRSIZE | drop_keys) \
+      [ -n "${BITWISE_NEW_KEYS:-}${BITWISE_NEW_SECTIONS:-}" ] && ! cmp -s <(h5dump -d /scene "$c" 2>/dev/null | tail -n +2 | grep -v STRSIZE | drop_keys) \
         <(h5dump -d /scene "$d" 2>/dev/null | tail -n +2 | grep -v STRSIZE | drop_keys) &&
         { echo "$name $(basename "$c") /scene: DIFFERENT"; status=1; }
       n=$((n + 1))
