@@ -12,19 +12,21 @@
 #include "reduce.h"
 #include "timers.h"
 
-/* A particle on the wire: its PF_MIGRATE fields (part.h) in table order, width values each (an
-   id's bytes in one double, a kind as a double); a field not in use or not live travels as
-   zeros and is not unpacked. F_LEN bounds the record. */
+/* A particle on the wire: its fields of one role (PF_MIGRATE: migration; PF_GHOST: a ghost of
+   the halo), in table order (part.h), width values each (an id's bytes in one double, a kind
+   as a double); a field not in use or not live travels as zeros and is not unpacked. F_LEN
+   bounds the record. */
 enum { F_LEN = 48 };
 
-static int record_len(void) {
-  static int len = 0;
-  if (len) return len;
+static int record_len(int role) {
+  static int len[2] = {0, 0};
+  const int k = role == PF_GHOST;
+  if (len[k]) return len[k];
   int n = 0;
   for (int i = 0; i < part_n_fields; i++)
-    if (part_fields[i].roles & PF_MIGRATE) n += part_fields[i].width;
-  if (n > F_LEN) die("a migrated particle record of %d values exceeds F_LEN (dd.c)", n);
-  return len = n;
+    if (part_fields[i].roles & role) n += part_fields[i].width;
+  if (n > F_LEN) die("a particle record of %d values exceeds F_LEN (dd.c)", n);
+  return len[k] = n;
 }
 
 /* tags: a message going to the left neighbour, one going to the right */
@@ -36,10 +38,10 @@ static void reserve_buf(double **buf, size_t *cap, size_t n) {
   *buf = mem_realloc(*buf, *cap, sizeof(double), "domain decomposition");
 }
 
-static void pack(const struct particles *P, size_t a, double *r) {
+static void pack(const struct particles *P, size_t a, double *r, int role) {
   for (int i = 0; i < part_n_fields; i++) {
     const struct part_field *f = &part_fields[i];
-    if (!(f->roles & PF_MIGRATE)) continue;
+    if (!(f->roles & role)) continue;
     const void *arr = part_field_live(P, f) ? part_field_ptr(P, f) : NULL;
     if (f->type == PT_I64)
       memcpy(r, (const int64_t *)arr + a, sizeof(double));
@@ -51,10 +53,10 @@ static void pack(const struct particles *P, size_t a, double *r) {
   }
 }
 
-static void unpack(struct particles *P, size_t a, const double *r) {
+static void unpack(struct particles *P, size_t a, const double *r, int role) {
   for (int i = 0; i < part_n_fields; i++) {
     const struct part_field *f = &part_fields[i];
-    if (!(f->roles & PF_MIGRATE)) continue;
+    if (!(f->roles & role)) continue;
     void *arr = part_field_live(P, f) ? part_field_ptr(P, f) : NULL;
     if (f->type == PT_I64)
       memcpy((int64_t *)arr + a, r, sizeof(double));
@@ -68,8 +70,8 @@ static void unpack(struct particles *P, size_t a, const double *r) {
 
 static void copy_slot(struct particles *P, size_t to, size_t from) {
   double r[F_LEN];
-  pack(P, from, r);
-  unpack(P, to, r);
+  pack(P, from, r, PF_MIGRATE);
+  unpack(P, to, r, PF_MIGRATE);
 }
 
 static void partition_even(struct dd *d) {
@@ -168,7 +170,7 @@ void dd_migrate(struct dd *d, struct particles *P, const struct nbr *nb) {
     nbr_wrap_position(nb, &P->x[a], &P->z[a]);
     const int col = nbr_column(nb, P->x[a]);
     dest[a] = owned(d, col) ? -1 : dd_owner(d, col);
-    if (dest[a] >= 0) scount[dest[a]] += record_len(), leaving++;
+    if (dest[a] >= 0) scount[dest[a]] += record_len(PF_MIGRATE), leaving++;
   }
   for (int r = 0; r < np; r++) sdisp[r + 1] = sdisp[r] + scount[r];
   reserve_buf(&d->sbuf, &d->cap_sbuf, (size_t)sdisp[np]);
@@ -181,8 +183,8 @@ void dd_migrate(struct dd *d, struct particles *P, const struct nbr *nb) {
       k++;
       continue;
     }
-    pack(P, a, d->sbuf + sdisp[dest[a]] + fill[dest[a]]);
-    fill[dest[a]] += record_len();
+    pack(P, a, d->sbuf + sdisp[dest[a]] + fill[dest[a]], PF_MIGRATE);
+    fill[dest[a]] += record_len(PF_MIGRATE);
   }
   P->n = k;
   CHECK_MPI(MPI_Alltoall(scount, 1, MPI_INT, rcount, 1, MPI_INT, MPI_COMM_WORLD));
@@ -190,9 +192,10 @@ void dd_migrate(struct dd *d, struct particles *P, const struct nbr *nb) {
   reserve_buf(&d->rbuf, &d->cap_rbuf, (size_t)rdisp[np]);
   CHECK_MPI(MPI_Alltoallv(d->sbuf, scount, sdisp, MPI_DOUBLE, d->rbuf, rcount, rdisp, MPI_DOUBLE,
                           MPI_COMM_WORLD));
-  const size_t arriving = (size_t)rdisp[np] / (size_t)record_len();
+  const size_t arriving = (size_t)rdisp[np] / (size_t)record_len(PF_MIGRATE);
   d->reserve(d->ctx, P->n + arriving);
-  for (size_t i = 0; i < arriving; i++) unpack(P, P->n + i, d->rbuf + i * (size_t)record_len());
+  for (size_t i = 0; i < arriving; i++)
+    unpack(P, P->n + i, d->rbuf + i * (size_t)record_len(PF_MIGRATE), PF_MIGRATE);
   P->n += arriving;
   for (int r = 0; r < np; r++)
     if (scount[r]) d->messages++;
@@ -248,25 +251,11 @@ static void exchange(struct dd *d, int nf, void (*pack_fn)(const void *, size_t,
   d->bytes += (double)ns * nf * sizeof(double);
 }
 
-/* A ghost on the wire: what the passes read at a neighbour before the first refresh (positions,
-   velocities, mass for the neighbour search and kernel sums, id and kind). Density, pressure and
-   the model terms follow in the refreshes (dd_update); nothing reads a ghost's gamma, kernel sum
-   or acceleration. */
-enum { H_X, H_Y, H_Z, H_U, H_V, H_W, H_M, H_ID, H_KIND, H_LEN };
-
+/* A ghost on the wire: its PF_GHOST fields (positions, velocities, mass for the neighbour
+   search and kernel sums, id and kind). Density, pressure and the model terms follow in the
+   refreshes (dd_update); nothing reads a ghost's gamma, kernel sum or acceleration. */
 static void pack_ghost(const void *arg, size_t a, double *r) {
-  const struct particles *P = arg;
-  r[H_X] = P->x[a], r[H_Y] = P->y[a], r[H_Z] = P->z[a];
-  r[H_U] = P->u[a], r[H_V] = P->v[a], r[H_W] = P->w[a], r[H_M] = P->m[a];
-  memcpy(&r[H_ID], &P->id[a], sizeof(double));
-  r[H_KIND] = P->kind[a];
-}
-
-static void unpack_ghost(struct particles *P, size_t a, const double *r) {
-  P->x[a] = r[H_X], P->y[a] = r[H_Y], P->z[a] = r[H_Z];
-  P->u[a] = r[H_U], P->v[a] = r[H_V], P->w[a] = r[H_W], P->m[a] = r[H_M];
-  memcpy(&P->id[a], &r[H_ID], sizeof(double));
-  P->kind[a] = (uint8_t)r[H_KIND];
+  pack(arg, a, r, PF_GHOST);
 }
 
 void dd_halo(struct dd *d, struct particles *P, struct nbr *nb) {
@@ -286,10 +275,11 @@ void dd_halo(struct dd *d, struct particles *P, struct nbr *nb) {
   CHECK_MPI(MPI_Isend(&sc[1], 1, MPI_UNSIGNED_LONG, d->right, TAG_RIGHT, MPI_COMM_WORLD, &req[3]));
   CHECK_MPI(MPI_Waitall(4, req, MPI_STATUSES_IGNORE));
   d->nrecv[0] = rc[0], d->nrecv[1] = rc[1];
-  exchange(d, H_LEN, pack_ghost, P);
+  const int hl = record_len(PF_GHOST);
+  exchange(d, hl, pack_ghost, P);
   const size_t ng = d->nrecv[0] + d->nrecv[1];
   d->reserve(d->ctx, P->n + ng);
-  for (size_t g = 0; g < ng; g++) unpack_ghost(P, P->n + g, d->rbuf + g * H_LEN);
+  for (size_t g = 0; g < ng; g++) unpack(P, P->n + g, d->rbuf + g * (size_t)hl, PF_GHOST);
   P->n_ghost = ng;
   nbr_sort_ghosts(nb, P, d->nrecv[0]);
   if (ng > d->cap_ghost) d->cap_ghost = ng + ng / 2;

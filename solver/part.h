@@ -100,7 +100,9 @@ enum part_role {
   PF_MIGRATE = 2, /*!< travels with its particle to another MPI rank */
   PF_CKPT = 4,    /*!< in the checkpoint as particles/NAME (by id; docs/checkpoint-format.md) */
   PF_WRITE = 8,   /*!< in particles.nc */
-  PF_HEALTH = 16  /*!< must be finite: health.c checks it before a state is written or sampled */
+  PF_HEALTH = 16, /*!< must be finite: health.c checks it before a state is written or sampled */
+  PF_GHOST = 32   /*!< sent with a ghost when the halo is built (dd_halo): what the passes read
+                       at a neighbour before the first refresh (dd_update) */
 };
 
 enum part_type { PT_F64, PT_I64, PT_U8 };
