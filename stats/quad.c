@@ -132,6 +132,8 @@ int quad_nc_write(const struct quad *q, int ncid, char *err, size_t errlen) {
   NC_TRY(nc_put_att_text(g, NC_GLOBAL, "description", strlen(desc), desc), done);
   NC_TRY(nc_def_dim(g, "level", nl, &dl), done);
   NC_TRY(nc_def_dim(g, "quadrant", 4, &dq), done);
+  static const char *const qlab[4] = {"Q1_outward", "Q2_ejection", "Q3_inward", "Q4_sweep"};
+  NC_TRY(ncout_labels(g, "quadrant", dq, "quadrant of (u', v')", qlab), done);
   NC_TRY(
       ncout_def(g, "level", NC_DOUBLE, 1, &dl, "m", "height of the plane above the lower wall", &v),
       done);
@@ -157,6 +159,9 @@ int quad_nc_write(const struct quad *q, int ncid, char *err, size_t errlen) {
   {
     int ds;
     NC_TRY(nc_def_dim(g, "sum_slot", QS_LEN, &ds), done);
+    static const char *const slab[QS_LEN] = {"uv_Q1", "uv_Q2", "uv_Q3", "uv_Q4",
+                                             "n_Q1",  "n_Q2",  "n_Q3",  "n_Q4"};
+    NC_TRY(ncout_labels(g, "sum_slot", ds, "slot of the raw sums", slab), done);
     d3[1] = ds;
     NC_TRY(ncout_def(g, "sums", NC_DOUBLE, 2, d3, "1",
                      "raw sums over the planes: u'v' of Q1..Q4 [m^2/s^2], then the sample counts "
