@@ -1,7 +1,6 @@
 /** @file snapshot.c @brief Implementation of snapshot.h. */
 #include "snapshot.h"
 #include "alloc.h"
-#include "turb.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -128,7 +127,7 @@ int snapshot_write(const char *dir, struct sim *S) {
   const struct particles *P = &S->P;
   const size_t n = P->n_fluid;
   const int root = S->dd.rank == 0;
-  if (P->qcrit) turb_q_criterion(&S->M, &S->P, &S->nb, S->P.qcrit); /* output.q_criterion */
+  sim_output_fields(S); /* output.q_criterion */
   /* the scalars this run has (every rank has the same arrays) */
   const struct snap_scalar all[] = {{"pressure", "Pa", P->p},
                                     {"density", "kg/m^3", P->rho},

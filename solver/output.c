@@ -18,7 +18,6 @@
 #include "git_commit.h"
 #include "ncout.h"
 #include "timers.h"
-#include "turb.h"
 
 /** The `source` attribute of the output files: version and git commit of the build. */
 #define CHANSPH_SOURCE "chansph " CHANSPH_VERSION " (git " CHANSPH_GIT_COMMIT ")"
@@ -516,7 +515,7 @@ int output_step(struct output *o, struct sim *S) {
 
 static int write_particles(struct output *o, struct sim *S) {
   const struct particles *P = &S->P;
-  if (P->qcrit) turb_q_criterion(&S->M, &S->P, &S->nb, S->P.qcrit); /* output.q_criterion */
+  sim_output_fields(S); /* output.q_criterion */
   const size_t n = P->n_fluid;
   enum { NC_MAX = 32 };
   const double *src[NC_MAX];

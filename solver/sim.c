@@ -102,6 +102,7 @@ int sim_create(struct sim *S, const struct scene *sc) {
   }
   if (sc->shifting != SHIFT_NONE) S->P.shift_dy = part_alloc("shift_dy", S->P.cap * sizeof(double));
   if (sc->q_criterion) S->P.qcrit = part_alloc("q_criterion", S->P.cap * sizeof(double));
+  S->qcrit_step = -1;
   S->wall_fx[0] = S->wall_fx[1] = NAN;
   drive_init(&S->drive, sc);
   S->fx = S->drive.force;
@@ -277,6 +278,12 @@ void sim_step(struct sim *S) {
   dd_migrate(&S->dd, P, &S->nb);
   update_state(S, 0, dt);
   if (S->sc->check_ids) dd_check_ids(&S->dd, P, P->n_fluid + P->n_vertex, S->step);
+}
+
+void sim_output_fields(struct sim *S) {
+  if (!S->P.qcrit || S->qcrit_step == S->step) return;
+  turb_q_criterion(&S->M, &S->P, &S->nb, S->P.qcrit);
+  S->qcrit_step = S->step;
 }
 
 void sim_diag(struct sim *S, struct diag *d) {

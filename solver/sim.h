@@ -39,6 +39,7 @@ struct sim {
                                  force pass (NaN if not sampled) [N, N/m in 2-D] */
   char violation[320];      /*!< a fixed dt broke a stability limit: what, where (else empty) */
   int distributed;          /*!< 1 after the particles were split over the ranks */
+  long qcrit_step;          /*!< step whose Q criterion P.qcrit holds (-1: none yet) */
   void *gather[SIM_GATHER]; /*!< this rank's id block of the state, for a checkpoint */
 };
 
@@ -99,6 +100,10 @@ static inline void sim_id_block(int r, int size, size_t N, size_t *lo, size_t *h
  * @return 0, or the number of wall values that differ from the stored ones (not bitwise)
  */
 size_t sim_restored(struct sim *S);
+
+/** @brief The derived per-particle fields that outputs write (output.q_criterion), computed at
+           most once per step: particles.nc and a snapshot of the same step share them. */
+void sim_output_fields(struct sim *S);
 
 /** @brief Diagnostics of the current state (deterministic sums). */
 void sim_diag(struct sim *S, struct diag *d);
