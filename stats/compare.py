@@ -186,7 +186,8 @@ def read_run(path):
             return np.ma.filled(x.astype(float), np.nan)
         y, u, uu, vv, ww, uv = (v(n) for n in ("y_mean", "u_mean", "uu", "vv", "ww", "uv"))
         se = {n: v(n + "_stderr") for n in ("u_mean", "uu", "vv", "ww", "uv")}
-        budget = {n: v(n) for n in BUDGET + ("total_stress", "total_stress_expected")
+        budget = {n: v(n) for n in BUDGET + ("total_stress", "total_stress_expected",
+                                             "momentum_change")
                   if n in d.variables} if "pair_stress" in d.variables else {}
     for k in ("u_tau", "nu", "delta"):
         if k not in a:
@@ -214,7 +215,7 @@ def read_run(path):
 
 
 BUDGET = ("reynolds_stress", "viscous_pair_stress", "model_pair_stress", "pair_stress",
-          "wall_term_stress")
+          "wall_term_stress", "advective_stress")
 
 
 def print_budget(ours):
@@ -223,16 +224,24 @@ def print_budget(ours):
     if not names:
         return
     yp = ours["yplus"]
-    print("momentum budget (shares of total_stress; total and expected in u_tau^2):")
+    tot, exp = ours["budget:total_stress"], ours["budget:total_stress_expected"]
+    # the unsteady term: total + d/dt = expected in any window (absent in earlier files: 0)
+    ddt = np.nan_to_num(ours.get("budget:momentum_change", np.zeros_like(tot)))
+    closure = tot + ddt - exp
+    print("momentum budget (shares of total_stress; total, d/dt (momentum_change), expected and "
+          "closure = total + d/dt - expected in u_tau^2):")
     print("%8s %8s " % ("y+", "y/delta") + " ".join("%10s" % n.replace("_stress", "")[:10]
-                                                  for n in names) + " %9s %9s" % ("total", "expected"))
+                                                  for n in names) +
+          " %9s %9s %9s %9s" % ("total", "d/dt", "expected", "closure"))
     rows = sorted({int(np.argmin(np.abs(yp - t))) for t in (5.0, 15.0, 30.0, 100.0,
                                                              0.5 * ours["re_tau"])})
     for i in rows:
-        tot = ours["budget:total_stress"][i]
         print("%8.1f %8.3f " % (yp[i], ours["y_delta"][i]) +
-              " ".join("%9.0f%%" % (100 * ours["budget:" + n][i] / tot) for n in names) +
-              " %9.4f %9.4f" % (tot, ours["budget:total_stress_expected"][i]))
+              " ".join("%9.0f%%" % (100 * ours["budget:" + n][i] / tot[i]) for n in names) +
+              " %9.4f %9.4f %9.4f %9.4f" % (tot[i], ddt[i], exp[i], closure[i]))
+    worst = int(np.nanargmax(np.abs(closure)))
+    print("budget closure: max |total + d/dt - expected| = %.4f u_tau^2 at y+ %.1f (over %d bins)"
+          % (abs(closure[worst]), yp[worst], np.sum(np.isfinite(closure))))
 
 
 def region_masks(yp, yd):

@@ -15,9 +15,17 @@
 /* Per-(column, bin) partial of one snapshot: a moment record, then the sum of u and the count
    (the weight sum with EULER_SPH) behind the per-snapshot bin mean of u, then the momentum
    budget: for each side of the channel (y < delta, y > delta; folded: the first) the sums of
-   m a_x of each part of the acceleration and of m. */
-enum { HB_MASS = EULER_SX, HB_MU, HB_LEN };
-enum { EU_PART_U = MOM_LEN, EU_PART_N, EU_PART_PL, EU_PART = EU_PART_PL + 2 * HB_LEN };
+   m a_x of each part of the acceleration, of m, m u and m u v, then the same sums weighted by
+   the particle's offset from its bin centre in bin widths, phi (add_particle, budget_planes;
+   the weighted m u v is not used). */
+enum { HB_MASS = EULER_SX, HB_MU, HB_UV, HB_LEN };
+enum {
+  EU_PART_U = MOM_LEN,
+  EU_PART_N,
+  EU_PART_PL,
+  EU_PART_PL1 = EU_PART_PL + 2 * HB_LEN,
+  EU_PART = EU_PART_PL1 + 2 * HB_LEN
+};
 
 /* Scratch of euler_sample. The columns are merged over a fixed binary tree on the global
    column index: node [lo, hi) with hi - lo >= 2 has the children [lo, mid) and [mid, hi),
@@ -66,19 +74,21 @@ const struct euler_meta euler_prof_meta[EP_NPROF] = {
     [EP_FLAT_W] = {"w_flatness", "1", "flatness (kurtosis) of w"},
     [EP_VISC] = {"viscous_stress", "m^2/s^2",
                  "viscous shear stress (nu + <nu_t>) dU/dy (Eq. 5.11; nu_t with LES only)"},
-    [EP_TOTAL] = {"total_stress", "m^2/s^2",
-                  "total shear stress: the sum of the momentum budget reynolds_stress + "
-                  "viscous_pair_stress + model_pair_stress + pair_stress + wall_term_stress "
-                  "(method of planes); without it (no sampled forces) nu dU/dy - <u'v'> "
-                  "(Eq. 5.12)"},
+    [EP_TOTAL] =
+        {"total_stress", "m^2/s^2",
+         "total shear stress: the sum of the momentum budget reynolds_stress + "
+         "viscous_pair_stress + model_pair_stress + pair_stress + wall_term_stress + "
+         "advective_stress (method of planes); without it (no sampled forces) nu dU/dy - <u'v'> "
+         "(Eq. 5.12)"},
     [EP_TOTAL_EXPECTED] = {"total_stress_expected", "m^2/s^2",
                            "what the total must be in a steady state: the body force on the fluid "
                            "between the plane and the centre per unit area and rho0, tau_w / rho "
                            "(1 - y / delta) for a uniform density (Eq. 5.13)"},
     [EP_NUT] = {"nu_t_mean", "m^2/s", "mean eddy viscosity (LES, thesis Eq. 5.45)"},
     [EP_KR] = {"k_r_mean", "m^2/s^2", "mean residual kinetic energy (LES, Yoshizawa)"},
-    [EP_TAU_REYNOLDS] = {"reynolds_stress", "m^2/s^2",
-                         "momentum budget: the kinetic flux of the particles -<u'v'>"},
+    [EP_TAU_REYNOLDS] =
+        {"reynolds_stress", "m^2/s^2",
+         "momentum budget: the Reynolds part of the particles' kinetic flux, -<u'v'>"},
     [EP_TAU_VISCOUS] = {"viscous_pair_stress", "m^2/s^2",
                         "momentum budget: x-momentum flux through the plane carried by the "
                         "viscous pair forces (molecular viscosity), method of planes"},
@@ -91,6 +101,11 @@ const struct euler_meta euler_prof_meta[EP_NPROF] = {
     [EP_TAU_WALL] = {"wall_term_stress", "m^2/s^2",
                      "momentum budget: x-force of the wall terms on the fluid between the plane "
                      "and the centre per unit area and rho0"},
+    [EP_TAU_ADVECT] = {"advective_stress", "m^2/s^2",
+                       "momentum budget: the rest of the particles' kinetic flux through the "
+                       "plane, -(sum over the bin of m u v) / (rho0 A w) - reynolds_stress: the "
+                       "mean flow's advection -U V and the density weighting of -<u'v'>; zero in "
+                       "a steady state of uniform density"},
     [EP_TAU_SOURCE] = {"pair_momentum_source", "m^2/s^2",
                        "net x-force of all pair forces on the fluid of this side of the channel "
                        "per unit area and rho0 (the scheme's momentum source; zero if the pair "
@@ -110,7 +125,9 @@ const struct euler_meta euler_prof_meta[EP_NPROF] = {
                        "standard error of pair_stress (batch means)"},
     [EP_SE_TAU + 4] = {"wall_term_stress_stderr", "m^2/s^2",
                        "standard error of wall_term_stress (batch means)"},
-    [EP_SE_TAU + 5] = {"total_stress_stderr", "m^2/s^2",
+    [EP_SE_TAU + 5] = {"advective_stress_stderr", "m^2/s^2",
+                       "standard error of advective_stress (batch means)"},
+    [EP_SE_TAU + 6] = {"total_stress_stderr", "m^2/s^2",
                        "standard error of total_stress (batch means)"},
 };
 
@@ -128,10 +145,12 @@ static void reserve_rows(struct euler *e, size_t rows) {
   e->mom = mem_realloc(e->mom, cap * nb * MOM_LEN, sizeof(double), "Eulerian statistics");
   e->snp = mem_realloc(e->snp, cap * nb * SCAL_LEN, sizeof(double), "Eulerian statistics");
   e->pln = mem_realloc(e->pln, cap * nb * PL_LEN, sizeof(double), "Eulerian statistics");
+  e->kin = mem_realloc(e->kin, cap * nb * KN_LEN, sizeof(double), "Eulerian statistics");
   memset(e->win + old * WIN_LEN, 0, (cap - old) * WIN_LEN * sizeof(double));
   memset(e->mom + old * nb * MOM_LEN, 0, (cap - old) * nb * MOM_LEN * sizeof(double));
   memset(e->snp + old * nb * SCAL_LEN, 0, (cap - old) * nb * SCAL_LEN * sizeof(double));
   memset(e->pln + old * nb * PL_LEN, 0, (cap - old) * nb * PL_LEN * sizeof(double));
+  memset(e->kin + old * nb * KN_LEN, 0, (cap - old) * nb * KN_LEN * sizeof(double));
   e->cap = cap;
 }
 
@@ -183,7 +202,7 @@ void euler_init(struct euler *e, const struct euler_config *cfg) {
 void euler_free(struct euler *e) {
   struct euler_work *k = e->work;
   if (k) free(k->part), free(k->mine), free(k->all), free(k->scr), free(k->node), free(k);
-  free(e->win), free(e->mom), free(e->snp), free(e->pln);
+  free(e->win), free(e->mom), free(e->snp), free(e->pln), free(e->kin);
   memset(e, 0, sizeof *e);
 }
 
@@ -256,16 +275,21 @@ static void node_record(struct euler_work *k, size_t nb, int lo, int hi, const d
 /* The momentum budget of one snapshot from its merged per-bin sums (snap: one EU_PART record
    per bin), added to the window's plane sums pl (docs/theory.md, "Momentum budget"). The
    planes are the bin edges, where no particle layer of the initial lattice lies (with
-   output.n_bins = 0 the layers are the bin centres); a bin gets the mean of its two edges.
-   The flux through a plane is what the fluid between it and the centre receives across it:
-   minus the net pair force on that fluid, by term, and the pull of the wall on it (below the
+   output.n_bins = 0 the layers are the bin centres). A bin gets the average over the planes
+   through it: the mean of its two edges, plus its own particles weighted by their offset
+   from the bin centre, phi = (y - y_c) / w (a particle at y lies on the centre side of the
+   fraction 1/2 + phi of those planes in the lower half, 1/2 - phi in the upper). With that weight
+   the budget is an identity for the bin's kinetic flux, the bin mean of m u v / w: a particle that
+   oscillates within a layer carries u'v' but crosses no edge, and the first moment of its forces
+   balances it. The flux through a plane is what the fluid between it and the centre receives across
+   it: minus the net pair force on that fluid, by term, and the pull of the wall on it (below the
    centre, or folded: the fluid of y < delta above the plane and the wall y = 0; above the
    centre: the fluid of y > delta below the plane, the wall y = 2 delta, and the signs of the
    stress convention, force on the fluid below). In a steady state they balance the body force
    on that fluid. The net pair force on a whole side (zero for a momentum-conserving scheme)
    is the momentum source. */
 static void budget_planes(const struct euler_config *c, const double *snap, double fx, double t,
-                          double *pl) {
+                          double *pl, double *kin) {
   const int nb = c->nb;
   double tot[2][HB_LEN] = {{0}}, below[2][HB_LEN] = {{0}}, prev[PL_LEN] = {0};
   for (int b = 0; b < nb; b++)
@@ -286,14 +310,30 @@ static void budget_planes(const struct euler_config *c, const double *snap, doub
         at[PL_WALL] = sum / norm;
       } else if (k == HB_MASS) {
         at[PL_DRIVE] = (lower ? fx : -fx) * centre / norm;
-      } else {
+      } else if (k == HB_MU) {
         at[PL_MU_LAST] = (lower ? centre : -centre) / norm;
       }
     }
     if (e > 0) {
+      /* the first moments of bin e - 1, both sides (one is empty unless the bin holds the
+         centre): in the stress convention the same sign on either side */
+      const double *m1 = snap + (size_t)(e - 1) * EU_PART + EU_PART_PL1;
+      double corr[PL_LEN] = {0};
+      for (int s = 0; s < 2; s++, m1 += HB_LEN) {
+        for (int k = 0; k < EULER_SX; k++) corr[PL_PRESSURE + k] -= m1[k] / norm;
+        corr[PL_DRIVE] += fx * m1[HB_MASS] / norm, corr[PL_MU_LAST] += m1[HB_MU] / norm;
+      }
+      /* the kinetic flux: -(sum of m u v over the bin) / (rho0 A w), either side, w the width
+         of the planes through the bin (add_particle) */
+      const double *hb = snap + (size_t)(e - 1) * EU_PART + EU_PART_PL;
+      const double yb = c->y0 + e * w, ya = yb - w;
+      const double wb = c->fold && ya < c->delta && yb > c->delta ? c->delta - ya : w;
+      double *K = kin + (size_t)(e - 1) * KN_LEN;
+      K[KN_SUM] -= (hb[HB_UV] + hb[HB_LEN + HB_UV]) / (norm * wb), K[KN_N] += 1.0;
       double *P = pl + (size_t)(e - 1) * PL_LEN;
-      for (int k = PL_PRESSURE; k <= PL_SOURCE; k++) P[k] += 0.5 * (prev[k] + at[k]);
-      P[PL_MU_LAST] = 0.5 * (prev[PL_MU_LAST] + at[PL_MU_LAST]), P[PL_T_LAST] = t;
+      for (int k = PL_PRESSURE; k <= PL_SOURCE; k++) P[k] += 0.5 * (prev[k] + at[k]) + corr[k];
+      P[PL_MU_LAST] = 0.5 * (prev[PL_MU_LAST] + at[PL_MU_LAST]) + corr[PL_MU_LAST];
+      P[PL_T_LAST] = t;
       if (P[PL_N] == 0.0) P[PL_MU_FIRST] = P[PL_MU_LAST], P[PL_T_FIRST] = t;
       P[PL_N] += 1.0;
     }
@@ -340,9 +380,19 @@ static void add_particle(const struct euler *e, const struct stats_snapshot *s, 
     int hb = (int)floor((y - c->y0) * scale);
     hb = hb < 0 ? 0 : hb >= c->nb ? c->nb - 1 : hb;
     double *H = P + (size_t)hb * EU_PART + EU_PART_PL + (size_t)(!c->fold && upper) * HB_LEN;
-    const double ma = s->m ? s->m[a] : 1.0;
-    for (int k = 0; k < EULER_SX; k++) H[k] += ma * s->sx[a * EULER_SX + k];
-    H[HB_MASS] += ma, H[HB_MU] += ma * s->u[a];
+    /* phi: the fraction of the planes through the bin that have the particle on their centre
+       side, less 1/2 (budget_planes); folded, the bin that holds the centre has planes only
+       up to delta */
+    const double ya = c->y0 + hb / scale, yb = ya + 1.0 / scale;
+    const double wb = c->fold && ya < c->delta && yb > c->delta ? c->delta - ya : 1.0 / scale;
+    const double ma = s->m ? s->m[a] : 1.0, phi = (y - ya) / wb - 0.5;
+    double *H1 = H + 2 * HB_LEN; /* the first moments (EU_PART_PL1) */
+    for (int k = 0; k < EULER_SX; k++) {
+      const double f = ma * s->sx[a * EULER_SX + k];
+      H[k] += f, H1[k] += f * phi;
+    }
+    H[HB_MASS] += ma, H[HB_MU] += ma * s->u[a], H[HB_UV] += ma * s->u[a] * v;
+    H1[HB_MASS] += ma * phi, H1[HB_MU] += ma * s->u[a] * phi;
   }
   if (c->method == EULER_SPH) {
     /* Eq. 5.56 averaged over the plane y = y_i: every profile point within 2h takes the
@@ -434,7 +484,9 @@ void euler_sample(struct euler *e, const struct stats_snapshot *s) {
     mom_merge(row + b * MOM_LEN, R);
     if (R[EU_PART_N] > 0.0) scal_add(srow + b * SCAL_LEN, R[EU_PART_U] / R[EU_PART_N]);
   }
-  if (s->sx) budget_planes(c, snap, s->fx, s->t, e->pln + e->nwin * nb * PL_LEN);
+  if (s->sx)
+    budget_planes(c, snap, s->fx, s->t, e->pln + e->nwin * nb * PL_LEN,
+                  e->kin + e->nwin * nb * KN_LEN);
   win[WIN_NSNAP] += 1.0;
   win[WIN_SUM_FX] += s->fx;
   /* wall shear stress over density: minus the wall force on the fluid per unit area */
@@ -455,31 +507,40 @@ static double deriv(const double *x, const double *f, const int *ok, int n, int 
          (h1 / (h2 * (h1 + h2))) * f[r];
 }
 
-/* Profiles of the momentum budget over rows [r0, r1) (pln: the plane sums): the mean of each
-   part, the Reynolds part -<u'v'>, their sum as total_stress and the drive as its expected
-   value, with batch-means standard errors over the complete windows. Returns 0 if no snapshot
-   of the range carried the forces (the profiles stay as they are). */
+/* Profiles of the momentum budget over rows [r0, r1) (pln: the plane sums; kin: the kinetic
+   flux, NULL or short in files of earlier versions): the mean of each part, the Reynolds part
+   -<u'v'>, the rest of the particles' kinetic flux as the advective part (NaN, and left out
+   of the total, where a row lacks it), their sum as total_stress and the drive as its
+   expected value, with batch-means standard errors over the complete windows. Returns 0 if no
+   snapshot of the range carried the forces (the profiles stay as they are). */
 static int budget_profiles(const struct euler_config *cfg, const double *mom, const double *pln,
-                           const int *complete, size_t r0, size_t r1, struct euler_result *res) {
+                           const double *kin, const int *complete, size_t r0, size_t r1,
+                           struct euler_result *res) {
   const int nb = cfg->nb;
   int any = 0;
   for (int b = 0; b < nb; b++) {
-    double sum[PL_LEN] = {0}, batch[6][SCAL_LEN] = {{0}};
-    int first = 0;
+    double sum[PL_LEN] = {0}, ksum[KN_LEN] = {0}, batch[7][SCAL_LEN] = {{0}};
+    int first = 0, has_kin = kin != NULL;
     for (size_t r = r0; r < r1; r++) {
       const double *p = pln + (r * (size_t)nb + (size_t)b) * PL_LEN;
+      const double *K = kin ? kin + (r * (size_t)nb + (size_t)b) * KN_LEN : NULL;
       for (int k = 0; k <= PL_SOURCE; k++) sum[k] += p[k];
+      if (K && K[KN_N] == p[PL_N])
+        ksum[KN_N] += K[KN_N], ksum[KN_SUM] += K[KN_SUM];
+      else
+        has_kin = 0;
       if (p[PL_N] > 0.0) { /* the unsteady term: first and last snapshots of the range */
         if (!first) sum[PL_MU_FIRST] = p[PL_MU_FIRST], sum[PL_T_FIRST] = p[PL_T_FIRST], first = 1;
         sum[PL_MU_LAST] = p[PL_MU_LAST], sum[PL_T_LAST] = p[PL_T_LAST];
       }
       const double *m = mom + (r * (size_t)nb + (size_t)b) * MOM_LEN;
       if (!complete[r] || p[PL_N] <= 0.0 || m[MOM_N] <= 0.0) continue;
-      /* in the order of EP_TAU_*: Reynolds, viscous, model, pair, wall; then the total */
-      double w[6] = {-m[MOM_C2 + MOM_UV] / m[MOM_N], p[PL_VISCOUS] / p[PL_N], p[PL_MODEL] / p[PL_N],
+      /* in the order of EP_TAU_*: Reynolds, viscous, model, pair, wall, advective; the total */
+      double w[7] = {-m[MOM_C2 + MOM_UV] / m[MOM_N], p[PL_VISCOUS] / p[PL_N], p[PL_MODEL] / p[PL_N],
                      p[PL_PRESSURE] / p[PL_N], p[PL_WALL] / p[PL_N]};
-      w[5] = w[0] + w[1] + w[2] + w[3] + w[4];
-      for (int k = 0; k < 6; k++) scal_add(batch[k], w[k]);
+      w[5] = K && K[KN_N] == p[PL_N] ? K[KN_SUM] / K[KN_N] - w[0] : 0.0;
+      w[6] = w[0] + w[1] + w[2] + w[3] + w[4] + w[5];
+      for (int k = 0; k < 7; k++) scal_add(batch[k], w[k]);
     }
     if (sum[PL_N] <= 0.0) {
       for (int k = EP_TAU_REYNOLDS; k < EP_SE_TAU_END; k++) res->prof[k][b] = NAN;
@@ -491,15 +552,17 @@ static int budget_profiles(const struct euler_config *cfg, const double *mom, co
     pr[EP_TAU_REYNOLDS][b] = -pr[EP_UV][b];
     pr[EP_TAU_VISCOUS][b] = sum[PL_VISCOUS] / n, pr[EP_TAU_MODEL][b] = sum[PL_MODEL] / n;
     pr[EP_TAU_PAIR][b] = sum[PL_PRESSURE] / n, pr[EP_TAU_WALL][b] = sum[PL_WALL] / n;
+    pr[EP_TAU_ADVECT][b] = has_kin ? ksum[KN_SUM] / ksum[KN_N] - pr[EP_TAU_REYNOLDS][b] : NAN;
     pr[EP_TOTAL][b] = pr[EP_TAU_REYNOLDS][b] + pr[EP_TAU_VISCOUS][b] + pr[EP_TAU_MODEL][b] +
-                      pr[EP_TAU_PAIR][b] + pr[EP_TAU_WALL][b];
+                      pr[EP_TAU_PAIR][b] + pr[EP_TAU_WALL][b] +
+                      (has_kin ? pr[EP_TAU_ADVECT][b] : 0.0);
     pr[EP_TOTAL_EXPECTED][b] = sum[PL_DRIVE] / n;
     pr[EP_TAU_SOURCE][b] = sum[PL_SOURCE] / n;
     const double span = sum[PL_T_LAST] - sum[PL_T_FIRST];
     pr[EP_TAU_INERTIA][b] = span > 0.0 ? (sum[PL_MU_LAST] - sum[PL_MU_FIRST]) / span : NAN;
-    for (int k = 0; k < 6; k++)
+    for (int k = 0; k < 7; k++)
       pr[EP_SE_TAU + k][b] =
-          batch[k][SCAL_N] >= 2.0
+          batch[k][SCAL_N] >= 2.0 && (k != 5 || has_kin)
               ? sqrt(batch[k][SCAL_M2] / (batch[k][SCAL_N] - 1.0) / batch[k][SCAL_N])
               : NAN;
   }
@@ -534,8 +597,8 @@ static int bin_profiles(const struct euler_config *cfg, int b, const double *m, 
 /* The shear-stress balance (Eq. 5.11-5.13; the momentum budget where the snapshots carried
    the forces) and its largest error over the interior bins. */
 static void stress_balance(const struct euler_config *cfg, const double *mom, const double *pln,
-                           const int *complete, size_t r0, size_t r1, const int *ok,
-                           double tw_force, struct euler_result *res) {
+                           const double *kin, const int *complete, size_t r0, size_t r1,
+                           const int *ok, double tw_force, struct euler_result *res) {
   const int nb = cfg->nb;
   const double nan = NAN;
   /* shear-stress balance (Eq. 5.11-5.13): nu dU/dy - <u'v'> = tau_w/rho (1 - y/delta) */
@@ -549,7 +612,7 @@ static void stress_balance(const struct euler_config *cfg, const double *mom, co
     res->prof[EP_TOTAL][b] = nu_eff * dudy - res->prof[EP_UV][b];
     res->prof[EP_TOTAL_EXPECTED][b] = tw_force * (1.0 - yb / cfg->delta);
   }
-  res->budget = pln && budget_profiles(cfg, mom, pln, complete, r0, r1, res);
+  res->budget = pln && budget_profiles(cfg, mom, pln, kin, complete, r0, r1, res);
   if (!res->budget)
     for (int k = EP_TAU_REYNOLDS; k < EP_SE_TAU_END; k++)
       for (int b = 0; b < nb; b++) res->prof[k][b] = nan;
@@ -562,8 +625,8 @@ static void stress_balance(const struct euler_config *cfg, const double *mom, co
 }
 
 void euler_finalise(const struct euler_config *cfg, const double *win, const double *mom,
-                    const double *snp, const double *pln, const int *complete, size_t r0, size_t r1,
-                    struct euler_result *res) {
+                    const double *snp, const double *pln, const double *kin, const int *complete,
+                    size_t r0, size_t r1, struct euler_result *res) {
   const int nb = cfg->nb;
   memset(res, 0, sizeof *res);
   res->nb = nb;
@@ -632,7 +695,7 @@ void euler_finalise(const struct euler_config *cfg, const double *win, const dou
                                 (2.0 * res->u_tau_wall)
                           : nan;
   res->re_tau = res->u_tau * cfg->delta / cfg->nu;
-  stress_balance(cfg, mom, pln, complete, r0, r1, ok, tw_force, res);
+  stress_balance(cfg, mom, pln, kin, complete, r0, r1, ok, tw_force, res);
   if (!(tw_force > 0.0)) res->balance_error = nan;
   free(ok), free(tot), free(bm), free(sn), free(within);
 }
@@ -670,6 +733,13 @@ static void *reserve_pln(void *owner, int rank, const size_t *dims) {
   return e->pln;
 }
 
+static void *reserve_kin(void *owner, int rank, const size_t *dims) {
+  struct euler *e = owner;
+  if (rank != 3 || dims[1] != (size_t)e->cfg.nb || dims[2] != KN_LEN) return NULL;
+  reserve_rows(e, dims[0]);
+  return e->kin;
+}
+
 void euler_state(struct euler *e, struct state_list *L) {
   const size_t rows = e->nwin + 1, nb = (size_t)e->cfg.nb;
   const size_t dw[2] = {rows, WIN_LEN}, dm[3] = {rows, nb, MOM_LEN}, ds[3] = {rows, nb, SCAL_LEN};
@@ -683,4 +753,8 @@ void euler_state(struct euler *e, struct state_list *L) {
   f = state_add(L, "stats/eulerian/planes", STATE_F64, 3, dp, e->pln, NULL);
   f->reserve = reserve_pln, f->owner = e;
   f->optional = 1; /* checkpoints of format 1.1 have no budget: zero rows, no budget profiles */
+  const size_t dk[3] = {rows, nb, KN_LEN};
+  f = state_add(L, "stats/eulerian/planes_kinetic", STATE_F64, 3, dk, e->kin, NULL);
+  f->reserve = reserve_kin, f->owner = e;
+  f->optional = 1; /* format 1.4: before it, rows without the advective part */
 }

@@ -45,6 +45,11 @@ enum {
   PL_LEN
 };
 
+/** Per window and bin, the particles' kinetic flux through the bin's planes (format 1.4;
+    a separate record, so that earlier checkpoints stay readable): the snapshots that carried
+    it and the sum over them of -(sum of m u v over the bin) / (rho0 A w) [m^2/s^2]. */
+enum { KN_N, KN_SUM, KN_LEN };
+
 /** Per-window scalars: nominal interval, snapshots, sums over snapshots. */
 enum { WIN_T0, WIN_T1, WIN_NSNAP, WIN_SUM_FX, WIN_SUM_TW0, WIN_SUM_TW1, WIN_LEN };
 
@@ -79,6 +84,7 @@ struct euler {
   double *mom;               /*!< [row][nb][MOM_LEN] moment records of the samples */
   double *snp;               /*!< [row][nb][SCAL_LEN] moments of the per-snapshot bin means of u */
   double *pln;               /*!< [row][nb][PL_LEN] momentum budget sums (enum above) */
+  double *kin;               /*!< [row][nb][KN_LEN] kinetic flux of the budget (enum above) */
   void *work;                /*!< scratch of euler_sample across ranks (euler.c) */
   size_t nsub;               /*!< column subtrees gathered at the last snapshot (diagnostic) */
   double w1[EULER_W1_N + 1]; /*!< plane-averaged kernel W1(q), q = |y_a - y_i| / h (SPH) */
@@ -156,10 +162,11 @@ enum {
   EP_TAU_MODEL,
   EP_TAU_PAIR,
   EP_TAU_WALL,
+  EP_TAU_ADVECT,
   EP_TAU_SOURCE,
   EP_TAU_INERTIA,
-  EP_SE_TAU, /* stderr of the five above and of total_stress, in that order */
-  EP_SE_TAU_END = EP_SE_TAU + 6,
+  EP_SE_TAU, /* stderr of the six above and of total_stress, in that order */
+  EP_SE_TAU_END = EP_SE_TAU + 7,
   EP_NPROF = EP_SE_TAU_END
 };
 
@@ -216,13 +223,14 @@ void euler_sample(struct euler *e, const struct stats_snapshot *s);
  *        force), the total shear stress of Eq. 5.11-5.13.
  *        Standard errors from the batch means of the complete windows in the range.
  * @param[in] cfg configuration (bins, delta, nu, rho0, area)
- * @param[in] win,mom,snp,pln raw rows, as in struct euler (pln may be NULL: no budget)
+ * @param[in] win,mom,snp,pln,kin raw rows, as in struct euler (pln may be NULL: no budget;
+ *            kin may be NULL: no advective part)
  * @param[in] complete per-row flag: 1 for a closed window (batch), 0 for a partial one
  * @param[out] res result (allocated; free with euler_result_free)
  */
 void euler_finalise(const struct euler_config *cfg, const double *win, const double *mom,
-                    const double *snp, const double *pln, const int *complete, size_t r0, size_t r1,
-                    struct euler_result *res);
+                    const double *snp, const double *pln, const double *kin, const int *complete,
+                    size_t r0, size_t r1, struct euler_result *res);
 
 /** @brief Free a result. */
 void euler_result_free(struct euler_result *res);

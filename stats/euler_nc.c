@@ -23,7 +23,7 @@ void euler_running_result(const struct euler *e, struct euler_result *res) {
   const size_t rows = euler_rows(e);
   int *complete = mem_calloc(rows ? rows : 1, sizeof *complete, "Eulerian statistics");
   for (size_t r = 0; r < rows; r++) complete[r] = r < e->nwin;
-  euler_finalise(&e->cfg, e->win, e->mom, e->snp, e->pln, complete, 0, rows, res);
+  euler_finalise(&e->cfg, e->win, e->mom, e->snp, e->pln, e->kin, complete, 0, rows, res);
   free(complete);
 }
 
@@ -71,6 +71,7 @@ static const char *const plane_names[PL_LEN] = {
     [PL_SOURCE] = "sum_source",     [PL_MU_FIRST] = "momentum_first",
     [PL_MU_LAST] = "momentum_last", [PL_T_FIRST] = "time_first",
     [PL_T_LAST] = "time_last"};
+static const char *const kinetic_names[KN_LEN] = {[KN_N] = "snapshots", [KN_SUM] = "sum_kinetic"};
 
 /* The root's profiles on dimension dy and the run's scalars as global attributes; t_reached:
    the time the run reached (NaN: not known), where an incomplete last window ends. */
@@ -149,7 +150,7 @@ static int write_raw_windows(const struct euler *e, const struct euler_result *r
   const struct euler_result r = *rp;
   const size_t nb = (size_t)e->cfg.nb, rows = euler_rows(e);
   int rc = NC_NOERR, dy;
-  int g, dw, dwf, dm, ds, dp, vw, vm, vs, vp, vc, v0, v1;
+  int g, dw, dwf, dm, ds, dp, dk, vw, vm, vs, vp, vk, vc, v0, v1;
   CK(nc_def_grp(ncid, "eulerian", &g));
   static const char desc[] =
       "raw per-window moment records of the wall-normal bins; re-average any range of windows "
@@ -165,6 +166,7 @@ static int write_raw_windows(const struct euler *e, const struct euler_result *r
   CK(nc_def_dim(g, "moment", MOM_LEN, &dm));
   CK(nc_def_dim(g, "snapshot_moment", SCAL_LEN, &ds));
   CK(nc_def_dim(g, "plane_field", PL_LEN, &dp));
+  CK(nc_def_dim(g, "kinetic_field", KN_LEN, &dk));
   CK(def_y(&e->cfg, g, dy, r.prof[EP_Y], lo, hi));
   if ((rc = def_window_axis(e, g, dw, err, errlen)) != NC_NOERR) goto fail; /* names its call */
   CK(ncout_labels(g, "window_field", dwf, "fields of the window records", window_fields));
@@ -176,10 +178,12 @@ static int write_raw_windows(const struct euler *e, const struct euler_result *r
                   "fields of the records of per-snapshot bin means of u: count, mean, M2",
                   scal_names));
   CK(ncout_labels(g, "plane_field", dp, "fields of the momentum-budget records", plane_names));
+  CK(ncout_labels(g, "kinetic_field", dk, "fields of the kinetic-flux records", kinetic_names));
   CK(ncout_def(g, "window_start", NC_DOUBLE, 1, &dw, "s", "start of the averaging window", &v0));
   CK(ncout_def(g, "window_end", NC_DOUBLE, 1, &dw, "s", "end of the averaging window", &v1));
   CK(ncout_def(g, "window_complete", NC_INT, 1, &dw, "1", "1: closed window, 0: still open", &vc));
-  const int d2[2] = {dw, dwf}, d3m[3] = {dw, dy, dm}, d3s[3] = {dw, dy, ds}, d3p[3] = {dw, dy, dp};
+  const int d2[2] = {dw, dwf}, d3m[3] = {dw, dy, dm}, d3s[3] = {dw, dy, ds}, d3p[3] = {dw, dy, dp},
+            d3k[3] = {dw, dy, dk};
   CK(ncout_def(g, "windows", NC_DOUBLE, 2, d2, NULL,
                "per window: t_start [s], t_end [s], snapshots, sum of body force [m/s^2], sums "
                "of tau_w/rho at y=0 and y=2delta [m^2/s^2]",
@@ -196,6 +200,11 @@ static int write_raw_windows(const struct euler *e, const struct euler_result *r
                "forces and the walls, of the body force it balances and of the momentum source, "
                "per unit area and rho0 [m^2/s^2] (docs/stats-format.md, momentum budget)",
                &vp));
+  CK(ncout_def(g, "planes_kinetic", NC_DOUBLE, 3, d3k, NULL,
+               "per window and bin: snapshots with forces and the sum over them of the "
+               "particles' kinetic flux through the bin's planes, -(sum of m u v over the bin) / "
+               "(rho0 A w) [m^2/s^2] (docs/stats-format.md, momentum budget)",
+               &vk));
   for (size_t w = 0; w < rows; w++) {
     const size_t st[1] = {w}, ct[1] = {1};
     const int cpl = w < e->nwin;
@@ -208,6 +217,7 @@ static int write_raw_windows(const struct euler *e, const struct euler_result *r
     CK(nc_put_var_double(g, vm, e->mom));
     CK(nc_put_var_double(g, vs, e->snp));
     CK(nc_put_var_double(g, vp, e->pln));
+    CK(nc_put_var_double(g, vk, e->kin));
   }
   return NC_NOERR;
 fail:

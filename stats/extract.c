@@ -55,6 +55,7 @@ struct stored {
   struct euler_config cfg;
   size_t rows;
   double *win, *mom, *snp, *pln; /* pln: NULL in a file without the momentum budget */
+  double *kin;                   /* NULL in a file without its kinetic flux (before 1.4) */
   int *complete;
   double t_reached; /* the run's reached time (global attribute t_reached; NaN if absent) */
 };
@@ -108,7 +109,21 @@ static int read_stored(const char *path, struct stored *s) {
       fprintf(stderr, "error: %s: cannot read the raw windows\n", path);
       bad = 1;
     }
-    int vp; /* the momentum budget: absent in files of earlier versions */
+    int vp, dp; /* the momentum budget: absent in files of earlier versions */
+    size_t np = 0;
+    if (!bad && s->rows && nc_inq_varid(g, "planes", &vp) == NC_NOERR &&
+        (nc_inq_dimid(g, "plane_field", &dp) || nc_inq_dimlen(g, dp, &np) || np != PL_LEN)) {
+      fprintf(stderr, "error: %s: the momentum-budget records (planes) have %zu fields, not %d\n",
+              path, np, (int)PL_LEN);
+      bad = 1;
+    }
+    if (!bad && s->rows && nc_inq_varid(g, "planes_kinetic", &vp) == NC_NOERR) {
+      s->kin = mem_alloc(1, r * nb * KN_LEN * sizeof(double), "chansph extract");
+      if (!s->kin || nc_get_var_double(g, vp, s->kin)) {
+        fprintf(stderr, "error: %s: cannot read the raw windows (planes_kinetic)\n", path);
+        bad = 1;
+      }
+    }
     if (!bad && s->rows && nc_inq_varid(g, "planes", &vp) == NC_NOERR) {
       s->pln = mem_alloc(1, r * nb * PL_LEN * sizeof(double), "chansph extract");
       if (!s->pln || nc_get_var_double(g, vp, s->pln)) {
@@ -122,7 +137,7 @@ static int read_stored(const char *path, struct stored *s) {
 }
 
 static void free_stored(struct stored *s) {
-  free(s->win), free(s->mom), free(s->snp), free(s->pln), free(s->complete);
+  free(s->win), free(s->mom), free(s->snp), free(s->pln), free(s->kin), free(s->complete);
 }
 
 /* A time of --window between text and stop: empty gives dflt; anything but one finite number
@@ -328,7 +343,7 @@ int extract_main(int argc, char **argv) {
     return 1;
   }
   struct euler_result res;
-  euler_finalise(&s.cfg, s.win, s.mom, s.snp, s.pln, s.complete, r0, r1, &res);
+  euler_finalise(&s.cfg, s.win, s.mom, s.snp, s.pln, s.kin, s.complete, r0, r1, &res);
   extract_header(&a, &s, &res, r0, r1, cols, rms, nc);
   extract_rows(&a, &s, &res, cols, rms, nc);
   euler_result_free(&res);
