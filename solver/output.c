@@ -441,6 +441,8 @@ void output_sample(struct output *o, struct sim *S) {
                                       .skip = P->kind,
                                       .t = S->t,
                                       .fx = S->fx,
+                                      .dt = S->dt,
+                                      .shift_dy = P->shift_dy,
                                       .step = S->step,
                                       .wall_fx = {S->wall_fx[0], S->wall_fx[1]},
                                       .col = o->col,

@@ -15,10 +15,11 @@
 /* Per-(column, bin) partial of one snapshot: a moment record, then the sum of u and the count
    (the weight sum with EULER_SPH) behind the per-snapshot bin mean of u, then the momentum
    budget: for each side of the channel (y < delta, y > delta; folded: the first) the sums of
-   m a_x of each part of the acceleration, of m, m u and m u v, then the same sums weighted by
-   the particle's offset from its bin centre in bin widths, phi (add_particle, budget_planes;
-   the weighted m u v is not used). */
-enum { HB_MASS = EULER_SX, HB_MU, HB_UV, HB_LEN };
+   m a_x of each part of the acceleration, of m and m u by the positions before the step
+   (HB_MU0), of m u and m u v by the sampled positions, then the same sums weighted by the
+   particle's offset from its bin centre in bin widths, phi (add_particle, budget_planes; the
+   weighted m u v is not used). */
+enum { HB_MASS = EULER_SX, HB_MU, HB_MU0, HB_UV, HB_LEN };
 enum {
   EU_PART_U = MOM_LEN,
   EU_PART_N,
@@ -289,15 +290,15 @@ static void node_record(struct euler_work *k, size_t nb, int lo, int hi, const d
    on that fluid. The net pair force on a whole side (zero for a momentum-conserving scheme)
    is the momentum source. */
 static void budget_planes(const struct euler_config *c, const double *snap, double fx, double t,
-                          double *pl, double *kin) {
+                          double dt, double *pl, double *kin) {
   const int nb = c->nb;
-  double tot[2][HB_LEN] = {{0}}, below[2][HB_LEN] = {{0}}, prev[PL_LEN] = {0};
+  double tot[2][HB_LEN] = {{0}}, below[2][HB_LEN] = {{0}}, prev[PL_LEN] = {0}, mu0_prev = 0.0;
   for (int b = 0; b < nb; b++)
     for (int k = 0; k < 2 * HB_LEN; k++)
       tot[k / HB_LEN][k % HB_LEN] += snap[(size_t)b * EU_PART + EU_PART_PL + k];
   const double norm = c->rho0 * c->area * (c->fold ? 2.0 : 1.0), w = (c->y1 - c->y0) / nb;
   for (int e = 0; e <= nb; e++) { /* edge e: the bins below it are in `below` */
-    double at[PL_LEN] = {0};
+    double at[PL_LEN] = {0}, mu0_at = 0.0;
     const int lower = c->fold || c->y0 + e * w <= c->delta;
     /* the centre side of the plane: sums over it (-1 in the lower half: above the plane) */
     for (int k = 0; k < HB_LEN; k++) {
@@ -312,32 +313,46 @@ static void budget_planes(const struct euler_config *c, const double *snap, doub
         at[PL_DRIVE] = (lower ? fx : -fx) * centre / norm;
       } else if (k == HB_MU) {
         at[PL_MU_LAST] = (lower ? centre : -centre) / norm;
+      } else if (k == HB_MU0) {
+        mu0_at = (lower ? centre : -centre) / norm;
       }
     }
     if (e > 0) {
       /* the first moments of bin e - 1, both sides (one is empty unless the bin holds the
          centre): in the stress convention the same sign on either side */
       const double *m1 = snap + (size_t)(e - 1) * EU_PART + EU_PART_PL1;
-      double corr[PL_LEN] = {0};
+      double corr[PL_LEN] = {0}, mu0_corr = 0.0;
       for (int s = 0; s < 2; s++, m1 += HB_LEN) {
         for (int k = 0; k < EULER_SX; k++) corr[PL_PRESSURE + k] -= m1[k] / norm;
         corr[PL_DRIVE] += fx * m1[HB_MASS] / norm, corr[PL_MU_LAST] += m1[HB_MU] / norm;
+        mu0_corr += m1[HB_MU0] / norm;
       }
-      /* the kinetic flux: -(sum of m u v over the bin) / (rho0 A w), either side, w the width
-         of the planes through the bin (add_particle) */
+      /* the kinetic flux: with the step dt, minus the change of the bin's momentum (as
+         PL_MU_LAST) that the step's displacements alone made, over dt, which makes the budget
+         of every step an identity; without it -(sum of m u v over the bin) / (rho0 A w),
+         either side, w the width of the planes through the bin (budget_bin) */
       const double *hb = snap + (size_t)(e - 1) * EU_PART + EU_PART_PL;
       const double yb = c->y0 + e * w, ya = yb - w;
       const double wb = c->fold && ya < c->delta && yb > c->delta ? c->delta - ya : w;
-      double *K = kin + (size_t)(e - 1) * KN_LEN;
-      K[KN_SUM] -= (hb[HB_UV] + hb[HB_LEN + HB_UV]) / (norm * wb), K[KN_N] += 1.0;
-      double *P = pl + (size_t)(e - 1) * PL_LEN;
+      const double mu_now = 0.5 * (prev[PL_MU_LAST] + at[PL_MU_LAST]) + corr[PL_MU_LAST];
+      const double mu_before = 0.5 * (mu0_prev + mu0_at) + mu0_corr;
+      const double kinetic =
+          dt > 0.0 ? -(mu_now - mu_before) / dt : -(hb[HB_UV] + hb[HB_LEN + HB_UV]) / (norm * wb);
+      double *K = kin + (size_t)(e - 1) * KN_LEN, *P = pl + (size_t)(e - 1) * PL_LEN;
+      if (K[KN_N] == 0.0) { /* the window's first snapshot, kept apart */
+        K[KN_FIRST] = 1.0, K[KN_F_KINETIC] = kinetic;
+        for (int k = PL_PRESSURE; k <= PL_DRIVE; k++)
+          K[KN_F + k - PL_PRESSURE] = 0.5 * (prev[k] + at[k]) + corr[k];
+      }
+      K[KN_SUM] += kinetic, K[KN_N] += 1.0;
       for (int k = PL_PRESSURE; k <= PL_SOURCE; k++) P[k] += 0.5 * (prev[k] + at[k]) + corr[k];
-      P[PL_MU_LAST] = 0.5 * (prev[PL_MU_LAST] + at[PL_MU_LAST]) + corr[PL_MU_LAST];
+      P[PL_MU_LAST] = mu_now;
       P[PL_T_LAST] = t;
       if (P[PL_N] == 0.0) P[PL_MU_FIRST] = P[PL_MU_LAST], P[PL_T_FIRST] = t;
       P[PL_N] += 1.0;
     }
     for (int k = 0; k < PL_LEN; k++) prev[k] = at[k];
+    mu0_prev = mu0_at;
     if (e < nb)
       for (int k = 0; k < 2 * HB_LEN; k++)
         below[k / HB_LEN][k % HB_LEN] += snap[(size_t)e * EU_PART + EU_PART_PL + k];
@@ -360,6 +375,21 @@ static void advance_window(struct euler *e, double t) {
   }
 }
 
+/* The budget sums (EU_PART_PL) of the bin and side of a particle at y (folded if the
+   statistics fold) in the per-bin partials P, and its phi: the fraction of the planes through
+   the bin that have it on their centre side, less 1/2 (budget_planes); folded, the bin that
+   holds the centre has planes only up to delta. */
+static double *budget_bin(const struct euler_config *c, double *P, double y, int upper,
+                          double *phi) {
+  const double scale = c->nb / (c->y1 - c->y0);
+  int hb = (int)floor((y - c->y0) * scale);
+  hb = hb < 0 ? 0 : hb >= c->nb ? c->nb - 1 : hb;
+  const double ya = c->y0 + hb / scale, yb = ya + 1.0 / scale;
+  const double wb = c->fold && ya < c->delta && yb > c->delta ? c->delta - ya : 1.0 / scale;
+  *phi = (y - ya) / wb - 0.5;
+  return P + (size_t)hb * EU_PART + EU_PART_PL + (size_t)(!c->fold && upper) * HB_LEN;
+}
+
 /* Particle a of the snapshot into its column's per-bin partials P (EU_PART a bin). */
 static void add_particle(const struct euler *e, const struct stats_snapshot *s, size_t a,
                          double *P) {
@@ -376,23 +406,24 @@ static void add_particle(const struct euler *e, const struct stats_snapshot *s, 
                               y,
                               s->nu_t ? s->nu_t[a] : 0.0,
                               s->k_r ? s->k_r[a] : 0.0};
-  if (s->sx) { /* the momentum budget: to the bin of the particle, by side */
-    int hb = (int)floor((y - c->y0) * scale);
-    hb = hb < 0 ? 0 : hb >= c->nb ? c->nb - 1 : hb;
-    double *H = P + (size_t)hb * EU_PART + EU_PART_PL + (size_t)(!c->fold && upper) * HB_LEN;
-    /* phi: the fraction of the planes through the bin that have the particle on their centre
-       side, less 1/2 (budget_planes); folded, the bin that holds the centre has planes only
-       up to delta */
-    const double ya = c->y0 + hb / scale, yb = ya + 1.0 / scale;
-    const double wb = c->fold && ya < c->delta && yb > c->delta ? c->delta - ya : 1.0 / scale;
-    const double ma = s->m ? s->m[a] : 1.0, phi = (y - ya) / wb - 0.5;
-    double *H1 = H + 2 * HB_LEN; /* the first moments (EU_PART_PL1) */
+  if (s->sx) { /* the momentum budget */
+    const double ma = s->m ? s->m[a] : 1.0, mu = ma * s->u[a];
+    /* the forces and the body force acted at the positions before the step: y - dt v, less
+       the shift (symplectic Euler, docs/theory.md); the momentum is that of the sampled state,
+       and also taken at those positions for the kinetic flux (budget_planes) */
+    double yf =
+        s->dt > 0.0 ? s->y[a] - s->dt * s->v[a] - (s->shift_dy ? s->shift_dy[a] : 0.0) : s->y[a];
+    const int upper_f = yf > c->delta;
+    if (c->fold && upper_f) yf = 2.0 * c->delta - yf;
+    double phi, phi_f;
+    double *H = budget_bin(c, P, y, upper, &phi), *Hf = budget_bin(c, P, yf, upper_f, &phi_f);
+    double *H1 = H + 2 * HB_LEN, *Hf1 = Hf + 2 * HB_LEN; /* the first moments (EU_PART_PL1) */
     for (int k = 0; k < EULER_SX; k++) {
       const double f = ma * s->sx[a * EULER_SX + k];
-      H[k] += f, H1[k] += f * phi;
+      Hf[k] += f, Hf1[k] += f * phi_f;
     }
-    H[HB_MASS] += ma, H[HB_MU] += ma * s->u[a], H[HB_UV] += ma * s->u[a] * v;
-    H1[HB_MASS] += ma * phi, H1[HB_MU] += ma * s->u[a] * phi;
+    Hf[HB_MASS] += ma, Hf1[HB_MASS] += ma * phi_f, Hf[HB_MU0] += mu, Hf1[HB_MU0] += mu * phi_f;
+    H[HB_MU] += mu, H1[HB_MU] += mu * phi, H[HB_UV] += mu * v;
   }
   if (c->method == EULER_SPH) {
     /* Eq. 5.56 averaged over the plane y = y_i: every profile point within 2h takes the
@@ -485,7 +516,7 @@ void euler_sample(struct euler *e, const struct stats_snapshot *s) {
     if (R[EU_PART_N] > 0.0) scal_add(srow + b * SCAL_LEN, R[EU_PART_U] / R[EU_PART_N]);
   }
   if (s->sx)
-    budget_planes(c, snap, s->fx, s->t, e->pln + e->nwin * nb * PL_LEN,
+    budget_planes(c, snap, s->fx, s->t, s->dt, e->pln + e->nwin * nb * PL_LEN,
                   e->kin + e->nwin * nb * KN_LEN);
   win[WIN_NSNAP] += 1.0;
   win[WIN_SUM_FX] += s->fx;
@@ -520,17 +551,19 @@ static int budget_profiles(const struct euler_config *cfg, const double *mom, co
   int any = 0;
   for (int b = 0; b < nb; b++) {
     double sum[PL_LEN] = {0}, ksum[KN_LEN] = {0}, batch[7][SCAL_LEN] = {{0}};
+    const double *K0 = NULL; /* the kinetic record of the range's first row with snapshots */
     int first = 0, has_kin = kin != NULL;
     for (size_t r = r0; r < r1; r++) {
       const double *p = pln + (r * (size_t)nb + (size_t)b) * PL_LEN;
       const double *K = kin ? kin + (r * (size_t)nb + (size_t)b) * KN_LEN : NULL;
       for (int k = 0; k <= PL_SOURCE; k++) sum[k] += p[k];
-      if (K && K[KN_N] == p[PL_N])
+      if (K && K[KN_N] == p[PL_N] && (K[KN_FIRST] == 1.0 || p[PL_N] == 0.0))
         ksum[KN_N] += K[KN_N], ksum[KN_SUM] += K[KN_SUM];
       else
         has_kin = 0;
       if (p[PL_N] > 0.0) { /* the unsteady term: first and last snapshots of the range */
-        if (!first) sum[PL_MU_FIRST] = p[PL_MU_FIRST], sum[PL_T_FIRST] = p[PL_T_FIRST], first = 1;
+        if (!first)
+          sum[PL_MU_FIRST] = p[PL_MU_FIRST], sum[PL_T_FIRST] = p[PL_T_FIRST], first = 1, K0 = K;
         sum[PL_MU_LAST] = p[PL_MU_LAST], sum[PL_T_LAST] = p[PL_T_LAST];
       }
       const double *m = mom + (r * (size_t)nb + (size_t)b) * MOM_LEN;
@@ -547,6 +580,12 @@ static int budget_profiles(const struct euler_config *cfg, const double *mom, co
       continue;
     }
     any = 1;
+    /* with the kinetic records: the range's fluxes without its first snapshot, the balance of
+       the momentum change from that snapshot to the last */
+    if (has_kin && K0 && K0[KN_FIRST] == 1.0 && sum[PL_N] >= 2.0) {
+      for (int k = PL_PRESSURE; k <= PL_DRIVE; k++) sum[k] -= K0[KN_F + k - PL_PRESSURE];
+      sum[PL_N] -= 1.0, ksum[KN_SUM] -= K0[KN_F_KINETIC], ksum[KN_N] -= 1.0;
+    }
     const double n = sum[PL_N];
     double *const *pr = res->prof;
     pr[EP_TAU_REYNOLDS][b] = -pr[EP_UV][b];

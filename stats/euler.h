@@ -45,10 +45,13 @@ enum {
   PL_LEN
 };
 
-/** Per window and bin, the particles' kinetic flux through the bin's planes (format 1.4;
-    a separate record, so that earlier checkpoints stay readable): the snapshots that carried
-    it and the sum over them of -(sum of m u v over the bin) / (rho0 A w) [m^2/s^2]. */
-enum { KN_N, KN_SUM, KN_LEN };
+/** Per window and bin (format 1.4; a separate record, so that earlier checkpoints stay
+    readable): the snapshots with the particles' kinetic flux through the bin's planes and the
+    sum over them of -(sum of m u v over the bin) / (rho0 A w) [m^2/s^2]; then the window's
+    first such snapshot: 1, and its values of PL_PRESSURE .. PL_DRIVE and of the kinetic flux.
+    A range leaves its first snapshot's fluxes out: each snapshot's forces stand for the steps
+    since the one before, and the momentum changes from the first snapshot on. */
+enum { KN_N, KN_SUM, KN_FIRST, KN_F, KN_F_KINETIC = KN_F + PL_DRIVE - PL_PRESSURE + 1, KN_LEN };
 
 /** Per-window scalars: nominal interval, snapshots, sums over snapshots. */
 enum { WIN_T0, WIN_T1, WIN_NSNAP, WIN_SUM_FX, WIN_SUM_TW0, WIN_SUM_TW1, WIN_LEN };
@@ -113,19 +116,21 @@ struct stats_snapshot {
       particle (pressure, molecular viscous and eddy-viscous pair forces of the fluid
       neighbours, the walls' part) [m/s^2], or NULL: the momentum budget (EULER_PLANES). */
   const double *sx;
-  const double *nu_t;  /*!< eddy viscosity [m^2/s], or NULL (no LES) */
-  const double *k_r;   /*!< residual kinetic energy [m^2/s^2], or NULL (no LES) */
-  const int64_t *id;   /*!< global ids */
-  const uint8_t *skip; /*!< nonzero: not a fluid particle, not sampled */
-  double t;            /*!< simulated time [s] */
-  double fx;           /*!< streamwise body acceleration applied [m/s^2] */
-  long step;           /*!< step number */
-  double wall_fx[2];   /*!< x-force of the walls y = 0, 2 delta on the fluid [N];
-                            NaN if unknown */
-  const int *col;      /*!< global cell column of each particle, or NULL (all in col0) */
-  int ncol;            /*!< global cell columns along x (0 with col = NULL: serial) */
-  int col0, col1;      /*!< this rank's columns [col0, col1) */
-  MPI_Comm comm;       /*!< ranks sharing the snapshot; MPI_COMM_NULL: serial */
+  const double *nu_t;     /*!< eddy viscosity [m^2/s], or NULL (no LES) */
+  const double *k_r;      /*!< residual kinetic energy [m^2/s^2], or NULL (no LES) */
+  const int64_t *id;      /*!< global ids */
+  const uint8_t *skip;    /*!< nonzero: not a fluid particle, not sampled */
+  double t;               /*!< simulated time [s] */
+  double fx;              /*!< streamwise body acceleration applied [m/s^2] */
+  double dt;              /*!< the step that led to this state [s], or 0: unknown */
+  const double *shift_dy; /*!< y-shift of each particle in that step [m], or NULL (none) */
+  long step;              /*!< step number */
+  double wall_fx[2];      /*!< x-force of the walls y = 0, 2 delta on the fluid [N];
+                               NaN if unknown */
+  const int *col;         /*!< global cell column of each particle, or NULL (all in col0) */
+  int ncol;               /*!< global cell columns along x (0 with col = NULL: serial) */
+  int col0, col1;         /*!< this rank's columns [col0, col1) */
+  MPI_Comm comm;          /*!< ranks sharing the snapshot; MPI_COMM_NULL: serial */
 };
 
 /** Finished profiles: names, units and long names are in euler_prof_meta. */

@@ -71,7 +71,10 @@ static const char *const plane_names[PL_LEN] = {
     [PL_SOURCE] = "sum_source",     [PL_MU_FIRST] = "momentum_first",
     [PL_MU_LAST] = "momentum_last", [PL_T_FIRST] = "time_first",
     [PL_T_LAST] = "time_last"};
-static const char *const kinetic_names[KN_LEN] = {[KN_N] = "snapshots", [KN_SUM] = "sum_kinetic"};
+static const char *const kinetic_names[KN_LEN] = {
+    [KN_N] = "snapshots",         [KN_SUM] = "sum_kinetic",     [KN_FIRST] = "first_recorded",
+    [KN_F] = "first_pair_stress", [KN_F + 1] = "first_viscous", [KN_F + 2] = "first_model",
+    [KN_F + 3] = "first_wall",    [KN_F + 4] = "first_drive",   [KN_F_KINETIC] = "first_kinetic"};
 
 /* The root's profiles on dimension dy and the run's scalars as global attributes; t_reached:
    the time the run reached (NaN: not known), where an incomplete last window ends. */
@@ -203,7 +206,9 @@ static int write_raw_windows(const struct euler *e, const struct euler_result *r
   CK(ncout_def(g, "planes_kinetic", NC_DOUBLE, 3, d3k, NULL,
                "per window and bin: snapshots with forces and the sum over them of the "
                "particles' kinetic flux through the bin's planes, -(sum of m u v over the bin) / "
-               "(rho0 A w) [m^2/s^2] (docs/stats-format.md, momentum budget)",
+               "(rho0 A w) [m^2/s^2]; then 1 and the window's first snapshot's values of the "
+               "planes fields sum_pair_stress .. sum_drive and of the kinetic flux "
+               "(docs/stats-format.md, momentum budget)",
                &vk));
   for (size_t w = 0; w < rows; w++) {
     const size_t st[1] = {w}, ct[1] = {1};

@@ -117,7 +117,12 @@ static int read_stored(const char *path, struct stored *s) {
               path, np, (int)PL_LEN);
       bad = 1;
     }
-    if (!bad && s->rows && nc_inq_varid(g, "planes_kinetic", &vp) == NC_NOERR) {
+    int dk; /* the kinetic records: absent before format 1.4, and a field count of another
+               version leaves them out (no advective part) */
+    size_t nk = 0;
+    if (!bad && s->rows && nc_inq_varid(g, "planes_kinetic", &vp) == NC_NOERR &&
+        nc_inq_dimid(g, "kinetic_field", &dk) == NC_NOERR &&
+        nc_inq_dimlen(g, dk, &nk) == NC_NOERR && nk == KN_LEN) {
       s->kin = mem_alloc(1, r * nb * KN_LEN * sizeof(double), "chansph extract");
       if (!s->kin || nc_get_var_double(g, vp, s->kin)) {
         fprintf(stderr, "error: %s: cannot read the raw windows (planes_kinetic)\n", path);
