@@ -104,9 +104,11 @@ const struct euler_meta euler_prof_meta[EP_NPROF] = {
                      "and the centre per unit area and rho0"},
     [EP_TAU_ADVECT] = {"advective_stress", "m^2/s^2",
                        "momentum budget: the rest of the particles' kinetic flux through the "
-                       "plane, -(sum over the bin of m u v) / (rho0 A w) - reynolds_stress: the "
-                       "mean flow's advection -U V and the density weighting of -<u'v'>; zero in "
-                       "a steady state of uniform density"},
+                       "bin's planes (the momentum the sampled step's displacements carried; "
+                       "without the step, the bin sum of m u v / (rho0 A w)) less "
+                       "reynolds_stress: the mean flow's advection -U V, the density weighting "
+                       "of -<u'v'> and particle shifting; zero in a steady state of uniform "
+                       "density"},
     [EP_TAU_SOURCE] = {"pair_momentum_source", "m^2/s^2",
                        "net x-force of all pair forces on the fluid of this side of the channel "
                        "per unit area and rho0 (the scheme's momentum source; zero if the pair "
@@ -273,6 +275,12 @@ static void node_record(struct euler_work *k, size_t nb, int lo, int hi, const d
   node_merge(out, right, nb);
 }
 
+/* The width of the planes through the bin from ya of width w: w, except folded in the bin that
+   holds the centre, whose planes reach only to delta. */
+static double plane_width(const struct euler_config *c, double ya, double w) {
+  return c->fold && ya < c->delta && ya + w > c->delta ? c->delta - ya : w;
+}
+
 /* The momentum budget of one snapshot from its merged per-bin sums (snap: one EU_PART record
    per bin), added to the window's plane sums pl (docs/theory.md, "Momentum budget"). The
    planes are the bin edges, where no particle layer of the initial lattice lies (with
@@ -332,8 +340,7 @@ static void budget_planes(const struct euler_config *c, const double *snap, doub
          of every step an identity; without it -(sum of m u v over the bin) / (rho0 A w),
          either side, w the width of the planes through the bin (budget_bin) */
       const double *hb = snap + (size_t)(e - 1) * EU_PART + EU_PART_PL;
-      const double yb = c->y0 + e * w, ya = yb - w;
-      const double wb = c->fold && ya < c->delta && yb > c->delta ? c->delta - ya : w;
+      const double wb = plane_width(c, c->y0 + e * w - w, w);
       const double mu_now = 0.5 * (prev[PL_MU_LAST] + at[PL_MU_LAST]) + corr[PL_MU_LAST];
       const double mu_before = 0.5 * (mu0_prev + mu0_at) + mu0_corr;
       const double kinetic =
@@ -384,9 +391,8 @@ static double *budget_bin(const struct euler_config *c, double *P, double y, int
   const double scale = c->nb / (c->y1 - c->y0);
   int hb = (int)floor((y - c->y0) * scale);
   hb = hb < 0 ? 0 : hb >= c->nb ? c->nb - 1 : hb;
-  const double ya = c->y0 + hb / scale, yb = ya + 1.0 / scale;
-  const double wb = c->fold && ya < c->delta && yb > c->delta ? c->delta - ya : 1.0 / scale;
-  *phi = (y - ya) / wb - 0.5;
+  const double ya = c->y0 + hb / scale;
+  *phi = (y - ya) / plane_width(c, ya, 1.0 / scale) - 0.5;
   return P + (size_t)hb * EU_PART + EU_PART_PL + (size_t)(!c->fold && upper) * HB_LEN;
 }
 
