@@ -56,20 +56,56 @@ def log_cost(run):
     return t, psteps, np.concatenate(([0.0], np.cumsum(dwall)))
 
 
-def group_profiles(run, group):
-    """[(t0, t1, profiles dict)] of the window groups of a run."""
+def read_windows(run):
+    """The window records of a run's stats.nc: dict of delta, nu, fold, win, mom, done, ut (u_tau
+    of the force balance over the completed windows)."""
     try:
         nc = netCDF4.Dataset(os.path.join(run, "stats.nc"))
     except OSError as e:
         raise InputError(f"{run}/stats.nc: {e}")
-    g = nc.groups.get("eulerian")
-    if g is None:
-        raise InputError(f"{run}/stats.nc: no group 'eulerian'")
-    delta, nu, fold = float(nc.delta), float(nc.nu), int(nc.fold)
-    win = np.asarray(g["windows"][:])
-    mom = np.asarray(g["moments"][:])
-    done = win[:, 2] > 0
-    ut = math.sqrt(max(delta * win[done, 3].sum() / max(win[done, 2].sum(), 1), 0.0))
+    with nc:
+        g = nc.groups.get("eulerian")
+        if g is None:
+            raise InputError(f"{run}/stats.nc: no group 'eulerian'")
+        r = {"delta": float(nc.delta), "nu": float(nc.nu), "fold": int(nc.fold),
+             "win": np.array(g["windows"][:]), "mom": np.array(g["moments"][:])}
+    r["done"] = r["win"][:, 2] > 0
+    w = r["win"][r["done"]]
+    r["ut"] = math.sqrt(max(r["delta"] * w[:, 3].sum() / max(w[:, 2].sum(), 1), 0.0))
+    return r
+
+
+def merged_profile(r, sel):
+    """Profiles of U+, u_rms+, v_rms+, w_rms+, -u'v'+ (force-balance wall units) over the windows
+    sel of read_windows' record: their counts, means and co-moments merged (Chan et al. 1979)."""
+    mom = r["mom"]
+    n = mom[sel][:, :, MOM_N].sum(axis=0)
+    ok = n > 0
+    nn = np.maximum(n, 1)
+    mean = sum(mom[i][:, MEAN:MEAN + 8] * mom[i][:, [MOM_N]] for i in sel) / nn[:, None]
+    pairs = ((0, 0), (1, 1), (2, 2), (0, 1))  # uu vv ww uv
+    c2 = np.zeros((len(n), len(pairs)))
+    for i in sel:
+        d = mom[i][:, MEAN:MEAN + 3] - mean[:, :3]
+        for c, (p, q) in enumerate(pairs):
+            c2[:, c] += mom[i][:, C2 + c] + mom[i][:, MOM_N] * d[:, p] * d[:, q]
+    y = np.where(ok, mean[:, 5], np.nan)
+    u = np.where(ok, mean[:, 0], np.nan)
+    uu, vv, ww, uv = (np.where(ok, c2[:, c] / nn, np.nan) for c in range(4))
+    delta, ut = r["delta"], r["ut"]
+    if not r["fold"]:
+        up = y > delta
+        y = np.where(up, 2 * delta - y, y)
+        uv = np.where(up, -uv, uv)
+    return {"yplus": y * ut / r["nu"], "y_delta": y / delta, "U+": u / ut,
+            "u_rms+": np.sqrt(uu) / ut, "v_rms+": np.sqrt(vv) / ut, "w_rms+": np.sqrt(ww) / ut,
+            "-u'v'+": -uv / ut**2}
+
+
+def group_profiles(run, group):
+    """[(t0, t1, profiles dict)] of the window groups of a run."""
+    r = read_windows(run)
+    win, done = r["win"], r["done"]
     out = []
     t_start = win[0, 0]
     k = 0
@@ -80,28 +116,7 @@ def group_profiles(run, group):
         sel = [i for i in sel if done[i]]
         if not sel:
             continue
-        # merge the windows' records (counts, means, co-moments; Chan et al. 1979)
-        n = mom[sel][:, :, MOM_N].sum(axis=0)
-        ok = n > 0
-        nn = np.maximum(n, 1)
-        mean = sum(mom[i][:, MEAN:MEAN + 8] * mom[i][:, [MOM_N]] for i in sel) / nn[:, None]
-        pairs = ((0, 0), (1, 1), (2, 2), (0, 1))  # uu vv ww uv
-        c2 = np.zeros((len(n), len(pairs)))
-        for i in sel:
-            d = mom[i][:, MEAN:MEAN + 3] - mean[:, :3]
-            for c, (p, q) in enumerate(pairs):
-                c2[:, c] += mom[i][:, C2 + c] + mom[i][:, MOM_N] * d[:, p] * d[:, q]
-        y = np.where(ok, mean[:, 5], np.nan)
-        u = np.where(ok, mean[:, 0], np.nan)
-        uu, vv, ww, uv = (np.where(ok, c2[:, c] / nn, np.nan) for c in range(4))
-        if not fold:
-            up = y > delta
-            y = np.where(up, 2 * delta - y, y)
-            uv = np.where(up, -uv, uv)
-        yp = y * ut / nu
-        prof = {"yplus": yp, "y_delta": y / delta, "U+": u / ut, "u_rms+": np.sqrt(uu) / ut,
-                "v_rms+": np.sqrt(vv) / ut, "w_rms+": np.sqrt(ww) / ut, "-u'v'+": -uv / ut**2}
-        out.append((win[sel[0], 0], win[sel[-1], 1], prof))
+        out.append((win[sel[0], 0], win[sel[-1], 1], merged_profile(r, sel)))
     return out
 
 

@@ -1,0 +1,68 @@
+#!/usr/bin/python3
+"""Peaks of the Reynolds stresses of runs over chosen time ranges, side by side with a DNS.
+
+usage: python3 stats/window_peaks.py --dns FILE [--units wall|force]
+                                    LABEL=RUN_DIR[+RUN_DIR...]@T0:T1 ...
+
+For each spec, the windows of stats.nc inside [T0, T1] (delta/u_tau; chained runs as in
+error_vs_time.py) are merged from their raw sums (old and new stats.nc formats alike), in wall
+units of the windows' mean wall shear stress (default, as `chansph extract --units wall`) or of
+the force balance (u_tau^2 = delta f). Printed: the peaks of -u'v'+, u_rms+, v_rms+ and w_rms+ with
+their deviation from the DNS peak, and the range of the relative deviation of v_rms+ and w_rms+
+over 20 < y+ < 150 (issue 12's acceptance measures). Used for the LES against quasi-DNS rows of
+docs/validation/turbulent_channel.md.
+"""
+import argparse
+import os
+import sys
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from compare import InputError, read_dns  # noqa: E402
+from resolution_extrapolate import window, window_profile  # noqa: E402
+
+PEAKS = ("-u'v'+", "u_rms+", "v_rms+", "w_rms+")
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("runs", nargs="+", help="LABEL=RUN_DIR[+RUN_DIR...]@T0:T1")
+    ap.add_argument("--dns", required=True)
+    ap.add_argument("--units", choices=("wall", "force"), default="wall")
+    a = ap.parse_args()
+    try:
+        dns = read_dns(a.dns)
+        rows = []
+        for spec in a.runs:
+            label, _, rest = spec.partition("=")
+            dirs, _, span = rest.rpartition("@")
+            if not dirs or not span:
+                raise InputError(f"{spec}: expected LABEL=RUN_DIR[+RUN_DIR...]@T0:T1")
+            try:
+                t0, t1 = window(span)
+            except argparse.ArgumentTypeError as e:
+                raise InputError(f"{spec}: {e}")
+            prof, got = window_profile(dirs, t0, t1, a.units)
+            rows.append((label, got, prof))
+    except InputError as e:
+        sys.exit(f"error: {e}")
+    print(f"# peaks (deviation from {dns['name']}) and the v_rms+, w_rms+ deviation over "
+          f"20 < y+ < 150; {a.units} units")
+    print(f"# {'run':<16} {'t':>11} " + " ".join(f"{q:>13}" for q in PEAKS) +
+          f" {'v_rms+ 20-150':>14} {'w_rms+ 20-150':>14}")
+    for label, got, prof in rows:
+        yp = prof["yplus"]
+        cells = []
+        for q in PEAKS:
+            v = np.nanmax(prof[q])
+            cells.append(f"{v:5.2f} ({100 * (v / dns[q].max() - 1):+4.0f}%)")
+        m = (yp > 20) & (yp < 150) & np.isfinite(yp)
+        for q in ("v_rms+", "w_rms+"):
+            rel = prof[q][m] / np.interp(yp[m], dns["yplus"], dns[q]) - 1
+            cells.append(f"{100 * rel.min():+5.0f}..{100 * rel.max():+4.0f}%")
+        print(f"  {label:<16} {got[0]:5.2f}-{got[1]:5.2f} " + " ".join(f"{c:>13}" for c in cells))
+
+
+if __name__ == "__main__":
+    main()
