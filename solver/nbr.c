@@ -93,8 +93,8 @@ void nbr_free(struct nbr *nb) {
   part_free(nb->start), part_free(nb->pos), part_free(nb->perm), part_free(nb->cell);
   part_free(nb->count), part_free(nb->list), part_free(nb->nfluid);
   for (int t = 0; t < nb->scratch_threads; t++)
-    part_free(nb->scratch[t]), part_free(nb->pairbuf[t]);
-  free(nb->scratch), free(nb->pairbuf);
+    part_free(nb->scratch[t]), part_free(nb->pairbuf[t]), part_free(nb->blocks[t]);
+  free(nb->scratch), free(nb->pairbuf), free(nb->blocks);
   memset(nb, 0, sizeof *nb);
 }
 
@@ -193,53 +193,54 @@ static inline __attribute__((always_inline)) int scan_scalar(
 }
 
 #if NBR_AVX512
-/* The same with AVX-512: 8 candidates at a time, the neighbours appended by compress stores (in
-   the order of the candidates, so the list is the same as scan_scalar's; the distances are
-   computed with the same operations in the same order). cap: scratch slots (stride + 16). */
+/* The same with AVX-512 over a whole cell's stencil at once: its candidate ranges cut into
+   blocks of 8 (cand_blocks), scanned in one loop, with no branch per row. The neighbours are
+   appended by compress in the order of the candidates, and the distances are computed with the
+   same operations in the same order as scan_scalar's ((x_a - sx) - x_b, the shifted coordinates
+   of a formed once for each of the three shifts), so the list and its distances are the same
+   as the portable scan's. Per block the shuffle port does only the comparison and the two
+   compresses (the slots and shifts are loaded, not broadcast). cap: scratch slots (stride +
+   16); lx, lz: the periods. */
 __attribute__((target("avx512f,avx512vl,avx512bw,avx512dq,avx512cd"))) static inline int
-scan_avx512(const struct particles *restrict P, size_t a, size_t b0, size_t b1, double sx,
-            double sz, double support2, int32_t *restrict lb, double *restrict r2b, int cnt,
-            int cap) {
+scan_blocks_avx512(const struct particles *restrict P, size_t a, const struct nbr_block *restrict B,
+                   int nblock, double lx, double lz, double support2, int32_t *restrict lb,
+                   double *restrict r2b, int cap) {
   const double *restrict x = P->x, *restrict y = P->y, *restrict z = P->z;
-  const __m512d xa = _mm512_set1_pd(x[a] - sx), ya = _mm512_set1_pd(y[a]);
-  const __m512d za = _mm512_set1_pd(z[a] - sz), s2 = _mm512_set1_pd(support2);
-  __m256i idx =
-      _mm256_add_epi32(_mm256_set1_epi32((int)b0), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
-  for (size_t b = b0; b < b1; b += 8) {
-    const __mmask8 live = b1 - b >= 8 ? 0xff : (__mmask8)((1u << (b1 - b)) - 1u);
-    const __m512d dx = _mm512_sub_pd(xa, _mm512_maskz_loadu_pd(live, x + b));
+  double xs[3][8] __attribute__((aligned(64))), zs[3][8] __attribute__((aligned(64)));
+  const double shift_x[3] = {-lx, 0.0, lx}, shift_z[3] = {-lz, 0.0, lz};
+  for (int k = 0; k < 3; k++) {
+    _mm512_store_pd(xs[k], _mm512_set1_pd(x[a] - shift_x[k]));
+    _mm512_store_pd(zs[k], _mm512_set1_pd(z[a] - shift_z[k]));
+  }
+  const __m512d ya = _mm512_set1_pd(y[a]), s2 = _mm512_set1_pd(support2);
+  int cnt = 0;
+  for (int k = 0; k < nblock; k++) {
+    const struct nbr_block *restrict bk = &B[k];
+    const int32_t b = bk->id[0];
+    const __mmask8 live = (__mmask8)bk->live;
+    const __m512d dx =
+        _mm512_sub_pd(_mm512_load_pd(xs[bk->sx]), _mm512_maskz_loadu_pd(live, x + b));
     const __m512d dy = _mm512_sub_pd(ya, _mm512_maskz_loadu_pd(live, y + b));
-    const __m512d dz = _mm512_sub_pd(za, _mm512_maskz_loadu_pd(live, z + b));
+    const __m512d dz =
+        _mm512_sub_pd(_mm512_load_pd(zs[bk->sz]), _mm512_maskz_loadu_pd(live, z + b));
     const __m512d r2 = _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy)),
                                      _mm512_mul_pd(dz, dz));
-    __mmask8 hit = _mm512_mask_cmp_pd_mask(live, r2, s2, _CMP_LT_OQ);
-    if (a >= b && a - b < 8) hit &= (__mmask8) ~(1u << (a - b));
+    const uint32_t d = (uint32_t)a - (uint32_t)b; /* a itself: lane d of this block */
+    const __mmask8 hit =
+        _mm512_mask_cmp_pd_mask(live, r2, s2, _CMP_LT_OQ) & (__mmask8) ~(d < 8 ? 1u << d : 0u);
     if (cnt + 8 <= cap) {
       /* compress in registers, then plain stores (a compress store to memory is slow on
          several processors); the slots past the hits are scratch */
-      _mm256_storeu_si256((__m256i *)(lb + cnt), _mm256_maskz_compress_epi32(hit, idx));
+      _mm256_storeu_si256(
+          (__m256i *)(lb + cnt),
+          _mm256_maskz_compress_epi32(hit, _mm256_load_si256((const __m256i *)bk->id)));
       _mm512_storeu_pd(r2b + cnt, _mm512_maskz_compress_pd(hit, r2));
     }
     cnt += __builtin_popcount(hit);
-    idx = _mm256_add_epi32(idx, _mm256_set1_epi32(8));
   }
   return cnt;
 }
 #endif
-
-/* Candidates [b0, b1) of particle a: the AVX-512 scan where the processor has it. */
-static inline __attribute__((always_inline)) int scan(const struct particles *restrict P, size_t a,
-                                                      size_t b0, size_t b1, double sx, double sz,
-                                                      double support2, int32_t *restrict lb,
-                                                      double *restrict r2b, int cnt, int stride,
-                                                      int avx512) {
-#if NBR_AVX512
-  if (avx512) return scan_avx512(P, a, b0, b1, sx, sz, support2, lb, r2b, cnt, stride + NBR_ALIGN);
-#else
-  (void)avx512;
-#endif
-  return scan_scalar(P, a, b0, b1, sx, sz, support2, lb, r2b, cnt, stride);
-}
 
 /* Kernel sum S_a = m_a w(0) + sum_b m_b w_ab over the list found (vectorised; the order of the
    list is the same on any decomposition and the scratch list is aligned, so the sum is too). */
@@ -296,61 +297,129 @@ static inline double cell_gap(double p, int j, double w) {
   return p < lo ? lo - p : p > hi ? p - hi : 0.0;
 }
 
+/* A run of candidates: the particles [b0, b1) of consecutive cells of one row of the stencil,
+   shifted by (sx, 0, sz), in row jy and plane jz of the grid. */
+struct cand_range {
+  size_t b0, b1;
+  double sx, sz;
+  int jy, jz;
+};
+enum { NBR_RANGES = (2 * NBR_REACH + 1) * (2 * NBR_REACH + 1) * (2 * NBR_REACH + 1) };
+
+/* The candidate ranges of owned cell c's stencil, in stencil order (planes, rows, columns),
+   each the same global cells with the same shifts on any decomposition; returns their count. */
+static int stencil_ranges(const struct nbr *nb, size_t c, struct cand_range *r) {
+  const int R = NBR_REACH;
+  const int dz_lo = nb->dim == 3 ? -R : 0, dz_hi = nb->dim == 3 ? R : 0;
+  const int lc = (int)(c % (size_t)nb->nxo);
+  const int iy = (int)(c / (size_t)nb->nxo % (size_t)nb->ny);
+  const int iz = (int)(c / ((size_t)nb->nxo * nb->ny));
+  const int gx = nb->ix0 + lc;
+  /* the x cells of the stencil are contiguous and unshifted away from the ends of the rank */
+  const int inner = lc >= R && lc < nb->nxo - R && gx >= R && gx < nb->nx - R;
+  int n = 0;
+  for (int dz = dz_lo; dz <= dz_hi; dz++) {
+    int jz = iz + dz;
+    double sz = 0.0;
+    if (jz < 0)
+      jz += nb->nz, sz = -nb->lz;
+    else if (jz >= nb->nz)
+      jz -= nb->nz, sz = nb->lz;
+    for (int dy = -R; dy <= R; dy++) {
+      const int jy = iy + dy;
+      if (jy < 0 || jy >= nb->ny) continue;
+      const size_t row = (size_t)jz * nb->ny + jy;
+      if (inner) {
+        const size_t c0 = row * nb->nxo + lc;
+        r[n++] = (struct cand_range){nb->start[c0 - R], nb->start[c0 + R + 1], 0.0, sz, jy, jz};
+        continue;
+      }
+      for (int dx = -R; dx <= R; dx++) {
+        double sx;
+        const int col = stencil_column(nb, lc, dx, &sx);
+        const size_t cc =
+            col >= 0 ? row * nb->nxo + col : nb->ncell_own + row * 2 * nb->halo + (-1 - col);
+        r[n++] = (struct cand_range){nb->start[cc], nb->start[cc + 1], sx, sz, jy, jz};
+      }
+    }
+  }
+  return n;
+}
+
+/* The list of particle a from the ranges: the portable scan, skipping the ranges whose cells
+   are farther than 2h in y and z (with a margin: the skipped candidates are outside the
+   support by far more than the rounding of the cell edges). */
+static inline __attribute__((always_inline)) int scan_ranges(const struct nbr *nb,
+                                                             const struct particles *P, size_t a,
+                                                             const struct cand_range *r, int nr,
+                                                             int32_t *lb, double *r2b) {
+  const double prune2 = nb->support2 * (1.0 + 1e-9);
+  const double wy = 1.0 / nb->cy, wz = 1.0 / nb->cz; /* cell widths */
+  int cnt = 0;
+  for (int k = 0; k < nr; k++) {
+    const double gz = nb->dim == 3 ? cell_gap(P->z[a] - r[k].sz, r[k].jz, wz) : 0.0;
+    const double gy = cell_gap(P->y[a], r[k].jy, wy);
+    if (gy * gy + gz * gz >= prune2) continue;
+    cnt = scan_scalar(P, a, r[k].b0, r[k].b1, r[k].sx, r[k].sz, nb->support2, lb, r2b, cnt,
+                      nb->stride);
+  }
+  return cnt;
+}
+
+#if NBR_AVX512
+/* Cut the candidate ranges into blocks of at most 8 consecutive particles (their slots, the
+   mask of the slots inside the range, the index of each shift in -L, 0, L); returns the
+   number of blocks. */
+__attribute__((target("avx512f,avx512vl,avx512bw,avx512dq,avx512cd"))) static inline int
+cand_blocks(const struct cand_range *r, int nr, struct nbr_block *B) {
+  const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  int n = 0;
+  for (int k = 0; k < nr; k++) {
+    const uint16_t sx = (uint16_t)(r[k].sx < 0.0 ? 0 : r[k].sx > 0.0 ? 2 : 1);
+    const uint16_t sz = (uint16_t)(r[k].sz < 0.0 ? 0 : r[k].sz > 0.0 ? 2 : 1);
+    for (size_t b = r[k].b0; b < r[k].b1; b += 8) {
+      const size_t m = r[k].b1 - b < 8 ? r[k].b1 - b : 8;
+      struct nbr_block *bk = &B[n++];
+      _mm256_store_si256((__m256i *)bk->id, _mm256_add_epi32(_mm256_set1_epi32((int)b), lane));
+      bk->live = (1u << m) - 1u, bk->sx = sx, bk->sz = sz;
+    }
+  }
+  return n;
+}
+#endif
+
 /* Neighbour lists and kernel sums of the particles of owned cell c; returns the largest count
    that did not fit the stride (0 if all fitted). Instantiated for the AVX-512 scan (avx512 = 1,
-   build_cell_avx512) and for the portable one (build_cell). */
+   build_cell_avx512: the cell's candidates cut into blocks once, every particle of the cell
+   scanning them in one loop) and for the portable one (build_cell: per range, pruned per particle).
+ */
 static inline __attribute__((always_inline)) int build_cell_t(struct nbr *nb,
                                                               const struct particles *P,
                                                               const struct kernel *K, size_t c,
                                                               double *ksum, const int avx512) {
   const int stride = nb->stride, R = NBR_REACH;
-  const int dz_lo = nb->dim == 3 ? -R : 0, dz_hi = nb->dim == 3 ? R : 0;
-  /* rows of the stencil farther than 2h in y and z are skipped (with a margin: the skipped
-     candidates are outside the support by far more than the rounding of the cell index) */
-  const double prune2 = nb->support2 * (1.0 + 1e-9);
-  const double wy = 1.0 / nb->cy, wz = 1.0 / nb->cz; /* cell widths */
-  const int lc = (int)(c % (size_t)nb->nxo);
   const int iy = (int)(c / (size_t)nb->nxo % (size_t)nb->ny);
-  const int iz = (int)(c / ((size_t)nb->nxo * nb->ny));
+  if (nb->start[c] == nb->start[c + 1]) return 0;
   int overflow = 0;
-  int32_t *lb = nb->scratch[omp_get_thread_num()];
+  const int t = omp_get_thread_num();
+  int32_t *lb = nb->scratch[t];
+  double *r2b = (double *)(lb + stride + NBR_ALIGN);
   /* only lists that reach the first or last row of cells can hold wall vertices */
   const int wall_rows = iy - R <= 0 || iy + R >= nb->ny - 1;
-  double *r2b = (double *)(lb + stride + NBR_ALIGN);
+  struct cand_range r[NBR_RANGES];
+  const int nr = stencil_ranges(nb, c, r);
+#if NBR_AVX512
+  const int nblock = avx512 ? cand_blocks(r, nr, nb->blocks[t]) : 0;
+#endif
   for (size_t a = nb->start[c]; a < nb->start[c + 1]; a++) {
-    int cnt = 0;
-    for (int dz = dz_lo; dz <= dz_hi; dz++) {
-      int jz = iz + dz;
-      double sz = 0.0;
-      if (jz < 0)
-        jz += nb->nz, sz = -nb->lz;
-      else if (jz >= nb->nz)
-        jz -= nb->nz, sz = nb->lz;
-      const double gz = nb->dim == 3 ? cell_gap(P->z[a] - sz, jz, wz) : 0.0;
-      for (int dy = -R; dy <= R; dy++) {
-        const int jy = iy + dy;
-        if (jy < 0 || jy >= nb->ny) continue;
-        const double gy = cell_gap(P->y[a], jy, wy);
-        if (gy * gy + gz * gz >= prune2) continue;
-        const size_t row = (size_t)jz * nb->ny + jy;
-        const int gx = nb->ix0 + lc;
-        if (lc >= R && lc < nb->nxo - R && gx >= R && gx < nb->nx - R) {
-          /* the x cells of the stencil are contiguous and unshifted */
-          const size_t c0 = row * nb->nxo + lc;
-          cnt = scan(P, a, nb->start[c0 - R], nb->start[c0 + R + 1], 0.0, sz, nb->support2, lb, r2b,
-                     cnt, stride, avx512);
-          continue;
-        }
-        for (int dx = -R; dx <= R; dx++) {
-          double sx;
-          const int col = stencil_column(nb, lc, dx, &sx);
-          const size_t cc =
-              col >= 0 ? row * nb->nxo + col : nb->ncell_own + row * 2 * nb->halo + (-1 - col);
-          cnt = scan(P, a, nb->start[cc], nb->start[cc + 1], sx, sz, nb->support2, lb, r2b, cnt,
-                     stride, avx512);
-        }
-      }
-    }
+    int cnt;
+#if NBR_AVX512
+    if (avx512)
+      cnt = scan_blocks_avx512(P, a, nb->blocks[t], nblock, nb->lx, nb->lz, nb->support2, lb, r2b,
+                               stride + NBR_ALIGN);
+    else
+#endif
+      cnt = scan_ranges(nb, P, a, r, nr, lb, r2b);
     nb->count[a] = cnt;
     if (cnt > stride) {
       if (cnt > overflow) overflow = cnt;
@@ -380,21 +449,35 @@ __attribute__((target("avx512f,avx512vl,avx512bw,avx512dq,avx512cd"))) static in
 }
 #endif
 
-/* Per-thread scratch lists of stride + 1 entries and their squared distances. */
+/* Per-thread scratch lists of stride + 1 entries and their squared distances, and (AVX-512
+   scan) room for the blocks of the fullest stencil: NBR_RANGES ranges of NBR_REACH * 2 + 1
+   cells of the fullest cell, each range cut into blocks of 8 and one partial block. */
 static void nbr_scratch(struct nbr *nb) {
   const int nt = omp_get_max_threads();
-  if (nb->scratch && nb->scratch_stride == nb->stride && nb->scratch_threads >= nt) return;
+  size_t fullest = 0;
+  if (nb->avx512)
+    for (size_t c = 0; c < nb->ncell; c++)
+      if (nb->start[c + 1] - nb->start[c] > fullest) fullest = nb->start[c + 1] - nb->start[c];
+  const size_t blocks = nb->avx512 ? NBR_RANGES * (fullest / 8 + 1) : 0;
+  if (nb->scratch && nb->scratch_stride == nb->stride && nb->scratch_threads >= nt &&
+      nb->block_cap >= blocks)
+    return;
   for (int t = 0; t < nb->scratch_threads; t++)
-    part_free(nb->scratch[t]), part_free(nb->pairbuf[t]);
-  free(nb->scratch), free(nb->pairbuf);
+    part_free(nb->scratch[t]), part_free(nb->pairbuf[t]), part_free(nb->blocks[t]);
+  free(nb->scratch), free(nb->pairbuf), free(nb->blocks);
   nb->scratch = mem_calloc((size_t)nt, sizeof *nb->scratch, "neighbour lists");
   nb->pairbuf = mem_calloc((size_t)nt, sizeof *nb->pairbuf, "neighbour lists");
-  if (!nb->scratch || !nb->pairbuf) die("out of memory for the neighbour scratch lists");
+  nb->blocks = mem_calloc((size_t)nt, sizeof *nb->blocks, "neighbour lists");
+  if (!nb->scratch || !nb->pairbuf || !nb->blocks)
+    die("out of memory for the neighbour scratch lists");
   const size_t bytes = (size_t)(nb->stride + NBR_ALIGN) * (sizeof(int32_t) + sizeof(double));
+  nb->block_cap = blocks + blocks / 2; /* made again only when a cell fills beyond it */
   for (int t = 0; t < nt; t++) {
     nb->scratch[t] = part_alloc("nbr_scratch", bytes);
     nb->pairbuf[t] =
         part_alloc("pair_buffer", PAIRBUF_FIELDS * (size_t)nb->stride * sizeof(double));
+    if (nb->block_cap)
+      nb->blocks[t] = part_alloc("nbr_blocks", nb->block_cap * sizeof(struct nbr_block));
   }
   nb->scratch_threads = nt, nb->scratch_stride = nb->stride;
 }

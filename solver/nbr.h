@@ -27,6 +27,15 @@ enum { NBR_REACH = 2 };
     sums over it split the same way into lanes on any decomposition (bitwise rank-independent). */
 enum { NBR_ALIGN = 16 };
 
+/** A block of the candidate scan (AVX-512, nbr.c): up to 8 consecutive particle slots of one
+    range of a cell's stencil and the periodic shifts of their cells. */
+struct nbr_block {
+  int32_t id[8];   /*!< the slots b .. b + 7 */
+  uint32_t live;   /*!< mask of those inside the range */
+  uint16_t sx, sz; /*!< shifts in x and z: 0, 1, 2 for -L, 0, L */
+  uint32_t pad[6]; /*!< to 64 bytes: the slots load aligned */
+};
+
 /**
  * Cell grid and neighbour list. The grid is global (cells of the whole channel, column ix
  * along x, row iy, plane iz); a rank owns the columns ix0 .. ix0+nxo-1 and, with several ranks,
@@ -59,11 +68,14 @@ struct nbr {
   double **pairbuf; /*!< per thread: the gathered records of one list (records.h),
                          16 fields of stride values, then PAIRBUF_GEOM fields of pair
                          geometry the force loop keeps for the strain sums (forces.c) */
-  int32_t **scratch;   /*!< per thread: a list being built and its squared distances */
-  int scratch_threads; /*!< threads the scratch lists were made for */
-  int scratch_stride;  /*!< stride they were made for */
-  int32_t *list;       /*!< neighbours of a: list[a*stride .. a*stride+count[a]-1], each part in
-                            stencil order (cells, then id) */
+  int32_t **scratch;         /*!< per thread: a list being built and its squared distances */
+  struct nbr_block **blocks; /*!< per thread: the candidate blocks of one cell's stencil
+                                  (AVX-512 scan) */
+  size_t block_cap;          /*!< blocks each of them holds */
+  int scratch_threads;       /*!< threads the scratch lists were made for */
+  int scratch_stride;        /*!< stride they were made for */
+  int32_t *list; /*!< neighbours of a: list[a*stride .. a*stride+count[a]-1], each part in
+                      stencil order (cells, then id) */
 };
 
 /** @brief Columns of the global cell grid along x for a scene (what nbr_init uses). */
