@@ -391,8 +391,8 @@ cand_blocks(const struct cand_range *r, int nr, struct nbr_block *B) {
 /* Neighbour lists and kernel sums of the particles of owned cell c; returns the largest count
    that did not fit the stride (0 if all fitted). Instantiated for the AVX-512 scan (avx512 = 1,
    build_cell_avx512: the cell's candidates cut into blocks once, every particle of the cell
-   scanning them in one loop) and for the portable one (build_cell: per range, pruned per particle).
- */
+   scanning them in one loop) and for the portable one (build_cell: per range, pruned per
+   particle). */
 static inline __attribute__((always_inline)) int build_cell_t(struct nbr *nb,
                                                               const struct particles *P,
                                                               const struct kernel *K, size_t c,
@@ -450,8 +450,9 @@ __attribute__((target("avx512f,avx512vl,avx512bw,avx512dq,avx512cd"))) static in
 #endif
 
 /* Per-thread scratch lists of stride + 1 entries and their squared distances, and (AVX-512
-   scan) room for the blocks of the fullest stencil: NBR_RANGES ranges of NBR_REACH * 2 + 1
-   cells of the fullest cell, each range cut into blocks of 8 and one partial block. */
+   scan) room for the blocks of any stencil: at most NBR_RANGES cells, each holding at most as
+   many particles as the fullest cell, in ranges of whole cells cut into blocks of 8 with at most
+   one partial block per cell. */
 static void nbr_scratch(struct nbr *nb) {
   const int nt = omp_get_max_threads();
   size_t fullest = 0;

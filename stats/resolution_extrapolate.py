@@ -49,18 +49,21 @@ def window(text):
         raise argparse.ArgumentTypeError(f"{text}: expected T0:T1")
 
 
+def range_deviation(prof, dns, q):
+    """Relative deviations of profile q from the DNS at the bins in Y_LO < y+ < Y_HI."""
+    yp, v = prof["yplus"], prof[q]
+    m = np.isfinite(v) & np.isfinite(yp) & (yp > Y_LO) & (yp < Y_HI)
+    if not m.any():
+        raise InputError(f"no bins in {Y_LO} < y+ < {Y_HI}")
+    return v[m] / np.interp(yp[m], dns["yplus"], dns[q]) - 1.0
+
+
 def deviation(prof, dns, q, kind):
     """Signed relative deviation of profile q from the DNS: the peak's, or the largest in size
     over Y_LO < y+ < Y_HI."""
-    yp, v = prof["yplus"], prof[q]
-    ok = np.isfinite(v) & np.isfinite(yp)
-    yp, v = yp[ok], v[ok]
     if kind == "peak":
-        return v.max() / dns[q].max() - 1.0
-    m = (yp > Y_LO) & (yp < Y_HI)
-    if not m.any():
-        raise InputError(f"no bins in {Y_LO} < y+ < {Y_HI}")
-    rel = v[m] / np.interp(yp[m], dns["yplus"], dns[q]) - 1.0
+        return np.nanmax(prof[q]) / dns[q].max() - 1.0
+    rel = range_deviation(prof, dns, q)
     return rel[np.argmax(np.abs(rel))]
 
 

@@ -21,7 +21,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from compare import InputError, read_dns  # noqa: E402
-from resolution_extrapolate import window, window_profile  # noqa: E402
+from resolution_extrapolate import deviation, range_deviation, window, window_profile  # noqa: E402,E501
 
 PEAKS = ("-u'v'+", "u_rms+", "v_rms+", "w_rms+")
 
@@ -54,14 +54,10 @@ def main():
     print(f"# {'run':<16} {'t':>11} " + " ".join(f"{q:>13}" for q in PEAKS) +
           f" {'v_rms+ 20-150':>14} {'w_rms+ 20-150':>14}")
     for label, got, prof in rows:
-        yp = prof["yplus"]
-        cells = []
-        for q in PEAKS:
-            v = np.nanmax(prof[q])
-            cells.append(f"{v:5.2f} ({100 * (v / dns[q].max() - 1):+4.0f}%)")
-        m = (yp > 20) & (yp < 150) & np.isfinite(yp)
+        cells = [f"{np.nanmax(prof[q]):5.2f} ({100 * deviation(prof, dns, q, 'peak'):+4.0f}%)"
+                 for q in PEAKS]
         for q in ("v_rms+", "w_rms+"):
-            rel = prof[q][m] / np.interp(yp[m], dns["yplus"], dns[q]) - 1
+            rel = range_deviation(prof, dns, q)
             cells.append(f"{100 * rel.min():+5.0f}..{100 * rel.max():+4.0f}%")
         print(f"  {label:<16} {got[0]:5.2f}-{got[1]:5.2f} " + " ".join(f"{c:>13}" for c in cells))
     if a.plot:
