@@ -76,8 +76,8 @@ struct fsums {
 static inline __attribute__((always_inline)) void strain_sums(const struct fctx *C, size_t a,
                                                               const double *bf, int ld,
                                                               const int32_t *restrict nl, int n,
-                                                              const int gathered, double A[6],
-                                                              double B[9]) {
+                                                              const int gathered,
+                                                              double ab[][TURB_CHUNK], int i) {
   const struct particles *P = C->P;
   const double *restrict u = gathered ? bf + (size_t)REC_U * ld : P->u;
   const double *restrict v = gathered ? bf + (size_t)REC_V * ld : P->v;
@@ -100,21 +100,21 @@ static inline __attribute__((always_inline)) void strain_sums(const struct fctx 
     byx += dv * qx, byy += dv * qy, byz += dv * qz;
     bzx += dw * qx, bzy += dw * qy, bzz += dw * qz;
   }
-  A[0] = axx, A[1] = axy, A[2] = axz, A[3] = ayy, A[4] = ayz, A[5] = azz;
-  B[0] = bxx, B[1] = bxy, B[2] = bxz, B[3] = byx, B[4] = byy, B[5] = byz;
-  B[6] = bzx, B[7] = bzy, B[8] = bzz;
+  const double sums[15] = {axx, axy, axz, ayy, ayz, azz, bxx, bxy,
+                           bxz, byx, byy, byz, bzx, bzy, bzz};
+  for (int k = 0; k < 15; k++) ab[k][i] = sums[k];
 }
 
 static CHANSPH_CLONES __attribute__((noinline)) void strain_sums_gathered(
     const struct fctx *C, size_t a, const double *bf, int ld, const int32_t *restrict nl, int n,
-    double A[6], double B[9]) {
-  strain_sums(C, a, bf, ld, nl, n, 1, A, B);
+    double ab[][TURB_CHUNK], int i) {
+  strain_sums(C, a, bf, ld, nl, n, 1, ab, i);
 }
 
 static CHANSPH_CLONES __attribute__((noinline)) void strain_sums_arrays(
     const struct fctx *C, size_t a, const double *bf, int ld, const int32_t *restrict nl, int n,
-    double A[6], double B[9]) {
-  strain_sums(C, a, bf, ld, nl, n, 0, A, B);
+    double ab[][TURB_CHUNK], int i) {
+  strain_sums(C, a, bf, ld, nl, n, 0, ab, i);
 }
 
 /** LES: the x part of Violeau's sum over the fluid neighbours of a with the molecular viscosity
@@ -311,9 +311,11 @@ static inline __attribute__((always_inline)) void force_range(const struct fctx 
   const struct particles *P = C->P;
   const int ld = nb->stride;
   double *bf = nb->pairbuf[omp_get_thread_num()];
+  double ab[15][TURB_CHUNK]; /* VK_LES_LAG: the strain sums of the chunk */
   for (size_t a = a0; a < a1; a++) {
     if (P->kind[a] != KIND_FLUID) {
-      if (visc == VK_LES_LAG) C->nur_next[a] = C->kr_next[a] = 0.0;
+      if (visc == VK_LES_LAG)
+        for (int k = 0; k < 15; k++) ab[k][a - a0] = 0.0;
       continue;
     }
     const int32_t *nl = nb->list + a * (size_t)nb->stride;
@@ -331,15 +333,16 @@ static inline __attribute__((always_inline)) void force_range(const struct fctx 
       pair_sums(C, a, bf, ld, nl, nf, n, gathered, 0, visc, corr, &sv);
     }
     force_finish(C, a, &s, &sv, mx);
-    if (visc == VK_LES_LAG) { /* the strain of this state, for the next step */
-      double A[6], B[9];
+    if (visc == VK_LES_LAG) { /* the strain sums of this state, for the next step */
       if (gathered)
-        strain_sums_gathered(C, a, bf, ld, nl, n, A, B);
+        strain_sums_gathered(C, a, bf, ld, nl, n, ab, (int)(a - a0));
       else
-        strain_sums_arrays(C, a, bf, ld, nl, n, A, B);
-      turb_model_gradient(C->M, P, C->W, a, A, B, &C->nur_next[a], &C->kr_next[a]);
+        strain_sums_arrays(C, a, bf, ld, nl, n, ab, (int)(a - a0));
     }
   }
+  if (visc == VK_LES_LAG) /* and the model of the whole chunk */
+    turb_model_chunk(C->M, P, C->W, a0, (int)(a1 - a0), (const double(*)[TURB_CHUNK])ab,
+                     C->nur_next + a0, C->kr_next + a0);
 }
 
 /* One function per combination, each built for several instruction sets (pair.h): for one
@@ -377,7 +380,7 @@ static const force_loop loops[2][2][VK_N][2] = {{FORCE_ROW(), FORCE_ROW(_rec)},
                                                 {FORCE_ROW(_sp), FORCE_ROW(_rec_sp)}};
 
 /** Particles per task of the force loop. */
-enum { FORCE_CHUNK = 128 };
+enum { FORCE_CHUNK = TURB_CHUNK };
 
 void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb,
                 const struct walls *W, double fx, struct force_info *info) {

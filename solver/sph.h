@@ -165,32 +165,52 @@ struct foot {
   double tx, tz;
 };
 
-static inline struct foot sph_foot(const struct model *M, const struct walls *W, int wall, double x,
-                                   double z) {
-  const double fx = x / M->dr - 0.5;
-  const double ix = floor(fx), tx = fx - ix;
-  int i0 = (int)ix % W->nx;
-  if (i0 < 0) i0 += W->nx;
-  const int i1 = (i0 + 1) % W->nx;
-  const size_t off = (size_t)wall * W->nx * W->nz;
+/** floor(v) for |v| < 2^31, by truncation: the loops that call sph_foot vectorise with it (GCC
+    vectorises floor() only without -ftrapping-math). */
+static inline double sph_floor(double v) {
+  const double t = (double)(int)v;
+  return t > v ? t - 1.0 : t;
+}
+
+/** The floored remainder i mod n in [0, n) of an integer-valued i, in double arithmetic (exact for
+    |i| < 2^31): no integer division, so that the loops that call sph_foot vectorise. */
+static inline int sph_wrap_index(double i, int n) {
+  return (int)(i - (double)n * sph_floor(i / (double)n));
+}
+
+/** sph_foot from the values it needs (dim, the spacing dr, the lattice nx x nz), so that a loop
+    with a constant dim and these in registers vectorises. */
+static inline struct foot sph_foot_of(int dim, double dr, int nx, int nz, int wall, double x,
+                                      double z) {
+  const double fx = x / dr - 0.5;
+  const double ix = sph_floor(fx), tx = fx - ix;
+  const int i0 = sph_wrap_index(ix, nx), i1 = i0 + 1 < nx ? i0 + 1 : 0;
+  const size_t off = (size_t)wall * nx * nz;
   struct foot f = {off + i0, off + i0, off + i1, off + i1, tx, 0.0};
-  if (M->dim == 2) return f;
-  const double fz = z / M->dr - 0.5;
-  const double iz = floor(fz), tz = fz - iz;
-  int k0 = (int)iz % W->nz;
-  if (k0 < 0) k0 += W->nz;
-  const int k1 = (k0 + 1) % W->nz;
-  const size_t nz = (size_t)W->nz;
-  f.c00 = off + i0 * nz + k0, f.c01 = off + i0 * nz + k1;
-  f.c10 = off + i1 * nz + k0, f.c11 = off + i1 * nz + k1;
+  if (dim == 2) return f;
+  const double fz = z / dr - 0.5;
+  const double iz = sph_floor(fz), tz = fz - iz;
+  const int k0 = sph_wrap_index(iz, nz), k1 = k0 + 1 < nz ? k0 + 1 : 0;
+  f.c00 = off + i0 * (size_t)nz + k0, f.c01 = off + i0 * (size_t)nz + k1;
+  f.c10 = off + i1 * (size_t)nz + k0, f.c11 = off + i1 * (size_t)nz + k1;
   f.tz = tz;
   return f;
 }
 
-static inline double sph_foot_value(const struct model *M, const struct foot *f, const double *v) {
-  if (M->dim == 2) return (1.0 - f->tx) * v[f->c00] + f->tx * v[f->c10];
+static inline struct foot sph_foot(const struct model *M, const struct walls *W, int wall, double x,
+                                   double z) {
+  return sph_foot_of(M->dim, M->dr, W->nx, W->nz, wall, x, z);
+}
+
+/** The (bi)linear interpolation of the vertex values v at a foot, in dim dimensions. */
+static inline double sph_foot_interp(int dim, const struct foot *f, const double *v) {
+  if (dim == 2) return (1.0 - f->tx) * v[f->c00] + f->tx * v[f->c10];
   return (1.0 - f->tx) * ((1.0 - f->tz) * v[f->c00] + f->tz * v[f->c01]) +
          f->tx * ((1.0 - f->tz) * v[f->c10] + f->tz * v[f->c11]);
+}
+
+static inline double sph_foot_value(const struct model *M, const struct foot *f, const double *v) {
+  return sph_foot_interp(M->dim, f, v);
 }
 
 /**

@@ -107,42 +107,87 @@ static inline void smagorinsky(const struct model *M, double ls2, double damp, d
 }
 
 /** S of turb_strain_gradient with L_a = A^-1 formed once (one division instead of a solve per
-    row; the same fallback for a degenerate A): the force loop's per-particle cost. */
-static double strain_gradient_inverse(int dim, const double A[6], const double B[9]) {
+    row; the same fallback for a degenerate A) from the sums of entry i of a chunk (A in
+    ab[0..5][i], B in ab[6..14][i]): the force loop's per-particle cost. Written with selects
+    instead of branches, for a constant dim, so that the loop over the chunk vectorises; the
+    same operations in the same order as the branches would do (C11: no contraction), so the
+    vector and scalar paths give the same bits. */
+static inline __attribute__((always_inline)) double strain_inverse(const int dim,
+                                                                   const double ab[][TURB_CHUNK],
+                                                                   int i) {
   double L[3][3] = {{0}};
   if (dim == 2) {
-    const double det = A[0] * A[3] - A[1] * A[1], tr = A[0] + A[3];
-    if (!(fabs(det) > 1e-12 * tr * tr)) {
-      L[0][0] = L[1][1] = tr > 0 ? 2.0 / tr : 0.0;
-    } else {
-      const double id = 1.0 / det;
-      L[0][0] = A[3] * id, L[0][1] = L[1][0] = -A[1] * id, L[1][1] = A[0] * id;
-    }
+    const double a = ab[0][i], b = ab[1][i], d = ab[3][i];
+    const double det = a * d - b * b, tr = a + d, id = 1.0 / det;
+    const int deg = !(fabs(det) > 1e-12 * tr * tr);
+    const double iso = tr > 0 ? 2.0 / tr : 0.0;
+    L[0][0] = deg ? iso : d * id, L[0][1] = L[1][0] = deg ? 0.0 : -b * id;
+    L[1][1] = deg ? iso : a * id;
   } else {
-    const double a = A[0], b = A[1], c = A[2], d = A[3], e = A[4], f = A[5];
+    const double a = ab[0][i], b = ab[1][i], c = ab[2][i], d = ab[3][i], e = ab[4][i];
+    const double f = ab[5][i];
     const double c0 = d * f - e * e, c1 = c * e - b * f, c2 = b * e - c * d;
-    const double det = a * c0 + b * c1 + c * c2, tr = a + d + f;
-    if (!(fabs(det) > 1e-12 * tr * tr * tr)) {
-      L[0][0] = L[1][1] = L[2][2] = tr > 0 ? 3.0 / tr : 0.0;
-    } else {
-      const double id = 1.0 / det;
-      L[0][0] = c0 * id, L[0][1] = L[1][0] = c1 * id, L[0][2] = L[2][0] = c2 * id;
-      L[1][1] = (a * f - c * c) * id, L[1][2] = L[2][1] = (b * c - a * e) * id;
-      L[2][2] = (a * d - b * b) * id;
-    }
+    const double det = a * c0 + b * c1 + c * c2, tr = a + d + f, id = 1.0 / det;
+    const int deg = !(fabs(det) > 1e-12 * tr * tr * tr);
+    const double iso = tr > 0 ? 3.0 / tr : 0.0;
+    L[0][0] = deg ? iso : c0 * id, L[0][1] = L[1][0] = deg ? 0.0 : c1 * id;
+    L[0][2] = L[2][0] = deg ? 0.0 : c2 * id;
+    L[1][1] = deg ? iso : (a * f - c * c) * id,
+    L[1][2] = L[2][1] = deg ? 0.0 : (b * c - a * e) * id;
+    L[2][2] = deg ? iso : (a * d - b * b) * id;
   }
   double G[3][3];
-  for (int i = 0; i < 3; i++)
+  for (int r = 0; r < 3; r++)
     for (int j = 0; j < 3; j++)
-      G[i][j] = B[3 * i] * L[0][j] + B[3 * i + 1] * L[1][j] + B[3 * i + 2] * L[2][j];
+      G[r][j] =
+          ab[6 + 3 * r][i] * L[0][j] + ab[7 + 3 * r][i] * L[1][j] + ab[8 + 3 * r][i] * L[2][j];
   return strain_rate(dim, G);
 }
 
-void turb_model_gradient(const struct model *M, const struct particles *P, const struct walls *W,
-                         size_t a, const double A[6], const double B[9], double *nur, double *kr) {
-  double damp, d, utau2;
-  const double ls2 = smagorinsky_length2(M, P, W, a, &damp, &d, &utau2);
-  smagorinsky(M, ls2, damp, strain_gradient_inverse(M->dim, A, B), nur, kr);
+/** turb_model_chunk for a constant dim: three loops over the chunk, the middle one scalar. */
+static inline __attribute__((always_inline)) void model_chunk(
+    const struct model *M, const struct particles *P, const struct walls *W, size_t a0, int n,
+    const double ab[][TURB_CHUNK], double *restrict nur, double *restrict kr, const int dim) {
+  const double *restrict x = P->x + a0, *restrict y = P->y + a0, *restrict z = P->z + a0;
+  const uint8_t *restrict kind = P->kind + a0;
+  const double nu = M->nu, a_plus = M->a_plus, cs = M->cs, cy = M->cy;
+  const double dg2 = M->delta_g * M->delta_g, ly = M->ly, dr = M->dr;
+  const int nx = W->nx, nz = W->nz;
+  const double *restrict wrho = W->rho, *restrict wtx = W->tx, *restrict wtz = W->tz;
+  double damp[TURB_CHUNK];
+  /* y+ from the local friction velocity at the foot on the nearest wall (smagorinsky_length2):
+     the foot indices are arithmetic and its values gathers, so this loop vectorises */
+#pragma omp simd
+  for (int i = 0; i < n; i++) {
+    const double top = ly - y[i];
+    const int wall = top < y[i]; /* nearest_wall */
+    const double d = wall ? top : y[i];
+    const struct foot f = sph_foot_of(dim, dr, nx, nz, wall, x[i], z[i]);
+    const double rs = sph_foot_interp(dim, &f, wrho), tsx = sph_foot_interp(dim, &f, wtx);
+    const double tsz = sph_foot_interp(dim, &f, wtz);
+    const double utau2 = sqrt(tsx * tsx + tsz * tsz) / rs;
+    damp[i] = d * sqrt(utau2) / nu; /* y+, the damping below */
+  }
+  /* the damping: expm1 of libm, particle by particle, the same for every particle whatever
+     the path of the other loops */
+  for (int i = 0; i < n; i++) damp[i] = M->van_driest ? turb_van_driest(damp[i], a_plus) : 1.0;
+#pragma omp simd
+  for (int i = 0; i < n; i++) {
+    const double S = strain_inverse(dim, ab, i), dm = damp[i];
+    const double ls2 = cs * cs * dg2 * dm * dm; /* l_S^2, as smagorinsky_length2 */
+    const int fluid = kind[i] == KIND_FLUID;
+    nur[i] = fluid ? ls2 * S : 0.0; /* smagorinsky() */
+    kr[i] = fluid && cy > 0.0 ? 2.0 * cy * dg2 * dm * dm * S * S : 0.0;
+  }
+}
+
+CHANSPH_CLONES void turb_model_chunk(const struct model *M, const struct particles *P,
+                                     const struct walls *W, size_t a0, int n,
+                                     const double ab[][TURB_CHUNK], double *nur, double *kr) {
+  if (M->dim == 3)
+    model_chunk(M, P, W, a0, n, ab, nur, kr, 3);
+  else
+    model_chunk(M, P, W, a0, n, ab, nur, kr, 2);
 }
 
 void turb_advance(struct particles *P) {

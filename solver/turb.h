@@ -12,7 +12,7 @@
  *     Eq. 38),
  *  3. with LES: the rate of strain S, the local y+ from the wall stress at the foot of the
  *     nearest wall, nu_r = l_S^2 S and k_r; with les.strain_lag (the default) the force loop
- *     of the previous step formed them from the strain of its state (turb_model_gradient,
+ *     of the previous step formed them from the strain of its state (turb_model_chunk,
  *     turb_advance), one time step of lag, and this step only takes their maximum,
  *  4. with C_Y > 0, sph_kr_pressure (sph.h, which sets every pressure the forces read): k_r
  *     of the vertices (Shepard), and the pressure of fluid and vertex particles as seen by the
@@ -54,13 +54,21 @@ void turb_wall_law(const struct model *M, struct particles *P, const struct nbr 
 double turb_eddy_viscosity(const struct model *M, struct particles *P, const struct nbr *nb,
                            const struct walls *W);
 
+/** Particles per call of turb_model_chunk (the force loop's chunk). */
+enum { TURB_CHUNK = 128 };
+
 /**
- * @brief nu_r and k_r of fluid particle a from its corrected velocity-gradient sums A and B (as
- *        turb_strain_gradient takes them), with the damping of the current wall stresses: what
- *        the force loop computes for the next step under les.strain_lag.
+ * @brief nu_r and k_r of the particles a0 .. a0+n-1 (n <= TURB_CHUNK) from their corrected
+ *        velocity-gradient sums (as turb_strain_gradient takes them: A in ab[0..5][i], B in
+ *        ab[6..14][i] for particle a0 + i), with the damping of the current wall stresses: what
+ *        the force loop computes for the next step under les.strain_lag. Particles that are not
+ *        fluid get 0. Vectorised over the chunk, and the same bits for a particle wherever it
+ *        sits in a chunk.
+ * @param[out] nur nu_r of the n particles (nur[i] for particle a0 + i) [m^2/s]
+ * @param[out] kr k_r [m^2/s^2]
  */
-void turb_model_gradient(const struct model *M, const struct particles *P, const struct walls *W,
-                         size_t a, const double A[6], const double B[9], double *nur, double *kr);
+void turb_model_chunk(const struct model *M, const struct particles *P, const struct walls *W,
+                      size_t a0, int n, const double ab[][TURB_CHUNK], double *nur, double *kr);
 
 /**
  * @brief les.strain_lag, after the force pass: the nu_r and k_r it formed (P->nur_next,
