@@ -297,6 +297,33 @@ static void force_finish(const struct fctx *C, size_t a, const struct fsums *s,
   if (gv > mx[1]) mx[1] = gv;
 }
 
+/** Zero the fields a pair loop reads (records.h: fields 0-7 of half 0 and REC_M .. REC_NUR of
+    half 1) at entries j .. j+7 of a pair buffer: zero records, whose pair terms are exact
+    zeros (V_b = m_b = rho_b = 0 and finite geometry). */
+static inline void pad_zero(double *bf, int ld, int j) {
+  for (int f = 0; f < REC_NUR + 1; f++)
+    for (int k = 0; k < 8; k++) bf[(size_t)f * ld + j + k] = 0.0;
+}
+
+/** Gather the records of a list of n neighbours, nf of them fluid, with each part padded by
+    zero records to a multiple of 8 entries, so that the pair loops over the parts run in whole
+    vectors (no scalar remainder): the fluid part at 0 .. nf8-1, the vertices from nf8 on;
+    returns the end of the padded vertex part. The buffer's ld (nbr.h pairbuf_ld) holds them. */
+static inline int gather_padded(const double *rec, const int32_t *nl, int nf, int n, double *bf,
+                                int ld, int *nf8) {
+  const int nv = n - nf;
+  *nf8 = (nf + 7) & ~7;
+  records_gather(rec, nl, nf, 0, bf, ld);
+  records_gather(rec, nl, nf, 1, bf + 8 * (size_t)ld, ld);
+  pad_zero(bf, ld, nf);
+  if (nv > 0) {
+    records_gather(rec, nl + nf, nv, 0, bf + *nf8, ld);
+    records_gather(rec, nl + nf, nv, 1, bf + 8 * (size_t)ld + *nf8, ld);
+    pad_zero(bf, ld, *nf8 + nv);
+  }
+  return *nf8 + ((nv + 7) & ~7);
+}
+
 /** One specialised loop over the fluid particles a0 .. a1-1. */
 typedef void (*force_loop)(const struct fctx *C, size_t a0, size_t a1, double mx[2]);
 
@@ -309,7 +336,7 @@ static inline __attribute__((always_inline)) void force_range(const struct fctx 
                                                               const int gathered, const int sp) {
   const struct nbr *nb = C->nb;
   const struct particles *P = C->P;
-  const int ld = nb->stride;
+  const int ld = nb->pairbuf_ld;
   double *bf = nb->pairbuf[omp_get_thread_num()];
   double ab[15][TURB_CHUNK]; /* VK_LES_LAG: the strain sums of the chunk */
   for (size_t a = a0; a < a1; a++) {
@@ -319,11 +346,10 @@ static inline __attribute__((always_inline)) void force_range(const struct fctx 
       continue;
     }
     const int32_t *nl = nb->list + a * (size_t)nb->stride;
-    const int nf = nb->nfluid[a], n = nb->count[a];
-    if (gathered) {
-      records_gather(P->rec, nl, n, 0, bf, ld);
-      records_gather(P->rec, nl, n, 1, bf + 8 * (size_t)ld, ld);
-    }
+    /* the fluid part of the list is 0 .. nf-1, the vertices nf .. n-1; gathered, each part
+       padded to whole vectors (gather_padded) */
+    int nf = nb->nfluid[a], n = nb->count[a];
+    if (gathered) n = gather_padded(P->rec, nl, nf, n, bf, ld, &nf);
     struct fsums s, sv;
     if (sp) {
       pair_sums_f(C, a, bf, ld, nl, 0, nf, gathered, 1, visc, corr, &s);

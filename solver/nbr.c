@@ -475,12 +475,13 @@ static void nbr_scratch(struct nbr *nb) {
   nb->block_cap = blocks + blocks / 2; /* made again only when a cell fills beyond it */
   for (int t = 0; t < nt; t++) {
     nb->scratch[t] = part_alloc("nbr_scratch", bytes);
-    nb->pairbuf[t] =
-        part_alloc("pair_buffer", PAIRBUF_FIELDS * (size_t)nb->stride * sizeof(double));
+    nb->pairbuf[t] = part_alloc("pair_buffer",
+                                PAIRBUF_FIELDS * (size_t)(nb->stride + NBR_ALIGN) * sizeof(double));
     if (nb->block_cap)
       nb->blocks[t] = part_alloc("nbr_blocks", nb->block_cap * sizeof(struct nbr_block));
   }
   nb->scratch_threads = nt, nb->scratch_stride = nb->stride;
+  nb->pairbuf_ld = nb->stride + NBR_ALIGN;
 }
 
 void nbr_build(struct nbr *nb, const struct particles *P, const struct kernel *K, double *ksum) {

@@ -66,8 +66,10 @@ struct nbr {
   int *nfluid;      /*!< of which fluid particles: they come first in the list, then the vertices */
   int avx512;       /*!< the candidate scan uses AVX-512 */
   double **pairbuf; /*!< per thread: the gathered records of one list (records.h),
-                         16 fields of stride values, then PAIRBUF_GEOM fields of pair
+                         16 fields of pairbuf_ld values, then PAIRBUF_GEOM fields of pair
                          geometry the force loop keeps for the strain sums (forces.c) */
+  int pairbuf_ld;   /*!< values per field of a pair buffer: stride + NBR_ALIGN, room for the
+                         fluid and vertex parts of a list each padded to a multiple of 8 */
   int32_t **scratch;         /*!< per thread: a list being built and its squared distances */
   struct nbr_block **blocks; /*!< per thread: the candidate blocks of one cell's stencil
                                   (AVX-512 scan) */

@@ -208,7 +208,7 @@ static inline __attribute__((always_inline)) void gradient_sums_t(const struct m
                                                                   double A[6], double B[9],
                                                                   const int gathered) {
   const struct kernel K = M->k;
-  const int ld = nb->stride, cnt = nb->count[a];
+  const int ld = nb->pairbuf_ld, cnt = nb->count[a];
   const int32_t *restrict nl = nb->list + a * (size_t)nb->stride;
   double *bf = nb->pairbuf[omp_get_thread_num()];
   if (gathered) records_gather(P->rec, nl, cnt, 0, bf, ld);

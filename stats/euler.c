@@ -396,6 +396,13 @@ static double *budget_bin(const struct euler_config *c, double *P, double y, int
   return P + (size_t)hb * EU_PART + EU_PART_PL + (size_t)(!c->fold && upper) * HB_LEN;
 }
 
+/* The share of a particle at y in the upper (side 1) or lower (side 0) half of the channel:
+   all of it, or half within tie of the centre delta. */
+static double side_weight(double y, double delta, double tie, int side) {
+  if (fabs(y - delta) <= tie) return 0.5;
+  return (y > delta) == side ? 1.0 : 0.0;
+}
+
 /* Particle a of the snapshot into its column's per-bin partials P (EU_PART a bin). */
 static void add_particle(const struct euler *e, const struct stats_snapshot *s, size_t a,
                          double *P) {
@@ -417,19 +424,36 @@ static void add_particle(const struct euler *e, const struct stats_snapshot *s, 
     /* the forces and the body force acted at the positions before the step: y - dt v, less
        the shift (symplectic Euler, docs/theory.md); the momentum is that of the sampled state,
        and also taken at those positions for the kinetic flux (budget_planes) */
-    double yf =
+    const double yf =
         s->dt > 0.0 ? s->y[a] - s->dt * s->v[a] - (s->shift_dy ? s->shift_dy[a] : 0.0) : s->y[a];
-    const int upper_f = yf > c->delta;
-    if (c->fold && upper_f) yf = 2.0 * c->delta - yf;
-    double phi, phi_f;
-    double *H = budget_bin(c, P, y, upper, &phi), *Hf = budget_bin(c, P, yf, upper_f, &phi_f);
-    double *H1 = H + 2 * HB_LEN, *Hf1 = Hf + 2 * HB_LEN; /* the first moments (EU_PART_PL1) */
-    for (int k = 0; k < EULER_SX; k++) {
-      const double f = ma * s->sx[a * EULER_SX + k];
-      Hf[k] += f, Hf1[k] += f * phi_f;
+    /* the half of the channel each goes to (folded: mirrored into the lower one); a particle
+       within 1e-9 delta of the centre counts half in each, so that the centre layer of a
+       mirror-symmetric flow, whose v is 0 up to rounding, is not sent to one side or the other
+       by that rounding (its momentum and forces are on the centre side of every plane) */
+    const double tie = 1e-9 * c->delta;
+    for (int side = 0; side < 2; side++) {
+      const double wf = side_weight(yf, c->delta, tie, side);
+      if (wf > 0.0) { /* forces, body force and momentum at the positions before the step */
+        double phi_f;
+        const double yb = c->fold && side ? 2.0 * c->delta - yf : yf;
+        double *Hf = budget_bin(c, P, yb, side, &phi_f), *Hf1 = Hf + 2 * HB_LEN; /* EU_PART_PL1 */
+        for (int k = 0; k < EULER_SX; k++) {
+          const double f = wf * ma * s->sx[a * EULER_SX + k];
+          Hf[k] += f, Hf1[k] += f * phi_f;
+        }
+        const double mf = wf * ma, muf = wf * mu;
+        Hf[HB_MASS] += mf, Hf1[HB_MASS] += mf * phi_f, Hf[HB_MU0] += muf,
+            Hf1[HB_MU0] += muf * phi_f;
+      }
+      const double wh = side_weight(s->y[a], c->delta, tie, side);
+      if (wh > 0.0) { /* the momentum of the sampled state */
+        double phi;
+        const double yb = c->fold && side ? 2.0 * c->delta - s->y[a] : s->y[a];
+        const double vb = c->fold && side ? -s->v[a] : s->v[a], muh = wh * mu;
+        double *H = budget_bin(c, P, yb, side, &phi), *H1 = H + 2 * HB_LEN;
+        H[HB_MU] += muh, H1[HB_MU] += muh * phi, H[HB_UV] += muh * vb;
+      }
     }
-    Hf[HB_MASS] += ma, Hf1[HB_MASS] += ma * phi_f, Hf[HB_MU0] += mu, Hf1[HB_MU0] += mu * phi_f;
-    H[HB_MU] += mu, H1[HB_MU] += mu * phi, H[HB_UV] += mu * v;
   }
   if (c->method == EULER_SPH) {
     /* Eq. 5.56 averaged over the plane y = y_i: every profile point within 2h takes the
