@@ -151,7 +151,7 @@ static inline __attribute__((always_inline)) void model_chunk(
   const double *restrict x = P->x + a0, *restrict y = P->y + a0, *restrict z = P->z + a0;
   const uint8_t *restrict kind = P->kind + a0;
   const double nu = M->nu, a_plus = M->a_plus, cs = M->cs, cy = M->cy;
-  const double dg2 = M->delta_g * M->delta_g, ly = M->ly, dr = M->dr;
+  const double dg2 = M->delta_g * M->delta_g, dr = M->dr;
   const int nx = W->nx, nz = W->nz;
   const double *restrict wrho = W->rho, *restrict wtx = W->tx, *restrict wtz = W->tz;
   double damp[TURB_CHUNK];
@@ -159,9 +159,8 @@ static inline __attribute__((always_inline)) void model_chunk(
      the foot indices are arithmetic and its values gathers, so this loop vectorises */
 #pragma omp simd
   for (int i = 0; i < n; i++) {
-    const double top = ly - y[i];
-    const int wall = top < y[i]; /* nearest_wall */
-    const double d = wall ? top : y[i];
+    int wall;
+    const double d = nearest_wall(M, y[i], &wall);
     const struct foot f = sph_foot_of(dim, dr, nx, nz, wall, x[i], z[i]);
     const double rs = sph_foot_interp(dim, &f, wrho), tsx = sph_foot_interp(dim, &f, wtx);
     const double tsz = sph_foot_interp(dim, &f, wtz);
@@ -174,9 +173,11 @@ static inline __attribute__((always_inline)) void model_chunk(
 #pragma omp simd
   for (int i = 0; i < n; i++) {
     const double S = strain_inverse(dim, ab, i), dm = damp[i];
-    const double ls2 = cs * cs * dg2 * dm * dm; /* l_S^2, as smagorinsky_length2 */
+    /* l_S^2 of smagorinsky_length2 and nu_r, k_r of smagorinsky(), written out with the
+       model's constants in registers: calling those two here stops the loop vectorising */
+    const double ls2 = cs * cs * dg2 * dm * dm;
     const int fluid = kind[i] == KIND_FLUID;
-    nur[i] = fluid ? ls2 * S : 0.0; /* smagorinsky() */
+    nur[i] = fluid ? ls2 * S : 0.0;
     kr[i] = fluid && cy > 0.0 ? 2.0 * cy * dg2 * dm * dm * S * S : 0.0;
   }
 }
