@@ -1,12 +1,12 @@
 /**
  * @file pair.h
- * @brief The physics of one particle pair a-b, one small inline function per term.
+ * @brief The geometry of one particle pair a-b and the small vector types of the pair terms.
  *
- * Every pass over the neighbour list (forces, the LES strain, the vertex values) computes the
- * pair geometry with pair_geom() and adds the terms it needs; which terms a scene needs is
- * decided once, outside the particle loop (forces.c assembles specialised loops). Each term
- * returns its contribution and the loop accumulates it: the functions have no side effects and
- * no branches, so the loops that use them vectorise (docs/performance.md, "Vectorisation").
+ * Every pass over a neighbour list (pair_loop.h) computes the pair geometry with pair_geom();
+ * the physical terms of a pair live in the term headers (term_pressure.h, term_viscous.h,
+ * term_diffusion.h, term_gradient.h), one inline function per contribution, without side
+ * effects or branches, so that the loops that use them vectorise (docs/performance.md,
+ * "Vectorisation").
  *
  * Notation: r_ab = r_a - r_b (minimum image in the periodic directions), grad_a w_ab = F_ab r_ab
  * (kernel.h), V_b = m_b / rho_b, u_ab = u_a - u_b.
@@ -27,27 +27,50 @@
 #define CHANSPH_CLONES
 #endif
 
+/** A vector in 3-D (z = 0 in 2-D). */
+struct v3 {
+  double x, y, z;
+};
+
+/** A symmetric 3x3 tensor {xx, xy, xz, yy, yz, zz}. */
+struct sym3 {
+  double xx, xy, xz, yy, yz, zz;
+};
+
+/** Geometry of a pair within the kernel support. */
+struct pair {
+  double dx, dy, dz; /*!< r_ab [m] */
+  double r2, r;      /*!< |r_ab|^2 [m^2], |r_ab| [m] */
+  double f;          /*!< F_ab = w'(r)/r [1/m^(dim+2)]; 0 outside the support */
+};
+
 /** Minimum-image separation in a periodic direction of length l (hl = l/2), branch-free. */
 static inline double pair_wrap(double d, double l, double hl) {
   return d > hl ? d - l : d < -hl ? d + l : d;
 }
 
-/* The geometry and the terms, in double (struct pair, pair_geom, term_pressure, ...) and in
-   float (struct pair_f, pair_geom_f, term_pressure_f, ...: sph.precision = mixed, where the
-   loops accumulate the float terms in double). */
-#define R double
-#define PF(name) name
-#define R_SQRT sqrt
-#include "pair_terms.h"
-#undef R
-#undef PF
-#undef R_SQRT
-#define R float
-#define PF(name) name##_f
-#define R_SQRT sqrtf
-#include "pair_terms.h"
-#undef R
-#undef PF
-#undef R_SQRT
+/**
+ * @brief Geometry of the pair (dx, dy, dz) = r_a - r_b before the periodic wrap.
+ * @param K kernel; lx, lz periodic lengths; d3 nonzero in 3-D (dz = 0 otherwise)
+ */
+static inline struct pair pair_geom(const struct kernel *K, double lx, double lz, int d3, double dx,
+                                    double dy, double dz) {
+  struct pair g;
+  g.dx = pair_wrap(dx, lx, 0.5 * lx), g.dy = dy;
+  g.dz = (d3 ? 1.0 : 0.0) * pair_wrap(dz, lz, 0.5 * lz); /* branch-free: vectorises */
+  g.r2 = g.dx * g.dx + g.dy * g.dy + g.dz * g.dz;
+  g.r = sqrt(g.r2);
+  const double t = 1.0 - 0.5 * g.r * K->inv_h; /* thesis Eq. 2.63: (1 - q/2)^3 for F */
+  const double tp = t > 0.0 ? t : 0.0;
+  g.f = K->ffac * tp * tp * tp;
+  return g;
+}
+
+/** Kernel value w(r) of a pair inside the support (thesis Eq. 2.63). */
+static inline double pair_w(const struct kernel *K, double r) {
+  const double q = r * K->inv_h, t = 1.0 - 0.5 * q;
+  const double tp = t > 0.0 ? t : 0.0, t2 = tp * tp;
+  return K->wfac * t2 * t2 * (1.0 + 2.0 * q);
+}
 
 #endif

@@ -101,8 +101,10 @@ enum part_role {
   PF_CKPT = 4,    /*!< in the checkpoint as particles/NAME (by id; docs/checkpoint-format.md) */
   PF_WRITE = 8,   /*!< in particles.nc */
   PF_HEALTH = 16, /*!< must be finite: health.c checks it before a state is written or sampled */
-  PF_GHOST = 32   /*!< sent with a ghost when the halo is built (dd_halo): what the passes read
+  PF_GHOST = 32,  /*!< sent with a ghost when the halo is built (dd_halo): what the passes read
                        at a neighbour before the first refresh (dd_update) */
+  PF_PAIR = 64    /*!< read by the pair loops at a neighbour: packed into slot `rec` of the pair
+                       records (records.h) */
 };
 
 enum part_type { PT_F64, PT_I64, PT_U8 };
@@ -123,6 +125,7 @@ struct part_field {
   int optional;          /*!< PF_CKPT: added in a later checkpoint format (may be absent) */
   const char *units;     /*!< PF_CKPT, PF_WRITE */
   const char *long_name; /*!< PF_WRITE */
+  int rec;               /*!< PF_PAIR: its slot in the pair records (enum rec_field) */
 };
 
 extern const struct part_field part_fields[]; /*!< every per-particle array (part.c) */

@@ -26,18 +26,22 @@ int records_fast(void) {
   return use_avx512;
 }
 
+const double *records_field_array(const struct particles *P, int k) {
+  for (int i = 0; i < part_n_fields; i++)
+    if ((part_fields[i].roles & PF_PAIR) && part_fields[i].rec == k)
+      return part_field_ptr(P, &part_fields[i]);
+  return NULL;
+}
+
 void records_pack(struct particles *P, size_t n) {
+  const double *src[REC_FIELDS];
+  for (int k = 0; k < REC_FIELDS; k++) src[k] = records_field_array(P, k);
   double *restrict rec = P->rec;
-  const double *nur = P->nur;
 #pragma omp parallel for schedule(static)
-  for (size_t a = 0; a < n; a++) {
+  for (size_t a = 0; a < n; a++) { /* one pass over the records, a record at a time */
     double *r = rec + a * REC_LEN;
-    r[REC_X] = P->x[a], r[REC_Y] = P->y[a], r[REC_Z] = P->z[a];
-    r[REC_U] = P->u[a], r[REC_V] = P->v[a], r[REC_W] = P->w[a];
-    r[REC_VOL] = P->vol[a], r[REC_RHO] = P->rho[a];
-    r[REC_M] = P->m[a], r[REC_PR2] = P->pr2[a], r[REC_C] = P->c[a];
-    r[REC_NUR] = nur ? nur[a] : 0.0;
-    for (int k = REC_NUR + 1; k < REC_LEN; k++) r[k] = 0.0;
+    for (int k = 0; k < REC_FIELDS; k++) r[k] = src[k] ? src[k][a] : 0.0;
+    for (int k = REC_FIELDS; k < REC_LEN; k++) r[k] = 0.0;
   }
 }
 
@@ -128,4 +132,25 @@ void records_gather(const double *rec, const int32_t *nl, int cnt, int half, dou
   }
 #endif
   gather_scalar(rec, nl, cnt, half, out, ld);
+}
+
+/** Zero the fields a pair loop reads (0 .. REC_FIELDS-1) at entries j .. j+7 of a pair buffer. */
+static inline void pad_zero(double *bf, int ld, int j) {
+  for (int f = 0; f < REC_FIELDS; f++)
+    for (int k = 0; k < 8; k++) bf[(size_t)f * ld + j + k] = 0.0;
+}
+
+int records_gather_padded(const double *rec, const int32_t *nl, int nf, int n, double *bf, int ld,
+                          int *nf8) {
+  const int nv = n - nf;
+  *nf8 = (nf + 7) & ~7;
+  records_gather(rec, nl, nf, 0, bf, ld);
+  records_gather(rec, nl, nf, 1, bf + 8 * (size_t)ld, ld);
+  pad_zero(bf, ld, nf);
+  if (nv > 0) {
+    records_gather(rec, nl + nf, nv, 0, bf + *nf8, ld);
+    records_gather(rec, nl + nf, nv, 1, bf + 8 * (size_t)ld + *nf8, ld);
+    pad_zero(bf, ld, *nf8 + nv);
+  }
+  return *nf8 + ((nv + 7) & ~7);
 }

@@ -29,7 +29,6 @@ enum les_model { LES_NONE = 0, LES_SMAGORINSKY = 1 };
 enum les_strain { STRAIN_GRADIENT = 0, STRAIN_VIOLEAU_ISSA = 1 };
 enum pressure_gradient { PGRAD_STANDARD = 0, PGRAD_CORRECTED = 1 };
 enum shifting { SHIFT_NONE = 0, SHIFT_FICKIAN = 1 };
-enum precision { PRECISION_DOUBLE = 0, PRECISION_MIXED = 1 };
 
 enum { SCENE_LIST_MAX = 8 };
 
@@ -53,7 +52,6 @@ struct scene {
   double wall_dmin;  /*!< delta r of Eq. 2.148 over dr [-] */
   double eta2;       /*!< regularisation of 1/r^2 in the viscous term, over h^2 [-] */
   int viscous;       /*!< enum viscous_form */
-  int precision;     /*!< enum precision: arithmetic of the force pair loops */
   int lap_norm;      /*!< enum laplacian_norm */
   int wall_weight;   /*!< enum wall_weight */
   int wall_pressure; /*!< enum wall_pressure */

@@ -3,7 +3,7 @@
 
 #include <math.h>
 
-#include "pair.h"
+#include "pair_loop.h"
 #include "timers.h"
 #include "wall.h"
 
@@ -11,17 +11,16 @@
     vertex neighbours (Lind et al. 2012, Eq. 22; anti-clustering term of Sun et al. 2017). */
 static CHANSPH_CLONES struct v3 shift_gradient(const struct model *M, const struct particles *P,
                                                const struct nbr *nb, size_t a) {
-  const struct kernel K = M->k;
+  const struct pair_frame F = pair_frame_of(M);
   const double *restrict x = P->x, *restrict y = P->y, *restrict z = P->z, *restrict V = P->vol;
-  const int32_t *restrict nl = nb->list + a * (size_t)nb->stride;
-  const double xa = x[a], ya = y[a], za = z[a], lx = M->lx, lz = M->lz, iwdr = M->shift_iwdr;
-  const int d3 = M->dim == 3;
+  const int32_t *restrict nl = pair_list(nb, a);
+  const double xa = x[a], ya = y[a], za = z[a], iwdr = M->shift_iwdr;
   double gx = 0.0, gy = 0.0, gz = 0.0;
 #pragma omp simd reduction(+ : gx, gy, gz)
   for (int j = 0; j < nb->count[a]; j++) {
     const int32_t b = nl[j];
-    const struct pair g = pair_geom(&K, lx, lz, d3, xa - x[b], ya - y[b], za - z[b]);
-    const double s = V[b] * (1.0 + sph_anticluster(pair_w(&K, g.r), iwdr)) * g.f;
+    const struct pair g = pair_at(&F, xa - x[b], ya - y[b], za - z[b]);
+    const double s = V[b] * (1.0 + sph_anticluster(pair_w(&F.K, g.r), iwdr)) * g.f;
     gx += s * g.dx, gy += s * g.dy, gz += s * g.dz;
   }
   return (struct v3){gx, gy, gz};

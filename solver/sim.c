@@ -12,6 +12,7 @@
 #include "records.h"
 #include "reduce.h"
 #include "shift.h"
+#include "term_viscous.h"
 #include "timers.h"
 #include "turb.h"
 
@@ -80,7 +81,7 @@ static void update_state(struct sim *S, int restored, double dt) {
   double *const wv[2] = {S->W.rho, S->W.p};
   dd_update_walls(&S->dd, P, 2, wv);
   model_update(S);
-  records_pack(P, P->n + P->n_ghost); /* what the force pass reads at neighbours */
+  if (records_fast()) records_pack(P, P->n + P->n_ghost); /* what the force pass gathers */
 }
 
 int sim_create(struct sim *S, const struct scene *sc) {
@@ -198,7 +199,7 @@ static double time_step(struct sim *S, const struct force_info *fi) {
   const struct scene *sc = S->sc;
   const double h = S->M.h;
   S->dt_limits[0] = sc->cfl * h / sc->c0;
-  S->dt_limits[1] = S->nu_max > 0.0 ? sc->c_visc * h * h / S->nu_max : INFINITY; /* nu + nu_r */
+  S->dt_limits[1] = viscous_dt_limit(sc->c_visc, h, S->nu_max); /* nu + nu_r */
   S->dt_limits[2] = fi->amax > 0.0 ? sc->c_force * sqrt(h / fi->amax) : INFINITY;
   S->dt_limits[3] = sc->c_gamma > 0.0 && fi->gvmax > 0.0 ? sc->c_gamma / fi->gvmax : INFINITY;
   if (sc->dt_fixed > 0.0) {

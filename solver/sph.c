@@ -12,7 +12,7 @@
 
 #include <math.h>
 
-#include "pair.h"
+#include "pair_loop.h"
 #include "records.h"
 #include "timers.h"
 #include "wall.h"
@@ -35,7 +35,6 @@ void sph_model_init(struct model *M, const struct scene *s) {
   M->wall_weight = s->wall_weight;
   M->wall_pressure = s->wall_pressure;
   M->pgrad = s->pgrad;
-  M->precision = s->precision;
   M->les = s->les != LES_NONE;
   M->strain = s->strain;
   M->strain_lag = M->les && s->strain == STRAIN_GRADIENT && s->strain_lag;
@@ -158,18 +157,17 @@ void sph_density(const struct model *M, struct particles *P, const double *ksum_
    out = {sum V_b w_vb, sum m_b w_vb, sum V_b (p_b/rho_b + g_y (y_v - y_b)) w_vb}. */
 static CHANSPH_CLONES void vertex_shepard(const struct model *M, const struct particles *P,
                                           const struct nbr *nb, size_t v, double out[3]) {
-  const struct kernel K = M->k;
+  const struct pair_frame F = pair_frame_of(M);
   const double *restrict x = P->x, *restrict y = P->y, *restrict z = P->z, *restrict m = P->m;
   const double *restrict rho = P->rho, *restrict p = P->p, *restrict V = P->vol;
-  const int32_t *restrict nl = nb->list + v * (size_t)nb->stride;
-  const double xv = x[v], yv = y[v], zv = z[v], lx = M->lx, lz = M->lz, gy = M->gy;
-  const int d3 = M->dim == 3;
+  const int32_t *restrict nl = pair_list(nb, v);
+  const double xv = x[v], yv = y[v], zv = z[v], gy = M->gy;
   double alpha = 0.0, mw = 0.0, pw = 0.0;
 #pragma omp simd reduction(+ : alpha, mw, pw)
   for (int j = 0; j < nb->nfluid[v]; j++) {
     const int32_t b = nl[j];
-    const struct pair g = pair_geom(&K, lx, lz, d3, xv - x[b], yv - y[b], zv - z[b]);
-    const double wvb = pair_w(&K, g.r), vol = V[b]; /* m_b / rho_b, set by sph_density */
+    const struct pair g = pair_at(&F, xv - x[b], yv - y[b], zv - z[b]);
+    const double wvb = pair_w(&F.K, g.r), vol = V[b]; /* m_b / rho_b, set by sph_density */
     alpha += vol * wvb;
     mw += m[b] * wvb;
     pw += vol * (p[b] / rho[b] + gy * g.dy) * wvb;
@@ -201,18 +199,17 @@ void sph_walls(const struct model *M, struct particles *P, const struct nbr *nb,
 CHANSPH_CLONES double sph_vertex_sums(const struct model *M, const struct particles *P,
                                       const struct nbr *nb, size_t s, int nf,
                                       const double *const *f, double *out) {
-  const struct kernel K = M->k;
+  const struct pair_frame F = pair_frame_of(M);
   const double *restrict x = P->x, *restrict y = P->y, *restrict z = P->z;
   const double *restrict vol = P->vol, *restrict f0 = f[0], *restrict f1 = nf > 1 ? f[1] : f[0];
-  const int32_t *restrict nl = nb->list + s * (size_t)nb->stride;
-  const double xs = x[s], ys = y[s], zs = z[s], lx = M->lx, lz = M->lz;
-  const int d3 = M->dim == 3;
+  const int32_t *restrict nl = pair_list(nb, s);
+  const double xs = x[s], ys = y[s], zs = z[s];
   double alpha = 0.0, s0 = 0.0, s1 = 0.0;
 #pragma omp simd reduction(+ : alpha, s0, s1)
   for (int j = 0; j < nb->nfluid[s]; j++) {
     const int32_t b = nl[j];
-    const struct pair g = pair_geom(&K, lx, lz, d3, xs - x[b], ys - y[b], zs - z[b]);
-    const double vw = vol[b] * pair_w(&K, g.r);
+    const struct pair g = pair_at(&F, xs - x[b], ys - y[b], zs - z[b]);
+    const double vw = vol[b] * pair_w(&F.K, g.r);
     alpha += vw, s0 += vw * f0[b], s1 += vw * f1[b];
   }
   out[0] = s0;
@@ -255,30 +252,44 @@ void sph_wall_stress(const struct model *M, const struct walls *W, int wall, dou
   *tz = sph_foot_value(M, &f, W->tz);
 }
 
-void sph_solve_sym(int dim, const double A[6], const double g[3], double x[3]) {
+void sph_sym_factor(int dim, const double A[6], struct sym_solve *f) {
+  f->dim = dim;
   if (dim == 2) {
-    const double det = A[0] * A[3] - A[1] * A[1];
-    const double tr = A[0] + A[3];
-    if (!(fabs(det) > 1e-12 * tr * tr)) { /* degenerate support: uncorrected */
-      x[0] = tr > 0 ? 2.0 * g[0] / tr : 0.0, x[1] = tr > 0 ? 2.0 * g[1] / tr : 0.0, x[2] = 0.0;
-      return;
-    }
-    x[0] = (A[3] * g[0] - A[1] * g[1]) / det;
-    x[1] = (A[0] * g[1] - A[1] * g[0]) / det;
-    x[2] = 0.0;
+    f->det = A[0] * A[3] - A[1] * A[1];
+    f->tr = A[0] + A[3];
+    f->deg = !(fabs(f->det) > 1e-12 * f->tr * f->tr); /* degenerate support: uncorrected */
+    f->c[0] = A[3], f->c[1] = A[1], f->c[2] = A[0];
     return;
   }
   /* A = [a b c; b d e; c e f] stored as {a, b, c, d, e, f} */
-  const double a = A[0], b = A[1], c = A[2], d = A[3], e = A[4], f = A[5];
-  const double c0 = d * f - e * e, c1 = c * e - b * f, c2 = b * e - c * d;
-  const double det = a * c0 + b * c1 + c * c2;
-  const double tr = a + d + f;
-  if (!(fabs(det) > 1e-12 * tr * tr * tr)) {
-    for (int i = 0; i < 3; i++) x[i] = tr > 0 ? 3.0 * g[i] / tr : 0.0;
+  const double a = A[0], b = A[1], c = A[2], d = A[3], e = A[4], ff = A[5];
+  f->c[0] = d * ff - e * e, f->c[1] = c * e - b * ff, f->c[2] = b * e - c * d;
+  f->det = a * f->c[0] + b * f->c[1] + c * f->c[2];
+  f->tr = a + d + ff;
+  f->deg = !(fabs(f->det) > 1e-12 * f->tr * f->tr * f->tr);
+  f->c[3] = a * ff - c * c, f->c[4] = b * c - a * e, f->c[5] = a * d - b * b;
+}
+
+void sph_sym_apply(const struct sym_solve *f, const double g[3], double x[3]) {
+  const double *c = f->c, det = f->det, tr = f->tr;
+  if (f->deg) {
+    const double n = f->dim;
+    for (int i = 0; i < 3; i++) x[i] = i < f->dim && tr > 0 ? n * g[i] / tr : 0.0;
     return;
   }
-  const double c4 = a * f - c * c, c5 = b * c - a * e, c8 = a * d - b * b;
-  x[0] = (c0 * g[0] + c1 * g[1] + c2 * g[2]) / det;
-  x[1] = (c1 * g[0] + c4 * g[1] + c5 * g[2]) / det;
-  x[2] = (c2 * g[0] + c5 * g[1] + c8 * g[2]) / det;
+  if (f->dim == 2) {
+    x[0] = (c[0] * g[0] - c[1] * g[1]) / det;
+    x[1] = (c[2] * g[1] - c[1] * g[0]) / det;
+    x[2] = 0.0;
+    return;
+  }
+  x[0] = (c[0] * g[0] + c[1] * g[1] + c[2] * g[2]) / det;
+  x[1] = (c[1] * g[0] + c[3] * g[1] + c[4] * g[2]) / det;
+  x[2] = (c[2] * g[0] + c[4] * g[1] + c[5] * g[2]) / det;
+}
+
+void sph_solve_sym(int dim, const double A[6], const double g[3], double x[3]) {
+  struct sym_solve f;
+  sph_sym_factor(dim, A, &f);
+  sph_sym_apply(&f, g, x);
 }

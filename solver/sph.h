@@ -19,7 +19,6 @@ enum { LATTICE_KNOTS = 16, VIOLEAU_KNOTS = 128 };
 struct model {
   int dim;           /*!< 2 or 3 */
   int viscous;       /*!< enum viscous_form */
-  int precision;     /*!< enum precision: arithmetic of the force pair loops */
   struct kernel k;   /*!< Wendland kernel */
   struct eos e;      /*!< Tait equation of state */
   double lx, ly, lz; /*!< domain [m]; ly = 2 delta */
@@ -223,10 +222,27 @@ static inline double sph_foot_value(const struct model *M, const struct foot *f,
 void sph_wall_values(const struct model *M, const struct walls *W, int wall, double x, double z,
                      double *rho, double *p);
 
+/** A symmetric 2x2 or 3x3 matrix factorised for sph_sym_apply: its cofactors and determinant
+    (Cramer's rule), or the isotropic fallback of a degenerate matrix. */
+struct sym_solve {
+  int dim;     /*!< 2 or 3 */
+  int deg;     /*!< degenerate: x = dim g / trace(A) (0 if the trace is not positive) */
+  double det;  /*!< determinant */
+  double tr;   /*!< trace */
+  double c[6]; /*!< cofactors {xx, xy, xz, yy, yz, zz} (2-D: {yy, xy, xx}) */
+};
+
+/** @brief Factorise a symmetric A (stored as {xx, xy, xz, yy, yz, zz}) for sph_sym_apply. */
+void sph_sym_factor(int dim, const double A[6], struct sym_solve *f);
+
+/** @brief x = A^-1 g from the factorisation of A (the same arithmetic as sph_solve_sym). */
+void sph_sym_apply(const struct sym_solve *f, const double g[3], double x[3]);
+
 /**
  * @brief Solve A x = g for a symmetric positive definite A (2x2 or 3x3, stored as
  *        {xx, xy, xz, yy, yz, zz}): applies L = A^-1 of thesis Eq. 2.88. A degenerate A (an
- *        isolated particle) falls back to the isotropic dim / trace(A).
+ *        isolated particle) falls back to the isotropic dim / trace(A). sph_sym_factor and
+ *        sph_sym_apply: the same in two steps, for several right-hand sides.
  */
 void sph_solve_sym(int dim, const double A[6], const double g[3], double x[3]);
 

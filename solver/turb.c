@@ -5,8 +5,9 @@
 #include <omp.h>
 #include <string.h>
 
-#include "pair.h"
+#include "pair_loop.h"
 #include "records.h"
+#include "term_gradient.h"
 #include "timers.h"
 #include "wall.h"
 
@@ -198,78 +199,21 @@ void turb_advance(struct particles *P) {
   P->nur_live = 1;
 }
 
-/** Corrected velocity-gradient sums of particle a over its whole list (fluid and vertices):
-    A = -sum_b V_b F_ab r_ab (x) r_ab and B = sum_b V_b (v_b - v_a) (x) F_ab r_ab (thesis
-    Eq. 2.88-2.90, k = 0), as turb_strain_gradient takes them. The neighbours' positions,
-    velocities and volumes come from their gathered records (`gathered`, records.h) or from
-    the particle arrays through the list. */
-static inline __attribute__((always_inline)) void gradient_sums_t(const struct model *M,
-                                                                  const struct particles *P,
-                                                                  const struct nbr *nb, size_t a,
-                                                                  double A[6], double B[9],
-                                                                  const int gathered) {
-  const struct kernel K = M->k;
-  const int ld = nb->pairbuf_ld, cnt = nb->count[a];
-  const int32_t *restrict nl = nb->list + a * (size_t)nb->stride;
-  double *bf = nb->pairbuf[omp_get_thread_num()];
-  if (gathered) records_gather(P->rec, nl, cnt, 0, bf, ld);
-#define FIELD(k, arr) (gathered ? bf + (size_t)(k)*ld : P->arr)
-  const double *restrict x = FIELD(REC_X, x), *restrict y = FIELD(REC_Y, y);
-  const double *restrict z = FIELD(REC_Z, z), *restrict u = FIELD(REC_U, u);
-  const double *restrict v = FIELD(REC_V, v), *restrict w = FIELD(REC_W, w);
-  const double *restrict vol = FIELD(REC_VOL, vol);
-#undef FIELD
-  const double xa = P->x[a], ya = P->y[a], za = P->z[a], ua = P->u[a], va = P->v[a];
-  const double wa = P->w[a], lx = M->lx, lz = M->lz;
-  const int d3 = M->dim == 3;
-  double axx = 0, axy = 0, axz = 0, ayy = 0, ayz = 0, azz = 0;
-  double bxx = 0, bxy = 0, bxz = 0, byx = 0, byy = 0, byz = 0, bzx = 0, bzy = 0, bzz = 0;
-#pragma omp simd reduction(+ : axx, axy, axz, ayy, ayz, azz, bxx, bxy, bxz, byx, byy, byz, bzx, \
-                               bzy, bzz)
-  for (int j = 0; j < cnt; j++) {
-    const int32_t b = gathered ? j : nl[j];
-    const struct pair g = pair_geom(&K, lx, lz, d3, xa - x[b], ya - y[b], za - z[b]);
-    const struct sym3 t = term_moment(&g, vol[b]);
-    axx += t.xx, axy += t.xy, axz += t.xz, ayy += t.yy, ayz += t.yz, azz += t.zz;
-    const struct v3 gu = term_difference(&g, vol[b], u[b] - ua);
-    const struct v3 gv = term_difference(&g, vol[b], v[b] - va);
-    const struct v3 gw = term_difference(&g, vol[b], w[b] - wa);
-    bxx += gu.x, bxy += gu.y, bxz += gu.z, byx += gv.x, byy += gv.y, byz += gv.z;
-    bzx += gw.x, bzy += gw.y, bzz += gw.z;
-  }
-  A[0] = axx, A[1] = axy, A[2] = axz, A[3] = ayy, A[4] = ayz, A[5] = azz;
-  B[0] = bxx, B[1] = bxy, B[2] = bxz, B[3] = byx, B[4] = byy, B[5] = byz;
-  B[6] = bzx, B[7] = bzy, B[8] = bzz;
-}
-
-static CHANSPH_CLONES void gradient_sums(const struct model *M, const struct particles *P,
-                                         const struct nbr *nb, size_t a, double A[6], double B[9]) {
-  gradient_sums_t(M, P, nb, a, A, B, 0);
-}
-
-static CHANSPH_CLONES void gradient_sums_rec(const struct model *M, const struct particles *P,
-                                             const struct nbr *nb, size_t a, double A[6],
-                                             double B[9]) {
-  gradient_sums_t(M, P, nb, a, A, B, 1);
-}
-
 /** Violeau-Issa sum of particle a (thesis Eq. 5.48 without its factor 1 / (gamma_a rho_a)):
     -sum_b V_b (rho_a + rho_b)/2 |u_ab|^2 F_ab over its whole list. */
-static CHANSPH_CLONES double violeau_issa_sum(const struct model *M, const struct particles *P,
+static CHANSPH_CLONES double violeau_issa_sum(const struct model *M, const struct pair_view *V,
                                               const struct nbr *nb, size_t a) {
-  const struct kernel K = M->k;
-  const double *restrict x = P->x, *restrict y = P->y, *restrict z = P->z;
-  const double *restrict u = P->u, *restrict v = P->v, *restrict w = P->w;
-  const double *restrict vol = P->vol, *restrict rho = P->rho;
-  const int32_t *restrict nl = nb->list + a * (size_t)nb->stride;
+  const struct pair_frame F = pair_frame_of(M);
+  const double *restrict x = V->f[REC_X], *restrict y = V->f[REC_Y], *restrict z = V->f[REC_Z];
+  const double *restrict u = V->f[REC_U], *restrict v = V->f[REC_V], *restrict w = V->f[REC_W];
+  const double *restrict vol = V->f[REC_VOL], *restrict rho = V->f[REC_RHO];
+  const int32_t *restrict nl = pair_list(nb, a);
   const double xa = x[a], ya = y[a], za = z[a], ua = u[a], va = v[a], wa = w[a], ra = rho[a];
-  const double lx = M->lx, lz = M->lz;
-  const int d3 = M->dim == 3;
   double sum = 0.0;
 #pragma omp simd reduction(+ : sum)
   for (int j = 0; j < nb->count[a]; j++) {
     const int32_t b = nl[j];
-    const struct pair g = pair_geom(&K, lx, lz, d3, xa - x[b], ya - y[b], za - z[b]);
+    const struct pair g = pair_at(&F, xa - x[b], ya - y[b], za - z[b]);
     const double ux = ua - u[b], uy = va - v[b], uz = wa - w[b];
     sum -= vol[b] * 0.5 * (ra + rho[b]) * (ux * ux + uy * uy + uz * uz) * g.f;
   }
@@ -315,13 +259,14 @@ static void wall_law_stresses(const struct model *M, struct particles *P, const 
 
 void turb_q_criterion(const struct model *M, const struct particles *P, const struct nbr *nb,
                       double *q) {
+  const struct pair_view arrays = pair_view_arrays(P, NULL);
 #pragma omp parallel for schedule(dynamic, 256)
   for (size_t a = 0; a < P->n; a++) {
     q[a] = 0.0;
     if (P->kind[a] != KIND_FLUID) continue;
-    double A[6], B[9];
-    gradient_sums(M, P, nb, a, A, B); /* the particle arrays: the records may be older */
-    q[a] = turb_q_gradient(M->dim, A, B);
+    double s[GRADIENT_SUMS];
+    gradient_sums_of(M, P, nb, a, &arrays, s); /* the particle arrays: the records may be older */
+    q[a] = turb_q_gradient(M->dim, s, s + 6);
   }
 }
 
@@ -333,7 +278,9 @@ static double eddy_viscosity(const struct model *M, struct particles *P, const s
   const double *restrict u = P->u, *restrict w = P->w, *restrict rho = P->rho;
   const uint8_t *restrict kind = P->kind;
   double *restrict nur = P->nur, *restrict kr = P->kr;
-  records_pack(P, P->n + P->n_ghost); /* positions, velocities, volumes for the gradient */
+  const int records = records_fast(); /* the gathered records are faster with AVX-512 */
+  if (records) records_pack(P, P->n + P->n_ghost); /* positions, velocities, volumes */
+  const struct pair_view arrays = pair_view_arrays(P, NULL);
   double numax = nu;
 #pragma omp parallel for schedule(dynamic, 256) reduction(max : numax)
   for (size_t a = 0; a < P->n; a++) {
@@ -343,15 +290,12 @@ static double eddy_viscosity(const struct model *M, struct particles *P, const s
     const double ls2 = smagorinsky_length2(M, P, W, a, &damp, &d, &utau2);
     double S;
     if (M->strain == STRAIN_GRADIENT) {
-      double A[6], B[9];
-      if (records_fast())
-        gradient_sums_rec(M, P, nb, a, A, B);
-      else
-        gradient_sums(M, P, nb, a, A, B);
-      S = turb_strain_gradient(M->dim, A, B);
+      double s[GRADIENT_SUMS];
+      gradient_sums_of(M, P, nb, a, records ? NULL : &arrays, s);
+      S = turb_strain_gradient(M->dim, s, s + 6);
     } else { /* Violeau-Issa, Eq. 5.48 with nu_r,b = nu_r,a: S^3 - sum S - W / l_S^2 = 0 */
       const double ig = 1.0 / P->gam[a];
-      const double sum = violeau_issa_sum(M, P, nb, a) * ig / rho[a];
+      const double sum = violeau_issa_sum(M, &arrays, nb, a) * ig / rho[a];
       double wterm = 0.0; /* power of the wall shear: 2/gamma sum_s u_tau,s^2 |v_t| |grad gamma| */
       if (d < two_h)
         wterm =

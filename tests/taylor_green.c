@@ -12,10 +12,8 @@
  * vector of up to `jitter` dr per component (the disorder of a running simulation), with the
  * wall-clock time of each evaluation (neighbour search included).
  *
- * Usage: taylor_green [--jitter J] [--mixed] [--check]   prints a table; --mixed forms each pair's
- *   geometry and terms with the float terms of pair.h (sph.precision = mixed: separations and
- *   differences in double, rounded to float, sums in double); --check exits 1 unless the
- *   corrected gradient is exact to 1e-12 (1e-5 with --mixed) for a linear pressure, its error falls
+ * Usage: taylor_green [--jitter J] [--check]   prints a table; --check exits 1 unless the
+ *   corrected gradient is exact to 1e-12 for a linear pressure, its error falls
  * from N = 8 to N = 32 (so does the standard one's on the regular lattice; on the jittered lattice
  * the standard gradient's zeroth-order error p_a sum_b V_b grad w_ab grows like 1/dr), and on the
  * regular lattice the corrected gradient converges at second order (observed order >= 1.8). The
@@ -47,8 +45,6 @@ static double rnd(unsigned long long *s) {
 static double wrap(double d) {
   return d - floor(d + 0.5);
 }
-
-static int mixed; /* --mixed: the float pair terms of sph.precision = mixed */
 
 struct result {
   double l2[2], linf[2], seconds[2], linear_err;
@@ -97,22 +93,6 @@ static void evaluate(int N, double jitter, struct result *res) {
             const double r = sqrt(dx * dx + dy * dy);
             if (r >= 2.0 * h) continue;
             const double f = kernel_f(&K, r); /* grad_a w_ab = f r_ab */
-            if (mixed) { /* the solver's float terms (forces_pair.h), summed in double */
-              const struct pair_f gf = pair_geom_f(&K, 1.0, 1.0, 0, dx, dy, 0.0); /* wrapped */
-              if (mode == 0) {
-                const struct v3_f t =
-                    term_pressure_f(&gf, rho * vol, p[a] / (rho * rho), p[b] / (rho * rho));
-                g[0] += rho * (double)t.x, g[1] += rho * (double)t.y;
-              } else {
-                const struct sym3_f t = term_moment_f(&gf, vol);
-                A[0] += t.xx, A[1] += t.xy, A[3] += t.yy;
-                const struct v3_f d = term_difference_f(&gf, vol, p[b] - p[a]);
-                g[0] += d.x, g[1] += d.y;
-                const struct v3_f l = term_difference_f(&gf, vol, -(0.3 * dx - 0.7 * dy));
-                gl[0] += l.x, gl[1] += l.y;
-              }
-              continue;
-            }
             if (mode == 0) {
               const double c = rho * vol * rho * (p[a] / (rho * rho) + p[b] / (rho * rho)) * f;
               g[0] += c * dx, g[1] += c * dy;
@@ -155,18 +135,16 @@ int main(int argc, char **argv) {
       jitter = atof(argv[++i]);
     else if (!strcmp(argv[i], "--check"))
       check = 1;
-    else if (!strcmp(argv[i], "--mixed"))
-      mixed = 1;
     else {
-      fprintf(stderr, "usage: taylor_green [--jitter J] [--mixed] [--check]\n");
+      fprintf(stderr, "usage: taylor_green [--jitter J] [--check]\n");
       return 2;
     }
   }
   static const int Ns[] = {4, 6, 8, 10, 12, 14, 16, 18, 21, 24, 28, 32, 40};
   enum { NN = sizeof Ns / sizeof Ns[0] };
   struct result r[NN];
-  printf("# Taylor-Green Pi_xx (thesis Eq. 6.8), h/dr = 1.3, jitter %.2f dr, %s pair terms\n",
-         jitter, mixed ? "float (mixed)" : "double");
+  printf("# Taylor-Green Pi_xx (thesis Eq. 6.8), h/dr = 1.3, jitter %.2f dr, double pair terms\n",
+         jitter);
   printf(
       "# N_per_vortex particles L2_standard Linf_standard L2_corrected Linf_corrected "
       "s_standard s_corrected\n");
@@ -184,7 +162,7 @@ int main(int argc, char **argv) {
   }
   printf("# corrected gradient of a linear pressure: max relative error %.2e\n", worst_linear);
   if (!check) return 0;
-  int fail = worst_linear > (mixed ? 1e-5 : 1e-12);
+  int fail = worst_linear > 1e-12;
   for (int m = 0; m < 2; m++) {
     const double order = log(r[2].l2[m] / r[11].l2[m]) / log(32.0 / 8.0);
     printf("# %s: observed order of the L2 error, N = 8 -> 32: %.2f\n",

@@ -58,9 +58,7 @@ add_executable(taylor_green taylor_green.c)
 target_link_libraries(taylor_green PRIVATE chansph_core)
 add_test(NAME taylor_green_lattice COMMAND taylor_green --check)
 add_test(NAME taylor_green_jittered COMMAND taylor_green --jitter 0.2 --check)
-# sph.precision = mixed: the same checks with the float pair terms (docs/performance.md, "Precision")
-add_test(NAME taylor_green_mixed COMMAND taylor_green --jitter 0.2 --mixed --check)
-set_tests_properties(taylor_green_lattice taylor_green_jittered taylor_green_mixed
+set_tests_properties(taylor_green_lattice taylor_green_jittered
                      PROPERTIES LABELS "validation;models")
 
 # inviscid energy experiment of thesis Sec. 3.1.2 (stability case 2)
