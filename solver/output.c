@@ -15,8 +15,8 @@
 #include <time.h>
 
 #include "error.h"
-#include "git_commit.h"
 #include "euler.h"
+#include "git_commit.h"
 #include "ncout.h"
 #include "stats_nc.h"
 #include "timers.h"

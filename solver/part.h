@@ -49,8 +49,8 @@ struct particles {
   double *ax, *ay, *az; /*!< acceleration without the driving force at the start of the last
                              step [m/s^2]; permuted (and migrated) with the particles */
   /** x-acceleration of the last sampled force pass split by what exerts it, SX_LEN per
-      particle (enum part_sx) [m/s^2]: the momentum budget of the statistics (stats/contract.h). NULL
-      without Eulerian statistics; permuted and migrated with the particles while sx_live. */
+      particle (enum part_sx) [m/s^2]: the momentum budget of the statistics (stats/contract.h).
+     NULL without Eulerian statistics; permuted and migrated with the particles while sx_live. */
   double *sx;
   int sx_live; /*!< 1: sx holds the values of the last force pass (a sampled step) */
   /* turbulence model (turb.h), allocated only when used, NULL otherwise; recomputed from the

@@ -449,13 +449,13 @@ static int engine_write(const void *self, double t_reached, int ncid, char *err,
 }
 
 const struct stats_engine corr_engine = {.name = "two-point correlations",
-          .size = sizeof(struct corr),
-          .init_scene = engine_init_scene,
-          .init = engine_init,
-          .free = engine_free,
-          .sample = engine_sample,
-          .state = engine_state,
-          .bytes = engine_bytes,
-          .write = engine_write,
-          .warnings = NULL,
-          .log = NULL};
+                                         .size = sizeof(struct corr),
+                                         .init_scene = engine_init_scene,
+                                         .init = engine_init,
+                                         .free = engine_free,
+                                         .sample = engine_sample,
+                                         .state = engine_state,
+                                         .bytes = engine_bytes,
+                                         .write = engine_write,
+                                         .warnings = NULL,
+                                         .log = NULL};

@@ -626,13 +626,13 @@ static int engine_warnings(const void *self, char *buf, size_t len) {
 }
 
 const struct stats_engine lagr_engine = {.name = "Lagrangian statistics",
-          .size = sizeof(struct lagr),
-          .init_scene = engine_init_scene,
-          .init = engine_init,
-          .free = engine_free,
-          .sample = engine_sample,
-          .state = engine_state,
-          .bytes = engine_bytes,
-          .write = engine_write,
-          .warnings = engine_warnings,
-          .log = NULL};
+                                         .size = sizeof(struct lagr),
+                                         .init_scene = engine_init_scene,
+                                         .init = engine_init,
+                                         .free = engine_free,
+                                         .sample = engine_sample,
+                                         .state = engine_state,
+                                         .bytes = engine_bytes,
+                                         .write = engine_write,
+                                         .warnings = engine_warnings,
+                                         .log = NULL};

@@ -27,7 +27,8 @@ int stats_nc_file(const char *path, const struct stats *st, const struct series 
   int ncid = -1, dt;
   NCOUT_OR_DISCARD(nc_create_mem(tmp, NC_NETCDF4, 1 << 20, &ncid));
   NCOUT_OR_DISCARD(nc_put_att_text(ncid, NC_GLOBAL, "Conventions", 6, "CF-1.8"));
-  NCOUT_OR_DISCARD(nc_put_att_text(ncid, NC_GLOBAL, "title", 36, "chansph channel-flow statistics file"));
+  NCOUT_OR_DISCARD(
+      nc_put_att_text(ncid, NC_GLOBAL, "title", 36, "chansph channel-flow statistics file"));
   NCOUT_OR_DISCARD(nc_put_att_text(ncid, NC_GLOBAL, "source", 7, "chansph"));
   NCOUT_OR_DISCARD(ncout_put_attrs(ncid, attrs, nattrs));
   /* the engines: profiles (dimension y), groups of raw accumulators */
@@ -45,7 +46,7 @@ int stats_nc_file(const char *path, const struct stats *st, const struct series 
   int rc = NC_NOERR;
   for (int c = 0; c < ts->ncol && rc == NC_NOERR; c++) {
     rc = ncout_def(ncid, ts->names[c], NC_DOUBLE, 1, &dt, ts->units[c],
-                 ts->long_names ? ts->long_names[c] : NULL, &vts[c]);
+                   ts->long_names ? ts->long_names[c] : NULL, &vts[c]);
     /* simulated time from the initial condition: no calendar date to refer to, so plain
        seconds (udunits "s", what xarray keeps as float seconds) and the origin in words
        (docs/stats-format.md) */
@@ -66,4 +67,3 @@ int stats_nc_file(const char *path, const struct stats *st, const struct series 
   NCOUT_OR_DISCARD(rc);
   return ncout_commit(ncid, tmp, path, err, errlen);
 }
-

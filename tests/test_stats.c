@@ -327,11 +327,12 @@ static void test_round_trip(double *buf) {
     if (!same) printf("field %s differs\n", fa->name);
   }
   EXPECT(same, "state after a round trip differs from the uninterrupted run");
-  EXPECT(test_la(&a)->releases > 2 && test_la(&a)->ntracks > 0, "Lagrangian engine idle in the round trip");
+  const struct lagr *la = test_la(&a);
+  EXPECT(la->releases > 2 && la->ntracks > 0, "Lagrangian engine idle in the round trip");
   printf(
       "state round trip after 61 of 137 snapshots (%d fields, Eulerian, correlations, "
       "Lagrangian with %g releases done and %zu tracks active): %s\n",
-      La.n, test_la(&a)->releases, test_la(&a)->ntracks, same ? "bitwise identical" : "DIFFERENT");
+      La.n, la->releases, la->ntracks, same ? "bitwise identical" : "DIFFERENT");
   for (int i = 0; i < sv.n; i++) free(sv.data[i]);
   state_free(&La), state_free(&Lc);
   stats_free(&c);

@@ -266,7 +266,8 @@ static struct test_stats_config config_a(void) { /* bins, not folded, LES; corr 
   return c;
 }
 
-static struct test_stats_config config_b(void) { /* SPH interpolation, folded; release plane x0 = 0 */
+static struct test_stats_config config_b(
+    void) { /* SPH interpolation, folded; release plane x0 = 0 */
   struct test_stats_config c = config_a();
   c.eul.method = EULER_SPH, c.eul.fold = 1, c.eul.h = 0.08, c.eul.les = 0, c.eul.nb = 20;
   c.eul.y1 = 1.0;
@@ -427,14 +428,17 @@ static void run_check(const char *name, const struct test_stats_config *cfg, siz
     EXPECT(d1 == 0, "%s: %d state fields differ from the serial run", name, d1);
     EXPECT(d2 == 0, "%s: MPI_COMM_NULL differs from MPI_COMM_SELF in %d fields", name, d2);
     /* the engines did work */
+    const struct euler *eu = test_eu(&par);
+    const struct corr *co = test_co(&par);
+    const struct lagr *la = test_la(&par);
     double pdf_n = 0.0; /* station crossings over all levels and stations */
     for (int k = 0; k < cfg->lagr.n_levels * cfg->lagr.n_stations; k++)
-      pdf_n += test_la(&par)->pdf[(size_t)k * (size_t)(cfg->lagr.pdf_bins + 3) + cfg->lagr.pdf_bins];
-    EXPECT(test_eu(&par)->nwin >= 2, "%s: %zu windows", name, test_eu(&par)->nwin);
-    EXPECT(test_co(&par)->samples[0] > 0, "%s: no correlation planes", name);
-    EXPECT(test_la(&par)->releases >= 2 && test_la(&par)->ntracks > 0 && pdf_n > 0,
-           "%s: Lagrangian idle (%g releases, %zu tracks, %g crossings)", name, test_la(&par)->releases,
-           test_la(&par)->ntracks, pdf_n);
+      pdf_n += la->pdf[(size_t)k * (size_t)(cfg->lagr.pdf_bins + 3) + cfg->lagr.pdf_bins];
+    EXPECT(eu->nwin >= 2, "%s: %zu windows", name, eu->nwin);
+    EXPECT(co->samples[0] > 0, "%s: no correlation planes", name);
+    EXPECT(la->releases >= 2 && la->ntracks > 0 && pdf_n > 0,
+           "%s: Lagrangian idle (%g releases, %zu tracks, %g crossings)", name, la->releases,
+           la->ntracks, pdf_n);
     char pa[256], pb[256];
     snprintf(pa, sizeof pa, "stats_mpi_%s_np%d.nc", name, size_g);
     snprintf(pb, sizeof pb, "stats_mpi_%s_np%d_serial.nc", name, size_g);
@@ -453,8 +457,8 @@ static void run_check(const char *name, const struct test_stats_config *cfg, siz
         "%s on %d rank(s), %d columns, %zu particles x %ld snapshots: state %s to the serial "
         "run (%zu windows, %g correlation planes, %g releases, %zu tracks, %g station "
         "crossings), the same on every rank: %s; stats.nc: %d variables %s\n",
-        name, size_g, ncol, W.n, nsnap, d1 ? "DIFFERENT" : "bitwise identical", test_eu(&par)->nwin,
-        test_co(&par)->samples[0], test_la(&par)->releases, test_la(&par)->ntracks, pdf_n, across ? "NO" : "yes", nvar,
+        name, size_g, ncol, W.n, nsnap, d1 ? "DIFFERENT" : "bitwise identical", eu->nwin,
+        co->samples[0], la->releases, la->ntracks, pdf_n, across ? "NO" : "yes", nvar,
         dn ? "DIFFERENT" : "bitwise identical");
     stats_free(&self), stats_free(&null);
   }
@@ -505,9 +509,10 @@ static void run_bench(void) {
       double dt = MPI_Wtime() - t0, dmax;
       MPI_Allreduce(&dt, &dmax, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
       tsum += dmax, tmax = fmax(tmax, dmax);
-      gathered += (parts[k].eul && size_g > 1 ? test_eu(&st)->nsub * (size_t)c.eul.nb * (MOM_LEN + 2) : 0) +
-                  (parts[k].corr && size_g > 1 ? test_co(&st)->nall * CORR_ENT : 0) +
-                  (parts[k].lagr && size_g > 1 ? test_la(&st)->nall * LAGR_REC : 0);
+      gathered +=
+          (parts[k].eul && size_g > 1 ? test_eu(&st)->nsub * (size_t)c.eul.nb * (MOM_LEN + 2) : 0) +
+          (parts[k].corr && size_g > 1 ? test_co(&st)->nall * CORR_ENT : 0) +
+          (parts[k].lagr && size_g > 1 ? test_la(&st)->nall * LAGR_REC : 0);
     }
     if (rank_g == 0)
       printf(
