@@ -72,7 +72,8 @@ struct stats_snapshot {
  * The scene as the engines see it: the channel, the fluid and the averaging as resolved
  * values (derived ones computed by the solver, so no engine repeats a formula of the scene),
  * and the keys of the engines' own sections ([stats], [correlations], [lagrangian], ...)
- * by name through get (stats_scene_num(), stats_scene_list() in stats.h). Each engine builds
+ * by name through get (stats_scene_num(), stats_scene_list() below, stats_scene.c). Each engine
+ * builds
  * its configuration from it (struct stats_engine.init_scene, engine.h).
  */
 struct stats_scene {
@@ -95,5 +96,26 @@ struct stats_scene {
   int (*get)(const void *scene, const char *key, double *v, int max);
   const void *scene; /*!< what get reads */
 };
+
+/**
+ * @brief A numeric scene key of an engine's own section ("correlations.nx"): its value (a
+ *        choice as its index). Dies if the scene has no such key (a bug of the engine).
+ */
+double stats_scene_num(const struct stats_scene *sc, const char *key);
+
+/**
+ * @brief A list key of the scene ("lagrangian.pdf_x"): up to max values into v.
+ * @return the number of values the key holds (dies if the scene has no such key)
+ */
+int stats_scene_list(const struct stats_scene *sc, const char *key, double *v, int max);
+
+/**
+ * @brief Wall-normal levels given in wall units by a list key ("correlations.y_plus"): y+ as
+ *        given and the heights y = y+ nu / u_tau from the lower wall [m] (sc->u_tau).
+ * @param[out] y_plus,y up to max levels each
+ * @return the number of levels (at most max)
+ */
+int stats_scene_levels(const struct stats_scene *sc, const char *key, double *y_plus, double *y,
+                       int max);
 
 #endif

@@ -2,7 +2,6 @@
 #include "corr.h"
 #include "engine.h"
 #include "ncutil.h"
-#include "stats.h"
 
 #include <fftw3.h>
 #include <math.h>

@@ -827,3 +827,11 @@ void euler_state(struct euler *e, struct state_list *L) {
   f->reserve = reserve_kin, f->owner = e;
   f->optional = 1; /* format 1.4: before it, rows without the advective part */
 }
+
+void euler_running_result(const struct euler *e, struct euler_result *res) {
+  const size_t rows = euler_rows(e);
+  int *complete = mem_calloc(rows ? rows : 1, sizeof *complete, "Eulerian statistics");
+  for (size_t r = 0; r < rows; r++) complete[r] = r < e->nwin;
+  euler_finalise(&e->cfg, e->win, e->mom, e->snp, e->pln, e->kin, complete, 0, rows, res);
+  free(complete);
+}

@@ -17,15 +17,6 @@
 #include "moments.h"
 #include "ncout.h"
 #include "ncutil.h"
-#include "stats.h"
-
-void euler_running_result(const struct euler *e, struct euler_result *res) {
-  const size_t rows = euler_rows(e);
-  int *complete = mem_calloc(rows ? rows : 1, sizeof *complete, "Eulerian statistics");
-  for (size_t r = 0; r < rows; r++) complete[r] = r < e->nwin;
-  euler_finalise(&e->cfg, e->win, e->mom, e->snp, e->pln, e->kin, complete, 0, rows, res);
-  free(complete);
-}
 
 #define CK(call) NC_TRY(call, fail)
 

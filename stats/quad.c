@@ -2,7 +2,6 @@
 #include "quad.h"
 #include "engine.h"
 #include "ncutil.h"
-#include "stats.h"
 
 #include <math.h>
 #include <netcdf.h>

@@ -42,25 +42,6 @@ void *stats_find(const struct stats *st, const struct stats_engine *e) {
   return st->self[index_of(e)];
 }
 
-int stats_scene_list(const struct stats_scene *sc, const char *key, double *v, int max) {
-  const int n = sc->get ? sc->get(sc->scene, key, v, max) : -1;
-  if (n < 0) die("statistics: the scene has no numeric key %s", key);
-  return n;
-}
-
-double stats_scene_num(const struct stats_scene *sc, const char *key) {
-  double v = 0.0;
-  if (stats_scene_list(sc, key, &v, 1) != 1) die("statistics: scene key %s is not a number", key);
-  return v;
-}
-
-int stats_scene_levels(const struct stats_scene *sc, const char *key, double *y_plus, double *y,
-                       int max) {
-  const int held = stats_scene_list(sc, key, y_plus, max), n = held < max ? held : max;
-  for (int l = 0; l < n; l++) y[l] = y_plus[l] * sc->nu / sc->u_tau;
-  return n;
-}
-
 void stats_free(struct stats *st) {
   for (int k = 0; k < stats_n_engines; k++)
     if (st->self[k]) stats_engines[k]->free(st->self[k]), free(st->self[k]);

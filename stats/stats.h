@@ -49,27 +49,6 @@ void stats_add(struct stats *st, const struct stats_engine *e, const void *cfg);
 void *stats_find(const struct stats *st, const struct stats_engine *e);
 
 /**
- * @brief A numeric scene key of an engine's own section ("correlations.nx"): its value (a
- *        choice as its index). Dies if the scene has no such key (a bug of the engine).
- */
-double stats_scene_num(const struct stats_scene *sc, const char *key);
-
-/**
- * @brief A list key of the scene ("lagrangian.pdf_x"): up to max values into v.
- * @return the number of values the key holds (dies if the scene has no such key)
- */
-int stats_scene_list(const struct stats_scene *sc, const char *key, double *v, int max);
-
-/**
- * @brief Wall-normal levels given in wall units by a list key ("correlations.y_plus"): y+ as
- *        given and the heights y = y+ nu / u_tau from the lower wall [m] (sc->u_tau).
- * @param[out] y_plus,y up to max levels each
- * @return the number of levels (at most max)
- */
-int stats_scene_levels(const struct stats_scene *sc, const char *key, double *y_plus, double *y,
-                       int max);
-
-/**
  * @brief Warnings about what the statistics could not give (Lagrangian lags without samples,
  *        T_L = NaN, no completed release): lines starting "warning: ".
  * @return the number of warnings (buf "" if none)
