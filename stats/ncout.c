@@ -12,6 +12,7 @@
 #include <string.h>
 #include <unistd.h>
 
+/* The calls of a column file being written: on failure, discard it (ncout.h). */
 #define NC(call) NCOUT_OR_DISCARD(call)
 
 int ncout_put_attrs(int ncid, const struct nc_attr *attrs, int nattrs) {
