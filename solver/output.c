@@ -15,8 +15,10 @@
 #include <time.h>
 
 #include "error.h"
+#include "euler.h"
 #include "git_commit.h"
 #include "ncout.h"
+#include "stats_nc.h"
 #include "timers.h"
 
 /** The `source` attribute of the output files: version and git commit of the build. */
@@ -107,68 +109,42 @@ static int open_files(struct output *o, const char *dir, const struct scene *sc,
   return CHANSPH_OK;
 }
 
+/* The scene's numeric keys by name, for the statistics engines (stats_scene.get). */
+static int scene_get(const void *scene, const char *key, double *v, int max) {
+  return scene_values(scene, key, v, max);
+}
+
+void output_stats_scene(const struct scene *sc, struct stats_scene *view) {
+  *view = (struct stats_scene){
+      .dim = sc->dim,
+      .delta = sc->delta,
+      .lx = sc->lx,
+      .lz = sc->lz,
+      .dr = sc->dr,
+      .h = scene_h(sc),
+      .nu = sc->nu,
+      .rho0 = sc->rho0,
+      .les = sc->les != LES_NONE,
+      .u_tau = sc->u_tau_ref > 0.0 ? sc->u_tau_ref : sqrt(sc->delta * fabs(sc->force)),
+      .t_average_start = sc->t_average_start,
+      .t_end = sc->t_end,
+      .bins = scene_bins(sc),
+      .get = scene_get,
+      .scene = sc};
+}
+
 /* Shared by output_open and output_reopen: the files (rank 0), the engines (every rank). */
 static int open_common(struct output *o, const char *dir, const struct scene *sc,
                        const char *log_mode) {
   if (agree(rank0() ? open_files(o, dir, sc, log_mode) : CHANSPH_OK)) return CHANSPH_ERR;
   if (!o->scene_text) o->scene_text = scene_text(sc);
-  struct stats_config cfg;
-  output_stats_config(sc, &cfg);
-  stats_init(&o->st, &cfg);
+  struct stats_scene view;
+  output_stats_scene(sc, &view);
+  stats_init(&o->st, &view);
   series_init(&o->ts, N_SERIES, series_names, sc->dim == 2 ? series_units_2d : series_units_3d,
               series_long_names);
   o->next_write = sc->write_every > 0.0 ? sc->write_every : INFINITY;
   return CHANSPH_OK;
-}
-
-/* The engine's configuration from the scene: default bins are of width dr around each particle
-   layer y = j dr (j = 1 .. 2delta/dr-1), the thin strips next to the walls joining the first and
-   last bins; folded, the layers 1 .. delta/dr; with n_bins set: uniform bins between the walls
-   (folded: between the wall and the centre). */
-void output_stats_config(const struct scene *sc, struct stats_config *cfg) {
-  memset(cfg, 0, sizeof *cfg);
-  struct euler_config *e = &cfg->eul;
-  cfg->eulerian = sc->stats_eulerian;
-  e->fold = sc->stats_fold, e->delta = sc->delta, e->nu = sc->nu, e->rho0 = sc->rho0;
-  e->area = sc->dim == 3 ? sc->lx * sc->lz : sc->lx;
-  e->t_start = sc->t_average_start;
-  e->les = sc->les != LES_NONE;
-  e->method = sc->stats_method, e->h = scene_h(sc), e->dim = sc->dim;
-  e->window = sc->stats_window > 0.0 ? sc->stats_window : (sc->t_end - sc->t_average_start) / 10;
-  if (!(e->window > 0.0)) e->window = sc->t_end > 0 ? sc->t_end / 10 : 1.0;
-  const double u_tau = sc->u_tau_ref > 0.0 ? sc->u_tau_ref : sqrt(sc->delta * fabs(sc->force));
-  struct corr_config *c = &cfg->corr;
-  c->n_levels = sc->corr_y_plus.n;
-  for (int l = 0; l < c->n_levels; l++)
-    c->y_plus[l] = sc->corr_y_plus.v[l], c->y[l] = c->y_plus[l] * sc->nu / u_tau;
-  c->nx = sc->corr_nx > 0 ? sc->corr_nx : (int)floor(sc->lx / sc->dr + 0.5);
-  c->nz = sc->dim == 2 ? 1 : sc->corr_nz > 0 ? sc->corr_nz : (int)floor(sc->lz / sc->dr + 0.5);
-  c->lx = sc->lx, c->lz = sc->lz, c->delta = sc->delta, c->t_start = sc->t_average_start;
-  c->half = 0.5 * sc->corr_thickness * sc->dr;
-  struct quad_config *qc = &cfg->quad;
-  qc->n_levels = sc->quad_y_plus.n;
-  for (int l = 0; l < qc->n_levels; l++)
-    qc->y_plus[l] = sc->quad_y_plus.v[l], qc->y[l] = qc->y_plus[l] * sc->nu / u_tau;
-  qc->half = 0.5 * sc->dr, qc->delta = sc->delta, qc->t_start = sc->t_average_start;
-  struct lagr_config *g = &cfg->lagr;
-  g->n_levels = sc->lagr_y_plus.n;
-  for (int l = 0; l < g->n_levels; l++)
-    g->y_plus[l] = sc->lagr_y_plus.v[l], g->y[l] = g->y_plus[l] * sc->nu / u_tau;
-  g->x0 = sc->lagr_x0, g->half = 0.5 * sc->dr, g->lx = sc->lx;
-  g->lz = sc->dim == 3 ? sc->lz : 0.0, g->delta = sc->delta;
-  g->horizon = sc->lagr_horizon, g->n_lags = sc->lagr_n_lags, g->pdf_bins = sc->lagr_pdf_bins;
-  g->release_every = sc->lagr_release_every > 0.0 ? sc->lagr_release_every : sc->lagr_horizon;
-  g->n_stations = sc->lagr_pdf_x.n;
-  for (int k = 0; k < g->n_stations; k++) g->station[k] = sc->lagr_pdf_x.v[k];
-  g->t_start = sc->t_average_start;
-  if (sc->n_bins > 0) {
-    e->nb = sc->n_bins, e->y0 = 0.0, e->y1 = (sc->stats_fold ? 1.0 : 2.0) * sc->delta;
-  } else if (sc->stats_fold) {
-    e->nb = (int)floor(sc->delta / sc->dr + 0.5), e->y0 = 0.5 * sc->dr;
-    e->y1 = e->y0 + e->nb * sc->dr;
-  } else {
-    e->nb = scene_bins(sc), e->y0 = 0.5 * sc->dr, e->y1 = 2.0 * sc->delta - 0.5 * sc->dr;
-  }
 }
 
 /* The checks and the directory of output_open (rank 0). */
@@ -266,7 +242,7 @@ static void log_progress(struct output *o, struct sim *S, const struct diag *d) 
 }
 
 /* The scene's convergence target; 0 if there is none. */
-static int target_of(const struct scene *sc, struct stats_target *tg) {
+static int target_of(const struct scene *sc, struct euler_target *tg) {
   if (!(sc->target_stderr > 0.0) || !sc->stats_eulerian) return 0;
   tg->rel_stderr = sc->target_stderr, tg->profiles = sc->target_profiles;
   tg->corr_ratio = sc->target_corr_ratio, tg->windows = sc->target_windows;
@@ -275,7 +251,7 @@ static int target_of(const struct scene *sc, struct stats_target *tg) {
 
 /* Where the standard errors stand against the target, and the projected simulated and wall
    time to reach it (this process's wall time per simulated second). */
-static void log_target(struct output *o, const struct sim *S, const struct stats_progress *p) {
+static void log_target(struct output *o, const struct sim *S, const struct euler_progress *p) {
   const struct scene *sc = S->sc;
   static const char *const which[3] = {"u_mean and the -u'v' peak", "u_mean", "the -u'v' peak"};
   char proj[320];
@@ -364,7 +340,7 @@ static int write_stats(struct output *o, const struct sim *S) {
   int rc = CHANSPH_OK;
   o->st.t_reached = S->t; /* an incomplete last window ends here, not at its nominal end */
   if (rank0() &&
-      ncout_stats(path, &o->st, &o->ts, attrs, sizeof attrs / sizeof attrs[0], err, sizeof err)) {
+      stats_nc_file(path, &o->st, &o->ts, attrs, sizeof attrs / sizeof attrs[0], err, sizeof err)) {
     error_input("%s", err);
     rc = CHANSPH_ERR;
   }
@@ -452,11 +428,12 @@ void output_sample(struct output *o, struct sim *S) {
                                       .comm = MPI_COMM_WORLD};
   stats_sample(&o->st, &snap);
   timer_pop();
-  struct stats_target tg;
-  if (target_of(sc, &tg) && o->st.eu.nwin != o->target_nwin) { /* a window closed */
-    o->target_nwin = o->st.eu.nwin;
-    struct stats_progress p;
-    stats_progress(&o->st, &tg, &p);
+  struct euler_target tg;
+  const struct euler *eu = stats_find(&o->st, &euler_engine); /* the target is on its profiles */
+  if (target_of(sc, &tg) && eu->nwin != o->target_nwin) {     /* a window closed */
+    o->target_nwin = eu->nwin;
+    struct euler_progress p;
+    euler_target_progress(eu, &tg, &p);
     if (agree(p.met)) {
       char line[1024];
       stats_convergence_line(&o->st, line, sizeof line);
@@ -497,14 +474,14 @@ int output_step(struct output *o, struct sim *S) {
     if (!have) sim_diag(S, &d);
     log_progress(o, S, &d);
   }
-  struct stats_target tg;
-  struct stats_progress prog;
+  struct euler_target tg;
+  struct euler_progress prog;
   if (S->t >= o->next_write) {
     char line[1024];
     stats_convergence_line(&o->st, line, sizeof line);
     output_log(o, "%s", line);
     if (line[0] && target_of(sc, &tg) && !o->converged)
-      stats_progress(&o->st, &tg, &prog), log_target(o, S, &prog);
+      euler_target_progress(stats_find(&o->st, &euler_engine), &tg, &prog), log_target(o, S, &prog);
     if (write_stats(o, S)) {
       timer_pop();
       return CHANSPH_ERR;
@@ -580,10 +557,10 @@ int output_finish(struct output *o, struct sim *S) {
   char line[1024];
   stats_convergence_line(&o->st, line, sizeof line);
   output_log(o, "%s", line);
-  struct stats_target tg;
-  struct stats_progress prog;
+  struct euler_target tg;
+  struct euler_progress prog;
   if (line[0] && target_of(S->sc, &tg) && !o->converged)
-    stats_progress(&o->st, &tg, &prog), log_target(o, S, &prog);
+    euler_target_progress(stats_find(&o->st, &euler_engine), &tg, &prog), log_target(o, S, &prog);
   output_log(o, "statistics engine: %.3f MB (%lld snapshots)\n", stats_memory(&o->st) / 1048576.0,
              (long long)o->st.samples);
   char warnings[4096];

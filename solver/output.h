@@ -43,8 +43,9 @@ struct output {
  */
 int output_open(struct output *o, const char *dir, const struct scene *sc, int overwrite);
 
-/** @brief The statistics engine's configuration from the scene (bins, windows, engines). */
-void output_stats_config(const struct scene *sc, struct stats_config *cfg);
+/** @brief The scene as the statistics engines see it (stats/contract.h): the channel's values,
+ *         derived ones resolved, and the engines' own keys by name. */
+void output_stats_scene(const struct scene *sc, struct stats_scene *view);
 
 /**
  * @brief Reopen the directory of a run being resumed: log.txt is appended to, scene.used.ini

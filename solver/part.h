@@ -13,6 +13,7 @@
 #include <stdint.h>
 #include <stdio.h>
 
+#include "contract.h"
 #include "scene.h"
 
 enum part_kind { KIND_FLUID = 0, KIND_VERTEX = 1 };
@@ -48,8 +49,8 @@ struct particles {
   double *ax, *ay, *az; /*!< acceleration without the driving force at the start of the last
                              step [m/s^2]; permuted (and migrated) with the particles */
   /** x-acceleration of the last sampled force pass split by what exerts it, SX_LEN per
-      particle (enum part_sx) [m/s^2]: the momentum budget of the statistics (euler.h). NULL
-      without Eulerian statistics; permuted and migrated with the particles while sx_live. */
+      particle (enum part_sx) [m/s^2]: the momentum budget of the statistics (stats/contract.h).
+     NULL without Eulerian statistics; permuted and migrated with the particles while sx_live. */
   double *sx;
   int sx_live; /*!< 1: sx holds the values of the last force pass (a sampled step) */
   /* turbulence model (turb.h), allocated only when used, NULL otherwise; recomputed from the
@@ -77,8 +78,17 @@ struct particles {
 
 /** Parts of the x-acceleration in part.sx: the pair forces of the fluid neighbours (pressure,
     molecular viscous, eddy-viscous) and everything the walls exert (vertex neighbours, wall
-    shear or wall law); their sum is ax. */
-enum part_sx { SX_PRESSURE, SX_VISCOUS, SX_MODEL, SX_WALL, SX_LEN };
+    shear or wall law); their sum is ax. One definition: the statistics contract's parts
+    (enum stats_part, stats/contract.h), which the snapshot hands the engines as they are. */
+enum part_sx {
+  SX_PRESSURE = STATS_PART_PRESSURE, /*!< pressure pair force of the fluid neighbours */
+  SX_VISCOUS = STATS_PART_VISCOUS,   /*!< molecular viscous pair force */
+  SX_MODEL = STATS_PART_MODEL,       /*!< eddy-viscous pair force */
+  SX_WALL = STATS_PART_WALL,         /*!< everything the walls exert */
+  SX_LEN = STATS_PARTS               /*!< parts per particle */
+};
+_Static_assert((int)SX_LEN == (int)STATS_PARTS && SX_WALL == SX_LEN - 1,
+               "part.sx must hold the statistics contract's parts (stats/contract.h)");
 
 /** Wall values on the vertex lattice: index (wall * nx + i) * nz + k, wall 0 at y = 0. */
 struct walls {

@@ -899,6 +899,26 @@ const char *scene_choice(const char *key, int value) {
   return "?";
 }
 
+int scene_values(const struct scene *s, const char *key, double *v, int max) {
+  const char *dot = strchr(key, '.');
+  char sec[32];
+  if (!dot || dot - key >= (int)sizeof sec) return -1;
+  snprintf(sec, sizeof sec, "%.*s", (int)(dot - key), key);
+  const int k = find_key(sec, dot + 1);
+  if (k < 0 || keys[k].type == T_STRING) return -1;
+  const void *field = (const char *)s + keys[k].offset;
+  if (keys[k].type == T_LIST) {
+    const struct scene_list *L = field;
+    for (int i = 0; i < L->n && i < max; i++) v[i] = L->v[i];
+    return L->n;
+  }
+  if (max < 1) return 1;
+  v[0] = keys[k].type == T_DOUBLE ? *(const double *)field
+         : keys[k].type == T_LONG ? (double)*(const long *)field
+                                  : (double)*(const int *)field; /* T_INT, T_CHOICE */
+  return 1;
+}
+
 static void value_text(const struct scene *s, int k, char *buf, size_t n) {
   const void *field = (const char *)s + keys[k].offset;
   switch (keys[k].type) {

@@ -211,6 +211,16 @@ char *scene_text(const struct scene *s);
 /** @brief Write docs/scenes.md (the key reference) to a stream. */
 void scene_write_doc(FILE *f);
 
+/**
+ * @brief The value(s) of a numeric key by name, as doubles (an integer exactly, a choice as its
+ *        index, a list entry by entry).
+ * @param[in] s scene
+ * @param[in] key "section.key", e.g. "correlations.nx"
+ * @param[out] v at most max values
+ * @return the number of values the key holds (1 for a scalar), or -1 for an unknown or text key
+ */
+int scene_values(const struct scene *s, const char *key, double *v, int max);
+
 /** @brief Name of an enum value of a choice key, e.g. scene_choice("drive.mode", 1) = "flux". */
 const char *scene_choice(const char *key, int value);
 

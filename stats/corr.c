@@ -2,7 +2,6 @@
 #include "corr.h"
 #include "engine.h"
 #include "ncutil.h"
-#include "stats.h"
 
 #include <fftw3.h>
 #include <math.h>
@@ -404,12 +403,23 @@ done:
 }
 
 /* The engine's table of operations (engine.h). */
-static int engine_wanted(const struct stats_config *cfg) {
-  return cfg->corr.n_levels > 0;
+static int engine_init_scene(void *self, const struct stats_scene *sc) {
+  struct corr_config c;
+  memset(&c, 0, sizeof c);
+  c.n_levels = stats_scene_levels(sc, "correlations.y_plus", c.y_plus, c.y, CORR_MAX_LEVELS);
+  const int nx = (int)stats_scene_num(sc, "correlations.nx");
+  const int nz = (int)stats_scene_num(sc, "correlations.nz");
+  c.nx = nx > 0 ? nx : (int)floor(sc->lx / sc->dr + 0.5);
+  c.nz = sc->dim == 2 ? 1 : nz > 0 ? nz : (int)floor(sc->lz / sc->dr + 0.5);
+  c.lx = sc->lx, c.lz = sc->lz, c.delta = sc->delta, c.t_start = sc->t_average_start;
+  c.half = 0.5 * stats_scene_num(sc, "correlations.thickness") * sc->dr;
+  if (!(c.n_levels > 0)) return 0;
+  corr_init(self, &c);
+  return 1;
 }
 
-static void engine_init(void *self, const struct stats_config *cfg) {
-  corr_init(self, &cfg->corr);
+static void engine_init(void *self, const void *cfg) {
+  corr_init(self, cfg);
 }
 
 static void engine_free(void *self) {
@@ -437,13 +447,14 @@ static int engine_write(const void *self, double t_reached, int ncid, char *err,
   return corr_nc_write(self, ncid, err, errlen);
 }
 
-const struct stats_engine corr_engine = {"two-point correlations",
-                                         offsetof(struct stats, co),
-                                         engine_wanted,
-                                         engine_init,
-                                         engine_free,
-                                         engine_sample,
-                                         engine_state,
-                                         engine_bytes,
-                                         engine_write,
-                                         NULL};
+const struct stats_engine corr_engine = {.name = "two-point correlations",
+                                         .size = sizeof(struct corr),
+                                         .init_scene = engine_init_scene,
+                                         .init = engine_init,
+                                         .free = engine_free,
+                                         .sample = engine_sample,
+                                         .state = engine_state,
+                                         .bytes = engine_bytes,
+                                         .write = engine_write,
+                                         .warnings = NULL,
+                                         .log = NULL};

@@ -17,9 +17,10 @@
 
 #include <stddef.h>
 
-#include "euler.h"
+#include "contract.h"
 
 struct state_list;
+struct stats_engine;
 
 enum { CORR_MAX_LEVELS = 8 };
 /** Spectrum slots per wavenumber: S_uu, S_vv, S_ww, Re S_uv, Im S_uv. */
@@ -87,5 +88,8 @@ void corr_results(const struct corr *c, double *rx, double *rz, double *ex, doub
 
 /** @brief Write group "correlations" into an open netCDF-4 file; returns a netCDF status. */
 int corr_nc_write(const struct corr *c, int ncid, char *err, size_t errlen);
+
+/** The correlation engine's table of operations (engine.h; corr.c). */
+extern const struct stats_engine corr_engine;
 
 #endif

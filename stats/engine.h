@@ -1,29 +1,33 @@
 /**
  * @file engine.h
- * @brief How the statistics layer (stats.c) reaches an engine: one table of operations per
- *        engine, defined by the engine's own module next to its accumulators and its netCDF
- *        writer.
+ * @brief How the statistics layer (stats.c, stats_nc.c) reaches an engine: one table of
+ *        operations per engine, defined by the engine's own module next to its accumulators
+ *        and its netCDF writer, and the one list of the engines (engines.c).
  *
- * Adding an engine: its module (state struct, init, free, sample, checkpoint state, memory,
- * writer; merging across ranks happens inside its sample, through spar.h), a member for its
- * state in struct stats, its switch in struct stats_config, and one line in `engines` in
- * stats.c (docs/stats-format.md, "How to add a statistic").
+ * Adding an engine: its module (state struct and configuration, the table below: built from
+ * the scene, free, sample, checkpoint state, memory, writer; merging across ranks happens
+ * inside its sample, through spar.h), its table declared in its header, and one line in
+ * `stats_engines` in engines.c (docs/stats-format.md, "How to add a statistic").
  */
 #ifndef CHANSPH_ENGINE_H
 #define CHANSPH_ENGINE_H
 
 #include <stddef.h>
 
-struct stats_config;
+struct stats_scene;
 struct stats_snapshot;
 struct state_list;
 
+/** The operations of one engine; self is its state (size bytes, zeroed, owned by stats.c). */
 struct stats_engine {
   const char *name; /*!< for messages */
-  size_t offset;    /*!< of the engine's state in struct stats */
-  /** 1 if the scene asks for this engine (else it is never allocated or called). */
-  int (*wanted)(const struct stats_config *cfg);
-  void (*init)(void *self, const struct stats_config *cfg);
+  size_t size;      /*!< bytes of the engine's state (its struct) */
+  /** Build the engine's configuration from the scene and set it up if the scene asks for it;
+      returns 1 if it does, 0 if not (then self is left as it was and never used). */
+  int (*init_scene)(void *self, const struct stats_scene *sc);
+  /** Set up from the engine's own configuration struct (struct euler_config, ...). */
+  void (*init)(void *self, const void *cfg);
+  /** Free what init allocated. */
   void (*free)(void *self);
   /** Accumulate one snapshot (collective across the ranks: merged in a fixed order). */
   void (*sample)(void *self, const struct stats_snapshot *s);
@@ -34,13 +38,18 @@ struct stats_engine {
   /** Write the engine's variables and groups into stats.nc (t_reached: the time the run
       reached, NaN if not known); netCDF status, with "message (in call)" in err. */
   int (*write)(const void *self, double t_reached, int ncid, char *err, size_t errlen);
-  /** Warnings about what it could not give ("warning: ..." lines), or NULL. */
+  /** Warnings about what it could not give ("warning: ..." lines), or NULL; returns how many. */
   int (*warnings)(const void *self, char *buf, size_t len);
+  /** Its lines for the log when stats.nc is written (each ending in a newline; nothing if it
+      has nothing to say yet), or NULL. */
+  void (*log)(const void *self, char *buf, size_t len);
 };
 
-extern const struct stats_engine euler_engine; /* euler_nc.c */
-extern const struct stats_engine corr_engine;  /* corr.c */
-extern const struct stats_engine lagr_engine;  /* lagr.c */
-extern const struct stats_engine quad_engine;  /* quad.c */
+enum { STATS_MAX_ENGINES = 16 }; /*!< room in struct stats (engines.c checks the list) */
+
+/** The engines, in the order they are initialised, sampled, checkpointed and written. */
+extern const struct stats_engine *const stats_engines[];
+/** How many there are. */
+extern const int stats_n_engines;
 
 #endif

@@ -19,7 +19,7 @@
    (HB_MU0), of m u and m u v by the sampled positions, then the same sums weighted by the
    particle's offset from its bin centre in bin widths, phi (add_particle, budget_planes; the
    weighted m u v is not used). */
-enum { HB_MASS = EULER_SX, HB_MU, HB_MU0, HB_UV, HB_LEN };
+enum { HB_MASS = STATS_PARTS, HB_MU, HB_MU0, HB_UV, HB_LEN };
 enum {
   EU_PART_U = MOM_LEN,
   EU_PART_N,
@@ -312,10 +312,10 @@ static void budget_planes(const struct euler_config *c, const double *snap, doub
     for (int k = 0; k < HB_LEN; k++) {
       const double centre = lower ? tot[0][k] - below[0][k] : below[1][k];
       const double sum = lower ? -centre : centre; /* stress convention */
-      if (k < EULER_SX_WALL) {
+      if (k < STATS_PART_WALL) {
         at[PL_PRESSURE + k] = sum / norm;
         at[PL_SOURCE] += (lower ? tot[0][k] : -tot[1][k]) / norm;
-      } else if (k == EULER_SX_WALL) {
+      } else if (k == STATS_PART_WALL) {
         at[PL_WALL] = sum / norm;
       } else if (k == HB_MASS) {
         at[PL_DRIVE] = (lower ? fx : -fx) * centre / norm;
@@ -331,7 +331,7 @@ static void budget_planes(const struct euler_config *c, const double *snap, doub
       const double *m1 = snap + (size_t)(e - 1) * EU_PART + EU_PART_PL1;
       double corr[PL_LEN] = {0}, mu0_corr = 0.0;
       for (int s = 0; s < 2; s++, m1 += HB_LEN) {
-        for (int k = 0; k < EULER_SX; k++) corr[PL_PRESSURE + k] -= m1[k] / norm;
+        for (int k = 0; k < STATS_PARTS; k++) corr[PL_PRESSURE + k] -= m1[k] / norm;
         corr[PL_DRIVE] += fx * m1[HB_MASS] / norm, corr[PL_MU_LAST] += m1[HB_MU] / norm;
         mu0_corr += m1[HB_MU0] / norm;
       }
@@ -437,8 +437,8 @@ static void add_particle(const struct euler *e, const struct stats_snapshot *s, 
         double phi_f;
         const double yb = c->fold && side ? 2.0 * c->delta - yf : yf;
         double *Hf = budget_bin(c, P, yb, side, &phi_f), *Hf1 = Hf + 2 * HB_LEN; /* EU_PART_PL1 */
-        for (int k = 0; k < EULER_SX; k++) {
-          const double f = wf * ma * s->sx[a * EULER_SX + k];
+        for (int k = 0; k < STATS_PARTS; k++) {
+          const double f = wf * ma * s->sx[a * STATS_PARTS + k];
           Hf[k] += f, Hf1[k] += f * phi_f;
         }
         const double mf = wf * ma, muf = wf * mu;
@@ -826,4 +826,12 @@ void euler_state(struct euler *e, struct state_list *L) {
   f = state_add(L, "stats/eulerian/planes_kinetic", STATE_F64, 3, dk, e->kin, NULL);
   f->reserve = reserve_kin, f->owner = e;
   f->optional = 1; /* format 1.4: before it, rows without the advective part */
+}
+
+void euler_running_result(const struct euler *e, struct euler_result *res) {
+  const size_t rows = euler_rows(e);
+  int *complete = mem_calloc(rows ? rows : 1, sizeof *complete, "Eulerian statistics");
+  for (size_t r = 0; r < rows; r++) complete[r] = r < e->nwin;
+  euler_finalise(&e->cfg, e->win, e->mom, e->snp, e->pln, e->kin, complete, 0, rows, res);
+  free(complete);
 }

@@ -14,14 +14,13 @@
 #ifndef CHANSPH_EULER_H
 #define CHANSPH_EULER_H
 
-#include <mpi.h>
 #include <stddef.h>
 #include <stdint.h>
 
-struct state_list;
+#include "contract.h"
 
-/** Parts of the x-acceleration a snapshot may carry (stats_snapshot.sx). */
-enum { EULER_SX_PRESSURE, EULER_SX_VISCOUS, EULER_SX_MODEL, EULER_SX_WALL, EULER_SX };
+struct state_list;
+struct stats_engine;
 
 /** Per window and profile point, the momentum budget by the method of planes (docs/theory.md,
     "Momentum budget"): snapshots with the parts, then sums over them of the x-momentum flux
@@ -91,46 +90,6 @@ struct euler {
   void *work;                /*!< scratch of euler_sample across ranks (euler.c) */
   size_t nsub;               /*!< column subtrees gathered at the last snapshot (diagnostic) */
   double w1[EULER_W1_N + 1]; /*!< plane-averaged kernel W1(q), q = |y_a - y_i| / h (SPH) */
-};
-
-/**
- * One snapshot of the particles, as plain arrays (the engine never sees solver structs).
- *
- * Across MPI ranks (docs/stats-format.md, "Statistics across ranks"): the arrays hold this
- * rank's owned particles; particle a lies in global cell column col[a] in [col0, col1); the
- * ranks of comm own contiguous column ranges in rank order covering 0 .. ncol - 1; within a
- * column the particles appear in the same order on any decomposition; the scalars are the
- * same on all ranks. The engine state then comes out bitwise identical on every rank and for
- * any number of ranks. col = NULL puts every particle in column col0; with ncol = 0 as well
- * (the layout left unset by an initialiser) the layout is one rank owning column 0.
- * comm = MPI_COMM_NULL (or left zero by an initialiser, or MPI not initialised) is serial and
- * makes no MPI call.
- */
-struct stats_snapshot {
-  size_t n;                   /*!< particles */
-  const double *x, *y, *z;    /*!< positions [m] */
-  const double *u, *v, *w;    /*!< velocities [m/s] */
-  const double *p, *rho, *m;  /*!< pressure [Pa], density [kg/m^3], mass [kg] */
-  const double *ax, *ay, *az; /*!< accelerations without the body force [m/s^2], or NULL */
-  /** Parts of the x-acceleration of the force pass that led to this state, EULER_SX per
-      particle (pressure, molecular viscous and eddy-viscous pair forces of the fluid
-      neighbours, the walls' part) [m/s^2], or NULL: the momentum budget (EULER_PLANES). */
-  const double *sx;
-  const double *nu_t;     /*!< eddy viscosity [m^2/s], or NULL (no LES) */
-  const double *k_r;      /*!< residual kinetic energy [m^2/s^2], or NULL (no LES) */
-  const int64_t *id;      /*!< global ids */
-  const uint8_t *skip;    /*!< nonzero: not a fluid particle, not sampled */
-  double t;               /*!< simulated time [s] */
-  double fx;              /*!< streamwise body acceleration applied [m/s^2] */
-  double dt;              /*!< the step that led to this state [s], or 0: unknown */
-  const double *shift_dy; /*!< y-shift of each particle in that step [m], or NULL (none) */
-  long step;              /*!< step number */
-  double wall_fx[2];      /*!< x-force of the walls y = 0, 2 delta on the fluid [N];
-                               NaN if unknown */
-  const int *col;         /*!< global cell column of each particle, or NULL (all in col0) */
-  int ncol;               /*!< global cell columns along x (0 with col = NULL: serial) */
-  int col0, col1;         /*!< this rank's columns [col0, col1) */
-  MPI_Comm comm;          /*!< ranks sharing the snapshot; MPI_COMM_NULL: serial */
 };
 
 /** Finished profiles: names, units and long names are in euler_prof_meta. */
@@ -252,5 +211,57 @@ void euler_state(struct euler *e, struct state_list *L);
 
 /** @brief Bin centre i of a configuration [m]. */
 double euler_centre(const struct euler_config *cfg, int i);
+
+/** Is it turbulent? Indicators of a finished Eulerian result (wall units of its u_tau). */
+struct euler_turb {
+  double uv_peak;        /*!< peak of -u'v'+ (upper half mirrored) */
+  double y_peak;         /*!< its y+ */
+  double r_uv;           /*!< -u'v' / (u_rms v_rms) averaged over 30 <= y+ <= 100 (about 0.4-0.5
+                              in wall turbulence, near 0 for particle noise) */
+  double resolved_share; /*!< reynolds_stress / total_stress in the bin nearest y+ = 30 */
+  double pair_share;     /*!< pair_stress / total_stress there (the scheme's numerical stress) */
+};
+
+/** @brief The indicators of a result (NaN where not available: no budget, no samples). */
+void euler_turbulence(const struct euler_config *c, const struct euler_result *r,
+                      struct euler_turb *t);
+
+/** A convergence target (scene keys stats.target_*). */
+struct euler_target {
+  double rel_stderr; /*!< target relative standard error (> 0) */
+  int profiles;      /*!< 0: u_mean and the -u'v' peak, 1: u_mean, 2: the -u'v' peak */
+  double corr_ratio; /*!< smallest window length / correlation time (0: none) */
+  int windows;       /*!< fewest complete windows */
+};
+
+/** Where the statistics stand against a target. */
+struct euler_progress {
+  double rel_u;          /*!< max stderr(u_mean) / max |u_mean| (NaN: not yet) */
+  double rel_uv;         /*!< stderr / value of -u'v' at its peak (NaN: not yet) */
+  double worst;          /*!< the largest of the chosen ones (NaN: not yet) */
+  int windows;           /*!< complete windows */
+  double ratio;          /*!< window length / correlation time (NaN: not measured) */
+  double windows_needed; /*!< projected complete windows at the target (stderr ~ n^-1/2) */
+  double t_reach;        /*!< projected simulated time at which they are complete [s] */
+  int met;               /*!< the target is met */
+};
+
+/**
+ * @brief The standard errors against a target, and the projection to reach it (the batch-means
+ *        standard error falls as one over the square root of the number of windows).
+ * @param[in] e the engine, or NULL (not running: everything NaN, not met)
+ */
+void euler_target_progress(const struct euler *e, const struct euler_target *tg,
+                           struct euler_progress *p);
+
+/**
+ * @brief The engine's lines for the log: windows, correlation time, largest standard error of
+ *        u_mean, friction velocities, the shear-stress balance and whether it is turbulent.
+ * @param[out] buf,len the text (ends with a newline; empty if nothing is gathered yet)
+ */
+void euler_log(const struct euler *e, char *buf, size_t len);
+
+/** The engine's table of operations (engine.h; euler_nc.c). */
+extern const struct stats_engine euler_engine;
 
 #endif

@@ -17,15 +17,6 @@
 #include "moments.h"
 #include "ncout.h"
 #include "ncutil.h"
-#include "stats.h"
-
-void euler_running_result(const struct euler *e, struct euler_result *res) {
-  const size_t rows = euler_rows(e);
-  int *complete = mem_calloc(rows ? rows : 1, sizeof *complete, "Eulerian statistics");
-  for (size_t r = 0; r < rows; r++) complete[r] = r < e->nwin;
-  euler_finalise(&e->cfg, e->win, e->mom, e->snp, e->pln, e->kin, complete, 0, rows, res);
-  free(complete);
-}
 
 #define CK(call) NC_TRY(call, fail)
 
@@ -253,12 +244,42 @@ fail:
   return rc ? rc : NC_EINVAL;
 }
 
-static int wanted(const struct stats_config *cfg) {
-  return cfg->eulerian;
+/* The configuration from the scene: default bins are of width dr around each particle layer
+   y = j dr (j = 1 .. 2delta/dr-1), the thin strips next to the walls joining the first and last
+   bins; folded, the layers 1 .. delta/dr; with output.n_bins set: uniform bins between the
+   walls (folded: between the wall and the centre). */
+static void config_of(const struct stats_scene *sc, struct euler_config *e) {
+  memset(e, 0, sizeof *e);
+  const int fold = (int)stats_scene_num(sc, "stats.fold");
+  const double window = stats_scene_num(sc, "stats.window");
+  e->fold = fold, e->delta = sc->delta, e->nu = sc->nu, e->rho0 = sc->rho0;
+  e->area = sc->dim == 3 ? sc->lx * sc->lz : sc->lx;
+  e->t_start = sc->t_average_start;
+  e->les = sc->les;
+  e->method = (int)stats_scene_num(sc, "stats.method"), e->h = sc->h, e->dim = sc->dim;
+  e->window = window > 0.0 ? window : (sc->t_end - sc->t_average_start) / 10;
+  if (!(e->window > 0.0)) e->window = sc->t_end > 0 ? sc->t_end / 10 : 1.0;
+  if (stats_scene_num(sc, "output.n_bins") > 0) {
+    e->nb = sc->bins, e->y0 = 0.0, e->y1 = (fold ? 1.0 : 2.0) * sc->delta;
+  } else if (fold) {
+    e->nb = (int)floor(sc->delta / sc->dr + 0.5), e->y0 = 0.5 * sc->dr;
+    e->y1 = e->y0 + e->nb * sc->dr;
+  } else {
+    e->nb = sc->bins, e->y0 = 0.5 * sc->dr, e->y1 = 2.0 * sc->delta - 0.5 * sc->dr;
+  }
 }
 
-static void init(void *self, const struct stats_config *cfg) {
-  euler_init(self, &cfg->eul);
+/* The engine's table of operations (engine.h). */
+static int init_scene(void *self, const struct stats_scene *sc) {
+  if (!stats_scene_num(sc, "stats.eulerian")) return 0;
+  struct euler_config cfg;
+  config_of(sc, &cfg);
+  euler_init(self, &cfg);
+  return 1;
+}
+
+static void init(void *self, const void *cfg) {
+  euler_init(self, cfg);
 }
 
 static void release(void *self) {
@@ -283,13 +304,18 @@ static int write(const void *self, double t_reached, int ncid, char *err, size_t
   return write_eulerian(self, t_reached, ncid, err, errlen);
 }
 
-const struct stats_engine euler_engine = {"Eulerian profiles",
-                                          offsetof(struct stats, eu),
-                                          wanted,
-                                          init,
-                                          release,
-                                          sample,
-                                          state,
-                                          bytes,
-                                          write,
-                                          NULL};
+static void log_lines(const void *self, char *buf, size_t len) {
+  euler_log(self, buf, len);
+}
+
+const struct stats_engine euler_engine = {.name = "Eulerian profiles",
+                                          .size = sizeof(struct euler),
+                                          .init_scene = init_scene,
+                                          .init = init,
+                                          .free = release,
+                                          .sample = sample,
+                                          .state = state,
+                                          .bytes = bytes,
+                                          .write = write,
+                                          .warnings = NULL,
+                                          .log = log_lines};

@@ -2,7 +2,6 @@
 #include "lagr.h"
 #include "engine.h"
 #include "ncutil.h"
-#include "stats.h"
 
 #include <math.h>
 #include <netcdf.h>
@@ -572,12 +571,26 @@ done:
 }
 
 /* The engine's table of operations (engine.h). */
-static int engine_wanted(const struct stats_config *cfg) {
-  return cfg->lagr.n_levels > 0;
+static int engine_init_scene(void *self, const struct stats_scene *sc) {
+  struct lagr_config c;
+  memset(&c, 0, sizeof c);
+  c.n_levels = stats_scene_levels(sc, "lagrangian.y_plus", c.y_plus, c.y, LAGR_MAX_LEVELS);
+  c.x0 = stats_scene_num(sc, "lagrangian.x0"), c.half = 0.5 * sc->dr, c.lx = sc->lx;
+  c.lz = sc->dim == 3 ? sc->lz : 0.0, c.delta = sc->delta;
+  c.horizon = stats_scene_num(sc, "lagrangian.horizon");
+  c.n_lags = (int)stats_scene_num(sc, "lagrangian.n_lags");
+  c.pdf_bins = (int)stats_scene_num(sc, "lagrangian.pdf_bins");
+  const double every = stats_scene_num(sc, "lagrangian.release_every");
+  c.release_every = every > 0.0 ? every : c.horizon;
+  c.n_stations = stats_scene_list(sc, "lagrangian.pdf_x", c.station, LAGR_MAX_STATIONS);
+  c.t_start = sc->t_average_start;
+  if (!(c.n_levels > 0)) return 0;
+  lagr_init(self, &c);
+  return 1;
 }
 
-static void engine_init(void *self, const struct stats_config *cfg) {
-  lagr_init(self, &cfg->lagr);
+static void engine_init(void *self, const void *cfg) {
+  lagr_init(self, cfg);
 }
 
 static void engine_free(void *self) {
@@ -611,13 +624,14 @@ static int engine_warnings(const void *self, char *buf, size_t len) {
   return lagr_warnings(self, buf, len);
 }
 
-const struct stats_engine lagr_engine = {"Lagrangian statistics",
-                                         offsetof(struct stats, la),
-                                         engine_wanted,
-                                         engine_init,
-                                         engine_free,
-                                         engine_sample,
-                                         engine_state,
-                                         engine_bytes,
-                                         engine_write,
-                                         engine_warnings};
+const struct stats_engine lagr_engine = {.name = "Lagrangian statistics",
+                                         .size = sizeof(struct lagr),
+                                         .init_scene = engine_init_scene,
+                                         .init = engine_init,
+                                         .free = engine_free,
+                                         .sample = engine_sample,
+                                         .state = engine_state,
+                                         .bytes = engine_bytes,
+                                         .write = engine_write,
+                                         .warnings = engine_warnings,
+                                         .log = NULL};

@@ -25,9 +25,10 @@
 
 #include <stddef.h>
 
-#include "euler.h"
+#include "contract.h"
 
 struct state_list;
+struct stats_engine;
 
 enum { LAGR_MAX_LEVELS = 8, LAGR_MAX_STATIONS = 8 };
 
@@ -148,5 +149,8 @@ double lagr_tl(const double *rho, size_t nlag, double dtau);
 
 /** @brief Write group "lagrangian" into an open netCDF-4 file; returns a netCDF status. */
 int lagr_nc_write(const struct lagr *g, int ncid, char *err, size_t errlen);
+
+/** The Lagrangian engine's table of operations (engine.h; lagr.c). */
+extern const struct stats_engine lagr_engine;
 
 #endif

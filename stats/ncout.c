@@ -2,8 +2,6 @@
 #include "ncout.h"
 #include "alloc.h"
 
-#include "stats.h"
-
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
@@ -14,19 +12,10 @@
 #include <string.h>
 #include <unistd.h>
 
-/* On any netCDF failure: record the message, close, remove the temporary file, return 1. */
-#define NC(call)                                                                             \
-  do {                                                                                       \
-    const int nc_rc_ = (call);                                                               \
-    if (nc_rc_ != NC_NOERR) {                                                                \
-      snprintf(err, errlen, "cannot write %s: %s (in %s)", tmp, nc_strerror(nc_rc_), #call); \
-      if (ncid >= 0) nc_close(ncid);                                                         \
-      remove(tmp);                                                                           \
-      return 1;                                                                              \
-    }                                                                                        \
-  } while (0)
+/* The calls of a column file being written: on failure, discard it (ncout.h). */
+#define NC(call) NCOUT_OR_DISCARD(call)
 
-static int put_attrs(int ncid, const struct nc_attr *attrs, int nattrs) {
+int ncout_put_attrs(int ncid, const struct nc_attr *attrs, int nattrs) {
   for (int i = 0; i < nattrs; i++) {
     const long long v = (long long)attrs[i].value;
     const int rc =
@@ -52,7 +41,7 @@ static int def_var(int ncid, const char *name, nc_type type, int ndim, const int
 /* The file is built in memory (nc_create_mem) and written here with plain POSIX calls, so that a
    full disk or a file-size limit is an error message, not a failure inside HDF5's close (which
    HDF5 1.10 does not survive). Write the image to tmp, make it durable, move it into place. */
-static int commit(int ncid, const char *tmp, const char *path, char *err, size_t errlen) {
+int ncout_commit(int ncid, const char *tmp, const char *path, char *err, size_t errlen) {
   NC_memio mem = {0, NULL, 0};
   const int rc = nc_close_memio(ncid, &mem);
   if (rc != NC_NOERR) {
@@ -136,53 +125,6 @@ int ncout_bounds(int ncid, const char *name, int varid, int dimid, const char *u
   return rc;
 }
 
-int ncout_stats(const char *path, const struct stats *st, const struct series *ts,
-                const struct nc_attr *attrs, int nattrs, char *err, size_t errlen) {
-  char tmp[4096];
-  snprintf(tmp, sizeof tmp, "%s.tmp", path);
-  int ncid = -1, dt;
-  NC(nc_create_mem(tmp, NC_NETCDF4, 1 << 20, &ncid));
-  NC(nc_put_att_text(ncid, NC_GLOBAL, "Conventions", 6, "CF-1.8"));
-  NC(nc_put_att_text(ncid, NC_GLOBAL, "title", 36, "chansph channel-flow statistics file"));
-  NC(nc_put_att_text(ncid, NC_GLOBAL, "source", 7, "chansph"));
-  NC(put_attrs(ncid, attrs, nattrs));
-  /* the engines: profiles (dimension y), groups of raw accumulators */
-  char eerr[1024] = "";
-  const int erc = stats_nc_write(st, ncid, eerr, sizeof eerr);
-  if (erc != NC_NOERR) {
-    snprintf(err, errlen, "cannot write %s: %s", tmp, eerr);
-    nc_close(ncid), remove(tmp);
-    return 1;
-  }
-  /* time series, column by column, on the unlimited dimension time */
-  NC(nc_def_dim(ncid, "time", NC_UNLIMITED, &dt));
-  int *vts = mem_alloc(1, (size_t)ts->ncol * sizeof *vts, "netCDF output");
-  double *col = mem_alloc(1, (ts->n ? ts->n : 1) * sizeof *col, "netCDF output");
-  int rc = NC_NOERR;
-  for (int c = 0; c < ts->ncol && rc == NC_NOERR; c++) {
-    rc = def_var(ncid, ts->names[c], NC_DOUBLE, 1, &dt, ts->units[c],
-                 ts->long_names ? ts->long_names[c] : NULL, &vts[c]);
-    /* simulated time from the initial condition: no calendar date to refer to, so plain
-       seconds (udunits "s", what xarray keeps as float seconds) and the origin in words
-       (docs/stats-format.md) */
-    static const char ref[] =
-        "t = 0 is the initial condition of the run (simulated time, not a "
-        "calendar date)";
-    if (rc == NC_NOERR && c == 0) rc = nc_put_att_text(ncid, vts[c], "standard_name", 4, "time");
-    if (rc == NC_NOERR && c == 0) rc = nc_put_att_text(ncid, vts[c], "axis", 1, "T");
-    if (rc == NC_NOERR && c == 0) rc = nc_put_att_text(ncid, vts[c], "reference", strlen(ref), ref);
-    if (rc == NC_NOERR && c > 0) rc = ncout_fill(ncid, vts[c]);
-  }
-  for (int c = 0; c < ts->ncol && rc == NC_NOERR && ts->n; c++) {
-    for (size_t r = 0; r < ts->n; r++) col[r] = ts->data[r * (size_t)ts->ncol + c];
-    const size_t start = 0, count = ts->n;
-    rc = ncout_put_filled(ncid, vts[c], &start, &count, col, ts->n);
-  }
-  free(col), free(vts);
-  NC(rc);
-  return commit(ncid, tmp, path, err, errlen);
-}
-
 int ncout_columns(const char *path, const char *title, const char *dim, size_t n, int ncol,
                   const char *const *names, const char *const *long_names, const char *const *units,
                   const double *const *cols, const long long *ids, const struct nc_attr *attrs,
@@ -208,11 +150,11 @@ int ncout_columns(const char *path, const char *title, const char *dim, size_t n
     if (rc != NC_NOERR) free(v);
     NC(rc);
   }
-  int rc = put_attrs(ncid, attrs, nattrs);
+  int rc = ncout_put_attrs(ncid, attrs, nattrs);
   if (rc == NC_NOERR) rc = nc_enddef(ncid);
   if (rc == NC_NOERR && ids) rc = nc_put_var_longlong(ncid, vid, ids);
   for (int c = 0; c < ncol && rc == NC_NOERR; c++) rc = nc_put_var_double(ncid, v[c], cols[c]);
   free(v);
   NC(rc);
-  return commit(ncid, tmp, path, err, errlen);
+  return ncout_commit(ncid, tmp, path, err, errlen);
 }

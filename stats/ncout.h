@@ -1,17 +1,17 @@
 /**
  * @file ncout.h
- * @brief netCDF-4 output: stats.nc (profiles + time series + run attributes) and column files
- *        (particle snapshots). Files are written to NAME.tmp, synced and renamed, so a reader
- *        or a crash never sees a half-written file and the previous version survives a failure.
+ * @brief The low-level netCDF-4 helpers of chansph's files (CF variables, fill values, labels,
+ *        cell bounds, global attributes, the atomic commit) and the column files (particle
+ *        snapshots). Files are built in memory, written to NAME.tmp, synced and renamed, so a
+ *        reader or a crash never sees a half-written file and the previous version survives a
+ *        failure. The stats.nc writer is stats_nc.h; this file knows no engine.
  */
 #ifndef CHANSPH_NCOUT_H
 #define CHANSPH_NCOUT_H
 
+#include <netcdf.h>
 #include <stddef.h>
-
-#include "series.h"
-
-struct stats;
+#include <stdio.h>
 
 /** A global attribute: text if text != NULL, else a double, or a 64-bit integer if integer. */
 struct nc_attr {
@@ -21,18 +21,33 @@ struct nc_attr {
   int integer; /*!< 1: a count or flag, written as an int64 */
 };
 
+/** Run a netCDF call of a file being written to tmp (ncid, or -1); on failure store "cannot
+    write TMP: message (in call)" in err (errlen bytes), close the file, remove tmp and return 1
+    from the calling function. */
+#define NCOUT_OR_DISCARD(call)                                                               \
+  do {                                                                                       \
+    const int nc_rc_ = (call);                                                               \
+    if (nc_rc_ != NC_NOERR) {                                                                \
+      snprintf(err, errlen, "cannot write %s: %s (in %s)", tmp, nc_strerror(nc_rc_), #call); \
+      if (ncid >= 0) nc_close(ncid);                                                         \
+      remove(tmp);                                                                           \
+      return 1;                                                                              \
+    }                                                                                        \
+  } while (0)
+
 /**
- * @brief Write stats.nc atomically.
- * @param[in] path final file name
- * @param[in] st statistics engine (its variables and groups, stats_nc_write)
- * @param[in] ts time series (unlimited dimension time; column 0 must be the time)
- * @param[in] attrs,nattrs global attributes
- * @param[out] err message buffer (filled on failure)
- * @param[in] errlen its size
- * @return 0 on success, nonzero on failure (the previous file is left untouched)
+ * @brief Put global attributes.
+ * @return a netCDF status
  */
-int ncout_stats(const char *path, const struct stats *st, const struct series *ts,
-                const struct nc_attr *attrs, int nattrs, char *err, size_t errlen);
+int ncout_put_attrs(int ncid, const struct nc_attr *attrs, int nattrs);
+
+/**
+ * @brief Close a file built in memory (nc_create_mem), write its image to tmp, make it durable
+ *        and rename it to path; on failure tmp is removed and an earlier path is kept.
+ * @param[out] err,errlen message on failure
+ * @return 0 on success, 1 on failure
+ */
+int ncout_commit(int ncid, const char *tmp, const char *path, char *err, size_t errlen);
 
 /**
  * @brief Write named double columns along one dimension atomically (e.g. particles.nc).

@@ -2,7 +2,6 @@
 #include "quad.h"
 #include "engine.h"
 #include "ncutil.h"
-#include "stats.h"
 
 #include <math.h>
 #include <netcdf.h>
@@ -176,12 +175,18 @@ done:
 }
 
 /* The engine's table of operations (engine.h). */
-static int engine_wanted(const struct stats_config *cfg) {
-  return cfg->quad.n_levels > 0;
+static int engine_init_scene(void *self, const struct stats_scene *sc) {
+  struct quad_config c;
+  memset(&c, 0, sizeof c);
+  c.n_levels = stats_scene_levels(sc, "quadrants.y_plus", c.y_plus, c.y, QUAD_MAX_LEVELS);
+  c.half = 0.5 * sc->dr, c.delta = sc->delta, c.t_start = sc->t_average_start;
+  if (!(c.n_levels > 0)) return 0;
+  quad_init(self, &c);
+  return 1;
 }
 
-static void engine_init(void *self, const struct stats_config *cfg) {
-  quad_init(self, &cfg->quad);
+static void engine_init(void *self, const void *cfg) {
+  quad_init(self, cfg);
 }
 
 static void engine_free(void *self) {
@@ -207,8 +212,14 @@ static int engine_write(const void *self, double t_reached, int ncid, char *err,
   return quad_nc_write(self, ncid, err, errlen);
 }
 
-const struct stats_engine quad_engine = {"quadrant analysis", offsetof(struct stats, qu),
-                                         engine_wanted,       engine_init,
-                                         engine_free,         engine_sample,
-                                         engine_state,        engine_bytes,
-                                         engine_write,        NULL};
+const struct stats_engine quad_engine = {.name = "quadrant analysis",
+                                         .size = sizeof(struct quad),
+                                         .init_scene = engine_init_scene,
+                                         .init = engine_init,
+                                         .free = engine_free,
+                                         .sample = engine_sample,
+                                         .state = engine_state,
+                                         .bytes = engine_bytes,
+                                         .write = engine_write,
+                                         .warnings = NULL,
+                                         .log = NULL};

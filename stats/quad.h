@@ -22,6 +22,7 @@
 
 struct stats_snapshot;
 struct state_list;
+struct stats_engine;
 
 enum { QUAD_MAX_LEVELS = 8 };
 /** Accumulator slots per level: u'v' sums of Q1..Q4, then the counts of Q1..Q4. */
@@ -63,5 +64,8 @@ void quad_state(struct quad *q, struct state_list *L);
 
 /** @brief Define and write the group `quadrants` of stats.nc (netCDF status, message in err). */
 int quad_nc_write(const struct quad *q, int ncid, char *err, size_t errlen);
+
+/** The quadrant engine's table of operations (engine.h; quad.c). */
+extern const struct stats_engine quad_engine;
 
 #endif

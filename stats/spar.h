@@ -16,7 +16,7 @@
 #include <mpi.h>
 #include <stddef.h>
 
-#include "euler.h"
+#include "contract.h"
 
 /** The layout of one snapshot across the ranks. */
 struct spar {

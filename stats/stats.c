@@ -1,191 +1,96 @@
-/** @file stats.c @brief Implementation of stats.h. */
+/** @file stats.c @brief Implementation of stats.h: the engines through their table of
+    operations (engine.h), none of them by name. */
 #include "stats.h"
-#include "ncutil.h"
 
 #include <math.h>
-#include <netcdf.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "alloc.h"
-#include "engine.h"
-#include "moments.h"
-#include "ncout.h"
+#include "error.h"
 #include "state.h"
 
-/* The engines, in the order they are initialised, sampled, checkpointed and written. */
-static const struct stats_engine *const engines[] = {&euler_engine, &corr_engine, &lagr_engine,
-                                                     &quad_engine};
-enum { N_ENGINES = sizeof engines / sizeof engines[0] };
-
-static void *self_of(struct stats *st, const struct stats_engine *e) {
-  return (char *)st + e->offset;
-}
-
-static const void *cself_of(const struct stats *st, const struct stats_engine *e) {
-  return (const char *)st + e->offset;
-}
-
-void stats_init(struct stats *st, const struct stats_config *cfg) {
+void stats_init(struct stats *st, const struct stats_scene *sc) {
   memset(st, 0, sizeof *st);
-  st->cfg = *cfg;
   st->t_reached = NAN;
-  for (int k = 0; k < N_ENGINES; k++)
-    if (engines[k]->wanted(cfg)) engines[k]->init(self_of(st, engines[k]), cfg);
+  for (int k = 0; k < stats_n_engines && sc; k++) {
+    const struct stats_engine *e = stats_engines[k];
+    void *self = mem_calloc(1, e->size, e->name);
+    if (e->init_scene(self, sc))
+      st->self[k] = self;
+    else
+      free(self);
+  }
+}
+
+/* The place of e in stats_engines. */
+static int index_of(const struct stats_engine *e) {
+  for (int k = 0; k < stats_n_engines; k++)
+    if (stats_engines[k] == e) return k;
+  die("statistics engine %s is not in stats_engines (engines.c)", e->name);
+  return -1;
+}
+
+void stats_add(struct stats *st, const struct stats_engine *e, const void *cfg) {
+  const int k = index_of(e);
+  if (st->self[k]) e->free(st->self[k]), free(st->self[k]);
+  st->self[k] = mem_calloc(1, e->size, e->name);
+  e->init(st->self[k], cfg);
+}
+
+void *stats_find(const struct stats *st, const struct stats_engine *e) {
+  return st->self[index_of(e)];
 }
 
 void stats_free(struct stats *st) {
-  for (int k = 0; k < N_ENGINES; k++)
-    if (engines[k]->wanted(&st->cfg)) engines[k]->free(self_of(st, engines[k]));
+  for (int k = 0; k < stats_n_engines; k++)
+    if (st->self[k]) stats_engines[k]->free(st->self[k]), free(st->self[k]);
   memset(st, 0, sizeof *st);
 }
 
 int stats_wanted(const struct stats *st) {
-  for (int k = 0; k < N_ENGINES; k++)
-    if (engines[k]->wanted(&st->cfg)) return 1;
+  for (int k = 0; k < stats_n_engines; k++)
+    if (st->self[k]) return 1;
   return 0;
 }
 
 void stats_sample(struct stats *st, const struct stats_snapshot *s) {
-  for (int k = 0; k < N_ENGINES; k++)
-    if (engines[k]->wanted(&st->cfg)) engines[k]->sample(self_of(st, engines[k]), s);
+  for (int k = 0; k < stats_n_engines; k++)
+    if (st->self[k]) stats_engines[k]->sample(st->self[k], s);
   st->samples++;
 }
 
 void stats_state(struct stats *st, struct state_list *L) {
   state_add(L, "stats/samples", STATE_I64, 0, NULL, &st->samples, NULL);
-  for (int k = 0; k < N_ENGINES; k++)
-    if (engines[k]->wanted(&st->cfg)) engines[k]->state(self_of(st, engines[k]), L);
+  for (int k = 0; k < stats_n_engines; k++)
+    if (st->self[k]) stats_engines[k]->state(st->self[k], L);
 }
 
 size_t stats_memory(const struct stats *st) {
   size_t b = 0;
-  for (int k = 0; k < N_ENGINES; k++)
-    if (engines[k]->wanted(&st->cfg)) b += engines[k]->bytes(cself_of(st, engines[k]));
+  for (int k = 0; k < stats_n_engines; k++)
+    if (st->self[k]) b += stats_engines[k]->bytes(st->self[k]);
   return b;
 }
 
 int stats_warnings(const struct stats *st, char *buf, size_t len) {
   buf[0] = '\0';
   int n = 0;
-  for (int k = 0; k < N_ENGINES; k++) {
-    const struct stats_engine *e = engines[k];
-    if (!e->warnings || !e->wanted(&st->cfg)) continue;
+  for (int k = 0; k < stats_n_engines; k++) {
+    const struct stats_engine *e = stats_engines[k];
+    if (!e->warnings || !st->self[k]) continue;
     const size_t used = strlen(buf);
-    n += e->warnings(cself_of(st, e), buf + used, len - used);
+    n += e->warnings(st->self[k], buf + used, len - used);
   }
   return n;
 }
 
-void stats_progress(const struct stats *st, const struct stats_target *tg,
-                    struct stats_progress *p) {
-  memset(p, 0, sizeof *p);
-  p->rel_u = p->rel_uv = p->worst = p->ratio = p->windows_needed = p->t_reach = NAN;
-  if (!st->cfg.eulerian || euler_rows(&st->eu) == 0) return;
-  struct euler_result r;
-  euler_running_result(&st->eu, &r);
-  double se = 0.0, umax = 0.0, uv = 0.0, se_uv = NAN;
-  for (int b = 0; b < r.nb; b++) {
-    if (isfinite(r.prof[EP_SE_U][b])) se = fmax(se, r.prof[EP_SE_U][b]);
-    if (isfinite(r.prof[EP_U][b])) umax = fmax(umax, fabs(r.prof[EP_U][b]));
-    if (isfinite(r.prof[EP_UV][b]) && fabs(r.prof[EP_UV][b]) > uv)
-      uv = fabs(r.prof[EP_UV][b]), se_uv = r.prof[EP_SE_U + 8][b]; /* stderr of uv */
-  }
-  p->windows = r.n_batches;
-  const double win = st->cfg.eul.window;
-  p->ratio = win / r.corr_time;
-  if (r.n_batches >= 2) {
-    p->rel_u = umax > 0.0 ? se / umax : NAN;
-    p->rel_uv = uv > 0.0 ? se_uv / uv : NAN;
-    p->worst = tg->profiles == 1   ? p->rel_u
-               : tg->profiles == 2 ? p->rel_uv
-                                   : fmax(p->rel_u, p->rel_uv);
-    if (tg->profiles == 0 && (isnan(p->rel_u) || isnan(p->rel_uv))) p->worst = NAN;
-  }
-  if (isfinite(p->worst)) {
-    const double q = p->worst / tg->rel_stderr;
-    p->windows_needed = fmax((double)tg->windows, ceil(r.n_batches * q * q));
-    p->t_reach = st->eu.win[WIN_T0] + p->windows_needed * win;
-  }
-  p->met = r.n_batches >= tg->windows && isfinite(p->worst) && p->worst <= tg->rel_stderr &&
-           (tg->corr_ratio <= 0.0 || p->ratio >= tg->corr_ratio);
-  euler_result_free(&r);
-}
-
-void stats_turbulence(const struct euler_config *c, const struct euler_result *r,
-                      struct stats_turb *t) {
-  const double ut = r->u_tau > 0.0 ? r->u_tau : r->u_tau_force, ut2 = ut * ut;
-  t->uv_peak = t->y_peak = t->r_uv = t->pair_share = t->resolved_share = NAN;
-  double rsum = 0.0, best = INFINITY;
-  int rn = 0;
-  for (int b = 0; b < r->nb; b++) {
-    const double y = r->prof[EP_Y_MEAN][b], up = !c->fold && y > c->delta;
-    const double yp = (up ? 2.0 * c->delta - y : y) * ut / c->nu;
-    const double muv = (up ? 1.0 : -1.0) * r->prof[EP_UV][b]; /* -u'v' towards the centre */
-    if (!isfinite(muv) || !(ut2 > 0.0)) continue;
-    if (!(muv / ut2 <= t->uv_peak)) t->uv_peak = muv / ut2, t->y_peak = yp;
-    const double rms = sqrt(r->prof[EP_UU][b] * r->prof[EP_VV][b]);
-    if (yp >= 30.0 && yp <= 100.0 && rms > 0.0) rsum += muv / rms, rn++;
-    const double tot = r->prof[EP_TOTAL][b];
-    if (r->budget && fabs(yp - 30.0) < best && fabs(tot) > 0.0) { /* the bin nearest y+ = 30 */
-      best = fabs(yp - 30.0);
-      t->pair_share = r->prof[EP_TAU_PAIR][b] / tot;
-      t->resolved_share = r->prof[EP_TAU_REYNOLDS][b] / tot;
-    }
-  }
-  if (rn) t->r_uv = rsum / rn;
-}
-
 void stats_convergence_line(const struct stats *st, char *buf, size_t len) {
   buf[0] = '\0';
-  if (!st->cfg.eulerian || euler_rows(&st->eu) == 0) return;
-  struct euler_result r;
-  euler_running_result(&st->eu, &r);
-  double se = 0.0, umax = 0.0;
-  for (int b = 0; b < r.nb; b++) {
-    if (isfinite(r.prof[EP_SE_U][b])) se = fmax(se, r.prof[EP_SE_U][b]);
-    if (isfinite(r.prof[EP_U][b])) umax = fmax(umax, fabs(r.prof[EP_U][b]));
+  for (int k = 0; k < stats_n_engines; k++) {
+    const struct stats_engine *e = stats_engines[k];
+    if (!e->log || !st->self[k]) continue;
+    const size_t used = strlen(buf);
+    e->log(st->self[k], buf + used, len - used);
   }
-  const double win = st->cfg.eul.window;
-  snprintf(buf, len,
-           "stats: %d complete windows of %.4g s, %.0f snapshots; correlation time %.3g s "
-           "(window/corr %.3g); max stderr(u_mean) %.3g m/s (%.3g%% of max u_mean); "
-           "u_tau wall %.6g force %.6g; stress balance error %.3g%s\n",
-           r.n_batches, win, r.snapshots, r.corr_time, win / r.corr_time, se,
-           umax > 0 ? 100 * se / umax : NAN, r.u_tau_wall, r.u_tau_force, r.balance_error,
-           r.n_batches < 2           ? " (fewer than 2 windows: no error bars yet)"
-           : win < 5.0 * r.corr_time ? " (windows shorter than 5 correlation times: error bars "
-                                       "too small; increase stats.window)"
-                                     : "");
-  /* is it turbulent? the -u'v' peak and R_uv of the last window, the budget's split at y+ 30 */
-  struct stats_turb all, last;
-  stats_turbulence(&st->cfg.eul, &r, &all);
-  euler_result_free(&r);
-  const struct euler *e = &st->eu;
-  const size_t rows = euler_rows(e), r0 = e->nwin > 0 ? e->nwin - 1 : 0; /* last complete */
-  int *complete = mem_alloc(rows, sizeof(int), "Eulerian statistics");
-  for (size_t w = 0; w < rows; w++) complete[w] = w < e->nwin;
-  euler_finalise(&e->cfg, e->win, e->mom, e->snp, e->pln, e->kin, complete, r0, r0 + 1, &r);
-  stats_turbulence(&st->cfg.eul, &r, &last);
-  euler_result_free(&r);
-  free(complete);
-  const size_t used = strlen(buf);
-  if (used > 0 && used < len) buf[used - 1] = ';';
-  snprintf(buf + used, len - used,
-           " turbulence (last window): -u'v'+ peak %.3g at y+ %.3g, R_uv(30<y+<100) %.3g; "
-           "average -u'v'+ peak %.3g; stress at y+ 30: resolved %.0f%%, pair (numerical) "
-           "%.0f%%\n",
-           last.uv_peak, last.y_peak, last.r_uv, all.uv_peak, 100.0 * all.resolved_share,
-           100.0 * all.pair_share);
-}
-
-int stats_nc_write(const struct stats *st, int ncid, char *err, size_t errlen) {
-  for (int k = 0; k < N_ENGINES; k++) {
-    const struct stats_engine *e = engines[k];
-    if (!e->wanted(&st->cfg)) continue;
-    const int rc = e->write(cself_of(st, e), st->t_reached, ncid, err, errlen);
-    if (rc) return rc;
-  }
-  return NC_NOERR;
 }

@@ -15,6 +15,7 @@
 #include "moments.h"
 #include "state.h"
 #include "stats.h"
+#include "stats_setup.h"
 
 static int failures = 0;
 
@@ -269,8 +270,8 @@ static void feed_all(struct stats *st, long s0, long s1, double *buf) {
   }
 }
 
-static struct stats_config all_engines(void) {
-  struct stats_config c = {.eulerian = 1, .eul = config()};
+static struct test_stats_config all_engines(void) {
+  struct test_stats_config c = {.eulerian = 1, .eul = config()};
   c.corr = (struct corr_config){.n_levels = 2,
                                 .y = {0.5, 0.25},
                                 .nx = 8,
@@ -298,11 +299,11 @@ static struct stats_config all_engines(void) {
 /* Acceptance 3 (engine side): serialise -> restore in a fresh engine -> continue gives the
    same state, field by field and bit for bit, as never stopping (all three engines). */
 static void test_round_trip(double *buf) {
-  const struct stats_config cfg = all_engines();
+  const struct test_stats_config cfg = all_engines();
   struct stats a, b, c;
-  stats_init(&a, &cfg);
+  test_stats_init(&a, &cfg);
   feed_all(&a, 0, 137, buf);
-  stats_init(&b, &cfg);
+  test_stats_init(&b, &cfg);
   feed_all(&b, 0, 61, buf);
   struct state_list L = {0};
   stats_state(&b, &L);
@@ -310,7 +311,7 @@ static void test_round_trip(double *buf) {
   save(&L, &sv);
   state_free(&L);
   stats_free(&b);
-  stats_init(&c, &cfg);
+  test_stats_init(&c, &cfg);
   stats_state(&c, &L);
   restore(&L, &sv);
   state_free(&L);
@@ -326,11 +327,12 @@ static void test_round_trip(double *buf) {
     if (!same) printf("field %s differs\n", fa->name);
   }
   EXPECT(same, "state after a round trip differs from the uninterrupted run");
-  EXPECT(a.la.releases > 2 && a.la.ntracks > 0, "Lagrangian engine idle in the round trip");
+  const struct lagr *la = test_la(&a);
+  EXPECT(la->releases > 2 && la->ntracks > 0, "Lagrangian engine idle in the round trip");
   printf(
       "state round trip after 61 of 137 snapshots (%d fields, Eulerian, correlations, "
       "Lagrangian with %g releases done and %zu tracks active): %s\n",
-      La.n, a.la.releases, a.la.ntracks, same ? "bitwise identical" : "DIFFERENT");
+      La.n, la->releases, la->ntracks, same ? "bitwise identical" : "DIFFERENT");
   for (int i = 0; i < sv.n; i++) free(sv.data[i]);
   state_free(&La), state_free(&Lc);
   stats_free(&c);
@@ -624,7 +626,7 @@ static void test_budget_identity(void) {
     cfg.y1 = fold ? 1.0 + 0.5 / (NBB - 0.5) : 2.0; /* folded: the last bin is centred on delta */
     struct euler e;
     euler_init(&e, &cfg);
-    static double y[NPB], u[NPB], v[NPB], w[NPB], p[NPB], rho[NPB], m[NPB], sx[NPB * EULER_SX];
+    static double y[NPB], u[NPB], v[NPB], w[NPB], p[NPB], rho[NPB], m[NPB], sx[NPB * STATS_PARTS];
     for (long s = 0; s * dt <= T + 1e-12; s++) {
       const double t = s * dt;
       for (int a = 0; a < NPB; a++) {
@@ -636,8 +638,8 @@ static void test_budget_identity(void) {
         const double ub = 1.0 + 2.0 * y0, du = 0.5 + uniform(10 * a + 5), lag = 0.4;
         y[a] = y0 + amp * sin(om * t + ph), v[a] = amp * om * cos(om * t + ph);
         u[a] = ub - du * sin(om * t + ph - lag); /* u' anti-correlated with v */
-        for (int k = 0; k < EULER_SX; k++) sx[a * EULER_SX + k] = 0.0;
-        sx[a * EULER_SX] = -du * om * cos(om * t + ph - lag);
+        for (int k = 0; k < STATS_PARTS; k++) sx[a * STATS_PARTS + k] = 0.0;
+        sx[a * STATS_PARTS] = -du * om * cos(om * t + ph - lag);
         w[a] = 0.0, p[a] = 0.0, rho[a] = 1000.0, m[a] = 2.0;
       }
       const struct stats_snapshot snap = {.n = NPB,

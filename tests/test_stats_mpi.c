@@ -22,6 +22,8 @@
 #include "moments.h"
 #include "state.h"
 #include "stats.h"
+#include "stats_nc.h"
+#include "stats_setup.h"
 
 static int failures = 0;
 
@@ -221,8 +223,8 @@ static void range_of(int r, int p, int ncol, int *c0, int *c1) {
   *c0 = b[r], *c1 = b[r + 1];
 }
 
-static struct stats_config config_a(void) { /* bins, not folded, LES; corr and Lagrangian */
-  struct stats_config c = {.eulerian = 1};
+static struct test_stats_config config_a(void) { /* bins, not folded, LES; corr and Lagrangian */
+  struct test_stats_config c = {.eulerian = 1};
   c.eul = (struct euler_config){.nb = 16,
                                 .y0 = 0.0,
                                 .y1 = 2.0,
@@ -264,8 +266,9 @@ static struct stats_config config_a(void) { /* bins, not folded, LES; corr and L
   return c;
 }
 
-static struct stats_config config_b(void) { /* SPH interpolation, folded; release plane x0 = 0 */
-  struct stats_config c = config_a();
+static struct test_stats_config config_b(
+    void) { /* SPH interpolation, folded; release plane x0 = 0 */
+  struct test_stats_config c = config_a();
   c.eul.method = EULER_SPH, c.eul.fold = 1, c.eul.h = 0.08, c.eul.les = 0, c.eul.nb = 20;
   c.eul.y1 = 1.0;
   c.corr.n_levels = 1, c.corr.y[0] = 0.5, c.corr.nz = 1;
@@ -392,14 +395,14 @@ static int compare_nc(const char *pa, const char *pb, int *nvar) {
 
 /* One configuration: nsnap snapshots to the distributed engine and, on rank 0, to the serial
    references; then the comparisons. */
-static void run_check(const char *name, const struct stats_config *cfg, size_t nf, size_t nw,
+static void run_check(const char *name, const struct test_stats_config *cfg, size_t nf, size_t nw,
                       int ncol, long nsnap, uint64_t seed) {
   struct world W;
   world_init(&W, nf, nw, ncol, cfg->corr.lx, cfg->corr.lz);
   struct local Lp = {0}, Ls = {0};
   struct stats par, self, null;
-  stats_init(&par, cfg);
-  if (rank_g == 0) stats_init(&self, cfg), stats_init(&null, cfg);
+  test_stats_init(&par, cfg);
+  if (rank_g == 0) test_stats_init(&self, cfg), test_stats_init(&null, cfg);
   int c0, c1;
   range_of(rank_g, size_g, ncol, &c0, &c1);
   for (long s = 0; s < nsnap; s++) {
@@ -425,14 +428,17 @@ static void run_check(const char *name, const struct stats_config *cfg, size_t n
     EXPECT(d1 == 0, "%s: %d state fields differ from the serial run", name, d1);
     EXPECT(d2 == 0, "%s: MPI_COMM_NULL differs from MPI_COMM_SELF in %d fields", name, d2);
     /* the engines did work */
+    const struct euler *eu = test_eu(&par);
+    const struct corr *co = test_co(&par);
+    const struct lagr *la = test_la(&par);
     double pdf_n = 0.0; /* station crossings over all levels and stations */
     for (int k = 0; k < cfg->lagr.n_levels * cfg->lagr.n_stations; k++)
-      pdf_n += par.la.pdf[(size_t)k * (size_t)(cfg->lagr.pdf_bins + 3) + cfg->lagr.pdf_bins];
-    EXPECT(par.eu.nwin >= 2, "%s: %zu windows", name, par.eu.nwin);
-    EXPECT(par.co.samples[0] > 0, "%s: no correlation planes", name);
-    EXPECT(par.la.releases >= 2 && par.la.ntracks > 0 && pdf_n > 0,
-           "%s: Lagrangian idle (%g releases, %zu tracks, %g crossings)", name, par.la.releases,
-           par.la.ntracks, pdf_n);
+      pdf_n += la->pdf[(size_t)k * (size_t)(cfg->lagr.pdf_bins + 3) + cfg->lagr.pdf_bins];
+    EXPECT(eu->nwin >= 2, "%s: %zu windows", name, eu->nwin);
+    EXPECT(co->samples[0] > 0, "%s: no correlation planes", name);
+    EXPECT(la->releases >= 2 && la->ntracks > 0 && pdf_n > 0,
+           "%s: Lagrangian idle (%g releases, %zu tracks, %g crossings)", name, la->releases,
+           la->ntracks, pdf_n);
     char pa[256], pb[256];
     snprintf(pa, sizeof pa, "stats_mpi_%s_np%d.nc", name, size_g);
     snprintf(pb, sizeof pb, "stats_mpi_%s_np%d_serial.nc", name, size_g);
@@ -451,8 +457,8 @@ static void run_check(const char *name, const struct stats_config *cfg, size_t n
         "%s on %d rank(s), %d columns, %zu particles x %ld snapshots: state %s to the serial "
         "run (%zu windows, %g correlation planes, %g releases, %zu tracks, %g station "
         "crossings), the same on every rank: %s; stats.nc: %d variables %s\n",
-        name, size_g, ncol, W.n, nsnap, d1 ? "DIFFERENT" : "bitwise identical", par.eu.nwin,
-        par.co.samples[0], par.la.releases, par.la.ntracks, pdf_n, across ? "NO" : "yes", nvar,
+        name, size_g, ncol, W.n, nsnap, d1 ? "DIFFERENT" : "bitwise identical", eu->nwin,
+        co->samples[0], la->releases, la->ntracks, pdf_n, across ? "NO" : "yes", nvar,
         dn ? "DIFFERENT" : "bitwise identical");
     stats_free(&self), stats_free(&null);
   }
@@ -465,7 +471,7 @@ static void run_check(const char *name, const struct stats_config *cfg, size_t n
    correlation levels on 50 x 25, two Lagrangian levels. Time of stats_sample per snapshot. */
 static void run_bench(void) {
   const int ncol = 38, nsnap = 30;
-  struct stats_config cfg = config_a();
+  struct test_stats_config cfg = config_a();
   cfg.eul.nb = 32, cfg.eul.window = 0.25, cfg.eul.t_start = 0.0;
   cfg.corr.lx = 3.125, cfg.corr.lz = 1.5625, cfg.corr.nx = 50, cfg.corr.nz = 25;
   cfg.corr.half = 0.03125, cfg.corr.t_start = 0.0;
@@ -484,12 +490,12 @@ static void run_bench(void) {
   int c0, c1;
   range_of(rank_g, size_g, ncol, &c0, &c1);
   for (size_t k = 0; k < sizeof parts / sizeof parts[0]; k++) {
-    struct stats_config c = cfg;
+    struct test_stats_config c = cfg;
     c.eulerian = parts[k].eul;
     if (!parts[k].corr) c.corr.n_levels = 0;
     if (!parts[k].lagr) c.lagr.n_levels = 0;
     struct stats st;
-    stats_init(&st, &c);
+    test_stats_init(&st, &c);
     double tsum = 0.0, tmax = 0.0;
     size_t gathered = 0;
     for (long s = 0; s < nsnap; s++) {
@@ -503,9 +509,10 @@ static void run_bench(void) {
       double dt = MPI_Wtime() - t0, dmax;
       MPI_Allreduce(&dt, &dmax, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
       tsum += dmax, tmax = fmax(tmax, dmax);
-      gathered += (parts[k].eul && size_g > 1 ? st.eu.nsub * (size_t)c.eul.nb * (MOM_LEN + 2) : 0) +
-                  (parts[k].corr && size_g > 1 ? st.co.nall * CORR_ENT : 0) +
-                  (parts[k].lagr && size_g > 1 ? st.la.nall * LAGR_REC : 0);
+      gathered +=
+          (parts[k].eul && size_g > 1 ? test_eu(&st)->nsub * (size_t)c.eul.nb * (MOM_LEN + 2) : 0) +
+          (parts[k].corr && size_g > 1 ? test_co(&st)->nall * CORR_ENT : 0) +
+          (parts[k].lagr && size_g > 1 ? test_la(&st)->nall * LAGR_REC : 0);
     }
     if (rank_g == 0)
       printf(
@@ -528,7 +535,7 @@ int main(int argc, char **argv) {
     MPI_Finalize();
     return 0;
   }
-  const struct stats_config a = config_a(), b = config_b();
+  const struct test_stats_config a = config_a(), b = config_b();
   run_check("bins", &a, 6000, 400, 13, 60, 1234567);
   run_check("sph_folded", &b, 5000, 300, 11, 50, 7654321);
   run_check("three_columns", &a, 3000, 200, 3, 40, 424242); /* empty ranges on 4 ranks */

@@ -1,0 +1,121 @@
+/**
+ * @file contract.h
+ * @brief The statistics contract: everything the solver hands the statistics engines, and
+ *        nothing an engine owns. One snapshot of the particles (struct stats_snapshot), the
+ *        parts of the x-acceleration a snapshot may carry (enum stats_part, which the solver's
+ *        per-particle parts of part.h are defined from), and the scene as the engines see it
+ *        (struct stats_scene: the channel's values, and the engines' own keys by name).
+ *
+ * The engines include this header, base headers and their own; never an engine's header to
+ * get the contract, and never a solver header (docs/architecture.md, "Layers").
+ */
+#ifndef CHANSPH_CONTRACT_H
+#define CHANSPH_CONTRACT_H
+
+#include <mpi.h>
+#include <stddef.h>
+#include <stdint.h>
+
+/** Parts of the x-acceleration a snapshot may carry (stats_snapshot.sx), STATS_PARTS per
+    particle: the pair forces of the fluid neighbours (pressure, molecular viscous,
+    eddy-viscous) and everything the walls exert (vertex neighbours, wall shear or wall law);
+    their sum is the particle's x-acceleration without the body force. The solver's
+    `enum part_sx` (part.h) takes its values from these. */
+enum stats_part {
+  STATS_PART_PRESSURE, /*!< pressure pair force of the fluid neighbours */
+  STATS_PART_VISCOUS,  /*!< molecular viscous pair force of the fluid neighbours */
+  STATS_PART_MODEL,    /*!< eddy-viscous pair force of the fluid neighbours (LES) */
+  STATS_PART_WALL,     /*!< everything the walls exert */
+  STATS_PARTS          /*!< parts per particle */
+};
+
+/**
+ * One snapshot of the particles, as plain arrays (the engine never sees solver structs).
+ *
+ * Across MPI ranks (docs/stats-format.md, "Statistics across ranks"): the arrays hold this
+ * rank's owned particles; particle a lies in global cell column col[a] in [col0, col1); the
+ * ranks of comm own contiguous column ranges in rank order covering 0 .. ncol - 1; within a
+ * column the particles appear in the same order on any decomposition; the scalars are the
+ * same on all ranks. The engine state then comes out bitwise identical on every rank and for
+ * any number of ranks. col = NULL puts every particle in column col0; with ncol = 0 as well
+ * (the layout left unset by an initialiser) the layout is one rank owning column 0.
+ * comm = MPI_COMM_NULL (or left zero by an initialiser, or MPI not initialised) is serial and
+ * makes no MPI call.
+ */
+struct stats_snapshot {
+  size_t n;                   /*!< particles */
+  const double *x, *y, *z;    /*!< positions [m] */
+  const double *u, *v, *w;    /*!< velocities [m/s] */
+  const double *p, *rho, *m;  /*!< pressure [Pa], density [kg/m^3], mass [kg] */
+  const double *ax, *ay, *az; /*!< accelerations without the body force [m/s^2], or NULL */
+  /** Parts of the x-acceleration of the force pass that led to this state, STATS_PARTS per
+      particle (enum stats_part) [m/s^2], or NULL: the momentum budget (EULER_PLANES). */
+  const double *sx;
+  const double *nu_t;     /*!< eddy viscosity [m^2/s], or NULL (no LES) */
+  const double *k_r;      /*!< residual kinetic energy [m^2/s^2], or NULL (no LES) */
+  const int64_t *id;      /*!< global ids */
+  const uint8_t *skip;    /*!< nonzero: not a fluid particle, not sampled */
+  double t;               /*!< simulated time [s] */
+  double fx;              /*!< streamwise body acceleration applied [m/s^2] */
+  double dt;              /*!< the step that led to this state [s], or 0: unknown */
+  const double *shift_dy; /*!< y-shift of each particle in that step [m], or NULL (none) */
+  long step;              /*!< step number */
+  double wall_fx[2];      /*!< x-force of the walls y = 0, 2 delta on the fluid [N];
+                               NaN if unknown */
+  const int *col;         /*!< global cell column of each particle, or NULL (all in col0) */
+  int ncol;               /*!< global cell columns along x (0 with col = NULL: serial) */
+  int col0, col1;         /*!< this rank's columns [col0, col1) */
+  MPI_Comm comm;          /*!< ranks sharing the snapshot; MPI_COMM_NULL: serial */
+};
+
+/**
+ * The scene as the engines see it: the channel, the fluid and the averaging as resolved
+ * values (derived ones computed by the solver, so no engine repeats a formula of the scene),
+ * and the keys of the engines' own sections ([stats], [correlations], [lagrangian], ...)
+ * by name through get (stats_scene_num(), stats_scene_list() below, stats_scene.c). Each engine
+ * builds
+ * its configuration from it (struct stats_engine.init_scene, engine.h).
+ */
+struct stats_scene {
+  int dim;                /*!< 2 or 3 */
+  double delta;           /*!< channel half-width [m] */
+  double lx, lz;          /*!< periodic lengths [m] (lz unused in 2-D) */
+  double dr;              /*!< initial particle spacing [m] */
+  double h;               /*!< smoothing length [m] */
+  double nu;              /*!< kinematic viscosity [m^2/s] */
+  double rho0;            /*!< reference density [kg/m^3] */
+  int les;                /*!< 1: an eddy-viscosity model runs (nu_t, k_r in the snapshots) */
+  double u_tau;           /*!< friction velocity that places y+ levels [m/s] */
+  double t_average_start; /*!< start of the averaging [s] */
+  double t_end;           /*!< end of the run [s] */
+  int bins;               /*!< wall-normal bins: output.n_bins, or if that is 0 one per
+                               particle layer, 2 delta / dr - 1 */
+  /** The value(s) of the scene key "section.key" (a number, a choice as its index, a list)
+      into v (at most max of them); returns how many the key holds, or -1 if it is not a
+      numeric key of the scene. */
+  int (*get)(const void *scene, const char *key, double *v, int max);
+  const void *scene; /*!< what get reads */
+};
+
+/**
+ * @brief A numeric scene key of an engine's own section ("correlations.nx"): its value (a
+ *        choice as its index). Dies if the scene has no such key (a bug of the engine).
+ */
+double stats_scene_num(const struct stats_scene *sc, const char *key);
+
+/**
+ * @brief A list key of the scene ("lagrangian.pdf_x"): up to max values into v.
+ * @return the number of values the key holds (dies if the scene has no such key)
+ */
+int stats_scene_list(const struct stats_scene *sc, const char *key, double *v, int max);
+
+/**
+ * @brief Wall-normal levels given in wall units by a list key ("correlations.y_plus"): y+ as
+ *        given and the heights y = y+ nu / u_tau from the lower wall [m] (sc->u_tau).
+ * @param[out] y_plus,y up to max levels each
+ * @return the number of levels (at most max)
+ */
+int stats_scene_levels(const struct stats_scene *sc, const char *key, double *y_plus, double *y,
+                       int max);
+
+#endif
