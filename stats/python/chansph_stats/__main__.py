@@ -22,20 +22,22 @@ TOOLS = {
 }
 
 
-def usage():
-    return "usage: chansph-stats TOOL [ARGS...]   (TOOL --help for its options)\ntools:\n" + \
-        "\n".join("  %-24s %s" % (name, line) for name, (_, line) in TOOLS.items())
+USAGE = "usage: chansph-stats TOOL [ARGS...]   (--help: the tools; TOOL --help: its options)"
+
+
+def tool_list():
+    return "tools:\n" + "\n".join("  %-24s %s" % (name, line) for name, (_, line) in TOOLS.items())
 
 
 def main(argv=None, prog="chansph-stats"):
     """Run the tool argv[0] with argv[1:]; returns its exit status."""
     argv = sys.argv[1:] if argv is None else argv
-    if not argv or argv[0] in ("-h", "--help"):
-        print(__doc__.split("\n")[0] + "\n" + usage())
-        return 0 if argv else 1
-    if argv[0] not in TOOLS:
-        print("error: unknown tool '%s'" % argv[0], file=sys.stderr)
-        print(usage(), file=sys.stderr)
+    if argv and argv[0] in ("-h", "--help"):
+        print(__doc__.split("\n")[0] + "\n" + USAGE + "\n" + tool_list())
+        return 0
+    if not argv or argv[0] not in TOOLS:
+        print("error: %s\n%s" % ("unknown tool '%s'" % argv[0] if argv else "no tool given",
+                                 USAGE), file=sys.stderr)
         return 1
     tool = importlib.import_module("." + TOOLS[argv[0]][0], __package__)
     return cli.run(tool.main, argv[1:], "%s %s" % (prog, argv[0])) or 0
