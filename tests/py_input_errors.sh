@@ -38,7 +38,8 @@ expect() {
   first=$(head -n 1 "$w/$name.err")
   echo "$name: exit $rc: $first"
   [ $rc -eq 1 ] || fail "$name: exit status $rc, expected 1"
-  echo "$first" | grep -Eq -- "^error: .*$regex" || fail "$name: first line is not 'error: ...$regex'"
+  echo "$first" | grep -Eq -- "^error: .*$regex" ||
+    fail "$name: first line is not 'error: ...$regex'"
   tail -n +2 "$w/$name.err" | grep -Evq '^(usage: |  )' &&
     fail "$name: more than the error line and the usage on stderr: $(tail -n +2 "$w/$name.err")"
   cat "$w/$name.out" "$w/$name.err" | grep -q Traceback && fail "$name: a Python traceback"
@@ -59,7 +60,8 @@ expect ab_table_from "argument --from: 'x' is not a number" "$tool" ab_table "$r
 expect window_peaks_spec "nowin: expected LABEL=RUN_DIR" "$tool" window_peaks --dns "$dns" "$run"
 expect window_peaks_span "A=.*@2:1: 2:1: expected T0:T1 with T0 <= T1" "$tool" window_peaks \
   --dns "$dns" "A=$run@2:1"
-expect window_peaks_dns "missing.nc: no such file" "$tool" window_peaks --dns "$missing" "A=$run@0:1"
+expect window_peaks_dns "missing.nc: no such file" "$tool" window_peaks --dns "$missing" \
+  "A=$run@0:1"
 expect error_vs_time_group "argument --group: 0: must be larger than 0" "$tool" error_vs_time \
   --dns "$dns" --group 0 "A=$run"
 expect error_vs_time_run "missing/log.txt" "$tool" error_vs_time --dns "$dns" "A=$w/missing"

@@ -9,12 +9,10 @@ A file that is missing, not HDF5 or not a complete chansph checkpoint raises cli
 Needs python3-h5py and python3-numpy (Debian packages). HDF5 verifies the Fletcher32 checksum of
 every dataset while reading.
 """
-import os
-
 import h5py
 import numpy as np
 
-from .cli import InputError
+from .cli import InputError, regular_file
 
 FORMAT = "chansph-checkpoint"
 MAJOR = 1
@@ -26,9 +24,7 @@ def _text(v):
 
 def open_h5(path):
     """h5py.File of path (read-only); InputError if it is missing or not HDF5."""
-    if not os.path.isfile(path):
-        raise InputError("%s: cannot open: %s" % (path, "No such file" if not
-                                                  os.path.exists(path) else "not a regular file"))
+    regular_file(path)
     try:
         return h5py.File(path, "r")
     except OSError as e:

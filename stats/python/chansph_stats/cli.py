@@ -7,6 +7,7 @@ A failed check (tests) is not an input error: it prints FAIL and exits 1 on its 
 """
 import argparse
 import math
+import os
 import sys
 
 
@@ -43,6 +44,14 @@ def run(main, *args):
     except OSError as e:
         where = "%s: " % e.filename if e.filename else ""
         sys.exit("error: %s%s" % (where, one_line(e.strerror or str(e))))
+
+
+def regular_file(path, what=""):
+    """InputError "PATH: cannot open[ WHAT]: No such file" unless path is a regular file."""
+    if not os.path.isfile(path):
+        raise InputError("%s: cannot open%s: %s" % (path, " " + what if what else "",
+                                                     "No such file" if not os.path.exists(path)
+                                                     else "not a regular file"))
 
 
 def one_line(text):

@@ -14,7 +14,7 @@ import re
 
 import numpy as np
 
-from .cli import InputError
+from .cli import InputError, regular_file
 
 QUANTITIES = ("U+", "u_rms+", "v_rms+", "w_rms+", "-u'v'+")
 Y_LO, Y_HI = 20.0, 150.0
@@ -25,9 +25,7 @@ def numeric_rows(path, ncol, what):
     before the first row are skipped; every row has at least ncol numbers, as many as the rows
     above, all finite; at least 2 rows. Returns the rows and their line numbers. Raises
     InputError naming the file and line (what: what the file should be, for the message)."""
-    if not os.path.isfile(path):
-        raise InputError("%s: cannot open %s: %s" % (path, what, "No such file" if not
-                         os.path.exists(path) else "not a regular file"))
+    regular_file(path, what)
     rows, lines, width = [], [], None
     try:
         with open(path, encoding="utf-8") as f:

@@ -32,11 +32,11 @@ def main(argv, prog):
     p.add_argument("table", help="derived/LM_Channel_Retau180.txt of stats/dns/lee_moser2015")
     path = p.parse_args(argv).table
     col, rows = read_table(path)
-    print("/* Generated from")
-    print(f" *   {path}")
-    print(" * (Lee & Moser 2015, J. Fluid Mech. 774, 395-415; Re_tau = 182.088; stats/dns/README.md)")
-    print(" * by the command in stats/python/chansph_stats/dns_c_table.py; do not edit. Columns: y+,")
-    print(" * U+, u'u'+, v'v'+, w'w'+, u'v'+ (wall units), all rows of the file, wall to centre line. */")
+    print(f"""/* Generated from
+ *   {path}
+ * (Lee & Moser 2015, J. Fluid Mech. 774, 395-415; Re_tau = 182.088; stats/dns/README.md)
+ * by the command in stats/python/chansph_stats/dns_c_table.py; do not edit. Columns: y+,
+ * U+, u'u'+, v'v'+, w'w'+, u'v'+ (wall units), all rows of the file, wall to centre line. */""")
     print("#ifndef CHANSPH_DNS_LM180_H")
     print("#define CHANSPH_DNS_LM180_H")
     print(f"enum {{ DNS_LM180_N = {len(rows)} }};")

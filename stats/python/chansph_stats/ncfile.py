@@ -11,45 +11,45 @@ what is asked for raises cli.InputError naming the file and the variable.
 Needs python3-netcdf4 and python3-numpy (Debian packages).
 """
 import math
-import os
 
 import netCDF4
 import numpy as np
 
-from .cli import InputError
+from .cli import InputError, regular_file
 
 PROFILE_VARS = ("y", "y_mean", "u_mean", "v_mean", "w_mean", "n_samples")
 
 
 def open_nc(path):
     """netCDF4.Dataset of path (read-only); InputError if it is missing or not netCDF."""
-    if not os.path.isfile(path):
-        raise InputError("%s: cannot open: %s" % (path, "No such file" if not
-                                                  os.path.exists(path) else "not a regular file"))
+    regular_file(path)
     try:
         return netCDF4.Dataset(path)
     except OSError as e:
         raise InputError("%s: cannot open as netCDF (%s)" % (path, e.strerror or e))
 
 
+def present(have, name, path, kind, what="a chansph stats.nc"):
+    """InputError "PATH: no KIND 'NAME' (not WHAT?)" unless name is in have."""
+    if name not in have:
+        raise InputError("%s: no %s '%s' (not %s?)" % (path, kind, name, what))
+
+
 def need(g, name, path, what="a chansph stats.nc"):
     """Variable name of group (or dataset) g; InputError naming path if it is absent."""
-    if name not in g.variables:
-        raise InputError("%s: no variable '%s' (not %s?)" % (path, name, what))
+    present(g.variables, name, path, "variable", what)
     return g.variables[name]
 
 
 def need_group(d, name, path, what="a chansph stats.nc"):
     """Group name of dataset d; InputError naming path if it is absent."""
-    if name not in d.groups:
-        raise InputError("%s: no group '%s' (not %s?)" % (path, name, what))
+    present(d.groups, name, path, "group", what)
     return d.groups[name]
 
 
 def attribute(d, name, path, what="a chansph stats.nc"):
     """Global attribute name of d; InputError naming path if it is absent."""
-    if name not in d.ncattrs():
-        raise InputError("%s: no global attribute '%s' (not %s?)" % (path, name, what))
+    present(d.ncattrs(), name, path, "global attribute", what)
     return d.getncattr(name)
 
 
@@ -86,8 +86,7 @@ def need_keys(s, path, variables=(), attrs=(), what="a chansph stats.nc"):
     s["attrs"]) that a read_stats or read_particles dict s lacks (what: what path should be)."""
     for names, have, kind in ((variables, s, "variable"), (attrs, s["attrs"], "global attribute")):
         for name in names:
-            if name not in have:
-                raise InputError("%s: no %s '%s' (not %s?)" % (path, kind, name, what))
+            present(have, name, path, kind, what)
 
 
 def read_particles(path):
