@@ -88,7 +88,7 @@ def merged_profile(r, sel):
 
 def window_profile(dirs, t0, t1, units="force"):
     """Profiles over [t0, t1] of a series: its runs' window records pooled (a later run's time
-    follows the earlier one's last window, as in error_vs_time.py). units: "force" (u_tau^2 =
+    follows the earlier one's last window, as error_vs_time does). units: "force" (u_tau^2 =
     delta f) or "wall" (u_tau^2 = the mean wall shear stress of the windows taken, both walls,
     as `chansph extract --units wall`)."""
     t_off, pool, span, wall = 0.0, None, None, np.zeros(2)
