@@ -31,4 +31,4 @@ ab corrected_gradient --set sph.pressure_gradient=corrected
 ab shifting --set sph.shifting=fickian
 done=()
 for r in "${runs[@]}"; do [ -f "$r/stats.nc" ] && done+=("$r"); done
-/usr/bin/python3 "$root/stats/ab_table.py" "${done[@]}" --from "$(echo "$tend / 2" | bc -l)" --markdown
+"$root/stats/python/chansph-stats" ab_table "${done[@]}" --from "$(echo "$tend / 2" | bc -l)" --markdown

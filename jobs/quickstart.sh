@@ -22,15 +22,17 @@ build/chansph compare "$out/stats.nc" --dns "$dns" --out "$out/compare"
 echo
 echo "quickstart: how converged the statistics are"
 grep '^stats:' "$out/log.txt" | tail -1
-/usr/bin/python3 - "$out/stats.nc" "$dns" "$here/stats" <<'EOF'
+/usr/bin/python3 - "$out/stats.nc" "$dns" "$here/stats/python" <<'EOF'
 import sys
 
 import numpy as np
 
 sys.path.insert(0, sys.argv[3])
-import compare  # noqa: E402  (chansph compare's readers)
+from chansph_stats.compare import read_run  # noqa: E402  (chansph compare's readers)
+from chansph_stats.dns import read_dns  # noqa: E402
+from chansph_stats.ncfile import open_nc  # noqa: E402
 
-ours, dns = compare.read_run(sys.argv[1]), compare.read_dns(sys.argv[2])
+ours, dns = read_run(sys.argv[1]), read_dns(sys.argv[2])
 print("  Is it turbulent? Peaks of the run's profiles against the DNS (chan180), with the run's")
 print("  standard error at the peak:")
 verdicts = []
@@ -43,9 +45,7 @@ for q in ("-u'v'+", "u_rms+", "v_rms+"):
                                                                   dpk, 100 * rel))
 ok = [q for q, v in verdicts if v]
 print("  Within 25%% of the DNS: %s." % (", ".join(ok) if ok else "none"))
-import netCDF4  # noqa: E402
-
-with netCDF4.Dataset(sys.argv[1]) as d:
+with open_nc(sys.argv[1]) as d:
     if "quadrants" in d.groups:
         g = d.groups["quadrants"]
         print("  Quadrant split of u'v' (share of u'v'; ejections Q2 and sweeps Q4 dominate in wall")

@@ -1,8 +1,8 @@
 /* Generated from
  *   stats/dns/lee_moser2015/derived/LM_Channel_Retau180.txt
  * (Lee & Moser 2015, J. Fluid Mech. 774, 395-415; Re_tau = 182.088; stats/dns/README.md)
- * by the command in stats/dns_c_table.py; do not edit. Columns: y+, U+, u'u'+, v'v'+,
- * w'w'+, u'v'+ (wall units), all rows of the file, wall to centre line. */
+ * by the command in stats/python/chansph_stats/dns_c_table.py; do not edit. Columns: y+,
+ * U+, u'u'+, v'v'+, w'w'+, u'v'+ (wall units), all rows of the file, wall to centre line. */
 #ifndef CHANSPH_DNS_LM180_H
 #define CHANSPH_DNS_LM180_H
 enum { DNS_LM180_N = 96 };

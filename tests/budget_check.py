@@ -16,51 +16,83 @@ With --window the profiles are those of the windows in T0:T1 (`chansph extract -
 e.g. the part of a resumed run written by a build with the present budget).
 Prints the split of the stress in every bin. Exit 1 on a failed check.
 """
-import argparse
 import csv
 import io
+import os
 import re
 import subprocess
 import sys
 
-import netCDF4
 import numpy as np
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "../stats/python"))
+from chansph_stats import cli  # noqa: E402
+from chansph_stats.ncfile import attribute, open_nc  # noqa: E402
 
 PARTS = ("reynolds_stress", "viscous_pair_stress", "model_pair_stress", "pair_stress",
          "wall_term_stress", "advective_stress")
 
 
 def main():
-    ap = argparse.ArgumentParser()
+    ap = cli.parser("budget_check.py", __doc__)
     ap.add_argument("stats")
-    ap.add_argument("--tol", type=float, required=True)
+    ap.add_argument("--tol", type=cli.number(float, 0), required=True)
     ap.add_argument("--laminar", action="store_true")
     ap.add_argument("--unsteady", action="store_true")
     ap.add_argument("--window", help="T0:T1: the windows of that range (chansph extract)")
     ap.add_argument("--chansph", default="build/chansph")
     a = ap.parse_args()
+    y, v = read_budget(a)
+    return check(a, y, v)
+
+
+def read_budget(a):
+    """y and the budget profiles of a.stats (of the windows in a.window if given), in u_tau^2 of
+    the force balance. InputError if the file has no budget or no averaging window."""
     names = PARTS + ("total_stress", "total_stress_expected", "viscous_stress",
                      "pair_momentum_source", "momentum_change")
-    d = netCDF4.Dataset(a.stats)
-    if "pair_stress" not in d.variables:
-        print(f"FAIL: {a.stats} has no momentum budget (pair_stress)")
-        return 1
-    if a.window:
-        have = [n for n in names if n in d.variables]
-        out = subprocess.run([a.chansph, "extract", a.stats, "--var", ",".join(have), "--units",
-                              "outer", "--format", "csv", "--window", a.window],
-                             capture_output=True, text=True, check=True).stdout
-        head = "".join(ln for ln in out.splitlines(True) if ln.startswith("#"))
-        print(head, end="")
-        ut2 = float(re.search(r"force balance ([0-9.eE+-]+)", head).group(1)) ** 2
-        rows = list(csv.DictReader(io.StringIO("".join(ln for ln in out.splitlines(True)
-                                                       if not ln.startswith("#")))))
-        y = np.array([float(r["y"]) for r in rows])
-        v = {n: np.array([float(r[n]) for r in rows]) / ut2 for n in have}
-    else:
-        ut2 = float(d.u_tau_force) ** 2
-        v = {n: np.asarray(d[n][:], dtype=float) / ut2 for n in d.variables if n in names}
-        y = np.asarray(d["y"][:])
+    with open_nc(a.stats) as d:
+        need = ("pair_stress", "total_stress", "total_stress_expected", "pair_momentum_source") + \
+            (("momentum_change",) if a.unsteady else ()) + \
+            (("wall_term_stress", "viscous_pair_stress", "viscous_stress") if a.laminar else ())
+        lack = [n for n in need if n not in d.variables]
+        if lack:
+            raise cli.InputError(f"{a.stats}: no momentum budget (no variable '{lack[0]}')")
+        if a.window:
+            y, v = extract_window(a, [n for n in names if n in d.variables])
+        else:
+            ut2 = float(attribute(d, "u_tau_force", a.stats)) ** 2
+            v = {n: np.ma.filled(d[n][:].astype(float), np.nan) / ut2
+                 for n in d.variables if n in names}
+            y = np.asarray(d["y"][:])
+    if not np.isfinite(v["total_stress"]).any():  # also with u_tau_force NaN
+        raise cli.InputError(f"{a.stats}: the budget has no value (no averaging window "
+                             f"completed yet?)")
+    return y, v
+
+
+def extract_window(a, have):
+    """y and the profiles have over the windows a.window, through chansph extract."""
+    res = subprocess.run([a.chansph, "extract", a.stats, "--var", ",".join(have), "--units",
+                          "outer", "--format", "csv", "--window", a.window],
+                         capture_output=True, text=True)
+    if res.returncode:
+        raise cli.InputError("chansph extract --window %s: %s" % (a.window, res.stderr.strip()))
+    out = res.stdout
+    head = "".join(ln for ln in out.splitlines(True) if ln.startswith("#"))
+    print(head, end="")
+    m = re.search(r"force balance ([0-9.eE+-]+)", head)
+    if not m:
+        raise cli.InputError(f"{a.stats}: chansph extract names no force-balance u_tau")
+    ut2 = float(m.group(1)) ** 2
+    rows = list(csv.DictReader(io.StringIO("".join(ln for ln in out.splitlines(True)
+                                                   if not ln.startswith("#")))))
+    y = np.array([float(r["y"]) for r in rows])
+    return y, {n: np.array([float(r[n]) for r in rows]) / ut2 for n in have}
+
+
+def check(a, y, v):
+    """Print the split of the stress and check it; returns the exit status."""
     parts = [n for n in PARTS if n in v]
     print("  y      " + " ".join(f"{n[:12]:>12}" for n in parts + ["total_stress",
                                                               "total_stress_expected"]))
@@ -98,4 +130,4 @@ def main():
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(cli.run(main))

@@ -16,6 +16,7 @@ usage: cf_check.py [resumed:]FILE.nc ...   (resumed: the history must hold a res
 """
 import ctypes
 import ctypes.util
+import os
 import re
 import sys
 
@@ -24,6 +25,10 @@ import warnings
 import netCDF4
 import numpy as np
 import xarray
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "../stats/python"))
+from chansph_stats import cli  # noqa: E402
+from chansph_stats.ncfile import open_nc  # noqa: E402
 
 INTEGER_ATTRS = ("dimension", "steps", "n_fluid", "n_snapshots", "n_windows", "fold", "les",
                  "step", "releases", "ranks", "threads")
@@ -88,12 +93,15 @@ def udunits():
 
 
 def main():
+    p = cli.parser("cf_check.py", __doc__)
+    p.add_argument("files", nargs="+", metavar="[resumed:]FILE.nc")
+    files = p.parse_args().files
     parses = udunits()
     problems, units_seen = [], 0
-    for arg in sys.argv[1:]:
+    for arg in files:
         resumed = arg.startswith("resumed:")
         path = arg[len("resumed:"):] if resumed else arg
-        with netCDF4.Dataset(path) as d:
+        with open_nc(path) as d:
             if "Conventions" not in d.ncattrs():
                 problems.append("%s: no global attribute Conventions" % path)
             a = {k: d.getncattr(k) for k in d.ncattrs()}
@@ -136,7 +144,8 @@ def main():
                     elif "bounds" in attrs:  # the windows: gaps where no sample fell
                         check_bounds(g, name, where, problems, False)
                     if name == "time" and v.dimensions == ("time",) and (
-                            v.getncattr("units") != "s" or "reference" not in attrs):
+                            "units" not in attrs or v.getncattr("units") != "s" or
+                            "reference" not in attrs):
                         problems.append("%s: time needs units 's' and a reference" % where)
                     if getattr(v.dtype, "kind", "") == "f":
                         v.set_auto_mask(False)
@@ -172,8 +181,8 @@ def main():
     for p in problems:
         print(p)
     print("%d files, %d units attributes checked with libudunits2: %s" %
-          (len(sys.argv) - 1, units_seen, "FAIL" if problems else "PASS"))
-    sys.exit(1 if problems else 0)
+          (len(files), units_seen, "FAIL" if problems else "PASS"))
+    return 1 if problems else 0
 
 
-main()
+sys.exit(cli.run(main))

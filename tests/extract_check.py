@@ -4,11 +4,15 @@ and a sub-range reproduces the count-weighted mean of its windows' raw moment re
 
 usage: extract_check.py CHANSPH STATS.nc
 """
+import os
 import subprocess
 import sys
 
-import netCDF4
 import numpy as np
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "../stats/python"))
+from chansph_stats import cli  # noqa: E402
+from chansph_stats.ncfile import need, need_group, open_nc  # noqa: E402
 
 
 def extract(chansph, path, *args):
@@ -22,13 +26,19 @@ def extract(chansph, path, *args):
 
 
 def main():
-    chansph, path = sys.argv[1], sys.argv[2]
-    with netCDF4.Dataset(path) as d:
-        u = np.ma.filled(d["u_mean"][:].astype(float), np.nan)
-        uu = np.ma.filled(d["uu"][:].astype(float), np.nan)
-        g = d.groups["eulerian"]
-        t0, t1 = g["window_start"][:], g["window_end"][:]
-        mom = g["moments"][:]
+    p = cli.parser("extract_check.py", __doc__)
+    p.add_argument("chansph")
+    p.add_argument("stats", metavar="STATS.nc")
+    a = p.parse_args()
+    chansph, path = a.chansph, a.stats
+    with open_nc(path) as d:
+        u = np.ma.filled(need(d, "u_mean", path)[:].astype(float), np.nan)
+        uu = np.ma.filled(need(d, "uu", path)[:].astype(float), np.nan)
+        g = need_group(d, "eulerian", path)
+        t0, t1 = need(g, "window_start", path)[:], need(g, "window_end", path)[:]
+        mom = need(g, "moments", path)[:]
+    if len(t0) == 0:
+        raise cli.InputError(f"{path}: no averaging window (the run has not begun averaging?)")
     ok = True
     full = extract(chansph, path, "--var", "u_mean,uu", "--units", "outer")
     e1 = np.nanmax(np.abs(full["u_mean"] - u) / np.nanmax(np.abs(u)))
@@ -50,8 +60,8 @@ def main():
     ok &= bad.returncode == 1 and "no averaging window" in bad.stderr
     print("empty range: exit %d, %s" % (bad.returncode, bad.stderr.strip()))
     print("PASS" if ok else "FAIL")
-    sys.exit(0 if ok else 1)
+    return 0 if ok else 1
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(cli.run(main))

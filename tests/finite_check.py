@@ -7,16 +7,21 @@ variable that holds a NaN or an infinity. In netCDF files, values equal to _Fill
 samples) are masked and not counted. --allow NAME: a variable that may be infinite (a
 checkpoint's output/next_write is +inf when stats.nc is written only at the end).
 """
+import os
 import sys
 
 import h5py
-import netCDF4
 import numpy as np
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "../stats/python"))
+from chansph_stats import cli  # noqa: E402
+from chansph_stats.ckpt import open_h5  # noqa: E402
+from chansph_stats.ncfile import open_nc  # noqa: E402
 
 
 def h5_vars(path):
     out = []
-    with h5py.File(path, "r") as f:
+    with open_h5(path) as f:
         def visit(name, obj):
             if isinstance(obj, h5py.Dataset) and obj.dtype.kind == "f":
                 out.append((name, np.asarray(obj[()])))
@@ -26,7 +31,7 @@ def h5_vars(path):
 
 def nc_vars(path):
     out = []
-    with netCDF4.Dataset(path) as d:
+    with open_nc(path) as d:
         def walk(g, prefix):
             for name, v in g.variables.items():
                 if getattr(v.dtype, "kind", "") == "f":  # not the string labels
@@ -39,13 +44,13 @@ def nc_vars(path):
 
 
 def main():
-    if len(sys.argv) < 2:
-        sys.exit(__doc__)
-    args, allow, status = sys.argv[1:], set(), 0
-    while len(args) > 1 and args[0] == "--allow":
-        allow.add(args[1])
-        args = args[2:]
-    for path in args:
+    p = cli.parser("finite_check.py", __doc__)
+    p.add_argument("--allow", action="append", default=[], metavar="NAME",
+                   help="a variable that may be infinite (not NaN)")
+    p.add_argument("files", nargs="+", metavar="FILE")
+    a = p.parse_args()
+    allow, status = set(a.allow), 0
+    for path in a.files:
         found = h5_vars(path) if path.endswith(".h5") else nc_vars(path)
         n = sum(a.size for _, a in found)
         bad = [name for name, a in found
@@ -54,7 +59,7 @@ def main():
               ", non-finite in " + ", ".join(bad) if bad else ", all finite"))
         if bad or not found:
             status = 1
-    sys.exit(status)
+    return status
 
 
-main()
+sys.exit(cli.run(main))

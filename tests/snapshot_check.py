@@ -11,8 +11,8 @@ import xml.etree.ElementTree as ET
 import h5py
 import numpy as np
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "stats"))
-from chansph_nc import read_particles  # noqa: E402
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "../stats/python"))
+from chansph_stats.ncfile import read_particles  # noqa: E402
 
 run = sys.argv[1]
 les = "--les" in sys.argv[2:]

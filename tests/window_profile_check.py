@@ -1,6 +1,6 @@
 #!/usr/bin/python3
-"""The Python merge of window records (stats/error_vs_time.py, resolution_extrapolate.py,
-window_peaks.py) against chansph extract: over a sub-range of windows, in wall units of the
+"""The Python merge of window records (chansph_stats.merge: error_vs_time,
+resolution_extrapolate, window_peaks) against chansph extract: over a sub-range of windows, in wall units of the
 range's wall shear stress, both give the same y+, u_rms+, v_rms+ and -u'v'+ (in the lower half, where an unfolded run's profiles are
 not mirrored by the Python side).
 
@@ -13,8 +13,8 @@ import sys
 import netCDF4
 import numpy as np
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "stats"))
-from resolution_extrapolate import window_profile  # noqa: E402
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "../stats/python"))
+from chansph_stats.merge import window_profile  # noqa: E402
 
 
 def main():

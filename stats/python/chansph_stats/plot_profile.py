@@ -1,33 +1,33 @@
-#!/usr/bin/python3
 """Plot u_mean of a chansph stats.nc against its reference profile.
 
 For a laminar run the reference is the analytical Poiseuille profile of the run's body force.
-usage: stats/plot_profile.py runs/laminar/stats.nc [-o profile.png]
+usage: chansph-stats plot_profile runs/laminar/stats.nc [-o profile.png]
 """
-import argparse
 import os
-import sys
 
-import matplotlib
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from chansph_nc import laminar_profile, read_stats  # noqa: E402
+from . import cli
+from .ncfile import laminar_profile, need_keys, read_stats
 
 
-def main():
-    p = argparse.ArgumentParser(description=__doc__)
+def main(argv, prog):
+    p = cli.parser(prog, __doc__, raw=True)
     p.add_argument("stats")
     p.add_argument("-o", "--output", default=None)
-    a = p.parse_args()
+    a = p.parse_args(argv)
     s = read_stats(a.stats)
+    need_keys(s, a.stats, ("y_mean", "u_mean"), ("body_force", "delta", "nu", "dr", "dimension"))
     at = s["attrs"]
     y, u = s["y_mean"], s["u_mean"]
     ok = np.isfinite(u)
+    if not ok.any():
+        raise cli.InputError(f"{a.stats}: u_mean has no value (no averaging window yet?)")
     ref = laminar_profile(at, y)
     err = np.sqrt(np.sum((u[ok] - ref[ok]) ** 2) / np.sum(ref[ok] ** 2))
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
     yy = np.linspace(0, 2 * at["delta"], 201)
     fig, ax = plt.subplots(figsize=(5, 4))
     ax.plot(laminar_profile(at, yy), yy, "k-", label="analytical Poiseuille")
@@ -41,7 +41,3 @@ def main():
     out = a.output or os.path.join(os.path.dirname(a.stats) or ".", "profile.png")
     fig.savefig(out, dpi=110)
     print("profile plot: %s (relative L2 error against the analytical profile %.3e)" % (out, err))
-
-
-if __name__ == "__main__":
-    main()

@@ -1,11 +1,10 @@
-#!/usr/bin/python3
 """Peaks of the Reynolds stresses of runs over chosen time ranges, side by side with a DNS.
 
-usage: python3 stats/window_peaks.py --dns FILE [--units wall|force]
-                                    LABEL=RUN_DIR[+RUN_DIR...]@T0:T1 ...
+usage: chansph-stats window_peaks --dns FILE [--units wall|force]
+                                 LABEL=RUN_DIR[+RUN_DIR...]@T0:T1 ...
 
 For each spec, the windows of stats.nc inside [T0, T1] (delta/u_tau; chained runs as in
-error_vs_time.py) are merged from their raw sums (old and new stats.nc formats alike), in wall
+error_vs_time) are merged from their raw sums (old and new stats.nc formats alike), in wall
 units of the windows' mean wall shear stress (default, as `chansph extract --units wall`) or of
 the force balance (u_tau^2 = delta f). Printed: the peaks of -u'v'+, u_rms+, v_rms+ and w_rms+ with
 their deviation from the DNS peak, and the range of the relative deviation of v_rms+ and w_rms+
@@ -14,41 +13,37 @@ u_rms+, v_rms+, w_rms+ and -u'v'+ of every spec against the DNS in one PNG. Used
 against quasi-DNS rows and the profile figure of docs/validation/turbulent_channel.md.
 """
 import argparse
-import os
-import sys
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from compare import InputError, read_dns  # noqa: E402
-from resolution_extrapolate import deviation, range_deviation, window, window_profile  # noqa: E402,E501
+from . import cli
+from .cli import InputError
+from .dns import deviation, range_deviation, read_dns
+from .merge import window_profile
 
 PEAKS = ("-u'v'+", "u_rms+", "v_rms+", "w_rms+")
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+def main(argv, prog):
+    ap = cli.parser(prog, __doc__)
     ap.add_argument("runs", nargs="+", help="LABEL=RUN_DIR[+RUN_DIR...]@T0:T1")
     ap.add_argument("--dns", required=True)
     ap.add_argument("--units", choices=("wall", "force"), default="wall")
     ap.add_argument("--plot", help="write the profiles against the DNS to this PNG")
-    a = ap.parse_args()
-    try:
-        dns = read_dns(a.dns)
-        rows = []
-        for spec in a.runs:
-            label, _, rest = spec.partition("=")
-            dirs, _, span = rest.rpartition("@")
-            if not dirs or not span:
-                raise InputError(f"{spec}: expected LABEL=RUN_DIR[+RUN_DIR...]@T0:T1")
-            try:
-                t0, t1 = window(span)
-            except argparse.ArgumentTypeError as e:
-                raise InputError(f"{spec}: {e}")
-            prof, got = window_profile(dirs, t0, t1, a.units)
-            rows.append((label, got, prof))
-    except InputError as e:
-        sys.exit(f"error: {e}")
+    a = ap.parse_args(argv)
+    dns = read_dns(a.dns)
+    rows = []
+    for spec in a.runs:
+        label, _, rest = spec.partition("=")
+        dirs, _, span = rest.rpartition("@")
+        if not dirs or not span:
+            raise InputError(f"{spec}: expected LABEL=RUN_DIR[+RUN_DIR...]@T0:T1")
+        try:
+            t0, t1 = cli.window(span)
+        except argparse.ArgumentTypeError as e:
+            raise InputError(f"{spec}: {e}")
+        prof, got = window_profile(dirs, t0, t1, a.units)
+        rows.append((label, got, prof))
     print(f"# peaks (deviation from {dns['name']}) and the v_rms+, w_rms+ deviation over "
           f"20 < y+ < 150; {a.units} units")
     print(f"# {'run':<16} {'t':>11} " + " ".join(f"{q:>13}" for q in PEAKS) +
@@ -87,7 +82,3 @@ def plot(path, rows, dns, units):
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     print(f"wrote {path}")
-
-
-if __name__ == "__main__":
-    main()

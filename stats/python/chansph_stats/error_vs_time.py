@@ -1,7 +1,6 @@
-#!/usr/bin/python3
 """Error against run time: how far a turbulent channel run is from the DNS, window by window.
 
-usage: python3 stats/error_vs_time.py --dns FILE [--dns FILE2] [--group T] [--out DIR]
+usage: chansph-stats error_vs_time --dns FILE [--dns FILE2] [--group T] [--out DIR]
                                       LABEL=RUN_DIR[+RUN_DIR...] ...
 
 Each series is one or more run directories (stats.nc, log.txt), the later ones continuing the
@@ -17,22 +16,19 @@ shared or not).
 
 Writes DIR/error_vs_time.csv (one row per series, group and DNS set) and
 DIR/error_vs_time.png (one panel per quantity, error against particle-steps), and prints the
-last group of each series. DNS files: those `chansph compare` reads (stats/compare.py).
+last group of each series. DNS files: those `chansph compare` reads (dns.py).
 """
-import argparse
 import math
 import os
 import re
-import sys
 
-import netCDF4
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from compare import QUANTITIES, InputError, read_dns  # noqa: E402
-
-MOM_N, MEAN = 0, 1
-C2 = MEAN + 8
+from . import cli
+from .cli import InputError
+from .dns import QUANTITIES, read_dns, rel_l2
+from .merge import merged_profile
+from .ncfile import read_windows
 
 
 def log_cost(run):
@@ -56,55 +52,9 @@ def log_cost(run):
     return t, psteps, np.concatenate(([0.0], np.cumsum(dwall)))
 
 
-def read_windows(run):
-    """The window records of a run's stats.nc: dict of delta, nu, fold, win, mom, done, ut (u_tau
-    of the force balance over the completed windows)."""
-    try:
-        nc = netCDF4.Dataset(os.path.join(run, "stats.nc"))
-    except OSError as e:
-        raise InputError(f"{run}/stats.nc: {e}")
-    with nc:
-        g = nc.groups.get("eulerian")
-        if g is None:
-            raise InputError(f"{run}/stats.nc: no group 'eulerian'")
-        r = {"delta": float(nc.delta), "nu": float(nc.nu), "fold": int(nc.fold),
-             "win": np.array(g["windows"][:]), "mom": np.array(g["moments"][:])}
-    r["done"] = r["win"][:, 2] > 0
-    w = r["win"][r["done"]]
-    r["ut"] = math.sqrt(max(r["delta"] * w[:, 3].sum() / max(w[:, 2].sum(), 1), 0.0))
-    return r
-
-
-def merged_profile(r, sel):
-    """Profiles of U+, u_rms+, v_rms+, w_rms+, -u'v'+ (force-balance wall units) over the windows
-    sel of read_windows' record: their counts, means and co-moments merged (Chan et al. 1979)."""
-    mom = r["mom"]
-    n = mom[sel][:, :, MOM_N].sum(axis=0)
-    ok = n > 0
-    nn = np.maximum(n, 1)
-    mean = sum(mom[i][:, MEAN:MEAN + 8] * mom[i][:, [MOM_N]] for i in sel) / nn[:, None]
-    pairs = ((0, 0), (1, 1), (2, 2), (0, 1))  # uu vv ww uv
-    c2 = np.zeros((len(n), len(pairs)))
-    for i in sel:
-        d = mom[i][:, MEAN:MEAN + 3] - mean[:, :3]
-        for c, (p, q) in enumerate(pairs):
-            c2[:, c] += mom[i][:, C2 + c] + mom[i][:, MOM_N] * d[:, p] * d[:, q]
-    y = np.where(ok, mean[:, 5], np.nan)
-    u = np.where(ok, mean[:, 0], np.nan)
-    uu, vv, ww, uv = (np.where(ok, c2[:, c] / nn, np.nan) for c in range(4))
-    delta, ut = r["delta"], r["ut"]
-    if not r["fold"]:
-        up = y > delta
-        y = np.where(up, 2 * delta - y, y)
-        uv = np.where(up, -uv, uv)
-    return {"yplus": y * ut / r["nu"], "y_delta": y / delta, "U+": u / ut,
-            "u_rms+": np.sqrt(uu) / ut, "v_rms+": np.sqrt(vv) / ut, "w_rms+": np.sqrt(ww) / ut,
-            "-u'v'+": -uv / ut**2}
-
-
 def group_profiles(run, group):
     """[(t0, t1, profiles dict)] of the window groups of a run."""
-    r = read_windows(run)
+    r = read_windows(os.path.join(run, "stats.nc"))
     win, done = r["win"], r["done"]
     out = []
     t_start = win[0, 0]
@@ -120,42 +70,31 @@ def group_profiles(run, group):
     return out
 
 
-def rel_l2(prof, dns, q):
-    yp = prof["yplus"]
-    inside = (yp >= dns["yplus"][0]) & (yp <= dns["yplus"][-1]) & np.isfinite(prof[q])
-    if not inside.any() or dns.get(q) is None:
-        return math.nan
-    ref = np.interp(yp[inside], dns["yplus"], dns[q])
-    return math.sqrt(np.mean((prof[q][inside] - ref) ** 2)) / math.sqrt(np.mean(ref**2))
-
-
-def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+def main(argv, prog):
+    ap = cli.parser(prog, __doc__)
     ap.add_argument("series", nargs="+", help="LABEL=RUN_DIR[+RUN_DIR...]")
     ap.add_argument("--dns", action="append", required=True)
-    ap.add_argument("--group", type=float, default=0.25, help="window group length [delta/u_tau]")
+    ap.add_argument("--group", type=cli.number(float, 0, above=True), default=0.25,
+                    help="window group length [delta/u_tau]")
     ap.add_argument("--out", default=".")
-    a = ap.parse_args()
-    try:
-        dns = [read_dns(p) for p in a.dns]
-        rows = []
-        for spec in a.series:
-            label, _, dirs = spec.partition("=")
-            if not dirs:
-                raise InputError(f"{spec}: expected LABEL=RUN_DIR[+RUN_DIR...]")
-            t_off = ps_off = wall_off = 0.0
-            for run in dirs.split("+"):
-                t, ps, wall = log_cost(run)
-                groups = group_profiles(run, a.group)
-                for t0, t1, prof in groups:
-                    p1, w1 = np.interp(t1, t, ps), np.interp(t1, t, wall)
-                    errs = [[rel_l2(prof, d, q) for q in QUANTITIES] for d in dns]
-                    rows.append((label, t_off + t0, t_off + t1, ps_off + p1, wall_off + w1, errs))
-                t_off += groups[-1][1] if groups else t[-1]
-                ps_off += ps[-1]
-                wall_off += wall[-1]
-    except InputError as e:
-        sys.exit(f"error: {e}")
+    a = ap.parse_args(argv)
+    dns = [read_dns(p) for p in a.dns]
+    rows = []
+    for spec in a.series:
+        label, _, dirs = spec.partition("=")
+        if not dirs:
+            raise InputError(f"{spec}: expected LABEL=RUN_DIR[+RUN_DIR...]")
+        t_off = ps_off = wall_off = 0.0
+        for run in dirs.split("+"):
+            t, ps, wall = log_cost(run)
+            groups = group_profiles(run, a.group)
+            for t0, t1, prof in groups:
+                p1, w1 = np.interp(t1, t, ps), np.interp(t1, t, wall)
+                errs = [[rel_l2(prof, d, q) for q in QUANTITIES] for d in dns]
+                rows.append((label, t_off + t0, t_off + t1, ps_off + p1, wall_off + w1, errs))
+            t_off += groups[-1][1] if groups else t[-1]
+            ps_off += ps[-1]
+            wall_off += wall[-1]
     os.makedirs(a.out, exist_ok=True)
     csv = os.path.join(a.out, "error_vs_time.csv")
     with open(csv, "w") as f:
@@ -205,7 +144,3 @@ def main():
     png = os.path.join(a.out, "error_vs_time.png")
     fig.savefig(png, dpi=110)
     print(f"wrote {csv} and {png}")
-
-
-if __name__ == "__main__":
-    main()

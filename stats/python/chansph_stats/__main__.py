@@ -1,0 +1,47 @@
+"""chansph-stats TOOL [ARGS...]: run one analysis tool of the chansph_stats package.
+
+`TOOL --help` describes each tool.
+"""
+import importlib
+import sys
+
+from . import cli
+
+# tool name: (module, one line)
+TOOLS = {
+    "compare": ("compare", "profiles of a run (stats.nc) against a DNS set (`chansph compare`)"),
+    "windows": ("windows", "per-window turbulence indicators of a run"),
+    "window_peaks": ("window_peaks", "Reynolds-stress peaks over time ranges against a DNS"),
+    "ab_table": ("ab_table", "A/B table of turbulent runs"),
+    "error_vs_time": ("error_vs_time", "error against the DNS window group by window group"),
+    "resolution_extrapolate": ("resolution_extrapolate",
+                               "the resolution a series extrapolates to"),
+    "plot_profile": ("plot_profile", "u_mean of a laminar run against the analytical profile"),
+    "dns_c_table": ("dns_c_table", "write solver/dns_lm180.h from the Lee & Moser table"),
+    "ckpt": ("ckpt_info", "summarise checkpoints (format, step, time, particles)"),
+}
+
+
+USAGE = "usage: chansph-stats TOOL [ARGS...]   (--help: the tools; TOOL --help: its options)"
+
+
+def tool_list():
+    return "tools:\n" + "\n".join("  %-24s %s" % (name, line) for name, (_, line) in TOOLS.items())
+
+
+def main(argv=None, prog="chansph-stats"):
+    """Run the tool argv[0] with argv[1:]; returns its exit status."""
+    argv = sys.argv[1:] if argv is None else argv
+    if argv and argv[0] in ("-h", "--help"):
+        print(__doc__.split("\n")[0] + "\n" + USAGE + "\n" + tool_list())
+        return 0
+    if not argv or argv[0] not in TOOLS:
+        print("error: %s\n%s" % ("unknown tool '%s'" % argv[0] if argv else "no tool given",
+                                 USAGE), file=sys.stderr)
+        return 1
+    tool = importlib.import_module("." + TOOLS[argv[0]][0], __package__)
+    return cli.run(tool.main, argv[1:], "%s %s" % (prog, argv[0])) or 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,115 @@
+"""Window records of stats.nc merged into profiles in wall units (the Python side of
+`chansph extract --window`; tests/window_profile_check.py holds the two together).
+
+The raw records of group eulerian (docs/stats-format.md): per window and bin, `moments` holds
+the sample count (MOM_N), the means (MEAN: u v w p rho y ...) and the co-moments (C2: uu vv ww
+uv ...); `planes` the momentum-budget sums (PL). Wall units: u_tau of the force balance
+(u_tau^2 = delta f, read_windows' "ut") or of the mean wall shear stress of the windows taken.
+With fold = 0 the upper half is mirrored onto the lower one (-u'v' and the stresses change sign).
+"""
+import math
+import os
+
+import numpy as np
+
+from .cli import InputError
+from .ncfile import read_windows
+
+MOM_N, MEAN = 0, 1
+C2 = MEAN + 8
+PL = {"n": 0, "pair": 1, "visc": 2, "model": 3, "wall": 4, "drive": 5, "source": 6}
+
+
+def window_values(mom, pln, delta, fold, ut, nu):
+    """Per-window indicators (arrays over the windows given)."""
+    out = []
+    for m, p in zip(mom, pln):
+        n = m[:, MOM_N]
+        ok = n > 0
+        y = m[:, MEAN + 5]
+        uu, vv, uv = (np.where(ok, m[:, C2 + k] / np.maximum(n, 1), np.nan) for k in (0, 1, 3))
+        u = m[:, MEAN]
+        if not fold:
+            up = y > delta
+            y = np.where(up, 2 * delta - y, y)
+            uv = np.where(up, -uv, uv)
+        yp = y * ut / nu
+        muv = -uv / ut**2
+        k = int(np.nanargmax(muv))
+        band = ok & (yp >= 30) & (yp <= 100)
+        r = dict(uv_peak=muv[k], y_peak=yp[k], urms=np.nanmax(np.sqrt(uu)) / ut,
+                 vrms=np.nanmax(np.sqrt(vv)) / ut,
+                 ruv=np.nanmean(-uv[band] / np.sqrt(uu[band] * vv[band])) if band.any() else math.nan,
+                 ub=np.sum(u[ok] * n[ok]) / np.sum(n[ok]) / ut)
+        if p is not None and p[:, 0].max() > 0:
+            pn = np.maximum(p[:, 0], 1)
+            parts = {key: p[:, i] / pn for key, i in PL.items() if key != "n"}
+            if not fold:  # mirrored like -u'v' above: the stresses of the upper half change sign
+                for key in parts:
+                    parts[key] = np.where(up, -parts[key], parts[key])
+            rey = -uv  # -u'v' towards the centre (upper half mirrored above)
+            total = rey + parts["pair"] + parts["visc"] + parts["model"] + parts["wall"]
+            for name, target in (("30", 30.0), ("half", 0.5 * delta * ut / nu)):
+                i = int(np.nanargmin(np.abs(yp - target) + np.where(ok, 0, np.inf)))
+                r["res_" + name] = rey[i] / total[i]
+                r["pair_" + name] = parts["pair"][i] / total[i]
+            r["closure"] = np.nanmax(np.abs(total - parts["drive"])) / ut**2
+            r["source"] = np.nanmean(parts["source"]) / ut**2
+        out.append(r)
+    return out
+
+
+def merged_profile(r, sel):
+    """Profiles of U+, u_rms+, v_rms+, w_rms+, -u'v'+ (force-balance wall units) over the windows
+    sel of a read_windows record: their counts, means and co-moments merged (Chan et al. 1979)."""
+    mom = r["mom"]
+    n = mom[sel][:, :, MOM_N].sum(axis=0)
+    ok = n > 0
+    nn = np.maximum(n, 1)
+    mean = sum(mom[i][:, MEAN:MEAN + 8] * mom[i][:, [MOM_N]] for i in sel) / nn[:, None]
+    pairs = ((0, 0), (1, 1), (2, 2), (0, 1))  # uu vv ww uv
+    c2 = np.zeros((len(n), len(pairs)))
+    for i in sel:
+        d = mom[i][:, MEAN:MEAN + 3] - mean[:, :3]
+        for c, (p, q) in enumerate(pairs):
+            c2[:, c] += mom[i][:, C2 + c] + mom[i][:, MOM_N] * d[:, p] * d[:, q]
+    y = np.where(ok, mean[:, 5], np.nan)
+    u = np.where(ok, mean[:, 0], np.nan)
+    uu, vv, ww, uv = (np.where(ok, c2[:, c] / nn, np.nan) for c in range(4))
+    delta, ut = r["delta"], r["ut"]
+    if not r["fold"]:
+        up = y > delta
+        y = np.where(up, 2 * delta - y, y)
+        uv = np.where(up, -uv, uv)
+    return {"yplus": y * ut / r["nu"], "y_delta": y / delta, "U+": u / ut,
+            "u_rms+": np.sqrt(uu) / ut, "v_rms+": np.sqrt(vv) / ut, "w_rms+": np.sqrt(ww) / ut,
+            "-u'v'+": -uv / ut**2}
+
+
+def window_profile(dirs, t0, t1, units="force"):
+    """Profiles over [t0, t1] of a series: its runs' window records pooled (a later run's time
+    follows the earlier one's last window, as error_vs_time does). units: "force" (u_tau^2 =
+    delta f) or "wall" (u_tau^2 = the mean wall shear stress of the windows taken, both walls,
+    as `chansph extract --units wall`)."""
+    t_off, pool, span, wall = 0.0, None, None, np.zeros(2)
+    for run in dirs.split("+"):
+        r = read_windows(os.path.join(run, "stats.nc"))
+        win = r["win"].copy()
+        win[:, :2] += t_off
+        sel = [i for i in range(len(win)) if r["done"][i] and win[i, 0] >= t0 - 1e-9
+               and win[i, 1] <= t1 + 1e-9]
+        if sel:
+            span = (span[0] if span else win[sel[0], 0], win[sel[-1], 1])
+            wall += (win[sel, 4].sum() + win[sel, 5].sum(), 2 * win[sel, 2].sum())
+            if pool is None:
+                pool = dict(r, mom=r["mom"][sel])
+            else:
+                if r["mom"].shape[1:] != pool["mom"].shape[1:] or r["fold"] != pool["fold"]:
+                    raise InputError(f"{run}: its bins differ from the earlier run's")
+                pool["mom"] = np.concatenate((pool["mom"], r["mom"][sel]))
+        t_off = win[r["done"]][-1, 1]
+    if pool is None:
+        raise InputError(f"{dirs}: no completed window inside {t0}-{t1}")
+    if units == "wall":
+        pool["ut"] = math.sqrt(max(wall[0] / max(wall[1], 1), 0.0))
+    return merged_profile(pool, list(range(len(pool["mom"])))), span
