@@ -253,7 +253,7 @@ static void exchange(struct dd *d, int nf, void (*pack_fn)(const void *, size_t,
 
 /* A ghost on the wire: its PF_GHOST fields (positions, velocities, mass for the neighbour
    search and kernel sums, id and kind). Density, pressure and the model terms follow in the
-   refreshes (dd_update); nothing reads a ghost's gamma, kernel sum or acceleration. */
+   refreshes (dd_refresh); nothing reads a ghost's gamma, kernel sum or acceleration. */
 static void pack_ghost(const void *arg, size_t a, double *r) {
   pack(arg, a, r, PF_GHOST);
 }
@@ -290,49 +290,50 @@ void dd_halo(struct dd *d, struct particles *P, struct nbr *nb) {
   timer_pop();
 }
 
+/* The arrays of one refresh: np per-particle arrays, then nw wall arrays (by vertex slot). */
 struct fields {
   const struct particles *P;
-  int nf;
-  double *const *f;
+  int np, nw;
+  double *f[32];
 };
 
 static void pack_fields(const void *arg, size_t a, double *r) {
   const struct fields *F = arg;
-  for (int k = 0; k < F->nf; k++) r[k] = F->f[k][a];
-}
-
-static void pack_walls(const void *arg, size_t a, double *r) {
-  const struct fields *F = arg;
+  for (int k = 0; k < F->np; k++) r[k] = F->f[k][a];
   const int vertex = F->P->kind[a] == KIND_VERTEX;
   const size_t slot = vertex ? part_vertex_slot(F->P, F->P->id[a]) : 0;
-  for (int k = 0; k < F->nf; k++) r[k] = vertex ? F->f[k][slot] : 0.0;
+  for (int k = F->np; k < F->np + F->nw; k++) r[k] = vertex ? F->f[k][slot] : 0.0;
 }
 
-void dd_update(struct dd *d, const struct particles *P, int nf, double *const *f) {
+/* The allocated arrays of the tables marked for stage. */
+static void stage_fields(const struct particles *P, const struct walls *W, int stage,
+                         struct fields *F) {
+  F->P = P, F->np = F->nw = 0;
+  for (int i = 0; i < part_n_fields; i++)
+    if ((part_fields[i].refresh & stage) && part_field_ptr(P, &part_fields[i]))
+      F->f[F->np++] = part_field_ptr(P, &part_fields[i]);
+  for (int i = 0; i < wall_n_fields; i++)
+    if ((wall_fields[i].refresh & stage) && wall_field_ptr(W, &wall_fields[i]))
+      F->f[F->np + F->nw++] = wall_field_ptr(W, &wall_fields[i]);
+}
+
+void dd_refresh(struct dd *d, const struct particles *P, const struct walls *W, int stage) {
   if (d->size == 1) return;
+  struct fields F;
+  stage_fields(P, W, stage, &F);
+  const int nf = F.np + F.nw;
+  if (nf == 0) return;
   timer_push("halo");
   const double t0 = MPI_Wtime();
-  const struct fields F = {P, nf, f};
   exchange(d, nf, pack_fields, &F);
-  const size_t ng = d->nrecv[0] + d->nrecv[1];
-  for (size_t g = 0; g < ng; g++)
-    for (int k = 0; k < nf; k++) f[k][d->ghost[g]] = d->rbuf[g * (size_t)nf + k];
-  d->seconds += MPI_Wtime() - t0;
-  timer_pop();
-}
-
-void dd_update_walls(struct dd *d, const struct particles *P, int nf, double *const *w) {
-  if (d->size == 1) return;
-  timer_push("halo");
-  const double t0 = MPI_Wtime();
-  const struct fields F = {P, nf, w};
-  exchange(d, nf, pack_walls, &F);
   const size_t ng = d->nrecv[0] + d->nrecv[1];
   for (size_t g = 0; g < ng; g++) {
     const size_t a = d->ghost[g];
-    if (P->kind[a] != KIND_VERTEX) continue;
+    const double *r = d->rbuf + g * (size_t)nf;
+    for (int k = 0; k < F.np; k++) F.f[k][a] = r[k];
+    if (F.nw == 0 || P->kind[a] != KIND_VERTEX) continue;
     const size_t slot = part_vertex_slot(P, P->id[a]);
-    for (int k = 0; k < nf; k++) w[k][slot] = d->rbuf[g * (size_t)nf + k];
+    for (int k = F.np; k < nf; k++) F.f[k][slot] = r[k];
   }
   d->seconds += MPI_Wtime() - t0;
   timer_pop();

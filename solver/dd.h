@@ -10,7 +10,8 @@
  *     neighbouring rank (ghosts, with their unshifted coordinates: the periodic shift is applied
  *     by the stencil, as on one rank), and nbr_sort_ghosts() orders them;
  *  4. after each pass that computes a per-particle value the next pass reads at neighbours,
- *     dd_update() / dd_update_walls() refresh the ghosts' copies.
+ *     dd_refresh() refreshes the ghosts' copies of the fields the field table (part.h) marks
+ *     for that stage, in one exchange.
  * Sums over all particles (dd_sum) are formed per global column in the cell order, then
  * added over the columns in a fixed order, so every result is bitwise the same on any number
  * of ranks and threads (docs/parallel.md).
@@ -89,15 +90,11 @@ void dd_migrate(struct dd *d, struct particles *P, const struct nbr *nb);
 void dd_halo(struct dd *d, struct particles *P, struct nbr *nb);
 
 /**
- * @brief Refresh the ghosts' copies of nf per-particle arrays from their owners. Collective.
+ * @brief Refresh the ghosts' copies of every allocated per-particle and wall array whose
+ *        table entry (part_fields, wall_fields) names this stage (enum part_refresh): one
+ *        exchange for them all (wall arrays at the ghost vertices, by vertex slot). Collective.
  */
-void dd_update(struct dd *d, const struct particles *P, int nf, double *const *f);
-
-/**
- * @brief Refresh nf wall arrays (indexed by vertex slot, part_vertex_slot) at the ghost vertex
- *        particles from their owners. Collective.
- */
-void dd_update_walls(struct dd *d, const struct particles *P, int nf, double *const *w);
+void dd_refresh(struct dd *d, const struct particles *P, const struct walls *W, int stage);
 
 /**
  * @brief Deterministic global sums of nv per-particle arrays over the owned particles: per

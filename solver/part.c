@@ -57,55 +57,98 @@ void part_memory_report(FILE *f) {
 /* Every per-particle array of part.h: what it takes part in (enum part_role), in the order of
    the files (particles.nc, checkpoint) and of the memory report. */
 const struct part_field part_fields[] = {
-    {F(x), "x", "x", PT_F64, 1, ALL | PF_GHOST | PF_PAIR, 1, 0, 0, "m", "position x (streamwise)",
-     REC_X},
-    {F(y), "y", "y", PT_F64, 1, ALL | PF_GHOST | PF_PAIR, 1, 0, 0, "m", "position y (wall-normal)",
-     REC_Y},
-    {F(z), "z", "z", PT_F64, 1, ALL | PF_GHOST | PF_PAIR, 1, 0, 0, "m", "position z (spanwise)",
-     REC_Z},
-    {F(u), "u", "u", PT_F64, 1, ALL | PF_GHOST | PF_PAIR, 1, 0, 0, "m/s", "velocity u (streamwise)",
-     REC_U},
-    {F(v), "v", "v", PT_F64, 1, ALL | PF_GHOST | PF_PAIR, 1, 0, 0, "m/s",
-     "velocity v (wall-normal)", REC_V},
-    {F(w), "w", "w", PT_F64, 1, ALL | PF_GHOST | PF_PAIR, 1, 0, 0, "m/s", "velocity w (spanwise)",
-     REC_W},
-    {F(rho), "rho", "rho", PT_F64, 1, ALL | PF_PAIR, 1, 0, 0, "kg/m^3", "density", REC_RHO},
-    {F(p), "pressure", "p", PT_F64, 1, PF_CKPT | PF_WRITE | PF_HEALTH, 1, 0, 0, "Pa", "pressure",
+    {F(x), "x", "x", PT_F64, 1, ALL | PF_GHOST | PF_PAIR, PN_CORE, 0, 0, "m",
+     "position x (streamwise)", REC_X, 0},
+    {F(y), "y", "y", PT_F64, 1, ALL | PF_GHOST | PF_PAIR, PN_CORE, 0, 0, "m",
+     "position y (wall-normal)", REC_Y, 0},
+    {F(z), "z", "z", PT_F64, 1, ALL | PF_GHOST | PF_PAIR, PN_CORE, 0, 0, "m",
+     "position z (spanwise)", REC_Z, 0},
+    {F(u), "u", "u", PT_F64, 1, ALL | PF_GHOST | PF_PAIR, PN_CORE, 0, 0, "m/s",
+     "velocity u (streamwise)", REC_U, 0},
+    {F(v), "v", "v", PT_F64, 1, ALL | PF_GHOST | PF_PAIR, PN_CORE, 0, 0, "m/s",
+     "velocity v (wall-normal)", REC_V, 0},
+    {F(w), "w", "w", PT_F64, 1, ALL | PF_GHOST | PF_PAIR, PN_CORE, 0, 0, "m/s",
+     "velocity w (spanwise)", REC_W, 0},
+    {F(rho), "rho", "rho", PT_F64, 1, ALL | PF_PAIR, PN_CORE, 0, 0, "kg/m^3", "density", REC_RHO,
+     PR_DENSITY | PR_WALLS},
+    {F(p), "pressure", "p", PT_F64, 1, PF_CKPT | PF_WRITE | PF_HEALTH, PN_CORE, 0, 0, "Pa",
+     "pressure", 0, PR_DENSITY | PR_WALLS},
+    {F(gam), "gamma", "gamma", PT_F64, 1, ALL, PN_CORE, 0, 0, "1", "wall renormalisation factor", 0,
      0},
-    {F(gam), "gamma", "gamma", PT_F64, 1, ALL, 1, 0, 0, "1", "wall renormalisation factor", 0},
-    {F(m), "mass", "mass", PT_F64, 1, ALL | PF_GHOST | PF_PAIR, 1, 0, 0, "kg",
-     "mass (per metre of span in 2-D)", REC_M},
-    {F(ksum), "kernel_sum", "kernel_sum", PT_F64, 1, ALL & ~PF_WRITE, 1, 0, 0, "kg/m^dim",
-     "kernel sum S of the continuity equation", 0},
-    {F(ddiff), "diffusion", NULL, PT_F64, 1, PF_PERMUTE | PF_MIGRATE, 1, 0, 0, NULL, NULL, 0},
-    {F(c), "sound", NULL, PT_F64, 1, PF_PAIR, 1, 0, 0, NULL, NULL, REC_C},
-    {F(pr2), "p_over_rho2", NULL, PT_F64, 1, PF_PAIR, 1, 0, 0, NULL, NULL, REC_PR2},
-    {F(vol), "volume", NULL, PT_F64, 1, PF_PAIR, 1, 0, 0, NULL, NULL, REC_VOL},
-    {F(rec), "pair_records", NULL, PT_F64, 16, 0, 1, 0, 0, NULL, NULL, 0},
-    {F(ax), "ax", "ax", PT_F64, 1, PF_PERMUTE | PF_MIGRATE | PF_HEALTH, 1, 0, 0, NULL, NULL, 0},
-    {F(ay), "ay", "ay", PT_F64, 1, PF_PERMUTE | PF_MIGRATE | PF_HEALTH, 1, 0, 0, NULL, NULL, 0},
-    {F(az), "az", "az", PT_F64, 1, PF_PERMUTE | PF_MIGRATE | PF_HEALTH, 1, 0, 0, NULL, NULL, 0},
-    {F(sx), "stress_ax", NULL, PT_F64, SX_LEN, PF_PERMUTE | PF_MIGRATE, 0, F(sx_live), 0, NULL,
-     NULL, 0},
-    {F(tmp), "sort_scratch", NULL, PT_F64, 1, 0, 1, 0, 0, NULL, NULL, 0},
-    {F(id), "id", NULL, PT_I64, 1, PF_PERMUTE | PF_MIGRATE | PF_GHOST, 1, 0, 0, NULL, NULL, 0},
-    {F(tmp_i), "sort_scratch_i", NULL, PT_I64, 1, 0, 1, 0, 0, NULL, NULL, 0},
-    {F(kind), "kind", NULL, PT_U8, 1, PF_PERMUTE | PF_MIGRATE | PF_GHOST, 1, 0, 0, NULL, NULL, 0},
-    {F(nur), "nu_r", "nu_r", PT_F64, 1, PF_PERMUTE | PF_MIGRATE | PF_CKPT | PF_HEALTH | PF_PAIR, 0,
-     F(nur_live), 1, "m^2/s", "eddy viscosity of the next step", REC_NUR},
-    {F(kr), "k_r", "k_r", PT_F64, 1, PF_PERMUTE | PF_MIGRATE | PF_CKPT | PF_HEALTH, 0, F(nur_live),
-     1, "m^2/s^2", "residual kinetic energy of the next step", 0},
-    {F(nur_next), "nu_r_next", NULL, PT_F64, 1, 0, 0, 0, 0, NULL, NULL, 0},
-    {F(kr_next), "k_r_next", NULL, PT_F64, 1, 0, 0, 0, 0, NULL, NULL, 0},
-    {F(twx), "wall_law_tx", NULL, PT_F64, 1, 0, 0, 0, 0, NULL, NULL, 0},
-    {F(twz), "wall_law_tz", NULL, PT_F64, 1, 0, 0, 0, 0, NULL, NULL, 0},
-    {F(shift_dy), "shift_dy", NULL, PT_F64, 1, PF_PERMUTE | PF_MIGRATE, 0, 0, 0, NULL, NULL, 0},
-    {F(qcrit), "q_criterion", "q_criterion", PT_F64, 1, PF_WRITE, 0, 0, 0, "1/s^2",
-     "Q criterion (|Omega|^2 - |S|^2)/2 of the corrected velocity gradient", 0},
+    {F(m), "mass", "mass", PT_F64, 1, ALL | PF_GHOST | PF_PAIR, PN_CORE, 0, 0, "kg",
+     "mass (per metre of span in 2-D)", REC_M, 0},
+    {F(ksum), "kernel_sum", "kernel_sum", PT_F64, 1, ALL & ~PF_WRITE, PN_CORE, 0, 0, "kg/m^dim",
+     "kernel sum S of the continuity equation", 0, 0},
+    {F(ddiff), "diffusion", NULL, PT_F64, 1, PF_PERMUTE | PF_MIGRATE, PN_CORE, 0, 0, NULL, NULL, 0,
+     0},
+    {F(c), "sound", NULL, PT_F64, 1, PF_PAIR, PN_CORE, 0, 0, NULL, NULL, REC_C,
+     PR_DENSITY | PR_WALLS},
+    {F(pr2), "p_over_rho2", NULL, PT_F64, 1, PF_PAIR, PN_CORE, 0, 0, NULL, NULL, REC_PR2,
+     PR_DENSITY | PR_WALLS | PR_KR},
+    {F(vol), "volume", NULL, PT_F64, 1, PF_PAIR, PN_CORE, 0, 0, NULL, NULL, REC_VOL,
+     PR_DENSITY | PR_WALLS},
+    {F(rec), "pair_records", NULL, PT_F64, 16, 0, PN_CORE, 0, 0, NULL, NULL, 0, 0},
+    {F(ax), "ax", "ax", PT_F64, 1, PF_PERMUTE | PF_MIGRATE | PF_HEALTH, PN_CORE, 0, 0, NULL, NULL,
+     0, 0},
+    {F(ay), "ay", "ay", PT_F64, 1, PF_PERMUTE | PF_MIGRATE | PF_HEALTH, PN_CORE, 0, 0, NULL, NULL,
+     0, 0},
+    {F(az), "az", "az", PT_F64, 1, PF_PERMUTE | PF_MIGRATE | PF_HEALTH, PN_CORE, 0, 0, NULL, NULL,
+     0, 0},
+    {F(sx), "stress_ax", NULL, PT_F64, SX_LEN, PF_PERMUTE | PF_MIGRATE, PN_EULERIAN, F(sx_live), 0,
+     NULL, NULL, 0, 0},
+    {F(tmp), "sort_scratch", NULL, PT_F64, 1, 0, PN_CORE, 0, 0, NULL, NULL, 0, 0},
+    {F(id), "id", NULL, PT_I64, 1, PF_PERMUTE | PF_MIGRATE | PF_GHOST, PN_CORE, 0, 0, NULL, NULL, 0,
+     0},
+    {F(tmp_i), "sort_scratch_i", NULL, PT_I64, 1, 0, PN_CORE, 0, 0, NULL, NULL, 0, 0},
+    {F(kind), "kind", NULL, PT_U8, 1, PF_PERMUTE | PF_MIGRATE | PF_GHOST, PN_CORE, 0, 0, NULL, NULL,
+     0, 0},
+    {F(nur), "nu_r", "nu_r", PT_F64, 1, PF_PERMUTE | PF_MIGRATE | PF_CKPT | PF_HEALTH | PF_PAIR,
+     PN_LES, F(nur_live), 1, "m^2/s", "eddy viscosity of the next step", REC_NUR, PR_MODEL},
+    {F(kr), "k_r", "k_r", PT_F64, 1, PF_PERMUTE | PF_MIGRATE | PF_CKPT | PF_HEALTH, PN_LES,
+     F(nur_live), 1, "m^2/s^2", "residual kinetic energy of the next step", 0, PR_MODEL},
+    {F(nur_next), "nu_r_next", NULL, PT_F64, 1, 0, PN_STRAIN_LAG, 0, 0, NULL, NULL, 0, 0},
+    {F(kr_next), "k_r_next", NULL, PT_F64, 1, 0, PN_STRAIN_LAG, 0, 0, NULL, NULL, 0, 0},
+    {F(twx), "wall_law_tx", NULL, PT_F64, 1, 0, PN_WALL_TAU, 0, 0, NULL, NULL, 0, 0},
+    {F(twz), "wall_law_tz", NULL, PT_F64, 1, 0, PN_WALL_TAU, 0, 0, NULL, NULL, 0, 0},
+    {F(shift_dy), "shift_dy", NULL, PT_F64, 1, PF_PERMUTE | PF_MIGRATE, PN_SHIFTING, 0, 0, NULL,
+     NULL, 0, 0},
+    {F(qcrit), "q_criterion", "q_criterion", PT_F64, 1, PF_WRITE, PN_QCRIT, 0, 0, "1/s^2",
+     "Q criterion (|Omega|^2 - |S|^2)/2 of the corrected velocity gradient", 0, 0},
 };
 #undef ALL
 #undef F
 const int part_n_fields = sizeof part_fields / sizeof part_fields[0];
+
+#define W(member) offsetof(struct walls, member)
+/* Every array of struct walls. */
+const struct wall_field wall_fields[] = {
+    {W(rho), "wall_rho", PN_CORE, PR_WALLS},
+    {W(p), "wall_p", PN_CORE, PR_WALLS | PR_KR},
+    {W(tx), "wall_tau_x", PN_WALL_TAU, PR_WALL_LAW},
+    {W(tz), "wall_tau_z", PN_WALL_TAU, PR_WALL_LAW},
+};
+#undef W
+const int wall_n_fields = sizeof wall_fields / sizeof wall_fields[0];
+
+int part_needed(enum part_need need, const struct scene *s) {
+  switch (need) {
+    case PN_CORE:
+      return 1;
+    case PN_LES:
+      return scene_les(s);
+    case PN_STRAIN_LAG:
+      return scene_strain_lag(s);
+    case PN_WALL_TAU:
+      return scene_wall_tau(s);
+    case PN_EULERIAN:
+      return s->stats_eulerian;
+    case PN_SHIFTING:
+      return s->shifting != SHIFT_NONE;
+    case PN_QCRIT:
+      return s->q_criterion;
+  }
+  return 0;
+}
 
 static size_t elem_size(const struct part_field *f) {
   return (size_t)f->width * (f->type == PT_F64   ? sizeof(double)
@@ -118,13 +161,13 @@ struct array {
   void **p;
   const char *label;
   size_t elem;
-  int core;
+  int core; /*!< need == PN_CORE */
 };
 
 static size_t arrays(struct particles *P, struct array *t) {
   for (int i = 0; i < part_n_fields; i++)
     t[i] = (struct array){(void **)((char *)P + part_fields[i].off), part_fields[i].label,
-                          elem_size(&part_fields[i]), part_fields[i].core};
+                          elem_size(&part_fields[i]), part_fields[i].need == PN_CORE};
   return (size_t)part_n_fields;
 }
 
@@ -180,8 +223,10 @@ void part_create(struct particles *P, struct walls *W, const struct scene *s) {
         P->id[a] = (int64_t)a, P->kind[a] = KIND_FLUID;
       }
   W->nx = nx, W->nz = nz;
-  W->rho = part_alloc("wall_rho", P->n_vertex * sizeof(double));
-  W->p = part_alloc("wall_p", P->n_vertex * sizeof(double));
+  for (int i = 0; i < wall_n_fields; i++)
+    if (wall_fields[i].need == PN_CORE)
+      *(double **)((char *)W + wall_fields[i].off) =
+          part_alloc(wall_fields[i].label, P->n_vertex * sizeof(double));
   for (int wall = 0; wall < 2; wall++)
     for (int i = 0; i < nx; i++)
       for (int k = 0; k < nz; k++, a++) {
@@ -192,12 +237,29 @@ void part_create(struct particles *P, struct walls *W, const struct scene *s) {
       }
 }
 
+void part_alloc_optional(struct particles *P, struct walls *W, const struct scene *s) {
+  for (int i = 0; i < part_n_fields; i++) {
+    const struct part_field *f = &part_fields[i];
+    if (f->need != PN_CORE && part_needed(f->need, s))
+      *(void **)((char *)P + f->off) = part_alloc(f->label, P->cap * elem_size(f));
+  }
+  for (int i = 0; i < wall_n_fields; i++) {
+    const struct wall_field *f = &wall_fields[i];
+    if (f->need != PN_CORE && part_needed(f->need, s))
+      *(double **)((char *)W + f->off) = part_alloc(f->label, P->n_vertex * sizeof(double));
+  }
+}
+
 void part_destroy(struct particles *P, struct walls *W) {
-  struct array t[N_ARRAYS_MAX];
-  for (size_t i = 0, na = arrays(P, t); i < na; i++)
-    if (t[i].core) part_free(*t[i].p), *t[i].p = NULL; /* the others: turb_free, sim_free */
-  part_free(W->rho), part_free(W->p);
-  W->rho = W->p = NULL;
+  for (int i = 0; i < part_n_fields; i++) {
+    void **p = (void **)((char *)P + part_fields[i].off);
+    part_free(*p), *p = NULL;
+  }
+  for (int i = 0; i < wall_n_fields; i++) {
+    double **p = (double **)((char *)W + wall_fields[i].off);
+    part_free(*p), *p = NULL;
+  }
+  P->nur_live = P->sx_live = 0;
 }
 
 static void grow(void *pp, const char *label, size_t elem, size_t used, size_t cap) {

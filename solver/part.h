@@ -112,16 +112,40 @@ enum part_role {
   PF_WRITE = 8,   /*!< in particles.nc */
   PF_HEALTH = 16, /*!< must be finite: health.c checks it before a state is written or sampled */
   PF_GHOST = 32,  /*!< sent with a ghost when the halo is built (dd_halo): what the passes read
-                       at a neighbour before the first refresh (dd_update) */
+                       at a neighbour before the first refresh (dd_refresh) */
   PF_PAIR = 64    /*!< read by the pair loops at a neighbour: packed into slot `rec` of the pair
                        records (records.h) */
 };
 
 enum part_type { PT_F64, PT_I64, PT_U8 };
 
+/** When an array is allocated (struct part_field.need, struct wall_field.need): for every run
+    (PN_CORE: part_create), or for the scenes that switch its module on (part_alloc_optional). */
+enum part_need {
+  PN_CORE,       /*!< every run */
+  PN_LES,        /*!< les.model != none */
+  PN_STRAIN_LAG, /*!< the LES force loop forms the next step's eddy viscosity (les.strain_lag) */
+  PN_WALL_TAU,   /*!< wall stresses at the vertices: LES or a turbulent wall law */
+  PN_EULERIAN,   /*!< Eulerian statistics (the momentum budget's parts) */
+  PN_SHIFTING,   /*!< particle shifting */
+  PN_QCRIT       /*!< output.q_criterion */
+};
+
+/** The refreshes of the ghosts' copies within a step (dd_refresh): after the pass that sets a
+    field, because a later pass reads it at a neighbour (struct part_field.refresh, struct
+    wall_field.refresh). A field read by several passes may be refreshed at several stages. */
+enum part_refresh {
+  PR_DENSITY = 1,  /*!< after sph_density: the fluid values sph_walls reads */
+  PR_WALLS = 2,    /*!< after sph_walls: the vertex and wall values the forces read */
+  PR_WALL_LAW = 4, /*!< after turb_wall_law: the wall stresses at the vertices */
+  PR_MODEL = 8,    /*!< after turb_eddy_viscosity: nu_r and k_r */
+  PR_KR = 16       /*!< after sph_kr_pressure: p/rho^2 and the wall pressure with 2/3 rho k_r */
+};
+
 /** One per-particle array of struct particles. Adding a field: the member in struct particles
-    and one line in part_fields (part.c); allocation, growth, sort, migration, checkpoint,
-    particles.nc and the health check follow from the roles. */
+    and one line in part_fields (part.c); allocation (need), growth, sort, migration,
+    checkpoint, particles.nc, the health check, the pair records and the halo refreshes follow
+    from the line. */
 struct part_field {
   size_t off;            /*!< offsetof(struct particles, the pointer member) */
   const char *label;     /*!< in the memory report */
@@ -129,17 +153,43 @@ struct part_field {
   enum part_type type;   /*!< element type */
   int width;             /*!< values per particle */
   int roles;             /*!< enum part_role */
-  int core;              /*!< allocated for every run; else by the module that uses it */
+  enum part_need need;   /*!< when it is allocated */
   size_t live;           /*!< offsetof an int of struct particles that must be set for the
                               array to hold particle values (permute, migrate), or 0 */
   int optional;          /*!< PF_CKPT: added in a later checkpoint format (may be absent) */
   const char *units;     /*!< PF_CKPT, PF_WRITE */
   const char *long_name; /*!< PF_WRITE */
   int rec;               /*!< PF_PAIR: its slot in the pair records (enum rec_field) */
+  int refresh;           /*!< enum part_refresh: when the ghosts' copies are refreshed */
 };
 
 extern const struct part_field part_fields[]; /*!< every per-particle array (part.c) */
 extern const int part_n_fields;
+
+/** One array of struct walls (indexed by vertex slot): allocation and halo refreshes. */
+struct wall_field {
+  size_t off;          /*!< offsetof(struct walls, the pointer member) */
+  const char *label;   /*!< in the memory report */
+  enum part_need need; /*!< when it is allocated */
+  int refresh;         /*!< enum part_refresh: when the ghost vertices' values are refreshed */
+};
+
+extern const struct wall_field wall_fields[]; /*!< every wall array (part.c) */
+extern const int wall_n_fields;
+
+/** The array of wall field f (NULL if not allocated). */
+static inline double *wall_field_ptr(const struct walls *W, const struct wall_field *f) {
+  return *(double *const *)((const char *)W + f->off);
+}
+
+/** @brief Whether a scene needs the arrays of `need` (enum part_need). */
+int part_needed(enum part_need need, const struct scene *s);
+
+/**
+ * @brief Allocate the optional arrays of particles and walls the scene needs (part_needed),
+ *        P->cap slots each (walls: one per vertex), zeroed; after part_create.
+ */
+void part_alloc_optional(struct particles *P, struct walls *W, const struct scene *s);
 
 /** The array of field f (NULL if not allocated). */
 static inline void *part_field_ptr(const struct particles *P, const struct part_field *f) {
@@ -188,7 +238,7 @@ void part_reserve(struct particles *P, size_t n);
  */
 void part_resize(struct particles *P, size_t cap);
 
-/** @brief Free everything part_create() allocated. */
+/** @brief Free everything part_create() and part_alloc_optional() allocated. */
 void part_destroy(struct particles *P, struct walls *W);
 
 /**

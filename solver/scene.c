@@ -17,6 +17,7 @@
 #include <string.h>
 
 #include "error.h"
+#include "walllaw.h"
 
 enum key_type { T_INT, T_LONG, T_DOUBLE, T_CHOICE, T_STRING, T_LIST };
 enum { REQUIRED = 1, LO_OPEN = 2 };
@@ -882,6 +883,18 @@ double scene_h(const struct scene *s) {
 
 double scene_xi(const struct scene *s) {
   return s->xi > 0.0 ? s->xi : 1000.0 * s->dr / (2.0 * s->delta);
+}
+
+int scene_les(const struct scene *s) {
+  return s->les != LES_NONE;
+}
+
+int scene_strain_lag(const struct scene *s) {
+  return scene_les(s) && s->strain == STRAIN_GRADIENT && s->strain_lag;
+}
+
+int scene_wall_tau(const struct scene *s) {
+  return scene_les(s) || s->wall_law != WALL_LAW_LAMINAR;
 }
 
 int scene_bins(const struct scene *s) {

@@ -199,6 +199,16 @@ double scene_h(const struct scene *s);
 /** @brief Effective volume-diffusion constant xi (mixing-length default, thesis Sec. 3.2). */
 double scene_xi(const struct scene *s);
 
+/** @brief The eddy viscosity is on (les.model != none). */
+int scene_les(const struct scene *s);
+
+/** @brief The LES force loop forms the next step's eddy viscosity (les.strain = gradient and
+           les.strain_lag = 1). */
+int scene_strain_lag(const struct scene *s);
+
+/** @brief Wall stresses are carried to the vertices: LES or a turbulent wall law. */
+int scene_wall_tau(const struct scene *s);
+
 /** @brief Effective number of wall-normal bins. */
 int scene_bins(const struct scene *s);
 

@@ -32,18 +32,14 @@ static void model_update(struct sim *S) {
   S->nu_max = M->nu;
   if (M->wall_tau) {
     turb_wall_law(M, P, &S->nb, &S->W);
-    double *const wt[2] = {S->W.tx, S->W.tz};
-    dd_update_walls(&S->dd, P, 2, wt);
+    dd_refresh(&S->dd, P, &S->W, PR_WALL_LAW);
   }
   if (M->les) {
     S->nu_max = turb_eddy_viscosity(M, P, &S->nb, &S->W);
-    double *const nk[2] = {P->nur, P->kr};
-    dd_update(&S->dd, P, 2, nk); /* read at neighbours by the forces and by sph_kr_pressure */
+    dd_refresh(&S->dd, P, &S->W, PR_MODEL); /* read by the forces and by sph_kr_pressure */
     if (M->cy > 0.0) {
       sph_kr_pressure(M, P, &S->nb, &S->W);
-      double *const pr[1] = {P->pr2}, *const wp[1] = {S->W.p};
-      dd_update(&S->dd, P, 1, pr);
-      dd_update_walls(&S->dd, P, 1, wp);
+      dd_refresh(&S->dd, P, &S->W, PR_KR);
     }
   }
   reduce_global_max(&S->nu_max, 1);
@@ -74,12 +70,9 @@ static void update_state(struct sim *S, int restored, double dt) {
   nbr_build(&S->nb, P, &S->M.k, S->ksum_new);
   /* the arrays may have moved (grown for the ghosts): take the pointers only now */
   sph_density(&S->M, P, restored ? P->ksum : S->ksum_new, dt);
-  double *const dens[5] = {P->rho, P->p, P->c, P->pr2, P->vol};
-  dd_update(&S->dd, P, 5, dens); /* fluid ghosts: what sph_walls reads */
+  dd_refresh(&S->dd, P, &S->W, PR_DENSITY); /* fluid ghosts: what sph_walls reads */
   sph_walls(&S->M, P, &S->nb, &S->W);
-  dd_update(&S->dd, P, 5, dens); /* vertex ghosts */
-  double *const wv[2] = {S->W.rho, S->W.p};
-  dd_update_walls(&S->dd, P, 2, wv);
+  dd_refresh(&S->dd, P, &S->W, PR_WALLS); /* vertex ghosts and wall values */
   model_update(S);
   if (records_fast()) records_pack(P, P->n + P->n_ghost); /* what the force pass gathers */
 }
@@ -91,18 +84,12 @@ int sim_create(struct sim *S, const struct scene *sc) {
   sph_model_init(&S->M, sc);
   /* every rank builds the same full initial state; sim_distribute keeps its own columns */
   part_create(&S->P, &S->W, sc);
-  turb_init(&S->M, &S->P, &S->W);
+  part_alloc_optional(&S->P, &S->W, sc); /* the arrays of the modules the scene turns on */
   if (init_fields(sc, &S->P)) {
-    turb_free(&S->P, &S->W);
     part_destroy(&S->P, &S->W);
     return CHANSPH_ERR;
   }
-  if (sc->stats_eulerian) {
-    S->wall_ax = part_alloc("wall_ax", sizeof(double));
-    S->P.sx = part_alloc("stress_ax", S->P.cap * SX_LEN * sizeof(double));
-  }
-  if (sc->shifting != SHIFT_NONE) S->P.shift_dy = part_alloc("shift_dy", S->P.cap * sizeof(double));
-  if (sc->q_criterion) S->P.qcrit = part_alloc("q_criterion", S->P.cap * sizeof(double));
+  if (sc->stats_eulerian) S->wall_ax = part_alloc("wall_ax", sizeof(double));
   S->qcrit_step = -1;
   S->wall_fx[0] = S->wall_fx[1] = NAN;
   drive_init(&S->drive, sc);
@@ -143,15 +130,11 @@ int sim_init(struct sim *S, const struct scene *sc) {
 }
 
 void sim_free(struct sim *S) {
-  turb_free(&S->P, &S->W);
   if (S->distributed) nbr_free(&S->nb), dd_free(&S->dd);
   for (int k = 0; k < SIM_GATHER; k++) free(S->gather[k]);
   for (int k = 0; k < 4; k++) part_free(S->scratch[k]);
   part_free(S->ksum_new);
   if (S->wall_ax) part_free(S->wall_ax);
-  part_free(S->P.sx), S->P.sx = NULL;
-  part_free(S->P.shift_dy), S->P.shift_dy = NULL;
-  part_free(S->P.qcrit), S->P.qcrit = NULL;
   part_destroy(&S->P, &S->W);
 }
 

@@ -35,14 +35,14 @@ void sph_model_init(struct model *M, const struct scene *s) {
   M->wall_weight = s->wall_weight;
   M->wall_pressure = s->wall_pressure;
   M->pgrad = s->pgrad;
-  M->les = s->les != LES_NONE;
+  M->les = scene_les(s);
   M->strain = s->strain;
-  M->strain_lag = M->les && s->strain == STRAIN_GRADIENT && s->strain_lag;
+  M->strain_lag = scene_strain_lag(s);
   M->van_driest = s->van_driest;
   M->cs = s->cs, M->delta_g = s->filter_h * M->h, M->a_plus = s->a_plus;
   M->cy = s->cy;
   M->law = wall_law_make(s->wall_law, s->kappa, s->log_b);
-  M->wall_tau = M->les || s->wall_law != WALL_LAW_LAMINAR;
+  M->wall_tau = scene_wall_tau(s);
   M->shifting = s->shifting;
   M->shift_ch2 = s->shift_coef * M->h * M->h;
   M->shift_iwdr = 1.0 / kernel_w(&M->k, s->dr);

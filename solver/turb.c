@@ -11,23 +11,6 @@
 #include "timers.h"
 #include "wall.h"
 
-void turb_init(const struct model *M, struct particles *P, struct walls *W) {
-  if (!M->wall_tau) return;
-  const size_t nd = P->n * sizeof(double), nv = P->n_vertex * sizeof(double);
-  P->twx = part_alloc("wall_law_tx", nd), P->twz = part_alloc("wall_law_tz", nd);
-  W->tx = part_alloc("wall_tau_x", nv), W->tz = part_alloc("wall_tau_z", nv);
-  if (M->les) P->nur = part_alloc("nu_r", nd), P->kr = part_alloc("k_r", nd);
-  if (M->strain_lag)
-    P->nur_next = part_alloc("nu_r_next", nd), P->kr_next = part_alloc("k_r_next", nd);
-  P->nur_live = 0;
-}
-
-void turb_free(struct particles *P, struct walls *W) {
-  double **d[] = {&P->twx, &P->twz, &P->nur, &P->kr, &P->nur_next, &P->kr_next, &W->tx, &W->tz};
-  for (size_t i = 0; i < sizeof d / sizeof d[0]; i++) part_free(*d[i]), *d[i] = NULL;
-  P->nur_live = 0;
-}
-
 double turb_van_driest(double yplus, double a_plus) {
   return -expm1(-yplus / a_plus); /* 1 - exp(-y+/A+) */
 }

@@ -30,12 +30,6 @@
 #include "part.h"
 #include "sph.h"
 
-/** @brief Allocate the model arrays a scene needs (none for quasi-DNS, laminar wall law). */
-void turb_init(const struct model *M, struct particles *P, struct walls *W);
-
-/** @brief Free them. */
-void turb_free(struct particles *P, struct walls *W);
-
 /**
  * @brief Steps 1-2: the wall-law stress of the near-wall fluid particles (ghosts included: they
  *        compute their own) and its Shepard interpolation to the vertices (W->tx, W->tz); the
