@@ -222,6 +222,7 @@ void part_create(struct particles *P, struct walls *W, const struct scene *s) {
         P->rho[a] = s->rho0, P->m[a] = mass, P->gam[a] = 1.0;
         P->id[a] = (int64_t)a, P->kind[a] = KIND_FLUID;
       }
+  memset(W, 0, sizeof *W); /* the optional wall arrays stay NULL (part_alloc_optional) */
   W->nx = nx, W->nz = nz;
   for (int i = 0; i < wall_n_fields; i++)
     if (wall_fields[i].need == PN_CORE)
