@@ -285,7 +285,9 @@ static const struct key keys[] = {
      "start a finer "
      "run. A relative path in a scene file is relative to the scene file's directory (on the "
      "command line, to the working directory). Overrides profile; streaks, modes and noise are "
-     "added on top. A source holding a NaN or Inf is refused (exit 1).",
+     "added on top. A source that is not a state of the box is refused (exit 1): variables "
+     "not 1-D over 'particle', no particles, ids not 0..n-1 each once, a NaN or Inf, rho or "
+     "mass not positive, a position outside the box.",
      OFF(init_from)},
     {"output", "log_every", T_INT, "100", 1, 1e9, 0, NULL, "steps",
      "Steps between progress lines (stdout and DIR/log.txt).", OFF(log_every)},
