@@ -250,6 +250,33 @@ static void rename_skipped(struct output *o, const struct skipped *sk, int rank)
   }
 }
 
+/* Rank 0: the identity a directory without DIR/run_id takes, the one every readable checkpoint
+   stores (id; "" when none stores one: a run started before identities existed). Checkpoints of
+   two runs are an input error: which run is this directory's cannot be known. */
+static int agreed_id(const char *dir, const long *steps, int n, char *id) {
+  char first[4096] = "", path[4096], err[2048];
+  id[0] = '\0';
+  for (int i = n - 1; i >= 0; i--) {
+    rotate_path(path, sizeof path, dir, steps[i]);
+    struct ckpt_info info;
+    const int bad = ckpt_info(path, &info, err, sizeof err);
+    free(info.scene);
+    if (bad || !info.run_id[0]) continue; /* unreadable, or from before run identities */
+    if (!id[0]) {
+      snprintf(id, CKPT_RUN_ID_MAX, "%s", info.run_id);
+      snprintf(first, sizeof first, "%s", path);
+    } else if (strcmp(id, info.run_id)) {
+      error_input(
+          "%s/run_id is missing and the checkpoints are of two runs (%s: run_id %s; %s: run_id "
+          "%s): which one is this directory's cannot be known; write the run's identity into "
+          "%s/run_id, or move the other run's checkpoints away, then resume again",
+          dir, first, id, path, info.run_id, dir);
+      return CHANSPH_ERR;
+    }
+  }
+  return CHANSPH_OK;
+}
+
 int restart_resume(const char *dir, int n_set, char *const *set, struct scene *sc, struct sim *S,
                    struct output *o) {
   long *steps;
@@ -271,6 +298,15 @@ int restart_resume(const char *dir, int n_set, char *const *set, struct scene *s
   double seconds[2] = {0.0, 0.0}; /* read, restore */
   char path[4096], dir_id[CKPT_RUN_ID_MAX];
   const int no_id = rundir_read_id(dir, dir_id);
+  if (no_id) { /* only checkpoints of one run: theirs (checked as the directory's below) */
+    int rc = rank == 0 ? agreed_id(dir, steps, n, dir_id) : CHANSPH_OK;
+    CHECK_MPI(MPI_Bcast(&rc, 1, MPI_INT, 0, MPI_COMM_WORLD));
+    CHECK_MPI(MPI_Bcast(dir_id, CKPT_RUN_ID_MAX, MPI_CHAR, 0, MPI_COMM_WORLD));
+    if (rc) {
+      free(steps), free(sk);
+      return CHANSPH_ERR;
+    }
+  }
   struct candidate cd = {.path = path, .dir_id = dir_id};
   for (int i = n - 1; i >= 0 && !fatal && found < 0; i--) {
     rotate_path(path, sizeof path, dir, steps[i]);
