@@ -4,6 +4,7 @@
  *        which scene keys a resume may change.
  */
 #include <errno.h>
+#include <math.h>
 #include <mpi.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -91,6 +92,41 @@ static int check_average_start(const struct scene *old, const struct scene *now,
     return CHANSPH_ERR;
   }
   return CHANSPH_OK;
+}
+
+/* stats.window may change only before averaging has begun: the windows already averaged
+   have the old length, and their means are the batches of the standard errors. t: time of the
+   checkpoint. */
+static int check_window(const struct scene *old, const struct scene *now, double t,
+                        const char *path) {
+  if (old->stats_window == now->stats_window || t < old->t_average_start) return CHANSPH_OK;
+  error_input(
+      "--set stats.window=%g: key 'stats.window' cannot change on resume once averaging has "
+      "begun (the checkpoint %s is at t = %.9g s, averaging began at %g s): the averaging "
+      "windows would differ in length; keep %g, or start a new run",
+      now->stats_window, path, t, old->t_average_start, old->stats_window);
+  return CHANSPH_ERR;
+}
+
+/* Once averaging has begun, the windows keep the length they have (output/window_length of the
+   checkpoint; before format 1.5, the length the checkpoint's scene gives), whatever a new
+   time.t_end would give; before, the resumed scene's length. t: time of the checkpoint. */
+static void keep_window(struct output *o, const struct scene *old, double t) {
+  const double fresh = o->st.cfg.eul.window; /* the resumed scene's */
+  double len = o->window_len;
+  if (t < old->t_average_start) {
+    len = fresh;
+  } else if (!(len > 0.0)) {
+    struct stats_config cfg;
+    output_stats_config(old, &cfg);
+    len = cfg.eul.window;
+  }
+  output_set_window(o, len);
+  if (len != fresh)
+    output_log(o,
+               "resume: the averaging windows keep their length %.9g s (fixed once averaging "
+               "has begun; the resumed scene alone would give %.9g s)\n",
+               len, fresh);
 }
 
 /* Log the accepted changes. */
@@ -184,7 +220,8 @@ static int try_one(const char *dir, struct candidate *cd, int n_set, char *const
     return CHANSPH_ERR;
   }
   const int bad = scene_load_text(sc, name, info.scene, n_set, set) ||
-                  check_changes(old, sc, path) || check_average_start(old, sc, info.time, path);
+                  check_changes(old, sc, path) || check_average_start(old, sc, info.time, path) ||
+                  check_window(old, sc, info.time, path);
   free(info.scene);
   /* the ranks must fit the slabs before anything is read (an input error, exit 1) */
   struct dd probe;
@@ -212,6 +249,7 @@ static int try_one(const char *dir, struct candidate *cd, int n_set, char *const
   struct state_list L = {0};
   sim_state(S, &L);
   output_state(o, &L);
+  o->window_len = NAN; /* stays NaN if the checkpoint has no window length (before 1.5) */
   const double t0 = timer_now();
   /* each rank reads its id block of the particles and all other fields; a checksum error
      seen by any rank skips the file on all */
@@ -346,5 +384,6 @@ int restart_resume(const char *dir, int n_set, char *const *set, struct scene *s
   rename_skipped(o, sk, rank);
   free(sk);
   log_changes(o, &old, sc);
+  keep_window(o, &old, S->t);
   return CHANSPH_OK;
 }

@@ -115,6 +115,7 @@ static int open_common(struct output *o, const char *dir, const struct scene *sc
   struct stats_config cfg;
   output_stats_config(sc, &cfg);
   stats_init(&o->st, &cfg);
+  o->window_len = cfg.eul.window;
   series_init(&o->ts, N_SERIES, series_names, sc->dim == 2 ? series_units_2d : series_units_3d,
               series_long_names);
   o->next_write = sc->write_every > 0.0 ? sc->write_every : INFINITY;
@@ -221,6 +222,13 @@ void output_state(struct output *o, struct state_list *L) {
   struct state_field *f = state_add(L, "stats/series", STATE_F64, 2, dims, o->ts.data, NULL);
   f->reserve = series_reserve, f->owner = &o->ts;
   state_add(L, "output/next_write", STATE_F64, 0, NULL, &o->next_write, "s");
+  /* format 1.5; before it, a resume takes the length from the checkpoint's scene */
+  state_add(L, "output/window_length", STATE_F64, 0, NULL, &o->window_len, "s")->optional = 1;
+}
+
+void output_set_window(struct output *o, double len) {
+  o->window_len = o->st.cfg.eul.window = len;
+  if (o->st.cfg.eulerian) o->st.eu.cfg.window = len;
 }
 
 void output_log(struct output *o, const char *fmt, ...) {

@@ -22,6 +22,8 @@ struct output {
   struct stats st;    /*!< the statistics engine */
   struct series ts;   /*!< time series */
   double next_write;  /*!< simulated time of the next stats.nc rewrite [s] */
+  double window_len;  /*!< length of the Eulerian averaging windows in use [s] (checkpointed:
+                           fixed once averaging has begun; NaN while a checkpoint is read) */
   double wall0;       /*!< wall clock at the start of the loop [s] */
   double t0;          /*!< simulated time at the start of the loop [s] */
   double last_wall;   /*!< wall clock of the last log line [s] */
@@ -60,6 +62,13 @@ int output_reopen(struct output *o, const char *dir, const struct scene *sc);
  *        rewrite. Rebuild the list before each checkpoint: growing arrays move.
  */
 void output_state(struct output *o, struct state_list *L);
+
+/**
+ * @brief Use this length for the Eulerian averaging windows from now on (a resume keeps the
+ *        length the windows already averaged have, whatever time.t_end says now).
+ * @param[in] len window length [s]
+ */
+void output_set_window(struct output *o, double len);
 
 /** @brief Log a line to stdout and log.txt (printf-style). */
 void output_log(struct output *o, const char *fmt, ...);

@@ -323,7 +323,8 @@ static const struct key keys[] = {
      "Length of an averaging window: stats.nc keeps the sums of every window (re-average a "
      "range with `chansph extract --window`), and the window means are the batch means of "
      "the standard errors, so a window should span several correlation times (the log "
-     "reports the estimate). 0 = a tenth of t_end - t_average_start.",
+     "reports the estimate). 0 = a tenth of t_end - t_average_start. Fixed once averaging "
+     "has begun: a resume keeps the length (also with a new t_end) and refuses a new value.",
      OFF(stats_window)},
     {"stats", "fold", T_INT, "0", 0, 1, 0, NULL, "-",
      "Fold the upper half onto the lower one (y -> 2 delta - y, v -> -v) before binning; the "
