@@ -129,6 +129,25 @@ static void keep_window(struct output *o, const struct scene *old, double t) {
                len, fresh);
 }
 
+/* A run that ended at its convergence target stays finished, as one that reached t_end does,
+   unless the resume changes the target (then it is evaluated again when a window closes). */
+static void keep_converged(struct output *o, const struct scene *old, const struct scene *now,
+                           long step) {
+  if (!o->converged) return;
+  if (old->target_stderr == now->target_stderr && old->target_profiles == now->target_profiles &&
+      old->target_corr_ratio == now->target_corr_ratio &&
+      old->target_windows == now->target_windows) {
+    output_log(o,
+               "resume: the run ended at step %ld when its statistics met stats.target_stderr = "
+               "%g: it stays finished (to go on, change the convergence target, e.g. --set "
+               "stats.target_stderr=...)\n",
+               step, old->target_stderr);
+    return;
+  }
+  o->converged = 0;
+  output_log(o, "resume: the convergence target changed: the run goes on\n");
+}
+
 /* Log the accepted changes. */
 static void log_changes(struct output *o, const struct scene *old, const struct scene *now) {
   for (int k = 0; k < scene_key_count(); k++) {
@@ -385,5 +404,6 @@ int restart_resume(const char *dir, int n_set, char *const *set, struct scene *s
   free(sk);
   log_changes(o, &old, sc);
   keep_window(o, &old, S->t);
+  keep_converged(o, &old, sc, S->step);
   return CHANSPH_OK;
 }

@@ -224,6 +224,8 @@ void output_state(struct output *o, struct state_list *L) {
   state_add(L, "output/next_write", STATE_F64, 0, NULL, &o->next_write, "s");
   /* format 1.5; before it, a resume takes the length from the checkpoint's scene */
   state_add(L, "output/window_length", STATE_F64, 0, NULL, &o->window_len, "s")->optional = 1;
+  /* format 1.5; before it, a run that ended at its target resumed as one that had not */
+  state_add(L, "output/converged", STATE_I32, 0, NULL, &o->converged, NULL)->optional = 1;
 }
 
 void output_set_window(struct output *o, double len) {

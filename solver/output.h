@@ -35,7 +35,8 @@ struct output {
   char run_id[64];    /*!< identity of the run (DIR/run_id), attribute of stats.nc, particles.nc */
   char *history;      /*!< DIR/history: every run and resume command, newest first (rank 0) */
   size_t target_nwin; /*!< complete windows when the convergence target was last checked */
-  int converged;      /*!< the convergence target (stats.target_stderr) is met: end the run */
+  int converged;      /*!< the convergence target (stats.target_stderr) is met: end the run
+                           (checkpointed: a resumed run that met it stays finished) */
 };
 
 /**

@@ -121,7 +121,7 @@ static int run(struct scene *sc, const struct cli *c) {
   /* the start state counts as checked: read from a checkpoint (checked when it was written), or
      built from the scene (analytic profiles; init.from is refused if not finite) */
   long checked = S.step;
-  while (!sim_done(&S)) {
+  while (!out.converged && !sim_done(&S)) { /* converged: a resumed run that had ended */
     sim_step(&S);
     if (c->inject_id >= 0 && S.step == c->inject_step)
       for (size_t a = 0; a < S.P.n; a++)
