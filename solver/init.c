@@ -393,16 +393,27 @@ void init_dns180(double yplus, double out[5]) {
     out[c] = dns_lm180[i][c + 1] + t * (dns_lm180[i + 1][c + 1] - dns_lm180[i][c + 1]);
 }
 
+double init_sem_count(const struct scene *sc) {
+  const double sig = sc->init_eddy_size * sc->delta;
+  const double vol = sc->lx * (2.0 * sc->delta + 2.0 * sig) * sc->lz;
+  return sc->init_eddies > 0 ? (double)sc->init_eddies
+                             : fmax(1.0, floor(vol / (sig * sig * sig) + 0.5));
+}
+
+double init_bytes(const struct scene *sc) {
+  if (sc->init_from[0] || sc->init_profile != INIT_SYNTHETIC) return 0.0;
+  /* positions and signs, the order by cell and the cell of each eddy (init_sem_make) */
+  return init_sem_count(sc) * (6.0 * sizeof(double) + sizeof(size_t) + sizeof(int));
+}
+
 int init_sem_make(struct init_sem *E, const struct scene *sc) {
   memset(E, 0, sizeof *E);
   const double sig = sc->init_eddy_size * sc->delta;
   E->sigma = sig, E->lx = sc->lx, E->lz = sc->lz, E->y0 = -sig;
   E->ly = 2.0 * sc->delta + 2.0 * sig;
   const double vol = E->lx * E->ly * E->lz;
-  long n = sc->init_eddies;
-  if (n <= 0) n = (long)fmax(1.0, floor(vol / (sig * sig * sig) + 0.5));
-  E->n = (size_t)n;
-  E->scale = sqrt(vol / (sig * sig * sig) / (double)n);
+  E->n = (size_t)init_sem_count(sc);
+  E->scale = sqrt(vol / (sig * sig * sig) / (double)E->n);
   /* cells of width w >= sigma, no more cells than about 4 per eddy (w grows for a few eddies
      in a large box); fewer than 3 along a periodic direction: one cell (the nearest image is
      then the only one within sigma, as sigma <= l/2) */

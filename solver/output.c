@@ -172,6 +172,18 @@ void output_stats_config(const struct scene *sc, struct stats_config *cfg) {
   }
 }
 
+void output_stats_bytes(const struct scene *sc, double *eulerian, double *corr) {
+  struct stats_config cfg;
+  output_stats_config(sc, &cfg);
+  *eulerian = cfg.eulerian ? (double)euler_sample_bytes(cfg.eul.nb, nbr_columns(sc)) : 0.0;
+  *corr = 0.0;
+  const struct corr_config *c = &cfg.corr;
+  if (c->n_levels > 0) { /* spectra per level, the FFTW grid and its transform (corr_init) */
+    const double nk = (double)c->nx * (c->nz / 2 + 1);
+    *corr = sizeof(double) * (c->n_levels * nk * CS_LEN + 4.0 * c->nx * c->nz + 6.0 * nk);
+  }
+}
+
 /* The checks and the directory of output_open (rank 0). */
 static int make_dir(const char *dir, int overwrite) {
   static const char *const results[] = {"stats.nc", "log.txt", "particles.nc"};

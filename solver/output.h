@@ -71,6 +71,14 @@ void output_state(struct output *o, struct state_list *L);
  */
 void output_set_window(struct output *o, double len);
 
+/**
+ * @brief Memory the statistics engines of a scene need on a rank, before they exist (lower
+ *        bounds, for the scene's memory check).
+ * @param[out] eulerian bytes of the Eulerian per-column partials (output.n_bins, domain.lx)
+ * @param[out] corr bytes of the correlation grids and spectra (correlations.*)
+ */
+void output_stats_bytes(const struct scene *sc, double *eulerian, double *corr);
+
 /** @brief Log a line to stdout and log.txt (printf-style). */
 void output_log(struct output *o, const char *fmt, ...);
 

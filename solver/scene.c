@@ -950,7 +950,8 @@ void scene_write_doc(FILE *f) {
           "after a section header (`[wall] law = x`: a key goes on a line of its own), keys "
           "set twice, values out of range and inconsistent geometry are errors that name the "
           "file, line and key; so is a domain of more than 2^30 particles along a direction, "
-          "or whose particles would need more memory than the machine has (the estimate, a "
+          "or a scene whose particles, statistics grids (`output.n_bins`, `correlations.*`) and "
+          "synthetic eddies would need more than 80%% of the machine's memory (the estimate, a "
           "lower bound, is checked before anything is allocated).\n"
           "The fully resolved scene (defaults included) is written to `DIR/scene.used.ini` "
           "and into the `scene` attribute of `stats.nc`.\n");

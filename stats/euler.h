@@ -208,6 +208,10 @@ void euler_free(struct euler *e);
 /** @brief Bytes of the scratch of euler_sample (per-column partials, gathered subtrees). */
 size_t euler_work_bytes(const struct euler *e);
 
+/** @brief Lower bound of those bytes before the engine exists: the per-column partials of nb
+    bins over ncol cell columns (the memory check of a scene). */
+size_t euler_sample_bytes(int nb, int ncol);
+
 /**
  * @brief Add one snapshot. Implements: thesis Eq. 5.54-5.55 (bins) or 5.56 (stats.method =
  *        sph), and the wall-stress sample of Eq. 5.13-5.14.
