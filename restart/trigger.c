@@ -149,6 +149,7 @@ int trigger_parse_walltime(const char *text, double *seconds) {
     errno = 0;
     const double v = strtod(p, &end);
     if (n == 3 || end == p || errno || v < 0.0 || !isfinite(v) || *p == '-' || *p == '+') return 1;
+    if (n > 0 && v >= 60.0) return 1; /* minutes and seconds after a ':' are below 60 */
     s = 60.0 * s + v;
     if (*end == '\0') break;
     if (*end != ':') return 1;
