@@ -139,6 +139,10 @@ int rundir_lock(const char *dir, int create);
  */
 int rundir_check(const char *dir);
 
+/** @brief rundir_check() on rank 0 alone, without a message: 1 if DIR is still the directory
+    this process locked (or it locked none). */
+int rundir_is_held(const char *dir);
+
 /**
  * @brief A new run's identity: CHANSPH_RUN_ID if set, else a random UUID; written to
  *        DIR/run_id and into every following checkpoint and snapshot (ckpt_set_run_id).

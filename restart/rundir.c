@@ -234,21 +234,24 @@ static int take_lock(const char *dir, int create) {
   return CHANSPH_OK;
 }
 
-/* Rank 0: whether DIR (and DIR/.lock) are still the ones this process holds. */
-static int still_held(const char *dir) {
-  if (!held.known) return CHANSPH_OK;
+int rundir_is_held(const char *dir) {
+  if (!held.known) return 1;
   char path[4096];
   snprintf(path, sizeof path, "%s/.lock", dir);
   struct stat d, l;
   const int same_dir = !stat(dir, &d) && d.st_dev == held.dev && d.st_ino == held.ino;
-  const int same_lock =
-      lock_fd < 0 || (!stat(path, &l) && l.st_dev == held.lock_dev && l.st_ino == held.lock_ino);
-  if (same_dir && same_lock) return CHANSPH_OK;
+  return same_dir && (lock_fd < 0 ||
+                      (!stat(path, &l) && l.st_dev == held.lock_dev && l.st_ino == held.lock_ino));
+}
+
+/* Rank 0: whether DIR (and DIR/.lock) are still the ones this process holds, or a message. */
+static int still_held(const char *dir) {
+  if (rundir_is_held(dir)) return CHANSPH_OK;
   error_input(
-      "%s is no longer the run directory this process locked (%s: deleted, moved or replaced "
+      "%s is no longer the run directory this process locked (deleted, moved or replaced "
       "while the run was working; another run may use it now): stopping without writing "
       "anything more",
-      dir, same_dir ? "its .lock is another file" : "the directory is gone or another one");
+      dir);
   return CHANSPH_ERR;
 }
 

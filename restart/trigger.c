@@ -74,6 +74,7 @@ static int stop_file(struct trigger *T) {
   if (rank != 0) return 0; /* rank 0 looks and removes it; trigger_check shares the result */
   snprintf(path, sizeof path, "%s/STOP", T->dir);
   if (stat(path, &st)) return 0;
+  if (!rundir_is_held(T->dir)) return 1; /* another run's STOP now: the run stops, keeps it */
   if (remove(path)) warn("%s: cannot remove the STOP file (%s)", path, strerror(errno));
   return 1;
 }

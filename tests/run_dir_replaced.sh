@@ -50,6 +50,7 @@ if [ "$case" = replaced ]; then
     [ "$(ckpt_id "$ck")" = "$id" ] || fail "$ck is not the second run's ($id)"
   done
   [ "$(ls "$d"/checkpoints/ckpt_*.h5 | wc -l)" -ge 2 ] || fail "the second run's checkpoints are gone"
+  [ -e "$d/STOP" ] || fail "the first run removed the STOP file of a directory it no longer holds"
   rm -f "$d/STOP"
   out=$("$chansph" resume "$d" --set time.t_end=0.25 2>&1)
   rc=$?
