@@ -131,6 +131,19 @@ int restart_resume(const char *dir, int n_set, char *const *set, struct scene *s
 int rundir_lock(const char *dir, int create);
 
 /**
+ * @brief Whether DIR is still the directory this process locked (the same inode, and DIR/.lock
+ *        the same file): a directory deleted and recreated by another run, or moved away, is
+ *        not; then nothing more may be written there. Called before every write of the run's
+ *        files (stats.nc, particles.nc, snapshots, checkpoints). Collective.
+ * @return CHANSPH_OK, or CHANSPH_ERR after a message
+ */
+int rundir_check(const char *dir);
+
+/** @brief rundir_check() on rank 0 alone, without a message: 1 if DIR is still the directory
+    this process locked (or it locked none). */
+int rundir_is_held(const char *dir);
+
+/**
  * @brief A new run's identity: CHANSPH_RUN_ID if set, else a random UUID; written to
  *        DIR/run_id and into every following checkpoint and snapshot (ckpt_set_run_id).
  * @param[out] id the identity (CKPT_RUN_ID_MAX bytes), the same on every rank

@@ -4,6 +4,7 @@
  *        which scene keys a resume may change.
  */
 #include <errno.h>
+#include <math.h>
 #include <mpi.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -91,6 +92,58 @@ static int check_average_start(const struct scene *old, const struct scene *now,
     return CHANSPH_ERR;
   }
   return CHANSPH_OK;
+}
+
+/* stats.window may change only before averaging has begun: the windows already averaged
+   have the old length, and their means are the batches of the standard errors. t: time of the
+   checkpoint. */
+static int check_window(const struct scene *old, const struct scene *now, double t,
+                        const char *path) {
+  if (old->stats_window == now->stats_window || t < old->t_average_start) return CHANSPH_OK;
+  error_input(
+      "--set stats.window=%g: key 'stats.window' cannot change on resume once averaging has "
+      "begun (the checkpoint %s is at t = %.9g s, averaging began at %g s): the averaging "
+      "windows would differ in length; keep %g, or start a new run",
+      now->stats_window, path, t, old->t_average_start, old->stats_window);
+  return CHANSPH_ERR;
+}
+
+/* Once averaging has begun, the windows keep the length they have (output/window_length of the
+   checkpoint; before format 1.5, the length the checkpoint's scene gives), whatever a new
+   time.t_end would give; before, the resumed scene's length. t: time of the checkpoint. */
+static void keep_window(struct output *o, const struct scene *old, double t) {
+  const double fresh = output_stats_window(o, NULL); /* the resumed scene's */
+  double len = o->window_len;
+  if (t < old->t_average_start) {
+    len = fresh;
+  } else if (!(len > 0.0)) {
+    len = output_stats_window(o, old);
+  }
+  output_set_window(o, len);
+  if (len != fresh)
+    output_log(o,
+               "resume: the averaging windows keep their length %.9g s (fixed once averaging "
+               "has begun; the resumed scene alone would give %.9g s)\n",
+               len, fresh);
+}
+
+/* A run that ended at its convergence target stays finished, as one that reached t_end does,
+   unless the resume changes the target (then it is evaluated again when a window closes). */
+static void keep_converged(struct output *o, const struct scene *old, const struct scene *now,
+                           long step) {
+  if (!o->converged) return;
+  if (old->target_stderr == now->target_stderr && old->target_profiles == now->target_profiles &&
+      old->target_corr_ratio == now->target_corr_ratio &&
+      old->target_windows == now->target_windows) {
+    output_log(o,
+               "resume: the run ended at step %ld when its statistics met stats.target_stderr = "
+               "%g: it stays finished (to go on, change the convergence target, e.g. --set "
+               "stats.target_stderr=...)\n",
+               step, old->target_stderr);
+    return;
+  }
+  o->converged = 0;
+  output_log(o, "resume: the convergence target changed: the run goes on\n");
 }
 
 /* Log the accepted changes. */
@@ -184,7 +237,8 @@ static int try_one(const char *dir, struct candidate *cd, int n_set, char *const
     return CHANSPH_ERR;
   }
   const int bad = scene_load_text(sc, name, info.scene, n_set, set) ||
-                  check_changes(old, sc, path) || check_average_start(old, sc, info.time, path);
+                  check_changes(old, sc, path) || check_average_start(old, sc, info.time, path) ||
+                  check_window(old, sc, info.time, path);
   free(info.scene);
   /* the ranks must fit the slabs before anything is read (an input error, exit 1) */
   struct dd probe;
@@ -212,6 +266,7 @@ static int try_one(const char *dir, struct candidate *cd, int n_set, char *const
   struct state_list L = {0};
   sim_state(S, &L);
   output_state(o, &L);
+  o->window_len = NAN; /* stays NaN if the checkpoint has no window length (before 1.5) */
   const double t0 = timer_now();
   /* each rank reads its id block of the particles and all other fields; a checksum error
      seen by any rank skips the file on all */
@@ -250,6 +305,33 @@ static void rename_skipped(struct output *o, const struct skipped *sk, int rank)
   }
 }
 
+/* Rank 0: the identity a directory without DIR/run_id takes, the one every readable checkpoint
+   stores (id; "" when none stores one: a run started before identities existed). Checkpoints of
+   two runs are an input error: which run is this directory's cannot be known. */
+static int agreed_id(const char *dir, const long *steps, int n, char *id) {
+  char first[4096] = "", path[4096], err[2048];
+  id[0] = '\0';
+  for (int i = n - 1; i >= 0; i--) {
+    rotate_path(path, sizeof path, dir, steps[i]);
+    struct ckpt_info info;
+    const int bad = ckpt_info(path, &info, err, sizeof err);
+    free(info.scene);
+    if (bad || !info.run_id[0]) continue; /* unreadable, or from before run identities */
+    if (!id[0]) {
+      snprintf(id, CKPT_RUN_ID_MAX, "%s", info.run_id);
+      snprintf(first, sizeof first, "%s", path);
+    } else if (strcmp(id, info.run_id)) {
+      error_input(
+          "%s/run_id is missing and the checkpoints are of two runs (%s: run_id %s; %s: run_id "
+          "%s): which one is this directory's cannot be known; write the run's identity into "
+          "%s/run_id, or move the other run's checkpoints away, then resume again",
+          dir, first, id, path, info.run_id, dir);
+      return CHANSPH_ERR;
+    }
+  }
+  return CHANSPH_OK;
+}
+
 int restart_resume(const char *dir, int n_set, char *const *set, struct scene *sc, struct sim *S,
                    struct output *o) {
   long *steps;
@@ -271,6 +353,15 @@ int restart_resume(const char *dir, int n_set, char *const *set, struct scene *s
   double seconds[2] = {0.0, 0.0}; /* read, restore */
   char path[4096], dir_id[CKPT_RUN_ID_MAX];
   const int no_id = rundir_read_id(dir, dir_id);
+  if (no_id) { /* only checkpoints of one run: theirs (checked as the directory's below) */
+    int rc = rank == 0 ? agreed_id(dir, steps, n, dir_id) : CHANSPH_OK;
+    CHECK_MPI(MPI_Bcast(&rc, 1, MPI_INT, 0, MPI_COMM_WORLD));
+    CHECK_MPI(MPI_Bcast(dir_id, CKPT_RUN_ID_MAX, MPI_CHAR, 0, MPI_COMM_WORLD));
+    if (rc) {
+      free(steps), free(sk);
+      return CHANSPH_ERR;
+    }
+  }
   struct candidate cd = {.path = path, .dir_id = dir_id};
   for (int i = n - 1; i >= 0 && !fatal && found < 0; i--) {
     rotate_path(path, sizeof path, dir, steps[i]);
@@ -310,5 +401,7 @@ int restart_resume(const char *dir, int n_set, char *const *set, struct scene *s
   rename_skipped(o, sk, rank);
   free(sk);
   log_changes(o, &old, sc);
+  keep_window(o, &old, S->t);
+  keep_converged(o, &old, sc, S->step);
   return CHANSPH_OK;
 }

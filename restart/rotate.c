@@ -78,14 +78,32 @@ int rotate_remove_tmp(const char *dir) {
   return n;
 }
 
-/* Delete the oldest checkpoints at or before step, keeping keep of them. */
-static void rotate_keep(const char *dir, long step, int keep) {
+/* Whether the checkpoint of a step in dir is one of run id's (its root attribute run_id); an
+   unreadable file or one of another run is not. */
+static int own_checkpoint(const char *dir, long step, const char *id) {
+  char path[4096], err[2048];
+  rotate_path(path, sizeof path, dir, step);
+  struct ckpt_info info;
+  const int rc = ckpt_info(path, &info, err, sizeof err);
+  free(info.scene);
+  return rc == 0 && id[0] && !strcmp(info.run_id, id);
+}
+
+/* Delete the oldest checkpoints of run id at or before step, keeping keep of them. Files of
+   another run (a directory deleted and recreated under a running process, a copied file) or
+   unreadable ones are neither counted nor deleted. */
+static void rotate_keep(const char *dir, long step, int keep, const char *id) {
   long *steps;
   const int n = rotate_list(dir, &steps);
   int older = 0;
-  for (int i = 0; i < n; i++) older += steps[i] <= step;
+  for (int i = 0; i < n; i++) {
+    if (steps[i] <= step && own_checkpoint(dir, steps[i], id))
+      older++;
+    else
+      steps[i] = -1; /* not a candidate */
+  }
   for (int i = 0; i < n && older > keep; i++) {
-    if (steps[i] > step) continue;
+    if (steps[i] < 0) continue;
     char path[4096];
     rotate_path(path, sizeof path, dir, steps[i]);
     if (remove(path)) warn("%s: cannot remove an old checkpoint (%s)", path, strerror(errno));
@@ -138,7 +156,7 @@ int restart_save(struct output *o, struct sim *S, double *seconds) {
   struct stat st;
   const double mb = stat(path, &st) ? 0.0 : (double)st.st_size / 1048576.0;
   output_log(o, "checkpoint %s (step %ld, %.2f MB, %.3f s)\n", path, S->step, mb, *seconds);
-  if (rank == 0) rotate_keep(o->dir, S->step, S->sc->ckpt_keep);
+  if (rank == 0) rotate_keep(o->dir, S->step, S->sc->ckpt_keep, o->run_id);
   return CHANSPH_OK;
 }
 

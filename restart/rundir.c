@@ -162,6 +162,22 @@ char *rundir_history(const char *dir, const char *cmdline, int fresh, int ranks,
 /* The lock: rank 0 holds a write lock (fcntl) on DIR/.lock until the process ends. */
 static int lock_fd = -1;
 
+/* The run directory and lock file this process holds (rank 0), to notice a directory deleted
+   and recreated, or moved away, while the run works in it (rundir_check). */
+static struct {
+  int known;           /*!< 1 once the directory is held */
+  dev_t dev, lock_dev; /*!< devices of DIR and DIR/.lock */
+  ino_t ino, lock_ino; /*!< inodes of DIR and DIR/.lock (lock_fd < 0: not compared) */
+} held;
+
+/* Remember which directory (and lock file) the process holds. */
+static void hold(const char *dir, int fd) {
+  struct stat d, l;
+  if (stat(dir, &d)) return;
+  held.dev = d.st_dev, held.ino = d.st_ino, held.known = 1;
+  if (fd >= 0 && !fstat(fd, &l)) held.lock_dev = l.st_dev, held.lock_ino = l.st_ino;
+}
+
 static int take_lock(const char *dir, int create) {
   struct stat st;
   if (stat(dir, &st)) {
@@ -194,6 +210,7 @@ static int take_lock(const char *dir, int create) {
       /* the pid is for people only */
     }
     lock_fd = fd;
+    hold(dir, fd);
     return CHANSPH_OK;
   }
   const int e = errno;
@@ -213,7 +230,33 @@ static int take_lock(const char *dir, int create) {
   close(fd); /* a file system without locks: go on, and say so */
   warn("%s: cannot lock the run directory (%s); make sure no other process uses it", path,
        strerror(e));
+  hold(dir, -1);
   return CHANSPH_OK;
+}
+
+int rundir_is_held(const char *dir) {
+  if (!held.known) return 1;
+  char path[4096];
+  snprintf(path, sizeof path, "%s/.lock", dir);
+  struct stat d, l;
+  const int same_dir = !stat(dir, &d) && d.st_dev == held.dev && d.st_ino == held.ino;
+  return same_dir && (lock_fd < 0 ||
+                      (!stat(path, &l) && l.st_dev == held.lock_dev && l.st_ino == held.lock_ino));
+}
+
+/* Rank 0: whether DIR (and DIR/.lock) are still the ones this process holds, or a message. */
+static int still_held(const char *dir) {
+  if (rundir_is_held(dir)) return CHANSPH_OK;
+  error_input(
+      "%s is no longer the run directory this process locked (deleted, moved or replaced "
+      "while the run was working; another run may use it now): stopping without writing "
+      "anything more",
+      dir);
+  return CHANSPH_ERR;
+}
+
+int rundir_check(const char *dir) {
+  return agree(rank0() ? still_held(dir) : CHANSPH_OK, NULL, 0);
 }
 
 int rundir_lock(const char *dir, int create) {

@@ -74,6 +74,7 @@ static int stop_file(struct trigger *T) {
   if (rank != 0) return 0; /* rank 0 looks and removes it; trigger_check shares the result */
   snprintf(path, sizeof path, "%s/STOP", T->dir);
   if (stat(path, &st)) return 0;
+  if (!rundir_is_held(T->dir)) return 1; /* another run's STOP now: the run stops, keeps it */
   if (remove(path)) warn("%s: cannot remove the STOP file (%s)", path, strerror(errno));
   return 1;
 }
@@ -149,6 +150,7 @@ int trigger_parse_walltime(const char *text, double *seconds) {
     errno = 0;
     const double v = strtod(p, &end);
     if (n == 3 || end == p || errno || v < 0.0 || !isfinite(v) || *p == '-' || *p == '+') return 1;
+    if (n > 0 && v >= 60.0) return 1; /* minutes and seconds after a ':' are below 60 */
     s = 60.0 * s + v;
     if (*end == '\0') break;
     if (*end != ':') return 1;

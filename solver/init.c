@@ -91,59 +91,133 @@ struct source {
   int dim;
 };
 
+/** The variables of particles.nc that init.from reads, in the order of source.col, then id. */
+static const char *const source_names[9] = {"x", "y", "z", "u", "v", "w", "rho", "mass", "id"};
+
 static void source_free(struct source *src) {
   for (int c = 0; c < 8; c++) free(src->col[c]);
   free(src->id);
 }
 
-static int read_source(const char *path, const struct scene *sc, struct source *src) {
-  memset(src, 0, sizeof *src);
+/** Whether variable vid is 1-D over dimension dimid (a longer or 2-D variable would overflow
+    the column of dimid's length it is read into). */
+static int source_var_ok(int nc, int vid, int dimid) {
+  int nd = 0, d = -1;
+  return !nc_inq_varndims(nc, vid, &nd) && nd == 1 && !nc_inq_vardimid(nc, vid, &d) && d == dimid;
+}
+
+/** Read the 'scene' attribute and the columns of particles.nc into src (src->n particles). */
+static int read_columns(const char *path, struct source *src, char **text) {
   int nc, rc, dimid, vid;
   if ((rc = nc_open(path, NC_NOWRITE, &nc))) {
     error_input("%s (init.from): cannot open: %s", path, nc_strerror(rc));
     return CHANSPH_ERR;
   }
   size_t n = 0, alen = 0;
-  char *text = NULL;
-  static const char *const names[8] = {"x", "y", "z", "u", "v", "w", "rho", "mass"};
   int ok = !nc_inq_dimid(nc, "particle", &dimid) && !nc_inq_dimlen(nc, dimid, &n) &&
            !nc_inq_attlen(nc, NC_GLOBAL, "scene", &alen);
   if (ok) {
-    text = mem_calloc(alen + 1, 1, "initial state");
-    ok = text && !nc_get_att_text(nc, NC_GLOBAL, "scene", text);
+    *text = mem_calloc(alen + 1, 1, "initial state");
+    ok = *text && !nc_get_att_text(nc, NC_GLOBAL, "scene", *text);
   }
   src->n = n;
-  for (int c = 0; ok && c < 8; c++) {
-    src->col[c] = mem_alloc(1, (n ? n : 1) * sizeof(double), "initial state");
-    ok = src->col[c] && !nc_inq_varid(nc, names[c], &vid) &&
-         !nc_get_var_double(nc, vid, src->col[c]);
-    if (!ok) error_input("%s (init.from): variable '%s' missing or unreadable", path, names[c]);
-  }
-  if (ok) {
-    src->id = mem_alloc(1, (n ? n : 1) * sizeof(long long), "initial state");
-    ok = src->id && !nc_inq_varid(nc, "id", &vid) && !nc_get_var_longlong(nc, vid, src->id);
+  for (int c = 0; ok && c < 9; c++) {
+    if (!nc_inq_varid(nc, source_names[c], &vid) && !source_var_ok(nc, vid, dimid)) {
+      error_input("%s (init.from): variable '%s' is not 1-D over dimension 'particle' (%zu)", path,
+                  source_names[c], n);
+      ok = 0;
+      break;
+    }
+    if (c < 8) {
+      src->col[c] = mem_alloc(1, (n ? n : 1) * sizeof(double), "initial state");
+      ok = src->col[c] && !nc_inq_varid(nc, source_names[c], &vid) &&
+           !nc_get_var_double(nc, vid, src->col[c]);
+    } else {
+      src->id = mem_alloc(1, (n ? n : 1) * sizeof(long long), "initial state");
+      ok = src->id && !nc_inq_varid(nc, "id", &vid) && !nc_get_var_longlong(nc, vid, src->id);
+    }
+    if (!ok)
+      error_input("%s (init.from): variable '%s' missing or unreadable", path, source_names[c]);
   }
   CHECK_NC(nc_close(nc));
   if (!ok) {
     error_input(
         "%s (init.from): not a chansph particles.nc (needs dimension 'particle', "
-        "variables x y z u v w rho mass id and the 'scene' attribute)",
+        "variables x y z u v w rho mass id over it and the 'scene' attribute)",
         path);
-    free(text), source_free(src);
+    free(*text), source_free(src);
+    *text = NULL;
     return CHANSPH_ERR;
   }
-  /* a broken source (NaN or Inf, say from a run that failed) is an input error here, not a
-     numerical failure at step 1 */
-  for (int c = 0; c < 8; c++)
-    for (size_t b = 0; b < n; b++)
+  return CHANSPH_OK;
+}
+
+/** Index of the first particle of src whose values are not a usable state (not finite, rho
+    or mass not positive, position outside the box), or src->n; *what names the check. */
+static size_t source_bad_particle(const struct source *src, const char **what, int *col) {
+  for (size_t b = 0; b < src->n; b++) {
+    for (int c = 0; c < 8; c++)
       if (!isfinite(src->col[c][b])) {
-        error_input(
-            "%s (init.from): variable '%s' of particle id %lld is not finite (%g): not a "
-            "usable initial state",
-            path, names[c], src->id[b], src->col[c][b]);
-        free(text), source_free(src);
-        return CHANSPH_ERR;
+        *what = "is not finite", *col = c;
+        return b;
       }
+    const double x = src->col[0][b], y = src->col[1][b], z = src->col[2][b];
+    *what = "is outside", *col = 0;
+    if (!(x >= 0.0 && x < src->lx)) return b;
+    *col = 1;
+    if (!(y > 0.0 && y < src->ly)) return b;
+    *col = 2;
+    if (src->dim == 3 && !(z >= 0.0 && z < src->lz)) return b;
+    *what = "is not positive";
+    for (*col = 6; *col < 8; (*col)++)
+      if (!(src->col[*col][b] > 0.0)) return b;
+  }
+  return src->n;
+}
+
+/** Refuse a source that is not a state of the box: no particles, ids not a permutation of
+    0..n-1, a value not finite, rho or mass not positive, a position outside the box. */
+static int check_source(const char *path, const struct source *src) {
+  if (src->n == 0) {
+    error_input("%s (init.from): no particles: not a usable initial state", path);
+    return CHANSPH_ERR;
+  }
+  const char *what = "";
+  int c = 0;
+  const size_t b = source_bad_particle(src, &what, &c);
+  if (b < src->n) {
+    char box[96] = "";
+    if (c < 3 && src->dim == 3)
+      snprintf(box, sizeof box, " the box [0, %g) x (0, %g) x [0, %g)", src->lx, src->ly, src->lz);
+    else if (c < 3)
+      snprintf(box, sizeof box, " the box [0, %g) x (0, %g)", src->lx, src->ly);
+    error_input(
+        "%s (init.from): variable '%s' of particle id %lld %s%s (%g): not a usable "
+        "initial state",
+        path, source_names[c], src->id[b], what, box, src->col[c][b]);
+    return CHANSPH_ERR;
+  }
+  unsigned char *seen = mem_calloc(src->n, 1, "initial state");
+  int rc = CHANSPH_OK;
+  for (size_t k = 0; k < src->n && rc == CHANSPH_OK; k++) {
+    const long long id = src->id[k];
+    if (id < 0 || (unsigned long long)id >= src->n || seen[id]) {
+      error_input("%s (init.from): particle id %lld %s: the ids must be 0..%zu, each once", path,
+                  id, id < 0 || (unsigned long long)id >= src->n ? "out of range" : "repeated",
+                  src->n - 1);
+      rc = CHANSPH_ERR;
+    } else {
+      seen[id] = 1;
+    }
+  }
+  free(seen);
+  return rc;
+}
+
+static int read_source(const char *path, const struct scene *sc, struct source *src) {
+  memset(src, 0, sizeof *src);
+  char *text = NULL;
+  TRY(read_columns(path, src, &text));
   const double dim = scene_text_value(text, "domain", "dimension");
   const double delta = scene_text_value(text, "domain", "delta");
   const double lx = scene_text_value(text, "domain", "lx");
@@ -163,6 +237,10 @@ static int read_source(const char *path, const struct scene *sc, struct source *
   }
   src->dim = sc->dim, src->lx = lx, src->ly = 2.0 * delta, src->lz = sc->dim == 3 ? lz : 1.0;
   src->h = hdr * dr;
+  if (check_source(path, src) != CHANSPH_OK) {
+    source_free(src);
+    return CHANSPH_ERR;
+  }
   return CHANSPH_OK;
 }
 
@@ -282,14 +360,8 @@ static int from_file(const struct scene *sc, struct particles *P) {
   TRY(read_source(sc->init_from, sc, &src));
   if (src.n == P->n_fluid) { /* same resolution: the state itself, by id */
     for (size_t b = 0; b < src.n; b++) {
-      const long long id = src.id[b];
-      if (id < 0 || (size_t)id >= P->n_fluid) {
-        error_input("%s (init.from): particle id %lld out of range 0..%zu", sc->init_from, id,
-                    P->n_fluid - 1);
-        source_free(&src);
-        return CHANSPH_ERR;
-      }
-      const size_t a = (size_t)id; /* fresh lattice: fluid particle a has id a */
+      /* fresh lattice: fluid particle a has id a; the ids are a permutation (check_source) */
+      const size_t a = (size_t)src.id[b];
       P->x[a] = src.col[0][b], P->y[a] = src.col[1][b], P->z[a] = src.col[2][b];
       P->u[a] = src.col[3][b], P->v[a] = src.col[4][b], P->w[a] = src.col[5][b];
       P->rho[a] = src.col[6][b];
@@ -321,16 +393,27 @@ void init_dns180(double yplus, double out[5]) {
     out[c] = dns_lm180[i][c + 1] + t * (dns_lm180[i + 1][c + 1] - dns_lm180[i][c + 1]);
 }
 
+double init_sem_count(const struct scene *sc) {
+  const double sig = sc->init_eddy_size * sc->delta;
+  const double vol = sc->lx * (2.0 * sc->delta + 2.0 * sig) * sc->lz;
+  return sc->init_eddies > 0 ? (double)sc->init_eddies
+                             : fmax(1.0, floor(vol / (sig * sig * sig) + 0.5));
+}
+
+double init_bytes(const struct scene *sc) {
+  if (sc->init_from[0] || sc->init_profile != INIT_SYNTHETIC) return 0.0;
+  /* positions and signs, the order by cell and the cell of each eddy (init_sem_make) */
+  return init_sem_count(sc) * (6.0 * sizeof(double) + sizeof(size_t) + sizeof(int));
+}
+
 int init_sem_make(struct init_sem *E, const struct scene *sc) {
   memset(E, 0, sizeof *E);
   const double sig = sc->init_eddy_size * sc->delta;
   E->sigma = sig, E->lx = sc->lx, E->lz = sc->lz, E->y0 = -sig;
   E->ly = 2.0 * sc->delta + 2.0 * sig;
   const double vol = E->lx * E->ly * E->lz;
-  long n = sc->init_eddies;
-  if (n <= 0) n = (long)fmax(1.0, floor(vol / (sig * sig * sig) + 0.5));
-  E->n = (size_t)n;
-  E->scale = sqrt(vol / (sig * sig * sig) / (double)n);
+  E->n = (size_t)init_sem_count(sc);
+  E->scale = sqrt(vol / (sig * sig * sig) / (double)E->n);
   /* cells of width w >= sigma, no more cells than about 4 per eddy (w grows for a few eddies
      in a large box); fewer than 3 along a periodic direction: one cell (the nearest image is
      then the only one within sigma, as sigma <= l/2) */

@@ -50,6 +50,13 @@ struct init_sem {
     init.eddy_size delta, positions and signs from init_noise keyed by init.seed and eddy
     index (streams 16-21). Returns CHANSPH_OK (dies when out of memory). */
 int init_sem_make(struct init_sem *E, const struct scene *sc);
+
+/** @brief Number of synthetic eddies of a scene: init.eddies, or (0) box volume / sigma^3. */
+double init_sem_count(const struct scene *sc);
+
+/** @brief Lower bound of the bytes the initial state needs beyond the particles (the
+    synthetic eddies of init.profile = synthetic; 0 otherwise): the scene's memory check. */
+double init_bytes(const struct scene *sc);
 void init_sem_free(struct init_sem *E);
 
 /** @brief Normalised fluctuation xi (zero mean, unit variance, uncorrelated components in

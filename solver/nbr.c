@@ -43,6 +43,13 @@ static int nbr_round_stride(int n) {
   return (n + NBR_ALIGN - 1) / NBR_ALIGN * NBR_ALIGN;
 }
 
+int nbr_stride(const struct scene *s) {
+  /* expected neighbours in the support, with head room; nbr_build grows it if needed */
+  const double per = s->dim == 3 ? 4.0 / 3.0 * M_PI * pow(2.0 * s->h_over_dr, 3)
+                                 : M_PI * pow(2.0 * s->h_over_dr, 2);
+  return nbr_round_stride((int)(1.5 * per) + 8);
+}
+
 void nbr_init(struct nbr *nb, const struct scene *s, size_t n, int ix0, int nxo, int halo) {
   memset(nb, 0, sizeof *nb);
   const double two_h = 2.0 * scene_h(s), cell = two_h / NBR_REACH;
@@ -59,10 +66,7 @@ void nbr_init(struct nbr *nb, const struct scene *s, size_t n, int ix0, int nxo,
   nb->support2 = two_h * two_h;
   nb->avx512 = nbr_cpu_avx512();
   nbr_set_range(nb, ix0, nxo, halo);
-  /* expected neighbours in the support, with head room; nbr_build grows it if needed */
-  const double per = s->dim == 3 ? 4.0 / 3.0 * M_PI * pow(2.0 * s->h_over_dr, 3)
-                                 : M_PI * pow(2.0 * s->h_over_dr, 2);
-  nb->stride = nbr_round_stride((int)(1.5 * per) + 8);
+  nb->stride = nbr_stride(s);
   nbr_reserve(nb, n);
 }
 

@@ -83,6 +83,10 @@ struct nbr {
 /** @brief Columns of the global cell grid along x for a scene (what nbr_init uses). */
 int nbr_columns(const struct scene *s);
 
+/** @brief Neighbour-list slots per particle a scene starts with (1.5 times the expected
+    neighbours within 2h, plus 8, rounded up to the alignment). */
+int nbr_stride(const struct scene *s);
+
 /**
  * @brief Set up the cell grid for a domain.
  * @param[out] nb neighbour structure

@@ -14,6 +14,7 @@
 #include <omp.h>
 #include <time.h>
 
+#include "corr.h"
 #include "error.h"
 #include "euler.h"
 #include "git_commit.h"
@@ -129,6 +130,7 @@ void output_stats_scene(const struct scene *sc, struct stats_scene *view) {
       .t_average_start = sc->t_average_start,
       .t_end = sc->t_end,
       .bins = scene_bins(sc),
+      .columns = nbr_columns(sc),
       .get = scene_get,
       .scene = sc};
 }
@@ -141,10 +143,19 @@ static int open_common(struct output *o, const char *dir, const struct scene *sc
   struct stats_scene view;
   output_stats_scene(sc, &view);
   stats_init(&o->st, &view);
+  const struct euler *eu = stats_find(&o->st, &euler_engine);
+  o->window_len = eu ? eu->cfg.window : NAN;
   series_init(&o->ts, N_SERIES, series_names, sc->dim == 2 ? series_units_2d : series_units_3d,
               series_long_names);
   o->next_write = sc->write_every > 0.0 ? sc->write_every : INFINITY;
   return CHANSPH_OK;
+}
+
+void output_stats_bytes(const struct scene *sc, double *eulerian, double *corr) {
+  struct stats_scene view;
+  output_stats_scene(sc, &view);
+  *eulerian = euler_engine.estimate(&view);
+  *corr = corr_engine.estimate(&view);
 }
 
 /* The checks and the directory of output_open (rank 0). */
@@ -197,6 +208,26 @@ void output_state(struct output *o, struct state_list *L) {
   struct state_field *f = state_add(L, "stats/series", STATE_F64, 2, dims, o->ts.data, NULL);
   f->reserve = series_reserve, f->owner = &o->ts;
   state_add(L, "output/next_write", STATE_F64, 0, NULL, &o->next_write, "s");
+  /* format 1.5; before it, a resume takes the length from the checkpoint's scene */
+  state_add(L, "output/window_length", STATE_F64, 0, NULL, &o->window_len, "s")->optional = 1;
+  /* format 1.5; before it, a run that ended at its target resumed as one that had not */
+  state_add(L, "output/converged", STATE_I32, 0, NULL, &o->converged, NULL)->optional = 1;
+}
+
+double output_stats_window(const struct output *o, const struct scene *sc) {
+  if (!sc) {
+    const struct euler *eu = stats_find(&o->st, &euler_engine);
+    return eu ? eu->cfg.window : NAN;
+  }
+  struct stats_scene view;
+  output_stats_scene(sc, &view);
+  return euler_scene_window(&view);
+}
+
+void output_set_window(struct output *o, double len) {
+  o->window_len = len;
+  struct euler *eu = stats_find(&o->st, &euler_engine);
+  if (eu) eu->cfg.window = len;
 }
 
 void output_log(struct output *o, const char *fmt, ...) {

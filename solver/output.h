@@ -22,6 +22,8 @@ struct output {
   struct stats st;    /*!< the statistics engine */
   struct series ts;   /*!< time series */
   double next_write;  /*!< simulated time of the next stats.nc rewrite [s] */
+  double window_len;  /*!< length of the Eulerian averaging windows in use [s] (checkpointed:
+                           fixed once averaging has begun; NaN while a checkpoint is read) */
   double wall0;       /*!< wall clock at the start of the loop [s] */
   double t0;          /*!< simulated time at the start of the loop [s] */
   double last_wall;   /*!< wall clock of the last log line [s] */
@@ -33,7 +35,8 @@ struct output {
   char run_id[64];    /*!< identity of the run (DIR/run_id), attribute of stats.nc, particles.nc */
   char *history;      /*!< DIR/history: every run and resume command, newest first (rank 0) */
   size_t target_nwin; /*!< complete windows when the convergence target was last checked */
-  int converged;      /*!< the convergence target (stats.target_stderr) is met: end the run */
+  int converged;      /*!< the convergence target (stats.target_stderr) is met: end the run
+                           (checkpointed: a resumed run that met it stays finished) */
 };
 
 /**
@@ -61,6 +64,27 @@ int output_reopen(struct output *o, const char *dir, const struct scene *sc);
  *        rewrite. Rebuild the list before each checkpoint: growing arrays move.
  */
 void output_state(struct output *o, struct state_list *L);
+
+/**
+ * @brief The length of the Eulerian averaging windows: of the running engine (sc NULL; NaN
+ *        without Eulerian statistics), or the one the scene sc would give.
+ */
+double output_stats_window(const struct output *o, const struct scene *sc);
+
+/**
+ * @brief Use this length for the Eulerian averaging windows from now on (a resume keeps the
+ *        length the windows already averaged have, whatever time.t_end says now).
+ * @param[in] len window length [s]
+ */
+void output_set_window(struct output *o, double len);
+
+/**
+ * @brief Memory the statistics engines of a scene need on a rank, before they exist (lower
+ *        bounds, for the scene's memory check).
+ * @param[out] eulerian bytes of the Eulerian per-column partials (output.n_bins, domain.lx)
+ * @param[out] corr bytes of the correlation grids and spectra (correlations.*)
+ */
+void output_stats_bytes(const struct scene *sc, double *eulerian, double *corr);
 
 /** @brief Log a line to stdout and log.txt (printf-style). */
 void output_log(struct output *o, const char *fmt, ...);

@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "error.h"
+#include "nbr.h"
 #include "records.h"
 
 enum { MAX_LABELS = 64 };
@@ -173,30 +174,24 @@ static size_t arrays(struct particles *P, struct array *t) {
 
 enum { N_ARRAYS_MAX = 64 };
 
-int part_check_memory(const struct scene *s) {
+double part_bytes(const struct scene *s, double *count) {
   const double nx = floor(s->lx / s->dr + 0.5), ny = floor(2.0 * s->delta / s->dr + 0.5);
   const double nz = s->dim == 3 ? floor(s->lz / s->dr + 0.5) : 1.0;
   const double n = nx * (ny - 1.0) * nz + 2.0 * nx * nz;
   /* a lower bound per particle: the arrays every run has, the step's scratch arrays (4
-     diagnostics, the new kernel sum), the neighbour search's sort and counts, and the
-     neighbour list at the expected number of neighbours within 2h */
+     diagnostics, the new kernel sum), the neighbour search's sort and counts, the neighbour
+     list at its starting stride, and the checkpoint's copy of the stored arrays (gathered by
+     id, then the writer's buffer) */
   struct particles P;
   struct array t[N_ARRAYS_MAX];
   double per = 5.0 * sizeof(double) + sizeof(size_t) + 2.0 * sizeof(int);
-  for (size_t i = 0, na = arrays(&P, t); i < na; i++)
+  for (size_t i = 0, na = arrays(&P, t); i < na; i++) {
     if (t[i].core) per += (double)t[i].elem;
-  const double q = 2.0 * scene_h(s) / s->dr, pi = 3.14159265358979323846;
-  per += sizeof(int32_t) * (s->dim == 3 ? 4.0 / 3.0 * pi * q * q * q : pi * q * q);
-  const double need = n * per;
-  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
-  const double have = pages > 0 && page > 0 ? (double)pages * (double)page : INFINITY;
-  if (need <= have) return 0;
-  error_input(
-      "%s: keys 'domain.lx', 'domain.delta', 'domain.lz', 'domain.dr': %.4g particles need at "
-      "least %.3g GB per MPI rank (every rank builds the initial lattice), more than the %.3g "
-      "GB of memory of this machine: use a smaller domain or a larger dr",
-      s->path[0] ? s->path : "(scene)", n, need / 1e9, have / 1e9);
-  return 1;
+    if (t[i].core && (part_fields[i].roles & PF_CKPT)) per += 2.0 * (double)t[i].elem;
+  }
+  per += sizeof(int32_t) * (double)nbr_stride(s);
+  *count = n;
+  return n * per;
 }
 
 void part_create(struct particles *P, struct walls *W, const struct scene *s) {

@@ -210,12 +210,13 @@ void part_free(void *ptr);
 void part_memory_report(FILE *f);
 
 /**
- * @brief Before anything is allocated: refuse a scene whose particles need more memory than
- *        the machine has (sysconf physical pages), with a message naming the keys and sizes.
- *        The estimate is a lower bound: per-particle arrays, step scratch, neighbour lists.
- * @return 0, or nonzero after the message
+ * @brief Memory the particles of a scene need on a rank (every rank builds the initial
+ *        lattice), before anything is allocated: a lower bound from the per-particle arrays,
+ *        the step's scratch, the neighbour lists and the checkpoint's copies.
+ * @param[out] count number of particles (fluid and wall vertices)
+ * @return bytes
  */
-int part_check_memory(const struct scene *s);
+double part_bytes(const struct scene *s, double *count);
 
 /**
  * @brief Create the fluid lattice (x = (i+1/2) dr, y = j dr for j = 1..2delta/dr-1,

@@ -279,7 +279,9 @@ static const struct key keys[] = {
      "start a finer "
      "run. A relative path in a scene file is relative to the scene file's directory (on the "
      "command line, to the working directory). Overrides profile; streaks, modes and noise are "
-     "added on top. A source holding a NaN or Inf is refused (exit 1).",
+     "added on top. A source that is not a state of the box is refused (exit 1): variables "
+     "not 1-D over 'particle', no particles, ids not 0..n-1 each once, a NaN or Inf, rho or "
+     "mass not positive, a position outside the box.",
      OFF(init_from)},
     {"output", "log_every", T_INT, "100", 1, 1e9, 0, NULL, "steps",
      "Steps between progress lines (stdout and DIR/log.txt).", OFF(log_every)},
@@ -315,7 +317,8 @@ static const struct key keys[] = {
      "Length of an averaging window: stats.nc keeps the sums of every window (re-average a "
      "range with `chansph extract --window`), and the window means are the batch means of "
      "the standard errors, so a window should span several correlation times (the log "
-     "reports the estimate). 0 = a tenth of t_end - t_average_start.",
+     "reports the estimate). 0 = a tenth of t_end - t_average_start. Fixed once averaging "
+     "has begun: a resume keeps the length (also with a new t_end) and refuses a new value.",
      OFF(stats_window)},
     {"stats", "fold", T_INT, "0", 0, 1, 0, NULL, "-",
      "Fold the upper half onto the lower one (y -> 2 delta - y, v -> -v) before binning; the "
@@ -337,7 +340,8 @@ static const struct key keys[] = {
      "this, with at least target_windows complete windows of at least target_corr_ratio "
      "correlation times, the run ends itself (checkpoint, stats.nc, exit 0). Checked when a "
      "window closes; every convergence line of the log gives the projected simulated and wall "
-     "time to reach it. 0 = off.",
+     "time to reach it. Needs stats.eulerian = 1. A resumed run that met it stays finished "
+     "unless a target key changes. 0 = off.",
      OFF(target_stderr)},
     {"stats", "target_profiles", T_CHOICE, "both", 0, 0, 0, names_stats_target_profiles, "-",
      "Profiles of the convergence target: u_mean and the -u'v' peak, or one of them (a laminar "
@@ -533,7 +537,10 @@ static const char *set_value(struct scene *s, int k, const char *text) {
   if (end == text || *end != '\0') return "is not a number";
   if (!isfinite(v)) return "is not finite";
   if (K->type != T_DOUBLE && v != floor(v)) return "is not an integer";
-  if (v < K->lo || v > K->hi || ((K->flags & LO_OPEN) && v == K->lo)) return "is out of range";
+  /* a bound of +-BIG is no bound ("-inf" or "inf" in the range text): any finite value */
+  if ((K->lo > -BIG && v < K->lo) || (K->hi < BIG && v > K->hi) ||
+      ((K->flags & LO_OPEN) && v == K->lo))
+    return "is out of range";
   if (K->type == T_INT)
     *(int *)field = (int)v;
   else if (K->type == T_LONG)
@@ -621,14 +628,19 @@ static int handler(void *user, const char *section, const char *name, const char
   return apply(ps, section, name, value, ps->line);
 }
 
-/* The section before a new header (or the end of the file) ends: an unknown one without keys
-   is reported here (one with keys is reported at each key). */
+/* The section before a new header (or the end of the file) ends: one without keys is reported
+   here (an unknown one with keys is reported at each key). */
 static void end_section(struct parse_state *ps) {
-  if (ps->section_line > 0 && ps->section[0] && !ps->section_keys && !known_section(ps->section)) {
+  if (ps->section_line <= 0 || !ps->section[0] || ps->section_keys) return;
+  if (!known_section(ps->section))
     error_input("%s:%d: unknown section [%s] (no keys; see docs/scenes.md)", ps->file,
                 ps->section_line, ps->section);
-    ps->errors++;
-  }
+  else
+    error_input(
+        "%s:%d: section [%s] has no keys (set a key in it, or remove the header; see "
+        "docs/scenes.md)",
+        ps->file, ps->section_line, ps->section);
+  ps->errors++;
 }
 
 /* A section header line ("[name]", optionally followed by a "; comment"): inih ignores what
@@ -660,11 +672,28 @@ static void check_header(struct parse_state *ps, const char *line) {
   }
 }
 
+/* inih's line reader (fgets, which would end the line silently at a NUL byte): a NUL byte is an
+   error naming the line. */
 static char *reader(char *str, int num, void *stream) {
   struct parse_state *ps = stream;
-  char *r = fgets(str, num, ps->fp);
-  if (r) ps->line++, check_header(ps, r);
-  return r;
+  int n = 0, c = EOF, nul = 0;
+  while (n < num - 1 && (c = getc(ps->fp)) != EOF) {
+    if (c == '\0') {
+      nul = 1;
+      continue;
+    }
+    str[n++] = (char)c;
+    if (c == '\n') break;
+  }
+  if (n == 0 && !nul) return NULL;
+  str[n] = '\0';
+  ps->line++;
+  if (nul) {
+    error_input("%s:%d: a NUL byte in the line (not a text file?)", ps->file, ps->line);
+    ps->errors++;
+  }
+  check_header(ps, str);
+  return str;
 }
 
 /** Report a geometry or combination problem at the line of the first key involved. */
@@ -692,7 +721,7 @@ static int is_multiple(double len, double dr) {
 
 /* The lattice: particles along x, y (layers plus one) and z fit an int index, and the particle
    count is exact in a double and an int64 id (larger counts would overflow before any
-   allocation; part_check_memory() then compares the memory with the machine's). */
+   allocation; check_memory() in sim.c then compares the memory with the machine's). */
 static void check_counts(struct parse_state *ps) {
   const struct scene *s = ps->s;
   const double nmax = 0x1p30, nx = s->lx / s->dr, ny = 2.0 * s->delta / s->dr;
@@ -758,6 +787,11 @@ static void validate(struct parse_state *ps) {
   if (s->t_average_start > s->t_end)
     inconsistent(ps, "output.t_average_start", "averaging start %g is after t_end = %g",
                  s->t_average_start, s->t_end);
+  if (s->target_stderr > 0.0 && !s->stats_eulerian)
+    inconsistent(ps, "stats.target_stderr",
+                 "a convergence target (%g) needs stats.eulerian = 1: it is met on the Eulerian "
+                 "profiles",
+                 s->target_stderr);
   if ((s->corr_y_plus.n || s->lagr_y_plus.n || s->quad_y_plus.n) && s->u_tau_ref == 0.0 &&
       (s->drive_mode == DRIVE_FLUX || s->force <= 0.0))
     inconsistent(ps, "stats.u_tau_ref",
@@ -1000,11 +1034,13 @@ void scene_write_doc(FILE *f) {
           "A scene is an INI file (parsed with inih). Comments start with `#` or `;` at the "
           "start of a line, or `;` after a value or a section header.\n"
           "Any key can be overridden on the command line with `--set section.key=value`.\n"
-          "Unknown keys and sections (also an empty `[]` or a section without keys), text "
+          "Unknown keys and sections (also an empty `[]` or a section without keys, known or "
+          "not), a NUL byte, text "
           "after a section header (`[wall] law = x`: a key goes on a line of its own), keys "
           "set twice, values out of range and inconsistent geometry are errors that name the "
           "file, line and key; so is a domain of more than 2^30 particles along a direction, "
-          "or whose particles would need more memory than the machine has (the estimate, a "
+          "or a scene whose particles, statistics grids (`output.n_bins`, `correlations.*`) and "
+          "synthetic eddies would need more than 80%% of the machine's memory (the estimate, a "
           "lower bound, is checked before anything is allocated).\n"
           "The fully resolved scene (defaults included) is written to `DIR/scene.used.ini` "
           "and into the `scene` attribute of `stats.nc`.\n");

@@ -90,6 +90,8 @@ struct stats_scene {
   double t_end;           /*!< end of the run [s] */
   int bins;               /*!< wall-normal bins: output.n_bins, or if that is 0 one per
                                particle layer, 2 delta / dr - 1 */
+  int columns;            /*!< cell columns of the global grid along x (the Eulerian engine's
+                               per-column sums) */
   /** The value(s) of the scene key "section.key" (a number, a choice as its index, a list)
       into v (at most max of them); returns how many the key holds, or -1 if it is not a
       numeric key of the scene. */

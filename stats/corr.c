@@ -402,20 +402,33 @@ done:
   return rc;
 }
 
+/* The configuration from the scene; returns its number of levels (0: the engine does not run). */
+static int config_of(const struct stats_scene *sc, struct corr_config *c) {
+  memset(c, 0, sizeof *c);
+  c->n_levels = stats_scene_levels(sc, "correlations.y_plus", c->y_plus, c->y, CORR_MAX_LEVELS);
+  const int nx = (int)stats_scene_num(sc, "correlations.nx");
+  const int nz = (int)stats_scene_num(sc, "correlations.nz");
+  c->nx = nx > 0 ? nx : (int)floor(sc->lx / sc->dr + 0.5);
+  c->nz = sc->dim == 2 ? 1 : nz > 0 ? nz : (int)floor(sc->lz / sc->dr + 0.5);
+  c->lx = sc->lx, c->lz = sc->lz, c->delta = sc->delta, c->t_start = sc->t_average_start;
+  c->half = 0.5 * stats_scene_num(sc, "correlations.thickness") * sc->dr;
+  return c->n_levels > 0 ? c->n_levels : 0;
+}
+
 /* The engine's table of operations (engine.h). */
 static int engine_init_scene(void *self, const struct stats_scene *sc) {
   struct corr_config c;
-  memset(&c, 0, sizeof c);
-  c.n_levels = stats_scene_levels(sc, "correlations.y_plus", c.y_plus, c.y, CORR_MAX_LEVELS);
-  const int nx = (int)stats_scene_num(sc, "correlations.nx");
-  const int nz = (int)stats_scene_num(sc, "correlations.nz");
-  c.nx = nx > 0 ? nx : (int)floor(sc->lx / sc->dr + 0.5);
-  c.nz = sc->dim == 2 ? 1 : nz > 0 ? nz : (int)floor(sc->lz / sc->dr + 0.5);
-  c.lx = sc->lx, c.lz = sc->lz, c.delta = sc->delta, c.t_start = sc->t_average_start;
-  c.half = 0.5 * stats_scene_num(sc, "correlations.thickness") * sc->dr;
-  if (!(c.n_levels > 0)) return 0;
+  if (!config_of(sc, &c)) return 0;
   corr_init(self, &c);
   return 1;
+}
+
+/* Spectra per level, the FFTW grid and its transform (corr_init). */
+static double engine_estimate(const struct stats_scene *sc) {
+  struct corr_config c;
+  if (!config_of(sc, &c)) return 0.0;
+  const double nk = (double)c.nx * (c.nz / 2 + 1);
+  return sizeof(double) * (c.n_levels * nk * CS_LEN + 4.0 * c.nx * c.nz + 6.0 * nk);
 }
 
 static void engine_init(void *self, const void *cfg) {
@@ -450,6 +463,7 @@ static int engine_write(const void *self, double t_reached, int ncid, char *err,
 const struct stats_engine corr_engine = {.name = "two-point correlations",
                                          .size = sizeof(struct corr),
                                          .init_scene = engine_init_scene,
+                                         .estimate = engine_estimate,
                                          .init = engine_init,
                                          .free = engine_free,
                                          .sample = engine_sample,

@@ -25,6 +25,10 @@ struct stats_engine {
   /** Build the engine's configuration from the scene and set it up if the scene asks for it;
       returns 1 if it does, 0 if not (then self is left as it was and never used). */
   int (*init_scene)(void *self, const struct stats_scene *sc);
+  /** A lower bound of the bytes the engine would allocate per rank for this scene (0 if the
+      scene does not ask for it), before anything is allocated: the memory check of a scene
+      (sim.c); NULL for an engine whose memory does not grow with the scene's keys. */
+  double (*estimate)(const struct stats_scene *sc);
   /** Set up from the engine's own configuration struct (struct euler_config, ...). */
   void (*init)(void *self, const void *cfg);
   /** Free what init allocated. */

@@ -221,6 +221,10 @@ size_t euler_work_bytes(const struct euler *e) {
          2 * k->node_cap * sizeof(int);
 }
 
+size_t euler_sample_bytes(int nb, int ncol) {
+  return (size_t)ncol * (size_t)nb * EU_PART * sizeof(double);
+}
+
 /* a := a merged with b, bin by bin (node records of nb bins). */
 static void node_merge(double *restrict a, const double *restrict b, size_t nb) {
   for (size_t i = 0; i < nb; i++) {

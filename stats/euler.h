@@ -167,6 +167,10 @@ void euler_free(struct euler *e);
 /** @brief Bytes of the scratch of euler_sample (per-column partials, gathered subtrees). */
 size_t euler_work_bytes(const struct euler *e);
 
+/** @brief Lower bound of those bytes before the engine exists: the per-column partials of nb
+    bins over ncol cell columns (the memory check of a scene). */
+size_t euler_sample_bytes(int nb, int ncol);
+
 /**
  * @brief Add one snapshot. Implements: thesis Eq. 5.54-5.55 (bins) or 5.56 (stats.method =
  *        sph), and the wall-stress sample of Eq. 5.13-5.14.
@@ -263,5 +267,9 @@ void euler_log(const struct euler *e, char *buf, size_t len);
 
 /** The engine's table of operations (engine.h; euler_nc.c). */
 extern const struct stats_engine euler_engine;
+
+/** @brief The averaging window length [s] the engine takes from a scene (stats.window, or a
+           tenth of the averaging span). */
+double euler_scene_window(const struct stats_scene *sc);
 
 #endif

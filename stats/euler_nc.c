@@ -278,6 +278,19 @@ static int init_scene(void *self, const struct stats_scene *sc) {
   return 1;
 }
 
+double euler_scene_window(const struct stats_scene *sc) {
+  struct euler_config cfg;
+  config_of(sc, &cfg);
+  return cfg.window;
+}
+
+static double estimate(const struct stats_scene *sc) {
+  if (!stats_scene_num(sc, "stats.eulerian")) return 0.0;
+  struct euler_config cfg;
+  config_of(sc, &cfg);
+  return (double)euler_sample_bytes(cfg.nb, sc->columns);
+}
+
 static void init(void *self, const void *cfg) {
   euler_init(self, cfg);
 }
@@ -311,6 +324,7 @@ static void log_lines(const void *self, char *buf, size_t len) {
 const struct stats_engine euler_engine = {.name = "Eulerian profiles",
                                           .size = sizeof(struct euler),
                                           .init_scene = init_scene,
+                                          .estimate = estimate,
                                           .init = init,
                                           .free = release,
                                           .sample = sample,

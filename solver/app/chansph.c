@@ -34,6 +34,15 @@ static int save(struct output *out, struct sim *S, struct trigger *T) {
   return CHANSPH_OK;
 }
 
+/** Whether the run directory is lost before the run's files are written (rundir_check: deleted
+    and recreated by another run, or moved away); then the run stops without writing. */
+static int dir_lost(struct output *out, const struct sim *S) {
+  if (rundir_check(out->dir) == CHANSPH_OK) return 0;
+  output_log(out, "error: stopped at step %ld: %s is no longer this run's directory\n", S->step,
+             out->dir);
+  return 1;
+}
+
 /** Health check of the state before it is written or sampled, once per step (checked: the
     step last checked); a failure is reported (step, particle id, position) and returns 1. */
 static int unhealthy(struct output *out, struct sim *S, long *checked) {
@@ -76,6 +85,7 @@ static int open_run(struct scene *sc, const struct cli *c, struct sim *S, struct
     a stopped one (EXIT_RESUBMIT) says how to continue. Returns the final exit code. */
 static int close_run(struct output *out, struct sim *S, struct trigger *T, int why, int rc,
                      long *checked) {
+  if ((rc == EXIT_DONE || rc == EXIT_RESUBMIT) && dir_lost(out, S)) rc = EXIT_IOERR;
   if (rc == EXIT_DONE && unhealthy(out, S, checked)) rc = EXIT_NUMERICAL;
   if (rc == EXIT_DONE && T->last_step != S->step && save(out, S, T)) rc = EXIT_IOERR;
   if (rc == EXIT_DONE && output_finish(out, S)) rc = EXIT_IOERR;
@@ -111,7 +121,7 @@ static int run(struct scene *sc, const struct cli *c) {
   /* the start state counts as checked: read from a checkpoint (checked when it was written), or
      built from the scene (analytic profiles; init.from is refused if not finite) */
   long checked = S.step;
-  while (!sim_done(&S)) {
+  while (!out.converged && !sim_done(&S)) { /* converged: a resumed run that had ended */
     sim_step(&S);
     if (c->inject_id >= 0 && S.step == c->inject_step)
       for (size_t a = 0; a < S.P.n; a++)
@@ -130,6 +140,10 @@ static int run(struct scene *sc, const struct cli *c) {
       break;
     }
     output_sample(&out, &S); /* statistics (stats/), when due */
+    if ((S.t >= out.next_write || snapshot_due(&S)) && dir_lost(&out, &S)) {
+      rc = EXIT_IOERR;
+      break;
+    }
     if (output_step(&out, &S)) {
       output_log(&out, "stopped at step %ld: cannot write stats.nc (the checkpoints are intact)\n",
                  S.step);
@@ -147,7 +161,7 @@ static int run(struct scene *sc, const struct cli *c) {
       rc = EXIT_NUMERICAL;
       break;
     }
-    if (save(&out, &S, &T)) {
+    if (dir_lost(&out, &S) || save(&out, &S, &T)) {
       rc = EXIT_IOERR;
       break;
     }
