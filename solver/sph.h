@@ -11,6 +11,7 @@
 #include "nbr.h"
 #include "part.h"
 #include "scene.h"
+#include "wall.h"
 #include "walllaw.h"
 
 enum { LATTICE_KNOTS = 16, VIOLEAU_KNOTS = 128 };
@@ -156,6 +157,26 @@ double sph_vertex_sums(const struct model *M, const struct particles *P, const s
  */
 void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb,
                 const struct walls *W, double fx, struct force_info *info);
+
+/** A wall seen from a fluid particle within the kernel support of it (sph_wall_near). */
+struct wall_near {
+  double d;  /*!< distance to the wall [m] */
+  double q;  /*!< d / h [-] */
+  double dg; /*!< |grad gamma_as| [1/m] */
+  double ny; /*!< y of the inward normal: 1 at y = 0, -1 at y = 2 delta */
+};
+
+/** Wall `wall` (0: y = 0, 1: y = 2 delta) as seen from height ya: returns 0 if it is at least
+    2h away (no wall term), else 1 with its distance, |grad gamma_as| and normal in *w. */
+static inline int sph_wall_near(const struct model *M, double ya, int wall, struct wall_near *w) {
+  const double ih = M->k.inv_h;
+  w->d = wall ? M->ly - ya : ya;
+  w->q = w->d * ih;
+  if (w->q >= 2.0) return 0;
+  w->dg = wall_dgamma(M->dim, w->q) * ih;
+  w->ny = wall ? -1.0 : 1.0;
+  return 1;
+}
 
 /** Foot of a particle on the wall lattice: corner indices and weights of the (bi)linear
     interpolation (the vertices sit at x = (i + 1/2) dr, z = (k + 1/2) dr). */

@@ -70,16 +70,14 @@ static inline struct v3 pressure_finish(const struct model *M, const struct part
     limit (Eq. 2.163), in either form. */
 static inline double pressure_wall(const struct model *M, const struct particles *P,
                                    const struct walls *W, size_t a, double mom1, double *aya) {
-  const double ih = M->k.inv_h, ya = P->y[a], va = P->v[a], pa = P->pr2[a];
+  const double ya = P->y[a], va = P->v[a], pa = P->pr2[a];
   const double ig = 1.0 / P->gam[a];
   const int corrected = M->pgrad == PGRAD_CORRECTED;
   double gv = 0.0;
   for (int wall = 0; wall < 2; wall++) {
-    const double d = wall ? M->ly - ya : ya;
-    const double q = d * ih;
-    if (q >= 2.0) continue;
-    const double dg = wall_dgamma(M->dim, q) * ih; /* |grad gamma_as| */
-    const double ny = wall ? -1.0 : 1.0;           /* inward normal */
+    struct wall_near wn;
+    if (!sph_wall_near(M, ya, wall, &wn)) continue;
+    const double q = wn.q, dg = wn.dg, ny = wn.ny;
     if (!corrected) {
       const struct foot ft = sph_foot(M, W, wall, P->x[a], P->z[a]);
       const double rs = sph_foot_value(M, &ft, W->rho), ps = sph_foot_value(M, &ft, W->p);

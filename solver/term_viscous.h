@@ -130,16 +130,14 @@ static inline void viscous_wall(const struct model *M, const struct particles *P
                                 const struct walls *W, size_t a, const struct viscous_norm *n,
                                 const struct viscous_wall_moments *wm, struct v3 *acc,
                                 double *awall) {
-  const double ih = M->k.inv_h, nu = M->nu, ig = 1.0 / P->gam[a], ira = 1.0 / P->rho[a];
+  const double nu = M->nu, ig = 1.0 / P->gam[a], ira = 1.0 / P->rho[a];
   const double ya = P->y[a], ua = P->u[a], wa = P->w[a];
   const int violeau = M->viscous == VISCOUS_VIOLEAU;
   const int discrete = M->wall_weight == WALL_WEIGHT_DISCRETE;
   for (int wall = 0; wall < 2; wall++) {
-    const double d = wall ? M->ly - ya : ya;
-    const double q = d * ih;
-    if (q >= 2.0) continue;
-    const double dg = wall_dgamma(M->dim, q) * ih; /* |grad gamma_as| */
-    const double ny = wall ? -1.0 : 1.0;           /* inward normal */
+    struct wall_near wn;
+    if (!sph_wall_near(M, ya, wall, &wn)) continue;
+    const double d = wn.d, dg = wn.dg, ny = wn.ny;
     if (M->law.law != WALL_LAW_LAMINAR) {
       /* -(2 / gamma_a) rho_s u_tau,s u_tau,s |grad gamma_as| / rho_a */
       const struct foot ft = sph_foot(M, W, wall, P->x[a], P->z[a]);
