@@ -112,6 +112,7 @@ static int run(struct scene *sc, const struct cli *c) {
   struct output out;
   struct sim S;
   if (open_run(sc, c, &S, &out)) return EXIT_INPUT;
+  out.max_steps = c->max_steps; /* the ETA counts it */
   if (sc->threads > 0) omp_set_num_threads(sc->threads);
   out.history =
       rundir_history(c->out, c->cmdline, c->cmd == CMD_RUN, S.dd.size, omp_get_max_threads());
