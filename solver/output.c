@@ -632,7 +632,10 @@ int output_finish(struct output *o, struct sim *S) {
              S->t, wall, wall > 0 ? (double)S->P.n_fluid * (S->step - o->step0) / wall : 0.0);
   if (rank0()) timer_report(stdout, wall);
   if (o->log) timer_report(o->log, wall);
-  output_log(o, "results: %s/stats.nc%s\n", o->dir, S->sc->particles ? ", particles.nc" : "");
+  output_log(o, "results: %s/stats.nc%s\n", o->dir,
+             S->sc->particles ? ", particles.nc, snapshots/particles.xdmf (the final state, for "
+                                "ParaView)"
+                              : "");
   return CHANSPH_OK;
 }
 
