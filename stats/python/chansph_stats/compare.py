@@ -1,6 +1,6 @@
 """chansph compare: profiles of a run (stats.nc) against a DNS data set, in wall units.
 
-(or: stats/python/chansph-stats compare STATS.nc --dns FILE ...)
+Also run as: stats/python/chansph-stats compare STATS.nc --dns FILE ...
 
 FILE is one file of a DNS set we ship in stats/dns/ (or one in the same formats):
   Moser, Kim & Mansour 1999: chanNNN.means (+ companion chanNNN.reystress, found by name)
