@@ -18,7 +18,11 @@ echo "quickstart: run took $(($(date +%s) - start)) s"
 echo
 echo "quickstart: comparison with the DNS (build/chansph compare $out/stats.nc --dns $dns)"
 echo "  L2, Linf: differences from the DNS in wall units; stderr: our own statistical uncertainty"
+echo "  Wall units of the wall stress averaged over the run (--u-tau wall; a burst raises it),"
+echo "  then the largest error in wall units of the driving force balance (--u-tau force):"
 build/chansph compare "$out/stats.nc" --dns "$dns" --out "$out/compare"
+build/chansph compare "$out/stats.nc" --dns "$dns" --out "$out/compare_force" --no-plots \
+  --u-tau force | grep -E "^(differences in|largest error)"
 echo
 echo "quickstart: how converged the statistics are"
 grep '^stats:' "$out/log.txt" | tail -1
@@ -34,7 +38,7 @@ from chansph_stats.ncfile import open_nc  # noqa: E402
 
 ours, dns = read_run(sys.argv[1]), read_dns(sys.argv[2])
 print("  Is it turbulent? Peaks of the run's profiles against the DNS (chan180), with the run's")
-print("  standard error at the peak:")
+print("  standard error at the peak, in wall units of %s:" % ours["u_tau_label"])
 verdicts = []
 for q in ("-u'v'+", "u_rms+", "v_rms+"):
     k = int(np.nanargmax(ours[q]))

@@ -250,25 +250,52 @@ static void record(struct output *o, struct sim *S, struct diag *d) {
   series_add(&o->ts, row);
 }
 
+/* The last step of this process: time.max_steps (a step number) or the command line's
+   --max-steps (steps of this process), whichever comes first; 0 if neither is set. */
+static long end_step(const struct output *o, const struct sim *S) {
+  long end = S->sc->max_steps > 0 ? S->sc->max_steps : 0;
+  if (o->max_steps > 0 && (end == 0 || o->step0 + o->max_steps < end))
+    end = o->step0 + o->max_steps;
+  return end;
+}
+
+/* Format seconds as hh:mm:ss into buf ("--:--:--" when not known). */
+static const char *hms(double s, char *buf, size_t size) {
+  if (!(s >= 0.0) || s > 3.6e8) {
+    snprintf(buf, size, "--:--:--");
+    return buf;
+  }
+  const long es = (long)s;
+  snprintf(buf, size, "%02ld:%02ld:%02ld", es / 3600, es / 60 % 60, es % 60);
+  return buf;
+}
+
+/* The fraction of this process's run done (by simulated time or by steps, whichever is ahead)
+   and the projected wall time to its end (NaN before the first step). */
+static double progress_left(const struct output *o, const struct sim *S, double now, double *frac) {
+  const double done = S->t - o->t0, span = S->sc->t_end - o->t0;
+  *frac = span > 0.0 ? done / span : 0.0;
+  const long steps = S->step - o->step0, end = end_step(o, S);
+  if (end > 0 && end > o->step0) *frac = fmax(*frac, (double)steps / (double)(end - o->step0));
+  *frac = fmin(1.0, fmax(0.0, *frac));
+  if (steps <= 0 || !(*frac > 0.0)) return NAN;
+  return (now - o->wall0) * (1.0 - *frac) / *frac;
+}
+
 static void log_progress(struct output *o, struct sim *S, const struct diag *d) {
   const double now = timer_now();
   const double rate = now > o->last_wall
                           ? (double)S->P.n_fluid * (S->step - o->last_step) / (now - o->last_wall)
                           : 0.0;
-  const double done = S->t - o->t0, left = S->sc->t_end - S->t;
-  double eta = done > 0.0 ? (now - o->wall0) * left / done : 0.0;
-  /* the run ends at t_end or at time.max_steps, whichever comes first */
-  const long steps = S->step - o->step0;
-  if (S->sc->max_steps > 0 && steps > 0) {
-    const double by_steps = (now - o->wall0) * (double)(S->sc->max_steps - S->step) / steps;
-    if (!(done > 0.0) || by_steps < eta) eta = by_steps;
-  }
-  const long es = (long)fmax(0.0, eta);
+  double frac;
+  const double eta = progress_left(o, S, now, &frac);
+  char el[32], et[32];
   output_log(o,
              "step %8ld  t %.6e  dt %.3e  u_bulk %.6e  force %.6e  max|v| %.4e  rho [%.6g, %.6g]"
-             "  min_gamma %.4f  %.3e p-steps/s  ETA %02ld:%02ld:%02ld\n",
+             "  min_gamma %.4f  %.3e p-steps/s  elapsed %s  %5.1f%%  ETA %s\n",
              S->step, S->t, S->dt, d->u_bulk, S->fx, d->max_speed, d->rho_min, d->rho_max,
-             d->min_gamma, rate, es / 3600, es / 60 % 60, es % 60);
+             d->min_gamma, rate, hms(now - o->wall0, el, sizeof el), 100.0 * frac,
+             hms(eta, et, sizeof et));
   o->last_wall = now, o->last_step = S->step;
 }
 
@@ -501,7 +528,8 @@ int output_step(struct output *o, struct sim *S) {
   struct diag d;
   int have = 0;
   if (S->step % sc->series_every == 0) record(o, S, &d), have = 1;
-  if (S->step % sc->log_every == 0) {
+  /* and the first step of this process, so that a short run shows its ETA at once */
+  if (S->step % sc->log_every == 0 || S->step == o->step0 + 1) {
     if (!have) sim_diag(S, &d);
     log_progress(o, S, &d);
   }
@@ -604,7 +632,10 @@ int output_finish(struct output *o, struct sim *S) {
              S->t, wall, wall > 0 ? (double)S->P.n_fluid * (S->step - o->step0) / wall : 0.0);
   if (rank0()) timer_report(stdout, wall);
   if (o->log) timer_report(o->log, wall);
-  output_log(o, "results: %s/stats.nc%s\n", o->dir, S->sc->particles ? ", particles.nc" : "");
+  output_log(o, "results: %s/stats.nc%s\n", o->dir,
+             S->sc->particles ? ", particles.nc, snapshots/particles.xdmf (the final state, for "
+                                "ParaView)"
+                              : "");
   return CHANSPH_OK;
 }
 

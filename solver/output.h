@@ -29,6 +29,7 @@ struct output {
   double last_wall;   /*!< wall clock of the last log line [s] */
   long last_step;     /*!< step of the last log line */
   long step0;         /*!< step at the start of the loop (0, or where a resume started) */
+  long max_steps;     /*!< the command line's --max-steps: steps of this process (0: none) */
   int *col;           /*!< global cell column of each owned particle (statistics snapshots) */
   size_t col_cap;     /*!< entries col holds */
   long rebalances;    /*!< re-partitions already reported in the log */

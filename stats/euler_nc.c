@@ -38,7 +38,10 @@ static void bin_bounds(const struct euler_config *c, double *lo, double *hi) {
 /* The bin coordinate y (centres, with bounds) on dimension dy of group ncid. */
 static int def_y(const struct euler_config *c, int ncid, int dy, const double *centre,
                  const double *lo, const double *hi) {
-  int v, rc = ncout_def(ncid, "y", NC_DOUBLE, 1, &dy, "m", euler_prof_meta[EP_Y].long_name, &v);
+  const char *name = c->fold ? "wall-normal bin centre, folded: distance from the nearer wall "
+                               "(wall at 0, centre at delta; y > delta mirrored)"
+                             : euler_prof_meta[EP_Y].long_name;
+  int v, rc = ncout_def(ncid, "y", NC_DOUBLE, 1, &dy, "m", name, &v);
   if (rc == NC_NOERR) rc = nc_put_att_text(ncid, v, "axis", 1, "Y");
   if (rc == NC_NOERR)
     rc =
@@ -106,7 +109,7 @@ static int write_profiles(const struct euler *e, const struct euler_result *rp, 
     if (scal[i].integer) {
       const long long v = (long long)scal[i].v;
       CK(nc_put_att_longlong(ncid, NC_GLOBAL, scal[i].name, NC_INT64, 1, &v));
-    } else {
+    } else if (isfinite(scal[i].v)) { /* not known (no windows, no force balance): absent */
       CK(put_att_d(ncid, NC_GLOBAL, scal[i].name, scal[i].v));
     }
   return NC_NOERR;

@@ -17,6 +17,7 @@
 
 int ncout_put_attrs(int ncid, const struct nc_attr *attrs, int nattrs) {
   for (int i = 0; i < nattrs; i++) {
+    if (!attrs[i].text && !isfinite(attrs[i].value)) continue; /* not known: left out */
     const long long v = (long long)attrs[i].value;
     const int rc =
         attrs[i].text
@@ -125,6 +126,24 @@ int ncout_bounds(int ncid, const char *name, int varid, int dimid, const char *u
   return rc;
 }
 
+/* CF point data (CF-1.8 Sec. 9, featureType point) of a column file with ids: the dimension's
+   coordinate variable (the ids) and, on every other column, the attribute coordinates naming
+   the position columns x, y, z present. Returns a netCDF status. */
+static int def_points(int ncid, const char *dim, int d, int ncol, const char *const *names,
+                      const int *v, int *cvid) {
+  char coords[16] = "";
+  for (int c = 0; c < ncol; c++)
+    if (!strcmp(names[c], "x") || !strcmp(names[c], "y") || !strcmp(names[c], "z"))
+      snprintf(coords + strlen(coords), sizeof coords - strlen(coords), "%s%s",
+               coords[0] ? " " : "", names[c]);
+  int rc = nc_put_att_text(ncid, NC_GLOBAL, "featureType", 5, "point");
+  if (rc == NC_NOERR) rc = def_var(ncid, dim, NC_INT64, 1, &d, NULL, "particle id", cvid);
+  for (int c = 0; c < ncol && rc == NC_NOERR && coords[0]; c++)
+    if (strlen(names[c]) > 1 || !strchr("xyz", names[c][0]))
+      rc = nc_put_att_text(ncid, v[c], "coordinates", strlen(coords), coords);
+  return rc;
+}
+
 int ncout_columns(const char *path, const char *title, const char *dim, size_t n, int ncol,
                   const char *const *names, const char *const *long_names, const char *const *units,
                   const double *const *cols, const long long *ids, const struct nc_attr *attrs,
@@ -150,9 +169,11 @@ int ncout_columns(const char *path, const char *title, const char *dim, size_t n
     if (rc != NC_NOERR) free(v);
     NC(rc);
   }
-  int rc = ncout_put_attrs(ncid, attrs, nattrs);
+  int cvid = -1, rc = ids ? def_points(ncid, dim, d, ncol, names, v, &cvid) : NC_NOERR;
+  if (rc == NC_NOERR) rc = ncout_put_attrs(ncid, attrs, nattrs);
   if (rc == NC_NOERR) rc = nc_enddef(ncid);
   if (rc == NC_NOERR && ids) rc = nc_put_var_longlong(ncid, vid, ids);
+  if (rc == NC_NOERR && ids) rc = nc_put_var_longlong(ncid, cvid, ids);
   for (int c = 0; c < ncol && rc == NC_NOERR; c++) rc = nc_put_var_double(ncid, v[c], cols[c]);
   free(v);
   NC(rc);

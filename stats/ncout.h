@@ -36,7 +36,7 @@ struct nc_attr {
   } while (0)
 
 /**
- * @brief Put global attributes.
+ * @brief Put global attributes; a number that is not finite (not known) is left out.
  * @return a netCDF status
  */
 int ncout_put_attrs(int ncid, const struct nc_attr *attrs, int nattrs);
@@ -59,7 +59,8 @@ int ncout_commit(int ncid, const char *tmp, const char *path, char *err, size_t 
  * @param[in] names,units column names and units (udunits strings)
  * @param[in] long_names column descriptions (attribute long_name; NULL: none)
  * @param[in] cols column data
- * @param[in] ids optional int64 ids written as variable "id" (may be NULL)
+ * @param[in] ids optional int64 ids written as variable "id" and as the coordinate variable of
+ *                dim, with CF point markup (featureType point, coordinates "x y z") (may be NULL)
  * @param[in] attrs,nattrs global attributes
  * @param[out] err,errlen message on failure
  * @return 0 on success

@@ -152,7 +152,8 @@ int quad_nc_write(const struct quad *q, int ncid, char *err, size_t errlen) {
       "share of the samples in each quadrant"};
   for (int k = 0; k < 3; k++) {
     NC_TRY(ncout_def(g, name[k], NC_DOUBLE, 2, d2, units[k], lname[k], &v), done);
-    NC_TRY(nc_put_var_double(g, v, r + (size_t)k * 4 * nl), done);
+    NC_TRY(ncout_fill(g, v), done); /* a level without samples: _FillValue, never NaN */
+    NC_TRY(ncout_put_filled(g, v, NULL, NULL, r + (size_t)k * 4 * nl, 4 * nl), done);
   }
   d3[1] = 0; /* the raw sums, re-averageable: [level][u'v' Q1..Q4, count Q1..Q4] */
   {
@@ -162,7 +163,7 @@ int quad_nc_write(const struct quad *q, int ncid, char *err, size_t errlen) {
                                              "n_Q1",  "n_Q2",  "n_Q3",  "n_Q4"};
     NC_TRY(ncout_labels(g, "sum_slot", ds, "slot of the raw sums", slab), done);
     d3[1] = ds;
-    NC_TRY(ncout_def(g, "sums", NC_DOUBLE, 2, d3, "1",
+    NC_TRY(ncout_def(g, "sums", NC_DOUBLE, 2, d3, NULL, /* mixed record: no units */
                      "raw sums over the planes: u'v' of Q1..Q4 [m^2/s^2], then the sample counts "
                      "of Q1..Q4",
                      &v),

@@ -27,7 +27,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "../stats/python"))
 from chansph_stats import cli  # noqa: E402
-from chansph_stats.ncfile import attribute, open_nc  # noqa: E402
+from chansph_stats.ncfile import attribute, attribute_or_nan, open_nc  # noqa: E402
 
 PARTS = ("reynolds_stress", "viscous_pair_stress", "model_pair_stress", "pair_stress",
          "wall_term_stress", "advective_stress")
@@ -61,7 +61,7 @@ def read_budget(a):
         if a.window:
             y, v = extract_window(a, [n for n in names if n in d.variables])
         else:
-            ut2 = float(attribute(d, "u_tau_force", a.stats)) ** 2
+            ut2 = attribute_or_nan(d, "u_tau_force") ** 2  # absent before the first window
             v = {n: np.ma.filled(d[n][:].astype(float), np.nan) / ut2
                  for n in d.variables if n in names}
             y = np.asarray(d["y"][:])

@@ -6,11 +6,14 @@ that count or flag are integers. Records of mixed quantities (eulerian/windows, 
 snapshot_u) carry no units. Provenance: history (a "DATE: chansph ..." line per run and resume,
 newest first), date_created (ISO 8601), source (version and git commit), ranks and threads.
 Axes: every dimension a variable uses has a coordinate variable of that name in the variable's
-own group (so xarray labels the axis; exempt: bnds, and particle, whose index is the id), the
+own group (so xarray labels the axis; exempt: bnds), the
 bin coordinates y and pdf_bin have CF bounds (contiguous, holding the centre), time has units
 "s" with a reference attribute. Missing values: no NaN or Inf anywhere, a value equal to the
 netCDF default fill only in a variable that declares it as _FillValue. xarray (python3-xarray)
 opens the file and every group without a warning, with every dimension indexed.
+Issue 26, point 14: no NaN or Inf in a global attribute (root or group: a value not known is
+left out), the y long_name of a folded file says so, a particle file is CF point data
+(featureType point, coordinates "x y z" on every other variable, a coordinate variable particle).
 
 usage: cf_check.py [resumed:]FILE.nc ...   (resumed: the history must hold a resume)
 """
@@ -33,8 +36,9 @@ from chansph_stats.ncfile import open_nc  # noqa: E402
 INTEGER_ATTRS = ("dimension", "steps", "n_fluid", "n_snapshots", "n_windows", "fold", "les",
                  "step", "releases", "ranks", "threads")
 STAMP = r"\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ"
-MIXED = ("windows", "moments", "snapshot_u")
-NO_COORD = ("bnds", "particle")
+MIXED = ("windows", "moments", "snapshot_u", "sums")
+NO_COORD = ("bnds",)
+POSITION = ("x", "y", "z")
 BINNED = ("y", "pdf_bin")
 FILL = netCDF4.default_fillvals["f8"]
 
@@ -90,6 +94,34 @@ def udunits():
             lib.ut_free(unit)
         return bool(unit)
     return parses
+
+
+def check_points(d, path, problems):
+    """A file of particles (dimension particle): CF point data, so that readers place them."""
+    if "particle" not in d.dimensions:
+        return
+    if d.ncattrs().count("featureType") == 0 or d.getncattr("featureType") != "point":
+        problems.append("%s: particle data without featureType = point" % path)
+    pos = " ".join(p for p in POSITION if p in d.variables)
+    for name, v in d.variables.items():
+        if name in POSITION + ("id", "particle") or v.dimensions != ("particle",):
+            continue
+        if "coordinates" not in v.ncattrs() or v.getncattr("coordinates") != pos:
+            problems.append("%s:%s: no coordinates = %r" % (path, name, pos))
+
+
+def check_global(g, where, problems, fold):
+    """Finite global attributes; the folded y coordinate described as folded."""
+    for k in g.ncattrs():
+        v = np.asarray(g.getncattr(k))
+        if v.dtype.kind == "f" and not np.all(np.isfinite(v)):
+            problems.append("%s: global attribute %s is %s (a value not known is left out)" %
+                            (where, k, v))
+    if fold and "y" in g.variables and "2 delta" in g.variables["y"].getncattr("long_name"):
+        problems.append("%s: y of a folded file is described as %r" %
+                        (where, g.variables["y"].getncattr("long_name")))
+    for name, sub in g.groups.items():
+        check_global(sub, where + name + "/", problems, fold)
 
 
 def main():
@@ -170,6 +202,8 @@ def main():
                 for name, sub in g.groups.items():
                     walk(sub, prefix + name + "/")
             walk(d, "")
+            check_global(d, path + ":/", problems, int(a.get("fold", 0)) == 1)
+            check_points(d, path, problems)
             groups = [None]
             stack = [(d, "")]
             while stack:

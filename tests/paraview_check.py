@@ -19,7 +19,8 @@ with netCDF4.Dataset(os.path.join(run, "particles.nc")) as d:
     n = len(d.dimensions["particle"])
 r = OpenDataFile(os.path.join(run, "snapshots", "particles.xdmf"))
 reader = r.GetXMLName()
-times = list(r.TimestepValues)
+tv = r.TimestepValues  # a float, not a list, for a single snapshot
+times = list(tv) if hasattr(tv, "__iter__") else [tv]
 # as the GUI does after Apply: the animation goes to the data's first time step (a temporal
 # Xdmf3 reader asked for no time at all, UpdatePipeline() without a time, returns nothing)
 GetAnimationScene().UpdateAnimationUsingDataTimeSteps()

@@ -88,6 +88,11 @@ static int close_run(struct output *out, struct sim *S, struct trigger *T, int w
   if ((rc == EXIT_DONE || rc == EXIT_RESUBMIT) && dir_lost(out, S)) rc = EXIT_IOERR;
   if (rc == EXIT_DONE && unhealthy(out, S, checked)) rc = EXIT_NUMERICAL;
   if (rc == EXIT_DONE && T->last_step != S->step && save(out, S, T)) rc = EXIT_IOERR;
+  /* with particles.nc, the final state also as a snapshot: ParaView opens the snapshots
+     (XDMF), not particles.nc (docs/formats.md); none twice if the last step wrote one */
+  if (rc == EXIT_DONE && S->sc->particles && !(S->step > 0 && snapshot_due(S)) &&
+      snapshot_write(out->dir, S))
+    rc = EXIT_IOERR;
   if (rc == EXIT_DONE && output_finish(out, S)) rc = EXIT_IOERR;
   if (rc == EXIT_RESUBMIT) {
     if (output_stop(out, S, trigger_text(T, why)))
@@ -112,6 +117,7 @@ static int run(struct scene *sc, const struct cli *c) {
   struct output out;
   struct sim S;
   if (open_run(sc, c, &S, &out)) return EXIT_INPUT;
+  out.max_steps = c->max_steps; /* the ETA counts it */
   if (sc->threads > 0) omp_set_num_threads(sc->threads);
   out.history =
       rundir_history(c->out, c->cmdline, c->cmd == CMD_RUN, S.dd.size, omp_get_max_threads());

@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "alloc.h"
 #include "error.h"
@@ -45,6 +46,29 @@ static const char *const cli_notes =
     "a checkpoint or output, 75 checkpointed before the end (signal, DIR/STOP, --walltime,\n"
     "--max-steps): resume me (docs/batch-jobs.md).\n";
 
+/* The options of run, resume and bench, for `chansph COMMAND --help` (bench: its own). */
+static const char *const cli_options_help =
+    "options:\n"
+    "  --out DIR        run directory (run; default runs/<scene file name without .ini>)\n"
+    "  --set SEC.KEY=V  override a scene key, repeatable (e.g. --set time.t_end=20); the keys:\n"
+    "                   chansph scene-doc, docs/scenes.md; resume accepts only the keys of\n"
+    "                   docs/batch-jobs.md (time.t_end, time.max_steps, output and checkpoint\n"
+    "                   intervals ...)\n"
+    "  --overwrite      run: replace the results of an earlier run in DIR\n"
+    "  --fpe            trap floating-point exceptions (division by zero, invalid, overflow):\n"
+    "                   SIGFPE kills the process at the first one (exit 136; a debugger\n"
+    "                   stops at the faulting line), instead of a NaN that health finds later\n"
+    "  --max-steps N    stop after N steps of this process (counted from the start or from\n"
+    "                   where resume began), checkpoint and exit 75; time.max_steps, by\n"
+    "                   contrast, is the step number at which the run itself ends (exit 0)\n"
+    "  --walltime T     stop with a checkpoint (exit 75) before T (HH:MM:SS, MM:SS or s) of\n"
+    "                   wall time, with a safety margin (docs/batch-jobs.md)\n";
+static const char *const cli_bench_help =
+    "Times N steps (--steps, default 50) of SCENE.ini, or of the built-in 3-D reference case\n"
+    "without one, after a warm-up, and reports the cost per phase and per particle-step;\n"
+    "nothing is written. --set SEC.KEY=V overrides a scene key (repeatable; chansph\n"
+    "scene-doc lists them). OMP_NUM_THREADS sets the threads.\n";
+
 void cli_usage(void) {
   printf("usage:\n");
   for (int i = 0; i < N_COMMANDS; i++)
@@ -63,7 +87,8 @@ void cli_command_usage(enum command cmd) {
   for (int i = 0; i < N_COMMANDS; i++)
     if (commands[i].cmd == cmd && commands[i].usage) {
       printf("usage:\n%s", commands[i].usage);
-      if (cmd == CMD_RUN || cmd == CMD_RESUME) printf("%s", cli_notes);
+      if (cmd == CMD_RUN || cmd == CMD_RESUME) printf("%s%s", cli_options_help, cli_notes);
+      if (cmd == CMD_BENCH) printf("%s", cli_bench_help);
       return;
     }
   cli_usage();
@@ -160,17 +185,32 @@ static int cli_option(struct cli *c, int code, char *arg) {
   return CHANSPH_ERR;
 }
 
+/* The name of a command. */
+static const char *cli_name(enum command cmd) {
+  for (int i = 0; i < N_COMMANDS; i++)
+    if (commands[i].cmd == cmd) return commands[i].name;
+  return "chansph";
+}
+
 /* After the options: the positional argument each command needs, the default run directory. */
 static int cli_finish(struct cli *c) {
   if (c->cmd == CMD_RUN && !c->scene) {
     error_input("run: missing SCENE.ini");
-    cli_usage();
+    cli_command_usage(c->cmd);
+    return CHANSPH_ERR;
+  }
+  struct stat st;
+  if ((c->cmd == CMD_RUN || c->cmd == CMD_BENCH) && c->scene && !stat(c->scene, &st) &&
+      S_ISDIR(st.st_mode)) {
+    error_input("%s: %s is a directory, not a scene file (SCENE.ini)%s%s", cli_name(c->cmd),
+                c->scene, c->cmd == CMD_RUN ? "; to continue the run in it: chansph resume " : "",
+                c->cmd == CMD_RUN ? c->scene : "");
     return CHANSPH_ERR;
   }
   if (c->cmd == CMD_RESUME) {
     if (!c->scene) {
       error_input("resume: missing DIR (the run directory)");
-      cli_usage();
+      cli_command_usage(c->cmd);
       return CHANSPH_ERR;
     }
     snprintf(c->out, sizeof c->out, "%s", c->scene);
@@ -220,7 +260,7 @@ int cli_parse(int argc, char **argv, struct cli *c) {
     } else if (code == 1 || code == '?' || code == ':') {
       error_input("unexpected argument '%s'%s", code == 1 ? optarg : args[at],
                   code == ':' ? " (missing value)" : "");
-      cli_usage();
+      cli_command_usage(c->cmd);
       return CHANSPH_ERR;
     } else if (cli_option(c, code, optarg)) {
       return CHANSPH_ERR;
@@ -229,7 +269,7 @@ int cli_parse(int argc, char **argv, struct cli *c) {
   for (int i = optind; i < argc - 1; i++) { /* after "--": positional arguments only */
     if (c->scene) {
       error_input("unexpected argument '%s'", args[i]);
-      cli_usage();
+      cli_command_usage(c->cmd);
       return CHANSPH_ERR;
     }
     c->scene = args[i];

@@ -1,7 +1,6 @@
 """chansph compare: profiles of a run (stats.nc) against a DNS data set, in wall units.
 
-usage: chansph compare STATS.nc --dns FILE [--out DIR] [--no-plots]
-       (or: stats/python/chansph-stats compare STATS.nc --dns FILE ...)
+Also run as: stats/python/chansph-stats compare STATS.nc --dns FILE ...
 
 FILE is one file of a DNS set we ship in stats/dns/ (or one in the same formats):
   Moser, Kim & Mansour 1999: chanNNN.means (+ companion chanNNN.reystress, found by name)
@@ -9,7 +8,13 @@ FILE is one file of a DNS set we ship in stats/dns/ (or one in the same formats)
                              or the derived table itself.
 STATS.nc may itself be a DNS file: comparing a DNS set with itself gives zero error.
 
-Wall units come from the run's own u_tau (stats.nc attribute u_tau). The DNS profiles are
+Wall units come from the run's u_tau, chosen with --u-tau: "wall" (default: the wall stress
+averaged over the averaging range, stats.nc attribute u_tau_wall), "force" (the force
+balance, u_tau_force: the driving u_tau of a force-driven run) or a number in m/s. Every table,
+compare.csv and every plot title say which u_tau and over which span (average_start ..
+average_end, number of windows); the summary names the largest error. A warning is printed
+with fewer than 2 windows (no standard errors: the plots then have no error bars) and when the
+run's Re_tau differs from the DNS's by more than 20%. The DNS profiles are
 interpolated (linearly in y+) to the run's bin positions; the upper half of an unfolded run
 is mirrored onto the lower one. Prints the L2 (root mean square) and Linf (maximum)
 differences of U+, u_rms+, v_rms+, w_rms+ and -u'v'+ per y+ range, with the RMS over the range
@@ -26,15 +31,38 @@ import numpy as np
 from . import cli
 from .cli import InputError
 from .dns import QUANTITIES, read_dns
-from .ncfile import attribute, need, open_nc
+from .ncfile import attribute, attribute_or_nan, need, open_nc
 
 RANGES = (("viscous sublayer", "y+ < 5"), ("buffer layer", "5 <= y+ < 30"),
           ("log layer", "y+ >= 30, y/delta < 0.3"), ("outer layer", "y+ >= 30, y/delta >= 0.3"))
 KAPPA, B_LOG = 0.41, 5.2
 
 
-def read_run(path):
-    """Our profiles in wall units (lower half, upper half mirrored), with standard errors."""
+def pick_u_tau(a, choice, path):
+    """The u_tau of choice ("wall", "force" or a number) and the words that say which and over
+    which span, from the global attributes a of a stats.nc."""
+    span = "t = %.6g .. %.6g s, %d windows" % (a.get("average_start", math.nan),
+                                               a.get("average_end", math.nan),
+                                               int(a.get("n_windows", 0)))
+    if choice in ("wall", "force"):
+        ut = float(a.get("u_tau_" + choice, math.nan))
+        what = "wall stress" if choice == "wall" else "force balance"
+        if not ut > 0:
+            raise InputError("%s: no positive u_tau (%s, attribute u_tau_%s = %r): no averaging "
+                             "window completed yet?" % (path, what, choice, ut))
+        return ut, "u_tau = %.6g m/s (%s, %s)" % (ut, what, span)
+    try:
+        ut = float(choice)
+    except ValueError:
+        raise InputError("--u-tau %s: expected force, wall or a number in m/s" % choice)
+    if not (math.isfinite(ut) and ut > 0):
+        raise InputError("--u-tau %s: must be a positive number" % choice)
+    return ut, "u_tau = %.6g m/s (given with --u-tau; run averaged over %s)" % (ut, span)
+
+
+def read_run(path, u_tau="wall"):
+    """Our profiles in wall units of u_tau (pick_u_tau; lower half, upper half mirrored), with
+    standard errors."""
     with open_nc(path) as d:
         a = {k: d.getncattr(k) for k in d.ncattrs()}
 
@@ -46,15 +74,16 @@ def read_run(path):
         budget = {n: v(n) for n in BUDGET + ("total_stress", "total_stress_expected",
                                              "momentum_change")
                   if n in d.variables} if "pair_stress" in d.variables else {}
-        ut, nu, delta = (float(attribute(d, k, path)) for k in ("u_tau", "nu", "delta"))
-    if not ut > 0:
-        raise InputError("%s: no positive u_tau (attribute u_tau = %r): no averaging window "
-                         "completed yet?" % (path, ut))
+        nu, delta = (float(attribute(d, k, path)) for k in ("nu", "delta"))
+        if u_tau == "wall" and "u_tau_wall" not in a:  # no wall stress: the file's u_tau
+            a["u_tau_wall"] = attribute_or_nan(d, "u_tau")
+    ut, ut_label = pick_u_tau(a, u_tau, path)
     upper = y > delta
     y = np.where(upper, 2 * delta - y, y)
     sign = np.where(upper, -1.0, 1.0)
     out = {"yplus": y * ut / nu, "y_delta": y / delta, "re_tau": ut * delta / nu, "label": "chansph",
-           "source": "chansph %s (u_tau = %.6g m/s, windows %d)" % (path, ut, a.get("n_windows", 0))}
+           "source": "chansph %s (%s)" % (path, ut_label), "u_tau_label": ut_label,
+           "n_windows": int(a.get("n_windows", 0)), "run": path}
     out["U+"], out["U+_se"] = u / ut, se["u_mean"] / ut
     for c, s2, name in (("u", uu, "uu"), ("v", vv, "vv"), ("w", ww, "ww")):
         r = np.sqrt(np.abs(s2)) / ut
@@ -102,17 +131,47 @@ def region_masks(yp, yd):
     return (yp < 5, (yp >= 5) & (yp < 30), (yp >= 30) & (yd < 0.3), (yp >= 30) & (yd >= 0.3))
 
 
-def main(argv, prog="chansph compare"):
+def parse(argv, prog):
     p = cli.parser(prog, __doc__, raw=True)
     p.add_argument("stats", help="stats.nc of a run (or a DNS file)")
     p.add_argument("--dns", required=True, help="one file of a DNS set")
     p.add_argument("--out", help="directory for compare.csv and the PNGs (default: beside STATS)")
+    p.add_argument("--u-tau", default="wall", metavar="force|wall|VALUE",
+                   help="u_tau of the wall units: wall (the averaged wall stress, default), force "
+                        "(the force balance) or a value in m/s")
     p.add_argument("--no-plots", action="store_true")
     p.add_argument("--max-error", type=cli.number(float, 0),
                    help="exit with status 1 if any L2 or Linf error exceeds this (tests)")
-    args = p.parse_args(argv)
+    return p.parse_args(argv)
+
+
+def warnings_for(ours, dns):
+    """Warnings on what the comparison cannot show: too few windows, another Re_tau."""
+    out = []
+    if ours.get("n_windows") is not None and ours["n_windows"] < 2:
+        out.append("%d averaging windows: no standard errors (at least 2 needed); the "
+                   "differences may be sampling noise" % ours["n_windows"])
+    if abs(ours["re_tau"] / dns["re_tau"] - 1) > 0.2:
+        out.append("the run's Re_tau = %.1f differs from the DNS's %.1f by more than 20%%: the "
+                   "profiles in wall units are not expected to agree" %
+                   (ours["re_tau"], dns["re_tau"]))
+    return out
+
+
+def largest(rows):
+    """The row with the largest relative L2 error, as words (or None)."""
+    have = [r for r in rows if r[2] > 0 and math.isfinite(r[5])]
+    if not have:
+        return None
+    r = max(have, key=lambda r: r[5])
+    return "%s in the %s: L2 %.1f%% of the DNS (Linf %.3g)" % (r[0], r[1], 100 * r[5], r[4])
+
+
+def main(argv, prog="chansph compare"):
+    args = parse(argv, prog)
     dns = read_dns(args.dns)
-    ours = read_run(args.stats) if args.stats.endswith(".nc") else read_dns(args.stats)
+    ours = read_run(args.stats, args.u_tau) if args.stats.endswith(".nc") else read_dns(args.stats)
+    ours.setdefault("u_tau_label", "the DNS file's own wall units")
     out_dir = args.out or os.path.join(os.path.dirname(os.path.abspath(args.stats)), "compare")
     try:
         os.makedirs(out_dir, exist_ok=True)
@@ -120,10 +179,13 @@ def main(argv, prog="chansph compare"):
         raise InputError("%s: cannot create the output directory (%s)" % (out_dir, e.strerror))
     print("ours: %s, Re_tau = %.2f" % (ours["source"], ours["re_tau"]))
     print("DNS:  %s, Re_tau = %.2f" % (dns["source"], dns["re_tau"]))
+    for w in warnings_for(ours, dns):
+        print("warning: " + w)
     yp, yd = ours["yplus"], ours["y_delta"]
     inside = (yp >= dns["yplus"][0]) & (yp <= dns["yplus"][-1])
     masks = region_masks(yp, yd)
     rows = []
+    print("differences in wall units of %s:" % ours["u_tau_label"])
     print("%-8s %-17s %6s %12s %12s %12s %12s" % ("quantity", "range", "points", "L2", "Linf",
                                                    "L2 relative", "stderr"))
     for q in QUANTITIES:
@@ -146,9 +208,13 @@ def main(argv, prog="chansph compare"):
             rows.append((q, name, int(sel.sum()), l2, linf, l2 / scale if scale > 0 else math.nan,
                          se_rms))
             print("%-8s %-17s %6d %12.4e %12.4e %12.4e %12.4e" % rows[-1])
+    worst = largest(rows)
+    if worst:
+        print("largest error: %s (wall units of %s)" % (worst, ours["u_tau_label"]))
     with open(os.path.join(out_dir, "compare.csv"), "w") as f:
-        f.write("# ours: %s\n# DNS: %s\nquantity,range,points,L2,Linf,L2_relative,stderr\n" %
-                (ours["source"], dns["source"]))
+        f.write("# ours: %s\n# DNS: %s\n# wall units of %s\n"
+                "quantity,range,points,L2,Linf,L2_relative,stderr\n" %
+                (ours["source"], dns["source"], ours["u_tau_label"]))
         for r in rows:
             f.write("%s,%s,%d,%.6e,%.6e,%.6e,%.6e\n" % r)
     if not args.no_plots:
@@ -163,6 +229,14 @@ def main(argv, prog="chansph compare"):
     return 0
 
 
+def plot_title(ours):
+    """The title of every plot: the run, Re_tau, the u_tau of the wall units, the windows."""
+    run = ours.get("run", ours.get("source", ""))
+    wins = "" if ours.get("n_windows") is None else ", %d windows" % ours["n_windows"]
+    return "%s: Re_tau = %.1f%s\nwall units of %s" % (run, ours["re_tau"], wins,
+                                                     ours["u_tau_label"])
+
+
 def plots(ours, dns, out_dir):
     import matplotlib
     matplotlib.use("Agg")
@@ -174,10 +248,11 @@ def plots(ours, dns, out_dir):
         ax.semilogx(dns["yplus"][1:], dns[q][1:], "k-", lw=1.2, label="DNS: " + dns["name"])
         se = ours.get(q + "_se")
         yerr = None
-        if se is not None and np.isfinite(se).any():
+        if se is not None and np.isfinite(se).any() and ours.get("n_windows", 2) >= 2:
             yerr = np.where(np.isfinite(se), 2 * se, 0.0)
         ax.errorbar(ours["yplus"], ours[q], yerr=yerr, fmt="o", ms=3, capsize=2,
-                    label="%s (bars: 2 standard errors)" % ours["label"])
+                    label=ours["label"] + (" (bars: 2 standard errors)" if yerr is not None
+                                           else " (no standard errors: < 2 windows)"))
         if q == "U+":
             y = np.logspace(-1, math.log10(max(dns["yplus"][-1], ours["yplus"][-1])), 200)
             ax.semilogx(y[y < 12], y[y < 12], "g--", lw=0.8, label="U+ = y+")
@@ -186,8 +261,12 @@ def plots(ours, dns, out_dir):
         ax.set_xlabel("y+")
         ax.set_ylabel(q)
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=8)
+        leg = ax.legend(fontsize=8)
+        title = plot_title(ours)
+        ax.set_title(title, fontsize=8)
         fig.tight_layout()
         name = q.replace("'", "").replace("-", "minus_").replace("+", "plus")
-        fig.savefig(os.path.join(out_dir, "%s.png" % name), dpi=110)
+        legend = "; ".join(t.get_text() for t in leg.get_texts())
+        fig.savefig(os.path.join(out_dir, "%s.png" % name), dpi=110,
+                    metadata={"Title": title.replace("\n", " "), "Description": legend})
         plt.close(fig)

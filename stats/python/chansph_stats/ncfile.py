@@ -53,6 +53,12 @@ def attribute(d, name, path, what="a chansph stats.nc"):
     return d.getncattr(name)
 
 
+def attribute_or_nan(d, name):
+    """Global attribute name of d as a float; NaN where it is absent (chansph leaves out a value
+    it does not know, e.g. u_tau before the first window, docs/stats-format.md)."""
+    return float(d.getncattr(name)) if name in d.ncattrs() else float("nan")
+
+
 def values(var):
     """The values of a variable; the float ones with fill values (no samples) as NaN."""
     data = var[:]

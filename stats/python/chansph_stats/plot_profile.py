@@ -1,7 +1,9 @@
 """Plot u_mean of a chansph stats.nc against its reference profile.
 
 For a laminar run the reference is the analytical Poiseuille profile of the run's body force.
-usage: chansph-stats plot_profile runs/laminar/stats.nc [-o profile.png]
+Prints the verdict of the laminar check: PASS when the relative L2 error of u_mean against the
+profile is at most --tol (default 0.01), else FAIL and exit status 1.
+usage: chansph-stats plot_profile runs/laminar/stats.nc [-o profile.png] [--tol 0.01]
 """
 import os
 
@@ -15,6 +17,8 @@ def main(argv, prog):
     p = cli.parser(prog, __doc__, raw=True)
     p.add_argument("stats")
     p.add_argument("-o", "--output", default=None)
+    p.add_argument("--tol", type=cli.number(float, 0), default=0.01,
+                   help="largest relative L2 error of a PASS (default 0.01)")
     a = p.parse_args(argv)
     s = read_stats(a.stats)
     need_keys(s, a.stats, ("y_mean", "u_mean"), ("body_force", "delta", "nu", "dr", "dimension"))
@@ -41,3 +45,7 @@ def main(argv, prog):
     out = a.output or os.path.join(os.path.dirname(a.stats) or ".", "profile.png")
     fig.savefig(out, dpi=110)
     print("profile plot: %s (relative L2 error against the analytical profile %.3e)" % (out, err))
+    ok = err <= a.tol
+    print("laminar check: %s: u_mean %s the analytic Poiseuille profile (relative L2 error %.3e, "
+          "limit %g)" % ("PASS" if ok else "FAIL", "matches" if ok else "does NOT match", err, a.tol))
+    return 0 if ok else 1
