@@ -169,7 +169,7 @@ static void *reserve_win(void *owner, int rank, const size_t *dims) {
 
 static void *reserve_pow(void *owner, int rank, const size_t *dims) {
   struct pdf *p = owner;
-  if (rank != 4 || dims[1] != (size_t)p->cfg.n_levels || dims[2] != PDF_COMP) return NULL;
+  if (rank != 3 || dims[1] != (size_t)p->cfg.n_levels * PDF_COMP) return NULL;
   return reserve_rows(p, rank, dims, PDF_POW, &p->pow);
 }
 
@@ -182,12 +182,12 @@ static void *reserve_hist(void *owner, int rank, const size_t *dims) {
 void pdf_state(struct pdf *p, struct state_list *L) {
   if (p->cfg.n_levels <= 0) return;
   const size_t rows = p->nwin + 1, nl = (size_t)p->cfg.n_levels;
-  const size_t dw[2] = {rows, PW_LEN}, dp[4] = {rows, nl, PDF_COMP, PDF_POW};
+  const size_t dw[2] = {rows, PW_LEN}, dp[3] = {rows, nl * PDF_COMP, PDF_POW};
   const size_t dh[3] = {rows, nl, p->nfine};
   /* optional: a checkpoint written without the engine resumes with it switched on */
   struct state_field *f = state_add(L, "stats/pdfs/windows", STATE_F64, 2, dw, p->win, "s");
   f->reserve = reserve_win, f->owner = p, f->optional = 1;
-  f = state_add(L, "stats/pdfs/power_sums", STATE_F64, 4, dp, p->pow, NULL);
+  f = state_add(L, "stats/pdfs/power_sums", STATE_F64, 3, dp, p->pow, NULL);
   f->reserve = reserve_pow, f->owner = p, f->optional = 1;
   f = state_add(L, "stats/pdfs/fine_counts", STATE_F64, 3, dh, p->hist, NULL);
   f->reserve = reserve_hist, f->owner = p, f->optional = 1;

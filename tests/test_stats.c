@@ -293,6 +293,15 @@ static struct test_stats_config all_engines(void) {
                                 .n_stations = 1,
                                 .station = {0.1},
                                 .pdf_bins = 10};
+  c.pdf = (struct pdf_config){.n_levels = 2,
+                              .y = {0.3, 0.6},
+                              .half = 0.05,
+                              .delta = 1.0,
+                              .window = 1.0,
+                              .u_tau = 0.1,
+                              .fine = 0.05,
+                              .bins = 20,
+                              .range = 4.0};
   return c;
 }
 
@@ -329,6 +338,8 @@ static void test_round_trip(double *buf) {
   EXPECT(same, "state after a round trip differs from the uninterrupted run");
   const struct lagr *la = test_la(&a);
   EXPECT(la->releases > 2 && la->ntracks > 0, "Lagrangian engine idle in the round trip");
+  const struct pdf *pd = test_pdf(&a);
+  EXPECT(pd->nwin >= 2 && pd->pow[0] > 0, "PDF engine idle in the round trip");
   printf(
       "state round trip after 61 of 137 snapshots (%d fields, Eulerian, correlations, "
       "Lagrangian with %g releases done and %zu tracks active): %s\n",

@@ -263,6 +263,17 @@ static struct test_stats_config config_a(void) { /* bins, not folded, LES; corr 
                                 .station = {0.15, 0.4},
                                 .pdf_bins = 10,
                                 .t_start = 0.1};
+  c.pdf = (struct pdf_config){.n_levels = 2,
+                              .y = {0.3, 0.7},
+                              .y_plus = {30, 70},
+                              .half = 0.06,
+                              .delta = 1.0,
+                              .t_start = 0.1,
+                              .window = 0.5,
+                              .u_tau = 0.05,
+                              .fine = 0.05,
+                              .bins = 24,
+                              .range = 4.0};
   return c;
 }
 
@@ -435,6 +446,8 @@ static void run_check(const char *name, const struct test_stats_config *cfg, siz
     for (int k = 0; k < cfg->lagr.n_levels * cfg->lagr.n_stations; k++)
       pdf_n += la->pdf[(size_t)k * (size_t)(cfg->lagr.pdf_bins + 3) + cfg->lagr.pdf_bins];
     EXPECT(eu->nwin >= 2, "%s: %zu windows", name, eu->nwin);
+    const struct pdf *pd = test_pdf(&par);
+    EXPECT(pd->nwin >= 2 && pd->pow[0] > 0, "%s: PDF engine idle (%zu windows)", name, pd->nwin);
     EXPECT(co->samples[0] > 0, "%s: no correlation planes", name);
     EXPECT(la->releases >= 2 && la->ntracks > 0 && pdf_n > 0,
            "%s: Lagrangian idle (%g releases, %zu tracks, %g crossings)", name, la->releases,
