@@ -91,10 +91,10 @@ static int write_axes(const struct pdf *p, int g, const int d[4], char *err, siz
   const double db = 2.0 * p->cfg.range / B;
   for (int j = 0; j < B; j++)
     lo[j] = -p->cfg.range + j * db, hi[j] = lo[j] + db, mid[j] = lo[j] + 0.5 * db;
-  CK(ncout_def(g, "bin", NC_DOUBLE, 1, d + 2, "1",
+  CK(ncout_def(g, "pdf_bin", NC_DOUBLE, 1, d + 2, "1",
                "centre of the PDF bin: fluctuation in units of the local rms", &v));
   CK(nc_put_var_double(g, v, mid));
-  CK(ncout_bounds(g, "bin", v, d[2], "1", "edges of the PDF bin", lo, hi, (size_t)B));
+  CK(ncout_bounds(g, "pdf_bin", v, d[2], "1", "edges of the PDF bin", lo, hi, (size_t)B));
   const double flo[PDF_COMP] = {pdf_lo[0], pdf_lo[1], pdf_lo[2]};
   const int nf[PDF_COMP] = {p->nf[0], p->nf[1], p->nf[2]};
   CK(ncout_def(g, "fine_lower", NC_DOUBLE, 1, d + 1, "1",
@@ -105,6 +105,30 @@ static int write_axes(const struct pdf *p, int g, const int d[4], char *err, siz
   CK(nc_put_var_int(g, v, nf));
 done:
   free(lo);
+  return rc;
+}
+
+/* The coordinates of the raw records: the middle of each window (bounds: its nominal start
+   and end) and the lower edge of each fine bin. d as for write_raw. */
+static int write_grid_axes(const struct pdf *p, int g, const int d[6], char *err, size_t errlen) {
+  const size_t rows = pdf_rows(p);
+  double *t = mem_alloc(3 * rows + p->nfine, sizeof(double), "PDF results");
+  double *t0 = t + rows, *t1 = t0 + rows, *f = t1 + rows;
+  int rc = NC_NOERR, v;
+  for (size_t r = 0; r < rows; r++) {
+    t0[r] = p->win[r * PW_LEN + PW_T0], t1[r] = p->win[r * PW_LEN + PW_T1];
+    t[r] = 0.5 * (t0[r] + t1[r]);
+  }
+  for (int c = 0, k = 0; c < PDF_COMP; c++)
+    for (int i = 0; i < p->nf[c]; i++) f[k++] = pdf_lo[c] + i * p->cfg.fine;
+  CK(ncout_def(g, "window", NC_DOUBLE, 1, &d[2], "s", "middle of the averaging window", &v));
+  CK(nc_put_var_double(g, v, t));
+  CK(ncout_bounds(g, "window", v, d[2], "s", "nominal start and end of the window", t0, t1, rows));
+  CK(ncout_def(g, "fine", NC_DOUBLE, 1, &d[5], "1",
+               "lower edge of the fine bin in units of u_tau_ref (u, v, w bins in turn)", &v));
+  CK(nc_put_var_double(g, v, f));
+done:
+  free(t);
   return rc;
 }
 
@@ -119,7 +143,8 @@ static int write_raw(const struct pdf *p, int g, const int d[6], char *err, size
   CK(ncout_labels(g, "window_field", d[3], "field of the window records", wf));
   CK(ncout_labels(g, "power", d[4], "power k of the sums of x^k, x = u_i / u_tau_ref", pw));
   const int dw[2] = {d[2], d[3]}, dp[4] = {d[2], d[0], d[1], d[4]}, dh[3] = {d[2], d[0], d[5]};
-  CK(ncout_def(g, "windows", NC_DOUBLE, 2, dw, "1",
+  if ((rc = write_grid_axes(p, g, d, err, errlen)) != NC_NOERR) goto done;
+  CK(ncout_def(g, "windows", NC_DOUBLE, 2, dw, NULL,
                "per window: nominal start and end [s], snapshots", &v));
   CK(nc_put_var_double(g, v, p->win));
   CK(ncout_def(g, "power_sums", NC_DOUBLE, 4, dp, "1",
