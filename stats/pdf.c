@@ -7,6 +7,7 @@
 #include <math.h>
 #include <mpi.h>
 #include <stddef.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -241,7 +242,7 @@ static double pdf_of(const struct pdf *p, int c, const double *h, double n, doub
     for (int j = 0; j < p->cfg.bins; j++) pd[j] = NAN;
     return NAN;
   }
-  const double out = rebin(p, c, h, mean, sd, pd);
+  const double out = fmax(rebin(p, c, h, mean, sd, pd), 0.0); /* not below 0 by rounding */
   for (int j = 0; j < p->cfg.bins; j++) pd[j] /= n * db;
   return out / n;
 }
@@ -332,6 +333,44 @@ void pdf_finalise(const struct pdf *p, size_t r0, size_t r1, struct pdf_result *
     for (int c = 0; c < PDF_COMP; c++) level_result(p, r0, r1, l, c, r);
 }
 
+/* Power sums and end-bin counts of level l, component c over every row with data. */
+static void level_totals(const struct pdf *p, size_t l, int c, double S[PDF_POW], double *ends) {
+  const size_t nl = (size_t)p->cfg.n_levels;
+  size_t off = 0;
+  for (int k = 0; k < c; k++) off += (size_t)p->nf[k];
+  memset(S, 0, PDF_POW * sizeof(double));
+  *ends = 0.0;
+  for (size_t r = 0; r < pdf_rows(p); r++) {
+    const double *src = p->pow + ((r * nl + l) * PDF_COMP + (size_t)c) * PDF_POW;
+    const double *h = p->hist + (r * nl + l) * p->nfine + off;
+    for (int k = 0; k < PDF_POW; k++) S[k] += src[k];
+    *ends += h[0] + h[p->nf[c] - 1];
+  }
+}
+
+int pdf_warnings(const struct pdf *p, char *buf, size_t len) {
+  static const char comp[PDF_COMP] = {'u', 'v', 'w'};
+  const double db = 2.0 * p->cfg.range / p->cfg.bins;
+  int n = 0;
+  size_t m = 0;
+  buf[0] = '\0';
+  for (int l = 0; l < p->cfg.n_levels && m < len; l++)
+    for (int c = 0; c < PDF_COMP && m < len; c++) {
+      double S[PDF_POW], ends, mo[4];
+      level_totals(p, (size_t)l, c, S, &ends);
+      moments_of(S, mo);
+      const double wide = p->cfg.fine / mo[1] / db, clip = S[0] > 0.0 ? ends / S[0] : 0.0;
+      if (!(mo[1] > 0.0) || (wide <= 0.5 && clip <= 1e-4)) continue;
+      m += (size_t)snprintf(buf + m, len - m,
+                            "warning: pdfs y+ = %g %c: a fine bin is %.3g PDF bins wide, %.3g of "
+                            "the samples lie at the ends of the fine grid: decrease pdfs.fine "
+                            "(or check stats.u_tau_ref)\n",
+                            p->cfg.y_plus[l], comp[c], wide, clip);
+      n++;
+    }
+  return n;
+}
+
 /* The engine's table of operations (engine.h). */
 static int engine_init_scene(void *self, const struct stats_scene *sc) {
   struct pdf_config c;
@@ -372,6 +411,10 @@ static size_t engine_bytes(const void *self) {
          sizeof(double);
 }
 
+static int engine_warnings(const void *self, char *buf, size_t len) {
+  return pdf_warnings(self, buf, len);
+}
+
 static int engine_write(const void *self, double t_reached, int ncid, char *err, size_t errlen) {
   (void)t_reached;
   return pdf_nc_write(self, ncid, err, errlen);
@@ -386,5 +429,5 @@ const struct stats_engine pdf_engine = {.name = "one-point PDFs",
                                         .state = engine_state,
                                         .bytes = engine_bytes,
                                         .write = engine_write,
-                                        .warnings = NULL,
+                                        .warnings = engine_warnings,
                                         .log = NULL};

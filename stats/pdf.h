@@ -118,6 +118,10 @@ void pdf_finalise(const struct pdf *p, size_t r0, size_t r1, struct pdf_result *
 /** @brief Free a result. */
 void pdf_result_free(struct pdf_result *r);
 
+/** @brief Warnings ("warning: ..." lines into buf) for PDFs the fine grid cannot resolve (a
+ *         fine bin wider than half a PDF bin) or that it clips; returns how many. */
+int pdf_warnings(const struct pdf *p, char *buf, size_t len);
+
 /** @brief Define and write the group `pdfs` of stats.nc (netCDF status, message in err). */
 int pdf_nc_write(const struct pdf *p, int ncid, char *err, size_t errlen);
 
