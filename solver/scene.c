@@ -779,8 +779,7 @@ static void validate(struct parse_state *ps) {
     inconsistent(ps, "output.t_average_start", "averaging start %g is after t_end = %g",
                  s->t_average_start, s->t_end);
   if ((s->corr_y_plus.n || s->lagr_y_plus.n || s->quad_y_plus.n || s->pdf_y_plus.n) &&
-      s->u_tau_ref == 0.0 &&
-      (s->drive_mode == DRIVE_FLUX || s->force <= 0.0))
+      s->u_tau_ref == 0.0 && (s->drive_mode == DRIVE_FLUX || s->force <= 0.0))
     inconsistent(ps, "stats.u_tau_ref",
                  "y+ levels need stats.u_tau_ref > 0 unless a positive drive.force gives it "
                  "(u_tau_ref = %g, force = %g)",

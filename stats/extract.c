@@ -181,13 +181,15 @@ struct extract_args {
 
 /* Parse the command line (argv[0]: the command name); 1: input error, -1: --help printed. */
 static int extract_parse(int argc, char **argv, struct extract_args *a) {
-  static const struct option opts[] = {
-      {"help", no_argument, NULL, 'h'},         {"var", required_argument, NULL, 'v'},
-      {"units", required_argument, NULL, 'u'},  {"format", required_argument, NULL, 'f'},
-      {"window", required_argument, NULL, 'w'}, {"pdfs", no_argument, NULL, 'p'},
-      {NULL, 0, NULL, 0}};
-  *a = (struct extract_args){NULL,     "u_mean,u_rms,v_rms,w_rms,uv", "wall", "csv", -INFINITY,
-                             INFINITY, 0};
+  static const struct option opts[] = {{"help", no_argument, NULL, 'h'},
+                                       {"var", required_argument, NULL, 'v'},
+                                       {"units", required_argument, NULL, 'u'},
+                                       {"format", required_argument, NULL, 'f'},
+                                       {"window", required_argument, NULL, 'w'},
+                                       {"pdfs", no_argument, NULL, 'p'},
+                                       {NULL, 0, NULL, 0}};
+  *a = (struct extract_args){
+      NULL, "u_mean,u_rms,v_rms,w_rms,uv", "wall", "csv", -INFINITY, INFINITY, 0};
   opterr = 0, optind = 1; /* "-": positional arguments in order (code 1); ':' missing value */
   for (;;) {
     const int at = optind, code = getopt_long(argc, argv, "-:h", opts, NULL);
@@ -348,16 +350,18 @@ static void extract_pdf_table(const struct extract_args *a, const struct pdf *p,
   pdf_finalise(p, r0, r1, &r);
   const char sep = !strcmp(a->fmt, "csv") ? ',' : '\t';
   static const char comp[PDF_COMP] = {'u', 'v', 'w'};
-  printf("# chansph extract --pdfs %s: windows %zu..%zu, t = %.9g .. %.9g s, %.0f snapshots, %d "
-         "batches; pdf of (u_i - <u_i>) / u_i,rms over +-%g rms\n",
-         a->path, r0, r1 - 1, r.t0, r.t1, r.snapshots, r.n_batches, p->cfg.range);
+  printf(
+      "# chansph extract --pdfs %s: windows %zu..%zu, t = %.9g .. %.9g s, %.0f snapshots, %d "
+      "batches; pdf of (u_i - <u_i>) / u_i,rms over +-%g rms\n",
+      a->path, r0, r1 - 1, r.t0, r.t1, r.snapshots, r.n_batches, p->cfg.range);
   for (int l = 0; l < p->cfg.n_levels; l++)
     for (int c = 0; c < PDF_COMP; c++) {
       const double *m = r.mom + (l * PDF_COMP + c) * 4, *e = r.mom_err + (l * PDF_COMP + c) * 4;
-      printf("# y+ %g %c: %.0f samples, mean %.6g +- %.3g m/s, rms %.6g +- %.3g m/s, skewness "
-             "%.4g +- %.3g, flatness %.4g +- %.3g, outside %.3g, clipped %.3g\n",
-             p->cfg.y_plus[l], comp[c], r.n[l], m[0], e[0], m[1], e[1], m[2], e[2], m[3], e[3],
-             r.outside[l * PDF_COMP + c], r.clipped[l * PDF_COMP + c]);
+      printf(
+          "# y+ %g %c: %.0f samples, mean %.6g +- %.3g m/s, rms %.6g +- %.3g m/s, skewness "
+          "%.4g +- %.3g, flatness %.4g +- %.3g, outside %.3g, clipped %.3g\n",
+          p->cfg.y_plus[l], comp[c], r.n[l], m[0], e[0], m[1], e[1], m[2], e[2], m[3], e[3],
+          r.outside[l * PDF_COMP + c], r.clipped[l * PDF_COMP + c]);
     }
   printf("y_plus%ccomponent%cx%cpdf%cpdf_stderr\n", sep, sep, sep, sep);
   for (int l = 0; l < p->cfg.n_levels; l++)

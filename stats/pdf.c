@@ -1,8 +1,7 @@
-/** @file pdf.c @brief Implementation of pdf.h: accumulation, checkpoint state, results, and the
- *         engine's table of operations (the stats.nc writer and reader are in pdf_nc.c). */
+/** @file pdf.c @brief Implementation of pdf.h: accumulation, checkpoint state, results and
+ *         warnings (the stats.nc writer and reader and the engine's table are in pdf_nc.c). */
 #include "pdf.h"
 #include "contract.h"
-#include "engine.h"
 
 #include <math.h>
 #include <mpi.h>
@@ -131,8 +130,8 @@ static void pdf_snapshot(struct pdf *p, const struct stats_snapshot *s, double *
   for (size_t k = 0; k < ncol; k++)
     for (size_t i = 0; i < p->rec; i++) sums[i] += p->all[k * p->rec + i];
   if (par.size > 1)
-    CHECK_MPI(MPI_Allreduce(MPI_IN_PLACE, p->cnt, (int)(npl * p->nfine), MPI_DOUBLE, MPI_SUM,
-                            par.comm));
+    CHECK_MPI(
+        MPI_Allreduce(MPI_IN_PLACE, p->cnt, (int)(npl * p->nfine), MPI_DOUBLE, MPI_SUM, par.comm));
   spar_close(&par);
 }
 
@@ -234,8 +233,8 @@ static double rebin(const struct pdf *p, int c, const double *h, double mean, do
 }
 
 /* The PDF p (bins) of one row range's counts h of component c with n samples. */
-static double pdf_of(const struct pdf *p, int c, const double *h, double n, double mean,
-                     double sd, double *pd) {
+static double pdf_of(const struct pdf *p, int c, const double *h, double n, double mean, double sd,
+                     double *pd) {
   const double db = 2.0 * p->cfg.range / p->cfg.bins;
   memset(pd, 0, (size_t)p->cfg.bins * sizeof(double));
   if (!(n > 0.0) || !(sd > 0.0)) {
@@ -370,64 +369,3 @@ int pdf_warnings(const struct pdf *p, char *buf, size_t len) {
     }
   return n;
 }
-
-/* The engine's table of operations (engine.h). */
-static int engine_init_scene(void *self, const struct stats_scene *sc) {
-  struct pdf_config c;
-  memset(&c, 0, sizeof c);
-  c.n_levels = stats_scene_levels(sc, "pdfs.y_plus", c.y_plus, c.y, PDF_MAX_LEVELS);
-  c.half = 0.5 * stats_scene_num(sc, "pdfs.thickness") * sc->dr;
-  c.delta = sc->delta, c.t_start = sc->t_average_start, c.u_tau = sc->u_tau;
-  c.window = stats_scene_window(sc);
-  c.fine = stats_scene_num(sc, "pdfs.fine");
-  c.bins = (int)stats_scene_num(sc, "pdfs.bins");
-  c.range = stats_scene_num(sc, "pdfs.range");
-  if (!(c.n_levels > 0)) return 0;
-  pdf_init(self, &c);
-  return 1;
-}
-
-static void engine_init(void *self, const void *cfg) {
-  pdf_init(self, cfg);
-}
-
-static void engine_free(void *self) {
-  pdf_free(self);
-}
-
-static void engine_sample(void *self, const struct stats_snapshot *s) {
-  pdf_sample(self, s);
-}
-
-static void engine_state(void *self, struct state_list *L) {
-  pdf_state(self, L);
-}
-
-static size_t engine_bytes(const void *self) {
-  const struct pdf *p = self;
-  const size_t nl = (size_t)p->cfg.n_levels;
-  return (p->cap * (PW_LEN + nl * (PDF_COMP * PDF_POW + p->nfine)) + p->ent_cap +
-          p->all_cap * p->rec + p->cnt_cap) *
-         sizeof(double);
-}
-
-static int engine_warnings(const void *self, char *buf, size_t len) {
-  return pdf_warnings(self, buf, len);
-}
-
-static int engine_write(const void *self, double t_reached, int ncid, char *err, size_t errlen) {
-  (void)t_reached;
-  return pdf_nc_write(self, ncid, err, errlen);
-}
-
-const struct stats_engine pdf_engine = {.name = "one-point PDFs",
-                                        .size = sizeof(struct pdf),
-                                        .init_scene = engine_init_scene,
-                                        .init = engine_init,
-                                        .free = engine_free,
-                                        .sample = engine_sample,
-                                        .state = engine_state,
-                                        .bytes = engine_bytes,
-                                        .write = engine_write,
-                                        .warnings = engine_warnings,
-                                        .log = NULL};

@@ -62,16 +62,16 @@ struct pdf_config {
 /** The engine: rows 0 .. nwin-1 are the closed windows, row nwin the open one. */
 struct pdf {
   struct pdf_config cfg;
-  int nf[PDF_COMP]; /*!< fine bins per component */
-  size_t nfine;     /*!< fine bins of a level (all components) */
-  size_t nwin;      /*!< closed windows */
-  size_t cap;       /*!< rows allocated (>= nwin + 1) */
-  double *win;      /*!< [row][PW_LEN] */
-  double *pow;      /*!< [row][level][PDF_COMP][PDF_POW] power sums */
-  double *hist;     /*!< [row][level][nfine] fine counts */
-  double *ent;      /*!< scratch: this rank's per-(column, plane) power sums */
-  double *all;      /*!< scratch: the same gathered from all ranks */
-  double *cnt;      /*!< scratch: [plane][nfine] counts of a snapshot */
+  int nf[PDF_COMP];                 /*!< fine bins per component */
+  size_t nfine;                     /*!< fine bins of a level (all components) */
+  size_t nwin;                      /*!< closed windows */
+  size_t cap;                       /*!< rows allocated (>= nwin + 1) */
+  double *win;                      /*!< [row][PW_LEN] */
+  double *pow;                      /*!< [row][level][PDF_COMP][PDF_POW] power sums */
+  double *hist;                     /*!< [row][level][nfine] fine counts */
+  double *ent;                      /*!< scratch: this rank's per-(column, plane) power sums */
+  double *all;                      /*!< scratch: the same gathered from all ranks */
+  double *cnt;                      /*!< scratch: [plane][nfine] counts of a snapshot */
   size_t ent_cap, all_cap, cnt_cap; /*!< capacities (doubles, records, doubles) */
   size_t rec;                       /*!< doubles per column record */
 };

@@ -1,5 +1,7 @@
-/** @file pdf_nc.c @brief The group `pdfs` of stats.nc (pdf.h): its writer, and its reader for
- *         `chansph extract --pdfs`. */
+/** @file pdf_nc.c @brief The group `pdfs` of stats.nc (pdf.h): its writer, its reader for
+ *         `chansph extract --pdfs`, and the engine's table of operations. */
+#include "contract.h"
+#include "engine.h"
 #include "ncutil.h"
 #include "pdf.h"
 
@@ -16,8 +18,8 @@
 #define CK(call) NC_TRY(call, done)
 
 /* Configuration attributes of the group, in this order (read back by pdf_nc_read). */
-static const char *const cfg_att[] = {"u_tau_ref", "fine_width", "range",    "bins",
-                                      "window_length", "slab_half", "delta", "average_start"};
+static const char *const cfg_att[] = {"u_tau_ref",     "fine_width", "range", "bins",
+                                      "window_length", "slab_half",  "delta", "average_start"};
 enum { N_CFG_ATT = 8 };
 
 static void cfg_values(const struct pdf_config *c, double v[N_CFG_ATT]) {
@@ -195,8 +197,8 @@ static int read_config(int g, struct pdf_config *c) {
   int dl, vl, vy;
   for (int k = 0; k < N_CFG_ATT; k++)
     if (nc_get_att_double(g, NC_GLOBAL, cfg_att[k], cv + k) != NC_NOERR) return -1;
-  if (nc_inq_dimid(g, "level", &dl) || nc_inq_dimlen(g, dl, &nl) || nl < 1 ||
-      nl > PDF_MAX_LEVELS || nc_inq_varid(g, "level", &vl) || nc_inq_varid(g, "y_plus", &vy) ||
+  if (nc_inq_dimid(g, "level", &dl) || nc_inq_dimlen(g, dl, &nl) || nl < 1 || nl > PDF_MAX_LEVELS ||
+      nc_inq_varid(g, "level", &vl) || nc_inq_varid(g, "y_plus", &vy) ||
       nc_get_var_double(g, vl, c->y) || nc_get_var_double(g, vy, c->y_plus))
     return -1;
   c->n_levels = (int)nl, c->u_tau = cv[0], c->fine = cv[1], c->range = cv[2];
@@ -218,9 +220,9 @@ int pdf_nc_read(struct pdf *p, int ncid, char *err, size_t errlen) {
   pdf_init(p, &c);
   if (nc_inq_dimid(g, "window", &dw) || nc_inq_dimlen(g, dw, &rows) ||
       nc_inq_dimid(g, "fine", &dfi) || nc_inq_dimlen(g, dfi, &nfine) || nfine != p->nfine ||
-      nc_get_att_int(g, NC_GLOBAL, "closed_windows", &nwin) || rows < 1 ||
-      (size_t)nwin > rows || nc_inq_varid(g, "windows", &vw) ||
-      nc_inq_varid(g, "power_sums", &vp) || nc_inq_varid(g, "fine_counts", &vh)) {
+      nc_get_att_int(g, NC_GLOBAL, "closed_windows", &nwin) || rows < 1 || (size_t)nwin > rows ||
+      nc_inq_varid(g, "windows", &vw) || nc_inq_varid(g, "power_sums", &vp) ||
+      nc_inq_varid(g, "fine_counts", &vh)) {
     snprintf(err, errlen, "the group 'pdfs' holds no raw windows of this layout");
     pdf_free(p);
     return -1;
@@ -235,3 +237,64 @@ int pdf_nc_read(struct pdf *p, int ncid, char *err, size_t errlen) {
   }
   return 0;
 }
+
+/* The engine's table of operations (engine.h). */
+static int engine_init_scene(void *self, const struct stats_scene *sc) {
+  struct pdf_config c;
+  memset(&c, 0, sizeof c);
+  c.n_levels = stats_scene_levels(sc, "pdfs.y_plus", c.y_plus, c.y, PDF_MAX_LEVELS);
+  c.half = 0.5 * stats_scene_num(sc, "pdfs.thickness") * sc->dr;
+  c.delta = sc->delta, c.t_start = sc->t_average_start, c.u_tau = sc->u_tau;
+  c.window = stats_scene_window(sc);
+  c.fine = stats_scene_num(sc, "pdfs.fine");
+  c.bins = (int)stats_scene_num(sc, "pdfs.bins");
+  c.range = stats_scene_num(sc, "pdfs.range");
+  if (!(c.n_levels > 0)) return 0;
+  pdf_init(self, &c);
+  return 1;
+}
+
+static void engine_init(void *self, const void *cfg) {
+  pdf_init(self, cfg);
+}
+
+static void engine_free(void *self) {
+  pdf_free(self);
+}
+
+static void engine_sample(void *self, const struct stats_snapshot *s) {
+  pdf_sample(self, s);
+}
+
+static void engine_state(void *self, struct state_list *L) {
+  pdf_state(self, L);
+}
+
+static size_t engine_bytes(const void *self) {
+  const struct pdf *p = self;
+  const size_t nl = (size_t)p->cfg.n_levels;
+  return (p->cap * (PW_LEN + nl * (PDF_COMP * PDF_POW + p->nfine)) + p->ent_cap +
+          p->all_cap * p->rec + p->cnt_cap) *
+         sizeof(double);
+}
+
+static int engine_warnings(const void *self, char *buf, size_t len) {
+  return pdf_warnings(self, buf, len);
+}
+
+static int engine_write(const void *self, double t_reached, int ncid, char *err, size_t errlen) {
+  (void)t_reached;
+  return pdf_nc_write(self, ncid, err, errlen);
+}
+
+const struct stats_engine pdf_engine = {.name = "one-point PDFs",
+                                        .size = sizeof(struct pdf),
+                                        .init_scene = engine_init_scene,
+                                        .init = engine_init,
+                                        .free = engine_free,
+                                        .sample = engine_sample,
+                                        .state = engine_state,
+                                        .bytes = engine_bytes,
+                                        .write = engine_write,
+                                        .warnings = engine_warnings,
+                                        .log = NULL};

@@ -16,6 +16,7 @@
 
 #include "contract.h"
 #include "pdf.h"
+#include "synthetic.h"
 
 static int failures = 0;
 
@@ -27,20 +28,6 @@ static int failures = 0;
       failures++;                   \
     }                               \
   } while (0)
-
-/* Counter-based generator (splitmix64 of a key): reproducible, no hidden state. */
-static uint64_t mix(uint64_t z) {
-  z += 0x9e3779b97f4a7c15ULL;
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  return z ^ (z >> 31);
-}
-static double uniform(uint64_t key) {
-  return ((double)(mix(key) >> 11) + 0.5) / 9007199254740992.0;
-}
-static double gauss(uint64_t key) { /* Box-Muller */
-  return sqrt(-2.0 * log(uniform(2 * key))) * cos(6.283185307179586 * uniform(2 * key + 1));
-}
 
 /* The synthetic slab: NP particles per snapshot, half at the level y = 0.3 (inside the slab),
    a quarter at the mirror 1.7 (v reversed), a quarter outside; u = U + SU g1, v = SV g2 (the
@@ -152,11 +139,10 @@ static void test_known(double *buf) {
   pdf_finalise(&p, 0, pdf_rows(&p), &r);
   const double n = NSNAP * 0.75 * NP;
   EXPECT(r.n[0] == n, "samples %g, expected %g", r.n[0], n);
-  static const char *const name[3] = {"u (Gaussian)", "v (Gaussian, mirrored)",
-                                      "w (exponential)"};
+  static const char *const name[3] = {"u (Gaussian)", "v (Gaussian, mirrored)", "w (exponential)"};
   const double exact[3][4] = {{U * UT, SU * UT, 0, 3}, {0, SV * UT, 0, 3}, {0, SW * UT, 2, 9}};
-  const double tol[3][4] = {{0.01, 0.005, 0.02, 0.04}, {0.01, 0.005, 0.02, 0.04},
-                            {0.01, 0.01, 0.1, 1.0}};
+  const double tol[3][4] = {
+      {0.01, 0.005, 0.02, 0.04}, {0.01, 0.005, 0.02, 0.04}, {0.01, 0.01, 0.1, 1.0}};
   for (int c = 0; c < 3; c++) {
     double d[4], sum = 0.0, err, z;
     direct_moments(c, buf, d);
@@ -165,8 +151,8 @@ static void test_known(double *buf) {
       const double scale = k < 2 ? SU * UT : 1.0; /* mean and rms relative to the u rms */
       EXPECT(fabs(m[k] - exact[c][k]) <= tol[c][k] * scale, "%s moment %d: %.6g vs exact %.6g",
              name[c], k, m[k], exact[c][k]);
-      EXPECT(fabs(m[k] - d[k]) <= 1e-9 * fmax(1.0, fabs(d[k])), "%s moment %d: %.15g vs direct %.15g",
-             name[c], k, m[k], d[k]);
+      EXPECT(fabs(m[k] - d[k]) <= 1e-9 * fmax(1.0, fabs(d[k])),
+             "%s moment %d: %.15g vs direct %.15g", name[c], k, m[k], d[k]);
       EXPECT(me[k] > 0.0 && fabs(m[k] - exact[c][k]) <= 5.0 * me[k] + 1e-12 * scale,
              "%s moment %d: error %.3g beyond 5 standard errors %.3g", name[c], k,
              fabs(m[k] - exact[c][k]), me[k]);

@@ -16,6 +16,7 @@
 #include "state.h"
 #include "stats.h"
 #include "stats_setup.h"
+#include "synthetic.h"
 
 static int failures = 0;
 
@@ -27,20 +28,6 @@ static int failures = 0;
       failures++;                   \
     }                               \
   } while (0)
-
-/* Counter-based generator (splitmix64 of a key): reproducible, no hidden state. */
-static uint64_t mix(uint64_t z) {
-  z += 0x9e3779b97f4a7c15ULL;
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  return z ^ (z >> 31);
-}
-static double uniform(uint64_t key) {
-  return ((double)(mix(key) >> 11) + 0.5) / 9007199254740992.0;
-}
-static double gauss(uint64_t key) { /* Box-Muller */
-  return sqrt(-2.0 * log(uniform(2 * key))) * cos(6.283185307179586 * uniform(2 * key + 1));
-}
 
 enum { NB = 8, NP = 4000, NSNAP = 400 };
 static const double A = 0.3, B = -0.2, C = 0.25, SW = 0.15; /* u' = A g1, v' = B g1 + C g2 */

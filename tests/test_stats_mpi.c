@@ -24,6 +24,7 @@
 #include "stats.h"
 #include "stats_nc.h"
 #include "stats_setup.h"
+#include "synthetic.h"
 
 static int failures = 0;
 
@@ -38,20 +39,6 @@ static int failures = 0;
   } while (0)
 
 static int rank_g = 0, size_g = 1;
-
-/* Counter-based generator (splitmix64 of a key): reproducible, no hidden state. */
-static uint64_t mix(uint64_t z) {
-  z += 0x9e3779b97f4a7c15ULL;
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  return z ^ (z >> 31);
-}
-static double uniform(uint64_t key) {
-  return ((double)(mix(key) >> 11) + 0.5) / 9007199254740992.0;
-}
-static double gauss(uint64_t key) { /* Box-Muller */
-  return sqrt(-2.0 * log(uniform(2 * key))) * cos(6.283185307179586 * uniform(2 * key + 1));
-}
 
 /* The global particle set of one snapshot (ids 0 .. nf - 1 fluid, then nw wall vertices). */
 struct world {
