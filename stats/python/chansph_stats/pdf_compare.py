@@ -126,7 +126,8 @@ def main(argv, prog):
     ap.add_argument("--dns", default=DEFAULT_DNS, help="folder of the MKM chan180.pdf.N files")
     ap.add_argument("--plot", help="write the PDFs against the DNS to this PNG")
     a = ap.parse_args(argv)
-    run, dns = read_run(a.stats), dns_levels(a.dns)
+    dns = dns_levels(a.dns)
+    run = read_run(a.stats)
     rows, curves = compare(run, dns)
     if not rows:
         raise InputError("%s: no level of group pdfs is near an MKM level" % a.stats)
