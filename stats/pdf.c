@@ -117,9 +117,9 @@ static void pdf_snapshot(struct pdf *p, const struct stats_snapshot *s, double *
   pdf_scratch(p, ncl, npl);
   for (size_t a = 0; a < s->n; a++) {
     if (s->skip && s->skip[a]) continue;
+    double *e = p->ent + (size_t)spar_lcol(&par, s, a) * p->rec;
     for (int l = 0; l < c->n_levels; l++) {
       const double ym = 2.0 * c->delta - c->y[l];
-      double *e = p->ent + (size_t)spar_lcol(&par, s, a) * p->rec;
       if (fabs(s->y[a] - c->y[l]) < c->half) pdf_add_particle(p, s, a, 2 * (size_t)l, 0, e);
       if (fabs(ym - c->y[l]) >= 2.0 * c->half && fabs(s->y[a] - ym) < c->half)
         pdf_add_particle(p, s, a, 2 * (size_t)l + 1, 1, e);
