@@ -14,6 +14,7 @@
 #include "error.h"
 #include "spar.h"
 #include "state.h"
+#include "timers.h"
 
 const double pdf_lo[PDF_COMP] = {-10.0, -10.0, -10.0};
 const double pdf_hi[PDF_COMP] = {35.0, 10.0, 10.0};
@@ -137,6 +138,7 @@ static void pdf_snapshot(struct pdf *p, const struct stats_snapshot *s, double *
 
 void pdf_sample(struct pdf *p, const struct stats_snapshot *s) {
   if (p->cfg.n_levels <= 0 || s->t < p->cfg.t_start) return;
+  timer_push("stats: pdfs"); /* its own line of the phase report: the engine's overhead */
   pdf_advance(p, s->t);
   double sums[2 * PDF_MAX_LEVELS * PDF_COMP * PDF_POW];
   pdf_snapshot(p, s, sums);
@@ -147,6 +149,7 @@ void pdf_sample(struct pdf *p, const struct stats_snapshot *s) {
     for (size_t k = 0; k < p->nfine; k++) h[k] += p->cnt[pl * p->nfine + k];
   }
   p->win[row * PW_LEN + PW_NSNAP] += 1.0;
+  timer_pop();
 }
 
 size_t pdf_rows(const struct pdf *p) {
