@@ -1,7 +1,7 @@
 /**
  * @file synthetic.h
- * @brief The counter-based random numbers of the statistics tests' synthetic fields: the same
- *        key gives the same number on every run, rank and thread (no hidden state, no rand()).
+ * @brief The counter-based random numbers of the statistics tests' synthetic fields (the same
+ *        key gives the same number on every run, rank and thread: no hidden state, no rand()).
  */
 #ifndef CHANSPH_TEST_SYNTHETIC_H
 #define CHANSPH_TEST_SYNTHETIC_H

@@ -15,19 +15,9 @@
 #include <string.h>
 
 #include "contract.h"
+#include "expect.h"
 #include "pdf.h"
 #include "synthetic.h"
-
-static int failures = 0;
-
-#define EXPECT(cond, ...)           \
-  do {                              \
-    if (!(cond)) {                  \
-      printf("FAIL: " __VA_ARGS__); \
-      printf("\n");                 \
-      failures++;                   \
-    }                               \
-  } while (0)
 
 /* The synthetic slab: NP particles per snapshot, half at the level y = 0.3 (inside the slab),
    a quarter at the mirror 1.7 (v reversed), a quarter outside; u = U + SU g1, v = SV g2 (the

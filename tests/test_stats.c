@@ -11,23 +11,13 @@
 #include <string.h>
 
 #include "euler.h"
+#include "expect.h"
 #include "lagr.h"
 #include "moments.h"
 #include "state.h"
 #include "stats.h"
 #include "stats_setup.h"
 #include "synthetic.h"
-
-static int failures = 0;
-
-#define EXPECT(cond, ...)           \
-  do {                              \
-    if (!(cond)) {                  \
-      printf("FAIL: " __VA_ARGS__); \
-      printf("\n");                 \
-      failures++;                   \
-    }                               \
-  } while (0)
 
 enum { NB = 8, NP = 4000, NSNAP = 400 };
 static const double A = 0.3, B = -0.2, C = 0.25, SW = 0.15; /* u' = A g1, v' = B g1 + C g2 */
