@@ -381,9 +381,10 @@ static const struct key keys[] = {
      "outside).",
      OFF(pdf_range)},
     {"pdfs", "fine", T_DOUBLE, "0.02", 0, 1, LO_OPEN, NULL, "u_tau",
-     "Width of the fine bins of the raw per-window counts of u_i / stats.u_tau_ref (over -10 .. 35 "
-     "for u, -10 .. 10 for v and w), rebinned in units of the rms at output; keep it below "
-     "a tenth of the smallest rms times 2 range / bins (v near the wall).",
+     "Width of the fine bins of the raw per-window counts of u_i / stats.u_tau_ref (over -10 .. "
+     "35 for u, -10 .. 10 for v and w), rebinned in units of the rms at output: keep it well "
+     "below a PDF bin, 2 range / bins times the smallest rms (v near the wall: 0.01); the log "
+     "warns where it is above half of one.",
      OFF(pdf_fine)},
     {"pdfs", "thickness", T_DOUBLE, "1", 0, 100, LO_OPEN, NULL, "dr",
      "Thickness of the slab of particles sampled at each level, in units of dr.",
