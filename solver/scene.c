@@ -380,7 +380,7 @@ static const struct key keys[] = {
      "Half-width of the PDFs in units of the local rms (samples beyond it are counted in "
      "outside).",
      OFF(pdf_range)},
-    {"pdfs", "fine", T_DOUBLE, "0.02", 0, 1, LO_OPEN, NULL, "u_tau",
+    {"pdfs", "fine", T_DOUBLE, "0.02", 0.001, 1, 0, NULL, "u_tau",
      "Width of the fine bins of the raw per-window counts of u_i / stats.u_tau_ref (over -10 .. "
      "35 for u, -10 .. 10 for v and w), rebinned in units of the rms at output: keep it well "
      "below a PDF bin, 2 range / bins times the smallest rms (v near the wall: 0.01); the log "
