@@ -275,8 +275,9 @@ static double batch_err(double s1, double s2, int nb) {
   return var > 0.0 ? sqrt(var / nb) : 0.0;
 }
 
-/* Standard errors of level l, component c over the complete windows of rows r0 .. r1-1: each
-   window's moments and PDF (about the range's mean m and rms sd) are one batch value. */
+/* Standard errors of level l, component c over the complete windows of rows r0 .. r1-1 with
+   samples at the level: each window's moments and PDF (about the range's mean m and rms sd)
+   are one batch value. */
 static void batch_errors(const struct pdf *p, size_t r0, size_t r1, size_t l, int c, double m,
                          double sd, double *mom_err, double *p_err) {
   const size_t nl = (size_t)p->cfg.n_levels, B = (size_t)p->cfg.bins;
@@ -286,9 +287,11 @@ static void batch_errors(const struct pdf *p, size_t r0, size_t r1, size_t l, in
   size_t off = 0;
   for (int k = 0; k < c; k++) off += (size_t)p->nf[k];
   int nb = 0;
-  for (size_t r = r0; r < r1 && r < p->nwin; r++, nb++) {
+  for (size_t r = r0; r < r1 && r < p->nwin; r++) {
     const double *S = p->pow + ((r * nl + l) * PDF_COMP + (size_t)c) * PDF_POW;
+    if (!(S[0] > 0.0)) continue; /* no sample at this level in the window: no batch */
     double w[4];
+    nb++;
     moments_of(S, w);
     for (int k = 0; k < 4; k++) s[k] += w[k], s[4 + k] += w[k] * w[k];
     pdf_of(p, c, p->hist + (r * nl + l) * p->nfine + off, S[0], m, sd, pd);
