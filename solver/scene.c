@@ -372,6 +372,27 @@ static const struct key keys[] = {
      "(ejections), Q3 (inward) and Q4 (sweeps); stats.nc group quadrants (docs/stats-format.md). "
      "Ejections and sweeps dominate in wall turbulence, not in particle noise. Empty = off.",
      OFF(quad_y_plus)},
+    {"pdfs", "y_plus", T_LIST, "", 0, BIG, 0, NULL, "-",
+     "Comma-separated y+ levels (up to 8) of the one-point PDFs of u', v', w' (issue 25; MKM "
+     "1999 give them at y+ = 5, 10, 19, 30, 40, 59, 79, 98, 178): fluid particles in a slab at "
+     "each level and its mirror (v -> -v), binned in units of the local rms about the mean of "
+     "the averaged windows; stats.nc group pdfs (docs/stats-format.md). Empty = off.",
+     OFF(pdf_y_plus)},
+    {"pdfs", "bins", T_INT, "40", 1, 1000, 0, NULL, "-",
+     "Bins of each PDF over -range .. range local rms.", OFF(pdf_bins)},
+    {"pdfs", "range", T_DOUBLE, "5", 0, 100, LO_OPEN, NULL, "rms",
+     "Half-width of the PDFs in units of the local rms (samples beyond it are counted in "
+     "outside).",
+     OFF(pdf_range)},
+    {"pdfs", "fine", T_DOUBLE, "0.02", 0.001, 1, 0, NULL, "u_tau",
+     "Width of the fine bins of the raw per-window counts of u_i / stats.u_tau_ref (over -10 .. "
+     "35 for u, -10 .. 10 for v and w), rebinned in units of the rms at output: keep it well "
+     "below a PDF bin, 2 range / bins times the smallest rms (v near the wall: 0.01); the log "
+     "warns where it is above half of one.",
+     OFF(pdf_fine)},
+    {"pdfs", "thickness", T_DOUBLE, "1", 0, 100, LO_OPEN, NULL, "dr",
+     "Thickness of the slab of particles sampled at each level, in units of dr.",
+     OFF(pdf_thickness)},
     {"lagrangian", "y_plus", T_LIST, "", 0, BIG, 0, NULL, "-",
      "Comma-separated y+ release levels (up to 8) of the Lagrangian statistics (thesis Sec. "
      "5.2.3.2, 6.1.3): fluid particles within dr/2 of each level (and of its mirror) and "
@@ -792,8 +813,8 @@ static void validate(struct parse_state *ps) {
                  "a convergence target (%g) needs stats.eulerian = 1: it is met on the Eulerian "
                  "profiles",
                  s->target_stderr);
-  if ((s->corr_y_plus.n || s->lagr_y_plus.n || s->quad_y_plus.n) && s->u_tau_ref == 0.0 &&
-      (s->drive_mode == DRIVE_FLUX || s->force <= 0.0))
+  if ((s->corr_y_plus.n || s->lagr_y_plus.n || s->quad_y_plus.n || s->pdf_y_plus.n) &&
+      s->u_tau_ref == 0.0 && (s->drive_mode == DRIVE_FLUX || s->force <= 0.0))
     inconsistent(ps, "stats.u_tau_ref",
                  "y+ levels need stats.u_tau_ref > 0 unless a positive drive.force gives it "
                  "(u_tau_ref = %g, force = %g)",

@@ -130,6 +130,12 @@ struct scene {
   struct scene_list quad_y_plus; /*!< y+ levels of the quadrant analysis (empty = off) */
   int corr_nx, corr_nz;          /*!< plane grid; 0 = lx/dr, lz/dr */
   double corr_thickness;         /*!< slab thickness around each level [dr] */
+  /* [pdfs] */
+  struct scene_list pdf_y_plus; /*!< y+ levels of the one-point PDFs (empty = off) */
+  int pdf_bins;                 /*!< PDF bins over +-pdf_range */
+  double pdf_range;             /*!< half-width of the PDFs [local rms] */
+  double pdf_fine;              /*!< fine bin width of the raw counts [u_tau_ref] */
+  double pdf_thickness;         /*!< slab thickness around each level [dr] */
   /* [lagrangian] */
   struct scene_list lagr_y_plus; /*!< release levels (empty = off) */
   double lagr_x0;                /*!< release plane x0 [m] */

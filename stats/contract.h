@@ -120,4 +120,10 @@ int stats_scene_list(const struct stats_scene *sc, const char *key, double *v, i
 int stats_scene_levels(const struct stats_scene *sc, const char *key, double *y_plus, double *y,
                        int max);
 
+/**
+ * @brief Length of an averaging window [s]: the key stats.window, or if that is 0 a tenth of
+ *        t_end - t_average_start (a tenth of t_end, or 1 s, if that is not positive).
+ */
+double stats_scene_window(const struct stats_scene *sc);
+
 #endif

@@ -8,10 +8,11 @@
 #include "corr.h"
 #include "euler.h"
 #include "lagr.h"
+#include "pdf.h"
 #include "quad.h"
 
 const struct stats_engine *const stats_engines[] = {&euler_engine, &corr_engine, &lagr_engine,
-                                                    &quad_engine};
+                                                    &quad_engine, &pdf_engine};
 const int stats_n_engines = sizeof stats_engines / sizeof stats_engines[0];
 
 _Static_assert(sizeof stats_engines / sizeof stats_engines[0] <= STATS_MAX_ENGINES,

@@ -14,6 +14,7 @@
 #include "euler.h"
 #include "moments.h"
 #include "ncutil.h"
+#include "pdf.h"
 
 /** How a profile scales: velocity, stress, pressure, length, or not at all. */
 enum unit_class { UC_NONE, UC_VEL, UC_STRESS, UC_PRESSURE, UC_LENGTH, UC_VISC };
@@ -161,28 +162,34 @@ static int parse_time(const char *text, const char *stop, double dflt, double *t
 static void usage(FILE *f) {
   fprintf(f,
           "usage: chansph extract STATS.nc [--var a,b,...] [--units wall|outer] "
-          "[--format csv|tsv] [--window T0:T1]\n"
+          "[--format csv|tsv] [--window T0:T1] [--pdfs]\n"
           "  variables: u_mean v_mean w_mean p_mean rho_mean uu vv ww uv uw vw u_rms v_rms "
           "w_rms\n"
           "  u_skewness ... w_flatness viscous_stress total_stress total_stress_expected "
           "n_samples y_mean nu_t_mean k_r_mean (LES)\n"
-          "  (standard errors are printed next to the variables that have them)\n");
+          "  (standard errors are printed next to the variables that have them)\n"
+          "  --pdfs: the one-point PDFs of group pdfs instead (rows y_plus, component, bin in "
+          "units of the rms, pdf, pdf_stderr; the moments in the header)\n");
 }
 
 /* The options of one extract command. */
 struct extract_args {
   const char *path, *vars, *units, *fmt;
   double t0, t1; /* --window */
+  int pdfs;      /* --pdfs */
 };
 
 /* Parse the command line (argv[0]: the command name); 1: input error, -1: --help printed. */
 static int extract_parse(int argc, char **argv, struct extract_args *a) {
-  static const struct option opts[] = {
-      {"help", no_argument, NULL, 'h'},         {"var", required_argument, NULL, 'v'},
-      {"units", required_argument, NULL, 'u'},  {"format", required_argument, NULL, 'f'},
-      {"window", required_argument, NULL, 'w'}, {NULL, 0, NULL, 0}};
-  *a = (struct extract_args){NULL,    "u_mean,u_rms,v_rms,w_rms,uv", "wall", "csv", -INFINITY,
-                             INFINITY};
+  static const struct option opts[] = {{"help", no_argument, NULL, 'h'},
+                                       {"var", required_argument, NULL, 'v'},
+                                       {"units", required_argument, NULL, 'u'},
+                                       {"format", required_argument, NULL, 'f'},
+                                       {"window", required_argument, NULL, 'w'},
+                                       {"pdfs", no_argument, NULL, 'p'},
+                                       {NULL, 0, NULL, 0}};
+  *a = (struct extract_args){
+      NULL, "u_mean,u_rms,v_rms,w_rms,uv", "wall", "csv", -INFINITY, INFINITY, 0};
   opterr = 0, optind = 1; /* "-": positional arguments in order (code 1); ':' missing value */
   for (;;) {
     const int at = optind, code = getopt_long(argc, argv, "-:h", opts, NULL);
@@ -191,7 +198,9 @@ static int extract_parse(int argc, char **argv, struct extract_args *a) {
       usage(stdout);
       return -1;
     }
-    if (code == 'v' || code == 'u' || code == 'f') {
+    if (code == 'p') {
+      a->pdfs = 1;
+    } else if (code == 'v' || code == 'u' || code == 'f') {
       *(code == 'v' ? &a->vars : code == 'u' ? &a->units : &a->fmt) = optarg;
     } else if (code == 'w') {
       const char *w = optarg, *colon = strchr(w, ':');
@@ -320,23 +329,89 @@ static void extract_rows(const struct extract_args *a, const struct stored *s,
   }
 }
 
+/* The rows r0 .. r1-1 of the windows (rows of len doubles, nominal start and end first) wholly
+   inside --window (with a relative tolerance for the nominal bounds); 1 if there is none. */
+static int window_range(const struct extract_args *a, const double *win, size_t len, size_t rows,
+                        double window, size_t *r0, size_t *r1) {
+  const double tol = 1e-9 * window;
+  *r0 = rows, *r1 = 0;
+  for (size_t r = 0; r < rows; r++) {
+    const double w0 = win[r * len], w1 = win[r * len + 1];
+    if (w0 >= a->t0 - tol && w1 <= a->t1 + tol) *r0 = r < *r0 ? r : *r0, *r1 = r + 1;
+  }
+  return *r1 <= *r0;
+}
+
+/* The PDF table of rows r0 .. r1-1: the moments as header lines, then one row per level,
+   component and bin. */
+static void extract_pdf_table(const struct extract_args *a, const struct pdf *p, size_t r0,
+                              size_t r1) {
+  struct pdf_result r;
+  pdf_finalise(p, r0, r1, &r);
+  const char sep = !strcmp(a->fmt, "csv") ? ',' : '\t';
+  static const char comp[PDF_COMP] = {'u', 'v', 'w'};
+  printf(
+      "# chansph extract --pdfs %s: windows %zu..%zu, t = %.9g .. %.9g s, %.0f snapshots, %d "
+      "batches; pdf of (u_i - <u_i>) / u_i,rms over +-%g rms\n",
+      a->path, r0, r1 - 1, r.t0, r.t1, r.snapshots, r.n_batches, p->cfg.range);
+  for (int l = 0; l < p->cfg.n_levels; l++)
+    for (int c = 0; c < PDF_COMP; c++) {
+      const double *m = r.mom + (l * PDF_COMP + c) * 4, *e = r.mom_err + (l * PDF_COMP + c) * 4;
+      printf(
+          "# y+ %g %c: %.0f samples, mean %.6g +- %.3g m/s, rms %.6g +- %.3g m/s, skewness "
+          "%.4g +- %.3g, flatness %.4g +- %.3g, outside %.3g, clipped %.3g\n",
+          p->cfg.y_plus[l], comp[c], r.n[l], m[0], e[0], m[1], e[1], m[2], e[2], m[3], e[3],
+          r.outside[l * PDF_COMP + c], r.clipped[l * PDF_COMP + c]);
+    }
+  printf("y_plus%ccomponent%cx%cpdf%cpdf_stderr\n", sep, sep, sep, sep);
+  for (int l = 0; l < p->cfg.n_levels; l++)
+    for (int c = 0; c < PDF_COMP; c++)
+      for (int j = 0; j < p->cfg.bins; j++) {
+        const size_t k = ((size_t)l * PDF_COMP + (size_t)c) * (size_t)p->cfg.bins + (size_t)j;
+        printf("%.9g%c%c%c%.9g%c%.9g%c%.9g\n", p->cfg.y_plus[l], sep, comp[c], sep,
+               r.bin_centres[j], sep, r.p[k], sep, r.p_err[k]);
+      }
+  pdf_result_free(&r);
+}
+
+/* chansph extract --pdfs: the group pdfs re-averaged over the windows of --window. */
+static int extract_pdfs(const struct extract_args *a) {
+  int ncid, rc = nc_open(a->path, NC_NOWRITE, &ncid);
+  char err[256];
+  struct pdf p;
+  if (rc != NC_NOERR) {
+    fprintf(stderr, "error: %s: %s\n", a->path, nc_strerror(rc));
+    return 1;
+  }
+  rc = pdf_nc_read(&p, ncid, err, sizeof err);
+  CHECK_NC(nc_close(ncid));
+  if (rc) {
+    fprintf(stderr, "error: %s: %s\n", a->path, err);
+    return 1;
+  }
+  size_t r0, r1;
+  const int none = window_range(a, p.win, PW_LEN, pdf_rows(&p), p.cfg.window, &r0, &r1);
+  if (none)
+    fprintf(stderr, "error: %s: no averaging window of group pdfs lies inside %g:%g\n", a->path,
+            a->t0, a->t1);
+  else
+    extract_pdf_table(a, &p, r0, r1);
+  pdf_free(&p);
+  return none;
+}
+
 int extract_main(int argc, char **argv) {
   struct extract_args a;
   const int prc = extract_parse(argc, argv, &a);
   if (prc) return prc < 0 ? 0 : 1;
+  if (a.pdfs) return extract_pdfs(&a);
   struct stored s;
   if (read_stored(a.path, &s)) {
     free_stored(&s);
     return 1;
   }
-  /* windows wholly inside [t0, t1] (with a relative tolerance for the nominal bounds) */
-  size_t r0 = s.rows, r1 = 0;
-  const double tol = 1e-9 * s.cfg.window;
-  for (size_t r = 0; r < s.rows; r++) {
-    const double w0 = s.win[r * WIN_LEN + WIN_T0], w1 = s.win[r * WIN_LEN + WIN_T1];
-    if (w0 >= a.t0 - tol && w1 <= a.t1 + tol) r0 = r < r0 ? r : r0, r1 = r + 1;
-  }
-  if (r1 <= r0) {
+  size_t r0, r1;
+  if (window_range(&a, s.win, WIN_LEN, s.rows, s.cfg.window, &r0, &r1)) {
     fprintf(stderr, "error: %s: no averaging window lies inside %g:%g\n", a.path, a.t0, a.t1);
     free_stored(&s);
     return 1;

@@ -8,7 +8,7 @@
 
 /**
  * @brief Run `chansph extract STATS.nc [--var a,b] [--units wall|outer] [--format csv|tsv]
- *        [--window T0:T1]` and print to stdout.
+ *        [--window T0:T1] [--pdfs]` and print to stdout (--pdfs: the one-point PDFs).
  * @param[in] argc,argv the command name ("extract", as getopt_long's program name) and
  *            its arguments
  * @return process exit code (0 success or --help, 1 input error)

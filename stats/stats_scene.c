@@ -25,3 +25,10 @@ int stats_scene_levels(const struct stats_scene *sc, const char *key, double *y_
   for (int l = 0; l < n; l++) y[l] = y_plus[l] * sc->nu / sc->u_tau;
   return n;
 }
+
+double stats_scene_window(const struct stats_scene *sc) {
+  const double key = stats_scene_num(sc, "stats.window");
+  if (key > 0.0) return key;
+  const double span = (sc->t_end - sc->t_average_start) / 10;
+  return span > 0.0 ? span : sc->t_end > 0 ? sc->t_end / 10 : 1.0;
+}

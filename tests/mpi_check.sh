@@ -77,7 +77,7 @@ open('$2', 'wb').write(b)" && rm x.bin
 }
 
 all_engines=(--set "correlations.y_plus=10,30" --set "lagrangian.y_plus=20" --set "quadrants.y_plus=10,30"
-  --set lagrangian.horizon=0.05 --set lagrangian.n_lags=10)
+  --set "pdfs.y_plus=10,30" --set lagrangian.horizon=0.05 --set lagrangian.n_lags=10)
 
 case $case in
   bitwise2d | bitwise3d)
@@ -87,7 +87,7 @@ case $case in
         --set init.modes=0.2 --set output.log_every=50 --set output.stats_every=5
         --set "correlations.y_plus=20,60" --set lagrangian.y_plus=40 --set lagrangian.horizon=0.2
         --set lagrangian.n_lags=10 --set stats.u_tau_ref=0.6 --set snapshots.every=0.5
-        --set "quadrants.y_plus=20,60")
+        --set "quadrants.y_plus=20,60" --set "pdfs.y_plus=20,60")
     else
       scene=$scenes/les395_smoke.ini
       args=(--set domain.lx=2.4 --set time.max_steps=200 --set output.stats_every=5 "${all_engines[@]}")

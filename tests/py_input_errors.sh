@@ -74,6 +74,10 @@ expect plot_profile_not_netcdf "text.nc: cannot open as netCDF" "$tool" plot_pro
 expect plot_profile_no_var "particles.nc: no variable 'y_mean'" "$tool" plot_profile "$part"
 expect plot_profile_no_window "stats.nc: u_mean has no value" "$tool" plot_profile "$nowin" \
   -o "$w/profile.png"
+expect pdf_compare_missing "missing.nc: cannot open: No such file" "$tool" pdf_compare "$missing"
+expect pdf_compare_not_netcdf "text.nc: cannot open as netCDF" "$tool" pdf_compare "$w/text.nc"
+expect pdf_compare_no_group "stats.nc: no group 'pdfs'" "$tool" pdf_compare "$nowin"
+expect pdf_compare_dns "text.txt: no MKM PDF files" "$tool" pdf_compare "$nowin" --dns "$w/text.txt"
 expect dns_c_table_missing "missing.nc: cannot open a Lee & Moser derived table: No such file" \
   "$tool" dns_c_table "$missing"
 expect dns_c_table_text "text.txt: a Lee & Moser derived table holds 0 data row" "$tool" \

@@ -9,6 +9,7 @@
 #include "corr.h"
 #include "euler.h"
 #include "lagr.h"
+#include "pdf.h"
 #include "quad.h"
 #include "stats.h"
 
@@ -19,6 +20,7 @@ struct test_stats_config {
   struct corr_config corr; /*!< two-point correlations (off if corr.n_levels == 0) */
   struct lagr_config lagr; /*!< Lagrangian statistics (off if lagr.n_levels == 0) */
   struct quad_config quad; /*!< quadrant analysis (off if quad.n_levels == 0) */
+  struct pdf_config pdf;   /*!< one-point PDFs (off if pdf.n_levels == 0) */
 };
 
 /** @brief Set up the engines c asks for. */
@@ -28,6 +30,7 @@ static inline void test_stats_init(struct stats *st, const struct test_stats_con
   if (c->corr.n_levels > 0) stats_add(st, &corr_engine, &c->corr);
   if (c->lagr.n_levels > 0) stats_add(st, &lagr_engine, &c->lagr);
   if (c->quad.n_levels > 0) stats_add(st, &quad_engine, &c->quad);
+  if (c->pdf.n_levels > 0) stats_add(st, &pdf_engine, &c->pdf);
 }
 
 /** @brief The Eulerian engine's state (NULL if off). */
@@ -43,6 +46,11 @@ static inline struct corr *test_co(const struct stats *st) {
 /** @brief The Lagrangian engine's state (NULL if off). */
 static inline struct lagr *test_la(const struct stats *st) {
   return stats_find(st, &lagr_engine);
+}
+
+/** @brief The PDF engine's state (NULL if off). */
+static inline struct pdf *test_pdf(const struct stats *st) {
+  return stats_find(st, &pdf_engine);
 }
 
 #endif

@@ -11,36 +11,13 @@
 #include <string.h>
 
 #include "euler.h"
+#include "expect.h"
 #include "lagr.h"
 #include "moments.h"
 #include "state.h"
 #include "stats.h"
 #include "stats_setup.h"
-
-static int failures = 0;
-
-#define EXPECT(cond, ...)           \
-  do {                              \
-    if (!(cond)) {                  \
-      printf("FAIL: " __VA_ARGS__); \
-      printf("\n");                 \
-      failures++;                   \
-    }                               \
-  } while (0)
-
-/* Counter-based generator (splitmix64 of a key): reproducible, no hidden state. */
-static uint64_t mix(uint64_t z) {
-  z += 0x9e3779b97f4a7c15ULL;
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  return z ^ (z >> 31);
-}
-static double uniform(uint64_t key) {
-  return ((double)(mix(key) >> 11) + 0.5) / 9007199254740992.0;
-}
-static double gauss(uint64_t key) { /* Box-Muller */
-  return sqrt(-2.0 * log(uniform(2 * key))) * cos(6.283185307179586 * uniform(2 * key + 1));
-}
+#include "synthetic.h"
 
 enum { NB = 8, NP = 4000, NSNAP = 400 };
 static const double A = 0.3, B = -0.2, C = 0.25, SW = 0.15; /* u' = A g1, v' = B g1 + C g2 */
@@ -293,6 +270,15 @@ static struct test_stats_config all_engines(void) {
                                 .n_stations = 1,
                                 .station = {0.1},
                                 .pdf_bins = 10};
+  c.pdf = (struct pdf_config){.n_levels = 2,
+                              .y = {0.3, 0.6},
+                              .half = 0.05,
+                              .delta = 1.0,
+                              .window = 1.0,
+                              .u_tau = 0.1,
+                              .fine = 0.05,
+                              .bins = 20,
+                              .range = 4.0};
   return c;
 }
 
@@ -329,6 +315,8 @@ static void test_round_trip(double *buf) {
   EXPECT(same, "state after a round trip differs from the uninterrupted run");
   const struct lagr *la = test_la(&a);
   EXPECT(la->releases > 2 && la->ntracks > 0, "Lagrangian engine idle in the round trip");
+  const struct pdf *pd = test_pdf(&a);
+  EXPECT(pd->nwin >= 2 && pd->pow[0] > 0, "PDF engine idle in the round trip");
   printf(
       "state round trip after 61 of 137 snapshots (%d fields, Eulerian, correlations, "
       "Lagrangian with %g releases done and %zu tracks active): %s\n",

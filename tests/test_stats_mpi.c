@@ -24,6 +24,7 @@
 #include "stats.h"
 #include "stats_nc.h"
 #include "stats_setup.h"
+#include "synthetic.h"
 
 static int failures = 0;
 
@@ -38,20 +39,6 @@ static int failures = 0;
   } while (0)
 
 static int rank_g = 0, size_g = 1;
-
-/* Counter-based generator (splitmix64 of a key): reproducible, no hidden state. */
-static uint64_t mix(uint64_t z) {
-  z += 0x9e3779b97f4a7c15ULL;
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  return z ^ (z >> 31);
-}
-static double uniform(uint64_t key) {
-  return ((double)(mix(key) >> 11) + 0.5) / 9007199254740992.0;
-}
-static double gauss(uint64_t key) { /* Box-Muller */
-  return sqrt(-2.0 * log(uniform(2 * key))) * cos(6.283185307179586 * uniform(2 * key + 1));
-}
 
 /* The global particle set of one snapshot (ids 0 .. nf - 1 fluid, then nw wall vertices). */
 struct world {
@@ -263,6 +250,17 @@ static struct test_stats_config config_a(void) { /* bins, not folded, LES; corr 
                                 .station = {0.15, 0.4},
                                 .pdf_bins = 10,
                                 .t_start = 0.1};
+  c.pdf = (struct pdf_config){.n_levels = 2,
+                              .y = {0.3, 0.7},
+                              .y_plus = {30, 70},
+                              .half = 0.06,
+                              .delta = 1.0,
+                              .t_start = 0.1,
+                              .window = 0.5,
+                              .u_tau = 0.05,
+                              .fine = 0.05,
+                              .bins = 24,
+                              .range = 4.0};
   return c;
 }
 
@@ -435,6 +433,8 @@ static void run_check(const char *name, const struct test_stats_config *cfg, siz
     for (int k = 0; k < cfg->lagr.n_levels * cfg->lagr.n_stations; k++)
       pdf_n += la->pdf[(size_t)k * (size_t)(cfg->lagr.pdf_bins + 3) + cfg->lagr.pdf_bins];
     EXPECT(eu->nwin >= 2, "%s: %zu windows", name, eu->nwin);
+    const struct pdf *pd = test_pdf(&par);
+    EXPECT(pd->nwin >= 2 && pd->pow[0] > 0, "%s: PDF engine idle (%zu windows)", name, pd->nwin);
     EXPECT(co->samples[0] > 0, "%s: no correlation planes", name);
     EXPECT(la->releases >= 2 && la->ntracks > 0 && pdf_n > 0,
            "%s: Lagrangian idle (%g releases, %zu tracks, %g crossings)", name, la->releases,

@@ -18,7 +18,7 @@ for scene in $scenes_list; do
     OMP_NUM_THREADS=$t "$chansph" run "$scenes/$scene.ini" --out "$runs/threads${tag}_${scene}_$t" \
       --overwrite --set time.t_end=1.0 --set output.t_average_start=0.5 --set stats.window=0.1 \
       --set stats.u_tau_ref=0.6 --set correlations.y_plus=1,2 --set lagrangian.y_plus=1,2 \
-      --set quadrants.y_plus=1,2 \
+      --set quadrants.y_plus=1,2 --set pdfs.y_plus=1,2 \
       --set lagrangian.horizon=0.2 --set lagrangian.release_every=0.1 \
       --set lagrangian.n_lags=10 --set lagrangian.pdf_x=0.01 "$@" > /dev/null
   done

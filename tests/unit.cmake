@@ -42,6 +42,12 @@ target_include_directories(test_stats PRIVATE ${PROJECT_SOURCE_DIR}/stats)
 add_test(NAME unit_stats COMMAND test_stats)
 set_tests_properties(unit_stats PROPERTIES LABELS unit)
 
+#   test_pdf:  one-point PDF engine: known distributions, standard errors, stats.nc read back
+add_executable(test_pdf test_pdf.c)
+target_link_libraries(test_pdf PRIVATE chansph_core)
+add_test(NAME unit_stats_pdf COMMAND test_pdf)
+set_tests_properties(unit_stats_pdf PROPERTIES LABELS unit)
+
 add_executable(test_walllaw test_walllaw.c)
 target_link_libraries(test_walllaw PRIVATE chansph_core m)
 add_test(NAME unit_walllaw COMMAND test_walllaw)

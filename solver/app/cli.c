@@ -76,7 +76,8 @@ void cli_usage(void) {
   printf(
       "  chansph scene-doc            print the scene key reference (docs/scenes.md)\n"
       "  chansph extract STATS.nc [--var a,b] [--units wall|outer] [--format csv|tsv]\n"
-      "                  [--window T0:T1]   print profiles (docs/stats-format.md)\n"
+      "                  [--window T0:T1] [--pdfs]   print profiles, or the one-point PDFs\n"
+      "                  (docs/stats-format.md)\n"
       "  chansph compare STATS.nc --dns FILE [--out DIR]   errors against DNS, PNG plots\n"
       "  chansph --version | --help   (also: chansph COMMAND --help)\n"
       "%s",

@@ -19,6 +19,7 @@ TOOLS = {
     "plot_profile": ("plot_profile", "u_mean of a laminar run against the analytical profile"),
     "dns_c_table": ("dns_c_table", "write solver/dns_lm180.h from the Lee & Moser table"),
     "ckpt": ("ckpt_info", "summarise checkpoints (format, step, time, particles)"),
+    "pdf_compare": ("pdf_compare", "one-point PDFs of u', v', w' against MKM Re_tau = 180"),
 }
 
 
