@@ -253,7 +253,8 @@ static void exchange(struct dd *d, int nf, void (*pack_fn)(const void *, size_t,
 
 /* A ghost on the wire: its PF_GHOST fields (positions, velocities, mass for the neighbour
    search and kernel sums, id and kind). Density, pressure and the model terms follow in the
-   refreshes (dd_refresh); nothing reads a ghost's gamma, kernel sum or acceleration. */
+   refreshes (dd_refresh); nothing reads a ghost's kernel sum or acceleration, and its gamma
+   only the budget's conservative split (PR_BUDGET). */
 static void pack_ghost(const void *arg, size_t a, double *r) {
   pack(arg, a, r, PF_GHOST);
 }

@@ -140,11 +140,14 @@ static void force_finish(const struct fctx *C, size_t a, const struct fsums *s,
   viscous_wall(M, P, C->W, a, &vn, &wm, &acc, &awall);
   acc.y += M->gy;
   P->ax[a] = acc.x, P->ay[a] = acc.y, P->az[a] = acc.z;
-  if (C->sx) { /* the budget parts; the rest of ax is the walls' */
+  if (C->sx) { /* the budget parts, as this particle's sums give them (sph_budget_pairs then
+                   splits off their conservative part); the rest of ax is the walls' */
     double *sx = C->sx + a * SX_LEN;
     sx[SX_PRESSURE] = pressure_budget_x(M, P, a, &s->p, &L);
-    viscous_budget_x(M, P, &C->arrays, C->nb, a, &s->v, vn.vis * vn.kx, sx);
-    sx[SX_WALL] = acc.x - sx[SX_PRESSURE] - sx[SX_VISCOUS] - sx[SX_MODEL];
+    sx[SX_VISCOUS] = viscous_budget_x(&vn, &s->v);
+    sx[SX_MODEL] = 0.0;
+    sx[SX_WALL] = acc.x - sx[SX_PRESSURE] - sx[SX_VISCOUS];
+    P->vfx[a] = vn.vis * vn.kx, P->vfy[a] = vn.vis * vn.kappa, P->vfz[a] = vn.vis * vn.kz;
   }
   if (C->wall_ax) C->wall_ax[a] = awall;
   P->ddiff[a] = diffusion_finish(M, s->diff);

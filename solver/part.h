@@ -53,6 +53,10 @@ struct particles {
      NULL without Eulerian statistics; permuted and migrated with the particles while sx_live. */
   double *sx;
   int sx_live; /*!< 1: sx holds the values of the last force pass (a sampled step) */
+  /** The viscous prefactor of each component (vis k_x, vis kappa, vis k_z of term_viscous.h) of
+      the last sampled force pass, which the conservative split of the budget reads at the
+      neighbours (sph_budget_pairs); NULL without Eulerian statistics; not permuted */
+  double *vfx, *vfy, *vfz;
   /* turbulence model (turb.h), allocated only when used, NULL otherwise; recomputed from the
      state after every step and not permuted, unless nur_live */
   double *nur; /*!< eddy viscosity nu_r [m^2/s] */
@@ -139,7 +143,9 @@ enum part_refresh {
   PR_WALLS = 2,    /*!< after sph_walls: the vertex and wall values the forces read */
   PR_WALL_LAW = 4, /*!< after turb_wall_law: the wall stresses at the vertices */
   PR_MODEL = 8,    /*!< after turb_eddy_viscosity: nu_r and k_r */
-  PR_KR = 16       /*!< after sph_kr_pressure: p/rho^2 and the wall pressure with 2/3 rho k_r */
+  PR_KR = 16,      /*!< after sph_kr_pressure: p/rho^2 and the wall pressure with 2/3 rho k_r */
+  PR_BUDGET = 32   /*!< after a sampled force pass: gamma and the viscous prefactors that the
+                        conservative split of the budget reads (sph_budget_pairs) */
 };
 
 /** One per-particle array of struct particles. Adding a field: the member in struct particles

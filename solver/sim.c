@@ -275,6 +275,10 @@ void sim_step(struct sim *S) {
                           .sx = P->sx_live ? P->sx : NULL};
   const double ub = S->drive.mode == DRIVE_FLUX ? bulk_velocity(S) : 0.0;
   sph_forces(&S->M, P, &S->nb, &S->W, S->fx, &fi);
+  if (P->sx_live) { /* the budget's conservative split, with the neighbours' factors */
+    dd_refresh(&S->dd, P, &S->W, PR_BUDGET);
+    sph_budget_pairs(&S->M, P, &S->nb, S->wall_ax);
+  }
   if (S->M.strain_lag) turb_advance(P); /* nu_r, k_r of the next step (les.strain_lag) */
   if (wall_sample) wall_force(S);
   double maxima[2] = {fi.amax, fi.gvmax};

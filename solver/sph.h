@@ -158,6 +158,15 @@ double sph_vertex_sums(const struct model *M, const struct particles *P, const s
 void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb,
                 const struct walls *W, double fx, struct force_info *info);
 
+/**
+ * @brief The conservative split of the budget parts (budget_pairs.c): after a sampled force pass
+ *        (P->sx_live) and the refresh PR_BUDGET, replaces the pair parts of P->sx by the
+ *        antisymmetric parts of the fluid pair forces, (f_ab - f_ba)/2, and adds the rest to
+ *        the walls' part and to wall_ax (if not NULL); the accelerations are not changed.
+ */
+void sph_budget_pairs(const struct model *M, struct particles *P, const struct nbr *nb,
+                      double *wall_ax);
+
 /** A wall seen from a fluid particle within the kernel support of it (sph_wall_near). */
 struct wall_near {
   double d;  /*!< distance to the wall [m] */

@@ -14,7 +14,7 @@
  * with the weight of sph.wall_shear_weight, or the wall law of wall.law).
  * Hooks: viscous_morris_pair / viscous_violeau_pair and the moments (summed by the force loop
  * into struct viscous_sums), viscous_norm and viscous_finish (the acceleration),
- * viscous_wall (the wall shear), viscous_budget_x (budget parts SX_VISCOUS and SX_MODEL),
+ * viscous_wall (the wall shear), viscous_budget_x (the budget's viscous part),
  * viscous_dt_limit (Eq. 2.161).
  */
 #ifndef CHANSPH_TERM_VISCOUS_H
@@ -163,25 +163,12 @@ static inline void viscous_wall(const struct model *M, const struct particles *P
   }
 }
 
-/** The molecular part of the LES operator's x-sum of particle a over its fluid neighbours
-    (mu_ab = rho_ab nu): the LES budget, on sampled steps only (forces.c). */
-double viscous_molecular_x(const struct model *M, const struct pair_view *arrays,
-                           const struct nbr *nb, size_t a);
-
-/**
- * @brief Budget parts SX_VISCOUS and SX_MODEL: the x-acceleration of particle a by the viscous
- *        pair forces of its fluid neighbours (fluid part s of the sums), molecular and
- *        eddy-viscous; with LES the sum holds rho (nu + nu_r), and its part with rho nu comes
- *        from one more pass over the fluid neighbours (viscous_molecular_x).
- * @param visk the prefactor times the x normalisation (viscous_norm: vis kx)
- * @param[out] sx the parts, indexed by enum part_sx
- */
-static inline void viscous_budget_x(const struct model *M, const struct particles *P,
-                                    const struct pair_view *arrays, const struct nbr *nb, size_t a,
-                                    const struct viscous_sums *s, double visk, double *sx) {
-  (void)P;
-  sx[SX_VISCOUS] = visk * (M->les ? viscous_molecular_x(M, arrays, nb, a) : s->vis.x);
-  sx[SX_MODEL] = M->les ? visk * s->vis.x - sx[SX_VISCOUS] : 0.0;
+/** The x-acceleration of particle a by the viscous pair forces of its fluid neighbours (fluid
+    part s of the sums), molecular and eddy-viscous together, as its own sums give it: the
+    budget (sph_budget_pairs splits it into its conservative molecular and eddy-viscous parts
+    and the walls' share). */
+static inline double viscous_budget_x(const struct viscous_norm *n, const struct viscous_sums *s) {
+  return n->vis * n->kx * s->vis.x;
 }
 
 /** The viscous time-step limit c_visc h^2 / max(nu + nu_r) (thesis Eq. 2.161) [s]. */

@@ -554,9 +554,12 @@ void euler_sample(struct euler *e, const struct stats_snapshot *s) {
                   e->kin + e->nwin * nb * KN_LEN);
   win[WIN_NSNAP] += 1.0;
   win[WIN_SUM_FX] += s->fx;
-  /* wall shear stress over density: minus the wall force on the fluid per unit area */
-  win[WIN_SUM_TW0] += -s->wall_fx[0] / (c->rho0 * c->area);
-  win[WIN_SUM_TW1] += -s->wall_fx[1] / (c->rho0 * c->area);
+  /* wall shear stress over density: minus the wall force on the fluid per unit area (the wall
+     terms and the non-conservative rest of the pair forces, sph_budget_pairs), plus the body
+     force on the layer of fluid the wall vertices stand for, which stays at rest and so passes
+     its body force to the wall (docs/theory.md, "Momentum at the walls") */
+  win[WIN_SUM_TW0] += -s->wall_fx[0] / (c->rho0 * c->area) + s->fx * c->wall_layer;
+  win[WIN_SUM_TW1] += -s->wall_fx[1] / (c->rho0 * c->area) + s->fx * c->wall_layer;
 }
 
 /* Derivative of f at point i from its neighbours (3-point Lagrange on uneven points). */

@@ -64,6 +64,8 @@ struct euler_config {
   double nu;      /*!< kinematic viscosity [m^2/s] */
   double rho0;    /*!< reference density [kg/m^3] */
   double area;    /*!< area of one wall (lx lz in 3-D, lx in 2-D) [m^2 or m] */
+  double wall_layer; /*!< thickness of the fluid layer the wall vertices stand for: their mass
+                          per wall over rho0 and the wall area, dr/2 (part_create) [m] */
   double t_start; /*!< start of the averaging [s] */
   double window;  /*!< length of an averaging window [s] */
   int les;        /*!< 1: eddy viscosity and residual kinetic energy profiles too */

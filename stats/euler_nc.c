@@ -257,6 +257,7 @@ static void config_of(const struct stats_scene *sc, struct euler_config *e) {
   const double window = stats_scene_num(sc, "stats.window");
   e->fold = fold, e->delta = sc->delta, e->nu = sc->nu, e->rho0 = sc->rho0;
   e->area = sc->dim == 3 ? sc->lx * sc->lz : sc->lx;
+  e->wall_layer = 0.5 * sc->dr;
   e->t_start = sc->t_average_start;
   e->les = sc->les;
   e->method = (int)stats_scene_num(sc, "stats.method"), e->h = sc->h, e->dim = sc->dim;

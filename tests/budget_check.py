@@ -11,7 +11,9 @@ Asserts, in wall units of the force balance (u_tau_force^2):
   - with --laminar: the pressure pair stress and the Reynolds stress are below 0.005, and where
     no wall term acts (farther than 2h from the walls; not the end bins, where nu dU/dy is
     one-sided) the viscous pair stress equals the continuum nu dU/dy (viscous_stress) within
-    0.01.
+    0.01; the pair forces conserve momentum (|pair_momentum_source| <= 0.005) and the wall
+    stress (u_tau_wall^2: wall terms, the pairs' non-conservative rest and the wall layer's
+    body force; docs/theory.md "Momentum at the walls") is the driving force within 0.01.
 With --window the profiles are those of the windows in T0:T1 (`chansph extract --window`,
 e.g. the part of a resumed run written by a build with the present budget).
 Prints the split of the stress in every bin. Exit 1 on a failed check.
@@ -43,6 +45,11 @@ def main():
     ap.add_argument("--chansph", default="build/chansph")
     a = ap.parse_args()
     y, v = read_budget(a)
+    with open_nc(a.stats) as d:  # the wall layer: within 2h of a wall, in the units of y
+        scale = float(d.delta) if a.window else 1.0
+        a.tau_wall = float(d.u_tau_wall) ** 2 / float(d.u_tau_force) ** 2
+        a.layer = 2.0 * float(d.h) / scale
+        a.width = 2.0 * float(d.delta) / scale
     return check(a, y, v)
 
 
@@ -119,12 +126,20 @@ def check(a, y, v):
             if not m <= 0.005:
                 print(f"FAIL: laminar flow with |{n}| up to {m:.3g} u_tau^2")
                 fail = 1
-        inner = np.abs(v["wall_term_stress"]) < 1e-12
+        inner = (y > a.layer) & (y < a.width - a.layer)
         inner[0] = inner[-1] = False  # nu dU/dy is one-sided there
         dv = np.nanmax(np.abs(v["viscous_pair_stress"] - v["viscous_stress"])[inner])
         print(f"viscous pair stress vs nu dU/dy away from the walls: max difference {dv:.3g}")
         if not dv <= 0.01:
             print("FAIL: the viscous pair stress is not nu dU/dy")
+            fail = 1
+        src = np.nanmax(np.abs(v["pair_momentum_source"]))
+        print(f"pair momentum source: max {src:.3g}; wall stress / driving force {a.tau_wall:.5f}")
+        if not src <= 0.005:
+            print("FAIL: the pair forces do not conserve momentum")
+            fail = 1
+        if not abs(a.tau_wall - 1.0) <= 0.01:
+            print("FAIL: the wall stress is not the driving force")
             fail = 1
     return fail
 

@@ -1,0 +1,116 @@
+/**
+ * @file budget_pairs.c
+ * @brief sph_budget_pairs (sph.h): the conservative split of the fluid pair forces for the
+ *        momentum budget (docs/theory.md, "Momentum at the walls").
+ *
+ * The force on particle a from fluid neighbour b, f_ab = m_a c_a T(a, b), carries per-particle
+ * factors c_a (1/gamma_a of the pressure gradient; the viscous normalisation kappa_a/gamma_a),
+ * so f_ab + f_ba != 0 where they differ: within 2h of a wall, where gamma falls to 1/2. Each
+ * pair force is split into its antisymmetric part (f_ab - f_ba)/2, which conserves momentum
+ * pair by pair, and the rest (f_ab + f_ba)/2, which is nonzero only where the factors differ.
+ * The budget keeps the first as the pair force of its term and gives the rest to the walls:
+ * summed over the fluid it is the share of the wall stress that the renormalised operators
+ * deliver through the pairs of the wall layer (it does not vanish as dr -> 0; docs/theory.md).
+ * The accelerations themselves are untouched: this runs on sampled steps only, after the force
+ * pass, with the neighbours' factors refreshed (PR_BUDGET).
+ *
+ * Determinism: each particle's sums run over its own neighbour list in list order.
+ */
+#include <math.h>
+
+#include "pair_loop.h"
+#include "sph.h"
+#include "term_pressure.h"
+#include "term_viscous.h"
+#include "timers.h"
+
+/** The conservative parts of particle a's fluid pair forces per unit mass of a. */
+struct cons_parts {
+  struct v3 p;  /*!< pressure (symmetric form) */
+  struct v3 mu; /*!< molecular viscous */
+  struct v3 m;  /*!< eddy-viscous (LES) */
+};
+
+/** m_a c_a T(a, b) - m_b c_b T(b, a) of a viscous term by component, the pair terms given. */
+static inline struct v3 antisym(double ma, struct v3 ca, struct v3 tab, double mb, struct v3 cb,
+                                struct v3 tba) {
+  return (struct v3){ma * ca.x * tab.x - mb * cb.x * tba.x, ma * ca.y * tab.y - mb * cb.y * tba.y,
+                     ma * ca.z * tab.z - mb * cb.z * tba.z};
+}
+
+/** The pair (b, a) seen from b: r_ba = -r_ab. */
+static inline struct pair pair_reversed(const struct pair *g) {
+  return (struct pair){-g->dx, -g->dy, -g->dz, g->r2, g->r, g->f};
+}
+
+/* The conservative parts of fluid particle a (CHANSPH_CLONES: one loop per instruction set). */
+static CHANSPH_CLONES struct cons_parts cons_parts_of(const struct model *M,
+                                                      const struct particles *P,
+                                                      const struct nbr *nb, size_t a) {
+  const struct pair_frame F = pair_frame_of(M);
+  const int32_t *restrict nl = pair_list(nb, a);
+  const double *restrict x = P->x, *restrict y = P->y, *restrict z = P->z;
+  const double *restrict u = P->u, *restrict v = P->v, *restrict w = P->w;
+  const double *restrict m = P->m, *restrict rho = P->rho, *restrict vol = P->vol;
+  const double *restrict pr2 = P->pr2, *restrict gam = P->gam;
+  const double *restrict vfx = P->vfx, *restrict vfy = P->vfy, *restrict vfz = P->vfz;
+  const double *restrict nur = P->nur ? P->nur : P->rho; /* read only with LES */
+  const int violeau = M->viscous == VISCOUS_VIOLEAU, les = M->les;
+  const double xa = x[a], ya = y[a], za = z[a], ua = u[a], va = v[a], wa = w[a];
+  const double ma = m[a], ra = rho[a], pa = pr2[a], iga = 1.0 / gam[a], vola = vol[a];
+  const double nu = M->nu, np2 = M->dim + 2.0, eta2 = M->eta2;
+  const double nua = les ? nu + nur[a] : nu;
+  const struct v3 ca = {vfx[a], vfy[a], vfz[a]};
+  double px = 0, py = 0, pz = 0, vx = 0, vy = 0, vz = 0, tx = 0, ty = 0, tz = 0;
+  const int nf = nb->nfluid[a];
+#pragma omp simd reduction(+ : px, py, pz, vx, vy, vz, tx, ty, tz)
+  for (int j = 0; j < nf; j++) {
+    const int32_t b = nl[j];
+    const struct pair g = pair_at(&F, xa - x[b], ya - y[b], za - z[b]), gr = pair_reversed(&g);
+    const struct v3 pp = pressure_pair(&g, m[b], pa, pr2[b]); /* times -(1/gamma_a + 1/gamma_b) */
+    const double ig = iga + 1.0 / gam[b];
+    px += ig * pp.x, py += ig * pp.y, pz += ig * pp.z;
+    const struct v3 uab = {ua - u[b], va - v[b], wa - w[b]}, uba = {-uab.x, -uab.y, -uab.z};
+    const struct v3 cb = {vfx[b], vfy[b], vfz[b]};
+    struct v3 mol, tot = {0, 0, 0};
+    if (!violeau && !les) { /* Morris */
+      mol = antisym(ma, ca, viscous_morris_pair(&g, m[b], 1.0 / ra, vol[b], eta2, uab), m[b], cb,
+                    viscous_morris_pair(&gr, ma, 1.0 / rho[b], vola, eta2, uba));
+    } else { /* Violeau; LES: with mu = rho (nu + nu_r), prefactor 1/(gamma rho) */
+      const double mu0 = 0.5 * (ra + rho[b]) * (les ? nu : 1.0);
+      mol = antisym(ma, ca, viscous_violeau_pair(&g, vol[b], mu0, np2, eta2, uab), m[b], cb,
+                    viscous_violeau_pair(&gr, vola, mu0, np2, eta2, uba));
+      if (les) {
+        const double mu = 0.5 * (ra * nua + rho[b] * (nu + nur[b]));
+        tot = antisym(ma, ca, viscous_violeau_pair(&g, vol[b], mu, np2, eta2, uab), m[b], cb,
+                      viscous_violeau_pair(&gr, vola, mu, np2, eta2, uba));
+      }
+    }
+    vx += mol.x, vy += mol.y, vz += mol.z;
+    tx += tot.x - (les ? mol.x : 0.0), ty += tot.y - (les ? mol.y : 0.0);
+    tz += tot.z - (les ? mol.z : 0.0);
+  }
+  const double h = 0.5 / ma;
+  return (struct cons_parts){{-0.5 * px, -0.5 * py, -0.5 * pz},
+                             {h * vx, h * vy, h * vz},
+                             {h * tx, h * ty, h * tz}};
+}
+
+void sph_budget_pairs(const struct model *M, struct particles *P, const struct nbr *nb,
+                      double *wall_ax) {
+  timer_push("budget");
+  const int corrected = M->pgrad == PGRAD_CORRECTED;
+#pragma omp parallel for schedule(dynamic, 256)
+  for (size_t a = 0; a < P->n; a++) {
+    if (P->kind[a] != KIND_FLUID) continue;
+    const struct cons_parts c = cons_parts_of(M, P, nb, a);
+    double *sx = P->sx + a * SX_LEN;
+    /* the corrected gradient is not antisymmetric anywhere (its L_a, Eq. 2.88): kept whole */
+    const double cp = corrected ? sx[SX_PRESSURE] : c.p.x;
+    const double rest = sx[SX_PRESSURE] + sx[SX_VISCOUS] + sx[SX_MODEL] - cp - c.mu.x - c.m.x;
+    sx[SX_PRESSURE] = cp, sx[SX_VISCOUS] = c.mu.x, sx[SX_MODEL] = c.m.x;
+    sx[SX_WALL] += rest;
+    if (wall_ax) wall_ax[a] += rest;
+  }
+  timer_pop();
+}
