@@ -266,7 +266,8 @@ static const struct key keys[] = {
      "Key of the random noise and of the synthetic eddies.", OFF(init_seed)},
     {"init", "eddies", T_LONG, "0", 0, 1e8, 0, NULL, "-",
      "Number N of synthetic eddies of profile = synthetic, placed in the box lx x (2 delta + "
-     "2 sigma) x lz (sigma = eddy_size delta); 0 = the box volume / sigma^3.",
+     "2 sigma) x lz (sigma = eddy_size delta); 0 = the box volume / sigma^3; at most 100 "
+     "times that plus 1000 (more gives the same Gaussian field at a growing cost).",
      OFF(init_eddies)},
     {"init", "eddy_size", T_DOUBLE, "0.2", 0, BIG, LO_OPEN, NULL, "delta",
      "Half-width sigma of the synthetic eddies (tent shape functions), in units of delta; at "
@@ -830,6 +831,16 @@ static void validate(struct parse_state *ps) {
                    sig, fmin(s->lx, s->lz));
     if (!(s->nu > 0.0))
       inconsistent(ps, "fluid.nu", "profile = synthetic needs nu > 0 (got %g)", s->nu);
+    /* the field is normalised by sqrt(box / sigma^3 / N): beyond a few times the default N it
+       is the same Gaussian field, while the work grows as N times the particles (1e8 eddies
+       in qdns180_smoke.ini ran for over 10 minutes at 5.5 GB before this limit) */
+    const double box = s->lx * (2.0 * s->delta + 2.0 * sig) * s->lz / (sig * sig * sig);
+    if (s->dim == 3 && sig > 0.0 && (double)s->init_eddies > 100.0 * box + 1000.0)
+      inconsistent(ps, "init.eddies",
+                   "%g synthetic eddies is more than 100 times the box volume / sigma^3 "
+                   "(%.4g) plus 1000: no different a field, at a cost that grows with the "
+                   "eddies (0 = the box volume / sigma^3)",
+                   (double)s->init_eddies, box);
   }
   if (s->dt_fixed > 0.0 && s->dt_fixed > s->t_end)
     inconsistent(ps, "time.dt", "fixed dt = %g is larger than t_end = %g", s->dt_fixed, s->t_end);
