@@ -91,9 +91,8 @@ static CHANSPH_CLONES struct cons_parts cons_parts_of(const struct model *M,
     tz += tot.z - (les ? mol.z : 0.0);
   }
   const double h = 0.5 / ma;
-  return (struct cons_parts){{-0.5 * px, -0.5 * py, -0.5 * pz},
-                             {h * vx, h * vy, h * vz},
-                             {h * tx, h * ty, h * tz}};
+  return (struct cons_parts){
+      {-0.5 * px, -0.5 * py, -0.5 * pz}, {h * vx, h * vy, h * vz}, {h * tx, h * ty, h * tz}};
 }
 
 void sph_budget_pairs(const struct model *M, struct particles *P, const struct nbr *nb,
@@ -104,13 +103,17 @@ void sph_budget_pairs(const struct model *M, struct particles *P, const struct n
   for (size_t a = 0; a < P->n; a++) {
     if (P->kind[a] != KIND_FLUID) continue;
     const struct cons_parts c = cons_parts_of(M, P, nb, a);
-    double *sx = P->sx + a * SX_LEN;
-    /* the corrected gradient is not antisymmetric anywhere (its L_a, Eq. 2.88): kept whole */
-    const double cp = corrected ? sx[SX_PRESSURE] : c.p.x;
-    const double rest = sx[SX_PRESSURE] + sx[SX_VISCOUS] + sx[SX_MODEL] - cp - c.mu.x - c.m.x;
-    sx[SX_PRESSURE] = cp, sx[SX_VISCOUS] = c.mu.x, sx[SX_MODEL] = c.m.x;
-    sx[SX_WALL] += rest;
-    if (wall_ax) wall_ax[a] += rest;
+    const double p[3] = {c.p.x, c.p.y, c.p.z}, mu[3] = {c.mu.x, c.mu.y, c.mu.z};
+    const double mo[3] = {c.m.x, c.m.y, c.m.z};
+    for (int k = 0; k < 3; k++) { /* components x, y, z */
+      double *sx = P->sx + a * SX_STRIDE + k * SX_LEN;
+      /* the corrected gradient is not antisymmetric anywhere (its L_a, Eq. 2.88): kept whole */
+      const double cp = corrected ? sx[SX_PRESSURE] : p[k];
+      const double rest = sx[SX_PRESSURE] + sx[SX_VISCOUS] + sx[SX_MODEL] - cp - mu[k] - mo[k];
+      sx[SX_PRESSURE] = cp, sx[SX_VISCOUS] = mu[k], sx[SX_MODEL] = mo[k];
+      sx[SX_WALL] += rest;
+      if (wall_ax && k == 0) wall_ax[a] += rest;
+    }
   }
   timer_pop();
 }

@@ -142,11 +142,14 @@ static void force_finish(const struct fctx *C, size_t a, const struct fsums *s,
   P->ax[a] = acc.x, P->ay[a] = acc.y, P->az[a] = acc.z;
   if (C->sx) { /* the budget parts, as this particle's sums give them (sph_budget_pairs then
                    splits off their conservative part); the rest of ax is the walls' */
-    double *sx = C->sx + a * SX_LEN;
-    sx[SX_PRESSURE] = pressure_budget_x(M, P, a, &s->p, &L);
-    sx[SX_VISCOUS] = viscous_budget_x(&vn, &s->v);
-    sx[SX_MODEL] = 0.0;
-    sx[SX_WALL] = acc.x - sx[SX_PRESSURE] - sx[SX_VISCOUS];
+    const struct v3 pb = pressure_budget(M, P, a, &s->p, &L), vb = viscous_budget(&vn, &s->v);
+    const double pc[3] = {pb.x, pb.y, pb.z}, vc[3] = {vb.x, vb.y, vb.z};
+    const double ac[3] = {acc.x, acc.y - M->gy, acc.z}; /* without the body forces */
+    for (int c = 0; c < 3; c++) {
+      double *sx = C->sx + a * SX_STRIDE + c * SX_LEN;
+      sx[SX_PRESSURE] = pc[c], sx[SX_VISCOUS] = vc[c], sx[SX_MODEL] = 0.0;
+      sx[SX_WALL] = ac[c] - pc[c] - vc[c];
+    }
     P->vfx[a] = vn.vis * vn.kx, P->vfy[a] = vn.vis * vn.kappa, P->vfz[a] = vn.vis * vn.kz;
   }
   if (C->wall_ax) C->wall_ax[a] = awall;

@@ -48,8 +48,9 @@ struct particles {
   double *rec;          /*!< pair records, REC_LEN doubles a slot (records.h) */
   double *ax, *ay, *az; /*!< acceleration without the driving force at the start of the last
                              step [m/s^2]; permuted (and migrated) with the particles */
-  /** x-acceleration of the last sampled force pass split by what exerts it, SX_LEN per
-      particle (enum part_sx) [m/s^2]: the momentum budget of the statistics (stats/contract.h).
+  /** Acceleration of the last sampled force pass split by what exerts it, SX_STRIDE per
+      particle: the SX_LEN parts of x, then of y, then of z (enum part_sx) [m/s^2]: the budgets
+      of the statistics (stats/contract.h).
      NULL without Eulerian statistics; permuted and migrated with the particles while sx_live. */
   double *sx;
   int sx_live; /*!< 1: sx holds the values of the last force pass (a sampled step) */
@@ -89,7 +90,8 @@ enum part_sx {
   SX_VISCOUS = STATS_PART_VISCOUS,   /*!< molecular viscous pair force */
   SX_MODEL = STATS_PART_MODEL,       /*!< eddy-viscous pair force */
   SX_WALL = STATS_PART_WALL,         /*!< everything the walls exert */
-  SX_LEN = STATS_PARTS               /*!< parts per particle */
+  SX_LEN = STATS_PARTS,              /*!< parts per component */
+  SX_STRIDE = STATS_ACC              /*!< values per particle: x parts, y parts, z parts */
 };
 _Static_assert((int)SX_LEN == (int)STATS_PARTS && SX_WALL == SX_LEN - 1,
                "part.sx must hold the statistics contract's parts (stats/contract.h)");

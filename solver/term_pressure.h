@@ -13,7 +13,7 @@
  *    its fluid part for the budget.
  * Hooks: pressure_pair / pressure_corrected_pair (the pair contributions, summed by the force
  * loop into struct pressure_sums), pressure_finish (the acceleration), pressure_wall (the wall
- * term and |grad gamma_as . v_a| of the wall time-step limit, Eq. 2.163), pressure_budget_x
+ * term and |grad gamma_as . v_a| of the wall time-step limit, Eq. 2.163), pressure_budget
  * (budget part SX_PRESSURE).
  */
 #ifndef CHANSPH_TERM_PRESSURE_H
@@ -45,7 +45,7 @@ static inline struct v3 pressure_corrected_pair(const struct pair *g, double vb,
 
 /** Acceleration -grad p / rho of fluid particle a without the wall term, from the sums of its
     fluid (s) and vertex (sv) neighbours; corrected form: L_a factorised into *L (read by
-    pressure_budget_x). */
+    pressure_budget). */
 static inline struct v3 pressure_finish(const struct model *M, const struct particles *P, size_t a,
                                         const struct pressure_sums *s,
                                         const struct pressure_sums *sv, struct sym_solve *L) {
@@ -96,18 +96,20 @@ static inline double pressure_wall(const struct model *M, const struct particles
   return gv;
 }
 
-/** Budget part SX_PRESSURE: the x-acceleration of particle a by the pressure of its fluid
+/** Budget part SX_PRESSURE: the acceleration of particle a by the pressure of its fluid
     neighbours (fluid part s of the sums; corrected form: the factorised L_a of
     pressure_finish, which the fluid and vertex parts share). */
-static inline double pressure_budget_x(const struct model *M, const struct particles *P, size_t a,
-                                       const struct pressure_sums *s, const struct sym_solve *L) {
+static inline struct v3 pressure_budget(const struct model *M, const struct particles *P, size_t a,
+                                        const struct pressure_sums *s, const struct sym_solve *L) {
   if (M->pgrad == PGRAD_CORRECTED) { /* -(1/rho_a) L_a g, g of the fluid neighbours only */
     const double gc[3] = {s->gc.x, s->gc.y, s->gc.z};
     double gr[3];
     sph_sym_apply(L, gc, gr);
-    return -gr[0] / P->rho[a];
+    const double ira = 1.0 / P->rho[a];
+    return (struct v3){-gr[0] * ira, -gr[1] * ira, -gr[2] * ira};
   }
-  return -s->gp.x / P->gam[a];
+  const double ig = 1.0 / P->gam[a];
+  return (struct v3){-s->gp.x * ig, -s->gp.y * ig, -s->gp.z * ig};
 }
 
 #endif

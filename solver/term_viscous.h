@@ -14,7 +14,7 @@
  * with the weight of sph.wall_shear_weight, or the wall law of wall.law).
  * Hooks: viscous_morris_pair / viscous_violeau_pair and the moments (summed by the force loop
  * into struct viscous_sums), viscous_norm and viscous_finish (the acceleration),
- * viscous_wall (the wall shear), viscous_budget_x (the budget's viscous part),
+ * viscous_wall (the wall shear), viscous_budget (the budget's viscous part),
  * viscous_dt_limit (Eq. 2.161).
  */
 #ifndef CHANSPH_TERM_VISCOUS_H
@@ -163,12 +163,13 @@ static inline void viscous_wall(const struct model *M, const struct particles *P
   }
 }
 
-/** The x-acceleration of particle a by the viscous pair forces of its fluid neighbours (fluid
+/** The acceleration of particle a by the viscous pair forces of its fluid neighbours (fluid
     part s of the sums), molecular and eddy-viscous together, as its own sums give it: the
     budget (sph_budget_pairs splits it into its conservative molecular and eddy-viscous parts
     and the walls' share). */
-static inline double viscous_budget_x(const struct viscous_norm *n, const struct viscous_sums *s) {
-  return n->vis * n->kx * s->vis.x;
+static inline struct v3 viscous_budget(const struct viscous_norm *n, const struct viscous_sums *s) {
+  return (struct v3){n->vis * n->kx * s->vis.x, n->vis * n->kappa * s->vis.y,
+                     n->vis * n->kz * s->vis.z};
 }
 
 /** The viscous time-step limit c_visc h^2 / max(nu + nu_r) (thesis Eq. 2.161) [s]. */

@@ -16,18 +16,23 @@
 #include <stddef.h>
 #include <stdint.h>
 
-/** Parts of the x-acceleration a snapshot may carry (stats_snapshot.sx), STATS_PARTS per
-    particle: the pair forces of the fluid neighbours (pressure, molecular viscous,
-    eddy-viscous) and everything the walls exert (vertex neighbours, wall shear or wall law);
-    their sum is the particle's x-acceleration without the body force. The solver's
-    `enum part_sx` (part.h) takes its values from these. */
+/** Parts of the acceleration a snapshot may carry (stats_snapshot.sx), STATS_PARTS per
+    component and particle: the antisymmetric parts of the pair forces of the fluid neighbours
+    (pressure, molecular viscous, eddy-viscous) and everything the walls exert (vertex
+    neighbours, wall shear or wall law, the pair forces' non-antisymmetric rest); their sum is
+    the particle's acceleration without the body force. The solver's `enum part_sx` (part.h)
+    takes its values from these. */
 enum stats_part {
   STATS_PART_PRESSURE, /*!< pressure pair force of the fluid neighbours */
   STATS_PART_VISCOUS,  /*!< molecular viscous pair force of the fluid neighbours */
   STATS_PART_MODEL,    /*!< eddy-viscous pair force of the fluid neighbours (LES) */
   STATS_PART_WALL,     /*!< everything the walls exert */
-  STATS_PARTS          /*!< parts per particle */
+  STATS_PARTS          /*!< parts per component */
 };
+
+/** Values per particle in stats_snapshot.sx: the STATS_PARTS parts of the x, then of the y,
+    then of the z acceleration. */
+enum { STATS_ACC = 3 * STATS_PARTS };
 
 /**
  * One snapshot of the particles, as plain arrays (the engine never sees solver structs).
@@ -48,8 +53,8 @@ struct stats_snapshot {
   const double *u, *v, *w;    /*!< velocities [m/s] */
   const double *p, *rho, *m;  /*!< pressure [Pa], density [kg/m^3], mass [kg] */
   const double *ax, *ay, *az; /*!< accelerations without the body force [m/s^2], or NULL */
-  /** Parts of the x-acceleration of the force pass that led to this state, STATS_PARTS per
-      particle (enum stats_part) [m/s^2], or NULL: the momentum budget (EULER_PLANES). */
+  /** Parts of the acceleration of the force pass that led to this state, STATS_ACC per
+      particle (x, y, z parts, enum stats_part) [m/s^2], or NULL: the budgets. */
   const double *sx;
   const double *nu_t;     /*!< eddy viscosity [m^2/s], or NULL (no LES) */
   const double *k_r;      /*!< residual kinetic energy [m^2/s^2], or NULL (no LES) */

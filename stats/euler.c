@@ -442,7 +442,7 @@ static void add_particle(const struct euler *e, const struct stats_snapshot *s, 
         const double yb = c->fold && side ? 2.0 * c->delta - yf : yf;
         double *Hf = budget_bin(c, P, yb, side, &phi_f), *Hf1 = Hf + 2 * HB_LEN; /* EU_PART_PL1 */
         for (int k = 0; k < STATS_PARTS; k++) {
-          const double f = wf * ma * s->sx[a * STATS_PARTS + k];
+          const double f = wf * ma * s->sx[a * STATS_ACC + k];
           Hf[k] += f, Hf1[k] += f * phi_f;
         }
         const double mf = wf * ma, muf = wf * mu;

@@ -57,21 +57,21 @@ enum { WIN_T0, WIN_T1, WIN_NSNAP, WIN_SUM_FX, WIN_SUM_TW0, WIN_SUM_TW1, WIN_LEN 
 
 /** Geometry and physics the Eulerian engine needs (filled from the scene by the caller). */
 struct euler_config {
-  int nb;         /*!< bins */
-  double y0, y1;  /*!< range of the uniform bins [m]; samples outside go to the end bins */
-  int fold;       /*!< 1: map the upper half onto the lower one (y -> 2 delta - y, v -> -v) */
-  double delta;   /*!< channel half-width [m] */
-  double nu;      /*!< kinematic viscosity [m^2/s] */
-  double rho0;    /*!< reference density [kg/m^3] */
-  double area;    /*!< area of one wall (lx lz in 3-D, lx in 2-D) [m^2 or m] */
+  int nb;            /*!< bins */
+  double y0, y1;     /*!< range of the uniform bins [m]; samples outside go to the end bins */
+  int fold;          /*!< 1: map the upper half onto the lower one (y -> 2 delta - y, v -> -v) */
+  double delta;      /*!< channel half-width [m] */
+  double nu;         /*!< kinematic viscosity [m^2/s] */
+  double rho0;       /*!< reference density [kg/m^3] */
+  double area;       /*!< area of one wall (lx lz in 3-D, lx in 2-D) [m^2 or m] */
   double wall_layer; /*!< thickness of the fluid layer the wall vertices stand for: their mass
                           per wall over rho0 and the wall area, dr/2 (part_create) [m] */
-  double t_start; /*!< start of the averaging [s] */
-  double window;  /*!< length of an averaging window [s] */
-  int les;        /*!< 1: eddy viscosity and residual kinetic energy profiles too */
-  int method;     /*!< EULER_BINS (Eq. 5.54-5.55) or EULER_SPH (Eq. 5.56) */
-  double h;       /*!< smoothing length of the SPH interpolation [m] */
-  int dim;        /*!< 2 or 3 (shape of the plane-averaged kernel) */
+  double t_start;    /*!< start of the averaging [s] */
+  double window;     /*!< length of an averaging window [s] */
+  int les;           /*!< 1: eddy viscosity and residual kinetic energy profiles too */
+  int method;        /*!< EULER_BINS (Eq. 5.54-5.55) or EULER_SPH (Eq. 5.56) */
+  double h;          /*!< smoothing length of the SPH interpolation [m] */
+  int dim;           /*!< 2 or 3 (shape of the plane-averaged kernel) */
 };
 
 /** How particles are assigned to the wall-normal profile points. */

@@ -614,7 +614,7 @@ static void test_budget_identity(void) {
     cfg.y1 = fold ? 1.0 + 0.5 / (NBB - 0.5) : 2.0; /* folded: the last bin is centred on delta */
     struct euler e;
     euler_init(&e, &cfg);
-    static double y[NPB], u[NPB], v[NPB], w[NPB], p[NPB], rho[NPB], m[NPB], sx[NPB * STATS_PARTS];
+    static double y[NPB], u[NPB], v[NPB], w[NPB], p[NPB], rho[NPB], m[NPB], sx[NPB * STATS_ACC];
     for (long s = 0; s * dt <= T + 1e-12; s++) {
       const double t = s * dt;
       for (int a = 0; a < NPB; a++) {
@@ -626,8 +626,8 @@ static void test_budget_identity(void) {
         const double ub = 1.0 + 2.0 * y0, du = 0.5 + uniform(10 * a + 5), lag = 0.4;
         y[a] = y0 + amp * sin(om * t + ph), v[a] = amp * om * cos(om * t + ph);
         u[a] = ub - du * sin(om * t + ph - lag); /* u' anti-correlated with v */
-        for (int k = 0; k < STATS_PARTS; k++) sx[a * STATS_PARTS + k] = 0.0;
-        sx[a * STATS_PARTS] = -du * om * cos(om * t + ph - lag);
+        for (int k = 0; k < STATS_ACC; k++) sx[a * STATS_ACC + k] = 0.0;
+        sx[a * STATS_ACC] = -du * om * cos(om * t + ph - lag);
         w[a] = 0.0, p[a] = 0.0, rho[a] = 1000.0, m[a] = 2.0;
       }
       const struct stats_snapshot snap = {.n = NPB,

@@ -86,3 +86,12 @@ add_executable(test_shift test_shift.c)
 target_link_libraries(test_shift PRIVATE chansph_core)
 add_test(NAME unit_shift COMMAND test_shift)
 set_tests_properties(unit_shift PROPERTIES LABELS unit)
+
+#   test_budget_parts: the budget parts of the force pass (x, y, z) add up to the acceleration,
+#                the pair parts conserve momentum in each component, the walls' part lives
+#                within 2h of the walls (docs/theory.md, "Momentum at the walls")
+add_executable(test_budget_parts test_budget_parts.c)
+target_link_libraries(test_budget_parts PRIVATE chansph_core m)
+add_test(NAME unit_budget_parts COMMAND test_budget_parts ${CMAKE_SOURCE_DIR}/jobs/scenes)
+set_tests_properties(unit_budget_parts PROPERTIES LABELS unit PASS_REGULAR_EXPRESSION "PASS"
+  FAIL_REGULAR_EXPRESSION "FAIL")
