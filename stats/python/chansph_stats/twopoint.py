@@ -107,7 +107,7 @@ def header(r, path):
 
 def save(fig, path):
     """Write a figure as a small PNG (the directory must exist)."""
-    fig.savefig(path, dpi=90)
+    fig.savefig(path, dpi=72)
     print("# wrote %s" % path)
 
 
