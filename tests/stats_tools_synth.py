@@ -64,6 +64,7 @@ def root(d, ys):
     var(d, "y_mean", ("y",), ys)
     var(d, "n_samples", ("y",), np.full(n, 1e4))
     var(d, "u_mean", ("y",), 10 * ys + 5)
+    var(d, "u_mean_stderr", ("y",), np.full(n, 0.01))
     for c, v in (("uu", 4.0), ("vv", 0.5), ("ww", 1.0)):
         var(d, c, ("y",), np.full(n, v))
         var(d, c + "_stderr", ("y",), np.full(n, 0.01 * v))
