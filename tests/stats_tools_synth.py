@@ -135,7 +135,7 @@ def spectra():
           "spectra_compare: Parseval and Wiener-Khinchin hold on a consistent file (exit %d) %s"
           % (rc, err.strip()))
     row = [ln for ln in out.splitlines() if re.match(r"\s+30\.0\s+30\.02\s+x\s+v\s", ln)]
-    err_col = float(row[0].split()[9]) if row else math.nan
+    err_col = float(row[0].split()[10]) if row else math.nan
     check(err_col < 1e-6, "spectra_compare: the MKM spectrum given at y+ 30 compares with "
           "error %.3g (< 1e-6)" % err_col)
     check("k_x delta = 0.5, 1, 1.5, 2, 2.5, 3 " in out,

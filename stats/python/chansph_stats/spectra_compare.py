@@ -29,7 +29,7 @@ import numpy as np
 
 from . import cli
 from .cli import InputError
-from .twopoint import (COMP, DNS_ROOT, dns_files, dns_table, header, nearest, out_dir, pyplot,
+from .twopoint import (COMP, DNS_ROOT, dns_files, dns_table, eulerian_variance, header, nearest, out_dir, pyplot,
                        read_corr, run_y_plus, save, u_tau_arg)
 
 DEFAULT_DNS = os.path.join(DNS_ROOT, "spectra")
@@ -127,9 +127,9 @@ def main(argv, prog):
     print("# the box holds kx delta = 0 and >= %.4g, kz delta = 0 and >= %.4g (no wavelength longer than lx = %g, lz = %g delta)" %
           (r["kx"][1] * r["delta"], r["kz"][1] * r["delta"], r["lx"] / r["delta"],
            r["lz"] / r["delta"]))
-    print("# %5s %6s %3s %4s %10s %10s %9s %9s %8s %8s %7s %7s  %s" %
-          ("y+", "MKM y+", "dir", "comp", "Parseval", "W-K", "<u'2>+", "MKM", "ratio",
-           "err", "k0 run", "k0 MKM", "verdict"))
+    print("# %5s %6s %3s %4s %10s %10s %9s %7s %9s %8s %8s %7s %7s %7s  %s" %
+          ("y+", "MKM y+", "dir", "comp", "Parseval", "W-K", "<u'2>+", "/Eul", "MKM", "ratio",
+           "err", "k0 run", "k0 MKM", "MKM>L", "verdict"))
     failed, levels, curves, lost = False, {"x": [], "z": []}, {"x": {}, "z": {}}, {}
     for lev in range(len(r["y_plus"])):
         if not r["samples"][lev] > 0:
@@ -148,9 +148,10 @@ def main(argv, prog):
                     continue
                 cv = dns_compare(r, lev, c, d, dns[d][near])
                 agree = abs(cv["ratio"] - 1) <= a.tol_energy and cv["err"] <= a.tol_shape
-                print("  %5.1f %6g %3s %4s %10.2e %10.2e %9.4f %9.4f %8.3f %8.3f %7.3f %7.3f %7.3f  "
+                print("  %5.1f %6g %3s %4s %10.2e %10.2e %9.4f %7.3f %9.4f %8.3f %8.3f %7.3f %7.3f %7.3f  "
                       "engine %s, DNS %s" %
-                      (yp, near, d, c, pars, wk, cv["var"], cv["var_d"], cv["ratio"], cv["err"],
+                      (yp, near, d, c, pars, wk, cv["var"],
+                       cv["var"] * r["u_tau"] ** 2 / eulerian_variance(r, lev, c), cv["var_d"], cv["ratio"], cv["err"],
                        cv["zero_share"], cv["zero_share_d"], cv["lost_share"], "PASS" if ok else "FAIL",
                        "agrees" if agree else "differs"))
                 curves[d][(yp, near, c)] = cv
@@ -166,8 +167,8 @@ def main(argv, prog):
                   (d, d, ", ".join("%g" % k for k in cv["lost_k"]), d, d,
                    cv["beyond"][0] if len(cv["beyond"]) else math.nan,
                    cv["beyond"][-1] if len(cv["beyond"]) else math.nan))
-    print("# Parseval: |sum E dk / R(0) - 1|; W-K: max |E - FT(R)| / max E; ratio: energy / MKM "
-          "<u'2>+; err: sum|E - E_MKM| / sum E_MKM over the held k; k0: share of the energy in "
+    print("# Parseval: |sum E dk / R(0) - 1|; W-K: max |E - FT(R)| / max E; /Eul: energy / the Eulerian "
+          "<u'2> profile at the level; ratio: energy / MKM <u'2>+; err: sum|E - E_MKM| / sum E_MKM over the held k; k0: share of the energy in "
           "the k = 0 mode; MKM>L: MKM share at 0 < k < 2 pi / L (tolerances: engine %g, DNS energy %g, shape %g)" %
           (EXACT, a.tol_energy, a.tol_shape))
     if not any(levels.values()):

@@ -50,6 +50,8 @@ def read_corr(path, u_tau="force"):
         for k in ("delta", "nu", "lx", "lz"):
             r[k] = float(attribute(nc, k, path))
         r["u_tau"] = pick_u_tau(nc, path, u_tau)
+        r["eul"] = {k: values(nc.variables[k]) for k in ("y_mean", "n_samples", "uu", "vv", "ww")
+                    if k in nc.variables}
         r["n_windows"] = int(nc.getncattr("n_windows")) if "n_windows" in nc.ncattrs() else 0
         r["t"] = tuple(float(nc.getncattr(k)) if k in nc.ncattrs() else float("nan")
                        for k in ("average_start", "average_end"))
@@ -96,6 +98,15 @@ def nearest(levels, yp):
 def run_y_plus(r, lev):
     """y+ of a level in the chosen u_tau (the y_plus variable is in stats.u_tau_ref)."""
     return r["level"][lev] * r["u_tau"] / r["nu"]
+
+
+def eulerian_variance(r, lev, c):
+    """The root profile <c'c'> interpolated to the level's height [m^2/s^2] (NaN if absent)."""
+    e = r["eul"]
+    if len(e) < 5:
+        return float("nan")
+    ok = e["n_samples"] > 0
+    return float(np.interp(r["level"][lev], e["y_mean"][ok], e[c + c][ok]))
 
 
 def header(r, path):
