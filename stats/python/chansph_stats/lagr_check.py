@@ -119,10 +119,12 @@ def read_ckpt(path, r):
 
 
 def real_lags(r, ds):
-    tau = r["lag"]
-    if not (ds > 0):
-        return tau
-    return np.ceil(tau / ds - 1e-9) * ds
+    """The lags the samples were taken at, on average: lag k > 0 is the first statistics sample
+    at or after tau_k, so tau_k + ds / 2 (ds: the mean sampling interval; dt varies in a run)."""
+    tau = np.array(r["lag"], dtype=float)
+    if ds > 0:
+        tau[1:] += ds / 2
+    return tau
 
 
 def eulerian_at(r, y):
@@ -173,37 +175,66 @@ def taylor_curve(t, rho, var):
     return out
 
 
-def short_time(r, l, t, sums, E):
-    """Rows of point 1 for level l: (axis, value, Eulerian, se, verdict, note)."""
+def release_se(r, l, nper, c, E):
+    """Modelled standard error of a release-ensemble mean of u_i^2 (module docstring)."""
+    S, how = line_factor(r, r["level"][l], c)
+    neff = nper / max(S, 1.0) / r["g"]
+    F = E[c + "_flatness"]
+    return E[c + c] * math.sqrt(max(F - 1.0, 0.0) / neff), neff, how
+
+
+def short_time(r, l, sums, E, ds):
+    """Rows of point 1 for level l: (axis, text, verdict)."""
     n = r["n_tracks"][l]
-    ks = [k for k in range(len(t)) if t[k] > 0 and n[k] > 0]
+    ks = [k for k in range(1, len(r["lag"])) if n[k] > 0]
     if not ks:
-        return [], None
-    k = ks[0]
+        return []
+    k, tau = ks[0], r["lag"][ks[0]]
     rows = []
-    nper = n[k]
-    for i, (p, c) in enumerate(zip(POS, COMP)):
-        s2 = r["sigma2_" + p][l][k] / t[k] ** 2
-        var_e, se_e = E[c + c], E[c + c + "_stderr"]
-        S, how = line_factor(r, r["level"][l], c)
-        neff = nper / max(S, 1.0) / r["g"]
-        F = E[c + "_flatness"]
-        se = var_e * math.sqrt(max(F - 1.0, 0.0) / neff)
-        note = how
+    if sums is not None:
+        R = sums[l, k]
+        mom = [R[LG_VEL + 5 * i:LG_VEL + 5 * i + 5] / R[LG_N] for i in range(3)]
+        # mean square of the interval-mean velocity (u(t0) + u(t0 + tau)) / 2
+        q = [(m[2] + 2 * m[4] + m[3]) / 4 for m in mom]
+        mean = [(m[0] + m[1]) / 2 for m in mom]
+        clock = math.sqrt(r["sigma2_x"][l][k] / q[0])
+        rows.append(("x", "lag %d (nominal %.4g s) is at tau = %.4g s (tau+ %.3g) by the x clock "
+                     "<dx^2> = tau^2 <((u(t0) + u(t0 + tau)) / 2)^2>; ensemble <u'^2> = %.5g, "
+                     "Eulerian %.5g (%+.1f%%)" %
+                     (k, tau, clock, clock * r["u_tau"] ** 2 / r["nu"], q[0] - mean[0] ** 2,
+                      E["uu"], 100 * ((q[0] - mean[0] ** 2) / E["uu"] - 1)), "used as the clock"))
+        for i, (p, c) in ((1, ("y", "v")), (2, ("z", "w"))):
+            s2 = r["sigma2_" + p][l][k] / clock ** 2
+            kin = s2 / q[i]
+            ok_kin = abs(kin - 1) <= 0.03
+            val = s2 - mean[i] ** 2
+            se, neff, how = release_se(r, l, n[k], c, E)
+            se = math.hypot(se, np.nan_to_num(E[c + c + "_stderr"]))
+            ok = abs(val - E[c + c]) <= 2 * se
+            rows.append((p, "sigma_%s^2/tau^2 = %.5g = %.4f x <((%s(t0) + %s(t0 + tau)) / 2)^2> "
+                         "(kinematics, within 3%%: %s); minus the mean drift %.5g, Eulerian "
+                         "<%s'^2> %.5g, difference %+.4g (%+.1f%%), 2 se %.3g (N_eff %.0f; %s)" %
+                         (p, s2, kin, c, c, "PASS" if ok_kin else "FAIL", val, c, E[c + c],
+                          val - E[c + c], 100 * (val / E[c + c] - 1), 2 * se, neff, how),
+                         "PASS" if ok and ok_kin else "FAIL"))
+        return rows
+    lo, hi = tau, tau + (ds if ds > 0 else 0.0)
+    for p, c in zip(POS, COMP):
+        s2 = r["sigma2_" + p][l][k]
+        v_hi, v_lo = s2 / lo ** 2, s2 / hi ** 2
+        se, neff, how = release_se(r, l, n[k], c, E)
         if p == "x":
-            if sums is not None:
-                R = sums[l, k]
-                drift = 0.5 * (R[LG_VEL] + R[LG_VEL + 1]) / R[LG_N]
-                note += "; drift from the checkpoint's Lagrangian mean %.4g m/s" % drift
-            else:
-                drift = E["u_mean"]
-                se = math.hypot(se, 2 * abs(drift) * math.sqrt(var_e / neff))
-                note += "; drift = Eulerian U(y0) %.4g m/s (no --ckpt)" % drift
-            s2 -= drift ** 2
-        se = math.hypot(se, se_e if se_e == se_e else 0.0)
-        verdict = "PASS" if abs(s2 - var_e) <= 2 * se else "FAIL"
-        rows.append((p, c, t[k], s2, var_e, se, neff, verdict, note))
-    return rows, k
+            drift = E["u_mean"]
+            v_hi, v_lo = v_hi - drift ** 2, v_lo - drift ** 2
+            se = math.hypot(se, 2 * abs(drift) * math.sqrt(E["uu"] / neff))
+            how += "; drift = Eulerian U(y0) %.4g m/s (no --ckpt)" % drift
+        se = math.hypot(se, np.nan_to_num(E[c + c + "_stderr"]))
+        ok = v_lo - 2 * se <= E[c + c] <= v_hi + 2 * se
+        rows.append((p, "sigma_%s^2/tau^2 = %.5g .. %.5g for the real lag between %.4g and %.4g s "
+                     "(lag %d; no --ckpt for the clock), Eulerian <%s'^2> %.5g, 2 se %.3g "
+                     "(N_eff %.0f; %s)" % (p, v_lo, v_hi, lo, hi, k, c, E[c + c], 2 * se, neff,
+                                           how), "PASS" if ok else "FAIL"))
+    return rows
 
 
 def report_level(r, l, t, sums, status):
@@ -211,14 +242,11 @@ def report_level(r, l, t, sums, status):
     E = eulerian_at(r, y)
     print("\n## level y+ %g (y = %.4g m; %d completed releases, %d tracks at lag 0)" %
           (r["y_plus"][l], y, r["releases"], r["n_tracks"][l][0]))
-    rows, k1 = short_time(r, l, t, sums, E)
+    rows = short_time(r, l, sums, E, r["ds"])
     if not rows:
         print("short-time dispersion: no lag with samples: not checked")
-    for p, c, tau, s2, var_e, se, neff, verdict, note in rows:
-        print("short-time %s: sigma_%s^2/tau^2 at tau = %.4g s (tau+ %.3g) = %.5g, Eulerian "
-              "<%s'^2> = %.5g, difference %+.4g (%.1f%%), 2 se = %.3g (N_eff %.0f; %s): %s" %
-              (p, p, tau, tau * ut ** 2 / nu, s2, c, var_e, s2 - var_e,
-               100 * (s2 / var_e - 1), 2 * se, neff, note, verdict))
+    for p, text, verdict in rows:
+        print("short-time %s: %s: %s" % (p, text, verdict))
         status["fail"] |= verdict == "FAIL"
     # T_L
     tl = {}
@@ -264,7 +292,7 @@ def report_level(r, l, t, sums, status):
         n0 = R[LG_N]
         ul = R[LG_VEL] / n0
         S, _ = line_factor(r, y, "u")
-        se = math.hypot(math.sqrt(E["uu"] * S * r["g"] / n0), E["u_mean_stderr"])
+        se = math.hypot(math.sqrt(E["uu"] * S * r["g"] / n0), np.nan_to_num(E["u_mean_stderr"]))
         verdict = "PASS" if abs(ul - E["u_mean"]) <= 2 * se else "FAIL"
         status["fail"] |= verdict == "FAIL"
         ok = r["n_tracks"][l] > 0
@@ -344,6 +372,7 @@ def main(argv, prog):
     r = read_run(a.stats, a.u_tau)
     sums = read_ckpt(a.ckpt, r) if a.ckpt else None
     ds = r["ds"] if a.sample_interval is None else a.sample_interval
+    r["ds"] = ds
     t = real_lags(r, ds)
     # releases closer than two correlation times are not independent: their number counts
     # as releases x release_every / (2 tau) (the statistical inefficiency of batch means)
@@ -354,7 +383,7 @@ def main(argv, prog):
     print("# %s: %d completed releases every %g s, horizon %g s, %d lags; wall units of u_tau = "
           "%.5g m/s; sampling interval %s; Eulerian correlation time %s s%s" %
           (a.stats, r["releases"], r["release_every"], r["horizon"], len(t) - 1, r["u_tau"],
-           "%.4g s (real lags used)" % ds if ds > 0 else "unknown (nominal lags)",
+           "%.4g s (mean; lags taken as nominal + half of it)" % ds if ds > 0 else "unknown (nominal lags)",
            "%.3g" % r["corr_time"], "; releases closer than 2 of it: N_eff divided by %.3g" % r["g"]
            if r["g"] > 1 else ""))
     status = {"fail": False}
