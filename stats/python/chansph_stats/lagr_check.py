@@ -18,9 +18,10 @@ interpolated to it):
    its mirror); their u_i^2 has variance (F - 1) <u_i'^2>^2 (F the Eulerian flatness) and
    correlation rho_ii,z(dz)^2 along the line (Gaussian rule; rho from group correlations at the
    nearest level), so the N particles count as N / S, S = sum over the grid's z separations of
-   rho_ii,z^2; releases closer than twice the Eulerian correlation time tau of the file
-   (attribute correlation_time, of the bin-mean u: conservative) count as independent only
-   in the ratio release_every / (2 tau). For x the term 2 U <u'> adds
+   rho_ii,z^2; releases closer than twice the Lagrangian integral time T of the component
+   (rho_L integrated to its first zero: the lifetime of the eddies that carry the particles;
+   the file's Eulerian correlation_time when T is unknown) count as independent only in the
+   ratio release_every / (2 T). For x the term 2 U <u'> adds
    2 U u_rms / sqrt(N_eff) unless --ckpt gives the mean. The Eulerian standard error of
    <u_i'^2> is added in quadrature. PASS within two standard errors.
 2. Taylor's whole curve, sigma^2(tau) = 2 <u_i'^2> int_0^tau (tau - s) rho_L(s) ds (y and z; the
@@ -178,9 +179,11 @@ def taylor_curve(t, rho, var):
 def release_se(r, l, nper, c, E):
     """Modelled standard error of a release-ensemble mean of u_i^2 (module docstring)."""
     S, how = line_factor(r, r["level"][l], c)
-    neff = nper / max(S, 1.0) / r["g"]
+    T = r["tl_now"].get(c, math.nan)
+    g = max(1.0, 2 * T / r["release_every"]) if T == T else r["g"]
+    neff = nper / max(S, 1.0) / g
     F = E[c + "_flatness"]
-    return E[c + c] * math.sqrt(max(F - 1.0, 0.0) / neff), neff, how
+    return E[c + c] * math.sqrt(max(F - 1.0, 0.0) / neff), neff, how + ", releases / %.2g" % g
 
 
 def short_time(r, l, sums, E, ds):
@@ -242,6 +245,7 @@ def report_level(r, l, t, sums, status):
     E = eulerian_at(r, y)
     print("\n## level y+ %g (y = %.4g m; %d completed releases, %d tracks at lag 0)" %
           (r["y_plus"][l], y, r["releases"], r["n_tracks"][l][0]))
+    r["tl_now"] = {c: first_zero_integral(t, r["rho_L_" + c][l])[0] for c in COMP}
     rows = short_time(r, l, sums, E, r["ds"])
     if not rows:
         print("short-time dispersion: no lag with samples: not checked")
@@ -291,8 +295,8 @@ def report_level(r, l, t, sums, status):
         R = sums[l, 0]
         n0 = R[LG_N]
         ul = R[LG_VEL] / n0
-        S, _ = line_factor(r, y, "u")
-        se = math.hypot(math.sqrt(E["uu"] * S * r["g"] / n0), np.nan_to_num(E["u_mean_stderr"]))
+        _, neff, _ = release_se(r, l, n0, "u", E)
+        se = math.hypot(math.sqrt(E["uu"] / neff), np.nan_to_num(E["u_mean_stderr"]))
         verdict = "PASS" if abs(ul - E["u_mean"]) <= 2 * se else "FAIL"
         status["fail"] |= verdict == "FAIL"
         ok = r["n_tracks"][l] > 0
@@ -381,11 +385,11 @@ def main(argv, prog):
     if a.out:
         out_dir(a.out)
     print("# %s: %d completed releases every %g s, horizon %g s, %d lags; wall units of u_tau = "
-          "%.5g m/s; sampling interval %s; Eulerian correlation time %s s%s" %
+          "%.5g m/s; sampling interval %s; Eulerian correlation time %s s" %
           (a.stats, r["releases"], r["release_every"], r["horizon"], len(t) - 1, r["u_tau"],
-           "%.4g s (mean; lags taken as nominal + half of it)" % ds if ds > 0 else "unknown (nominal lags)",
-           "%.3g" % r["corr_time"], "; releases closer than 2 of it: N_eff divided by %.3g" % r["g"]
-           if r["g"] > 1 else ""))
+           "%.4g s (mean; lags taken as nominal + half of it)" % ds if ds > 0 else
+           "unknown (nominal lags)",
+           "%.3g" % r["corr_time"]))
     status = {"fail": False}
     for l in range(len(r["level"])):
         report_level(r, l, t, sums, status)
