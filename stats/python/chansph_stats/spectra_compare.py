@@ -136,6 +136,8 @@ def main(argv, prog):
             print("# level %d (y+ %g): no samples: skipped" % (lev, r["y_plus"][lev]))
             continue
         yp = run_y_plus(r, lev)
+        print("# y+ %.1f: %.1f%% of the grid cells were empty (zero fluctuation there: the "
+              "spectra miss about that share of the variance)" % (yp, 100 * r["empty"][lev]))
         for d in "xz":
             near = nearest(dns[d], yp)
             for c in COMP:

@@ -50,6 +50,9 @@ def read_corr(path, u_tau="force"):
         for k in ("delta", "nu", "lx", "lz"):
             r[k] = float(attribute(nc, k, path))
         r["u_tau"] = pick_u_tau(nc, path, u_tau)
+        n_cells = len(g.dimensions["separation_x"]) * len(g.dimensions["separation_z"])
+        r["empty"] = (values(g.variables["empty_cells"]) / np.maximum(r["samples"], 1) / n_cells
+                      if "empty_cells" in g.variables else np.full(len(r["samples"]), np.nan))
         r["eul"] = {k: values(nc.variables[k]) for k in ("y_mean", "n_samples", "uu", "vv", "ww")
                     if k in nc.variables}
         r["n_windows"] = int(nc.getncattr("n_windows")) if "n_windows" in nc.ncattrs() else 0
