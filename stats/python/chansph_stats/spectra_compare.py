@@ -29,7 +29,8 @@ import numpy as np
 
 from . import cli
 from .cli import InputError
-from .twopoint import (COMP, DNS_ROOT, dns_files, dns_table, eulerian_variance, header, nearest, out_dir, pyplot,
+from .twopoint import (COMP, DNS_ROOT, dns_files, dns_table, eulerian_variance, header,
+                       nearest, out_dir, pyplot,
                        read_corr, run_y_plus, save, u_tau_arg)
 
 DEFAULT_DNS = os.path.join(DNS_ROOT, "spectra")
@@ -124,7 +125,8 @@ def main(argv, prog):
     if a.out:
         out_dir(a.out)
     header(r, a.stats)
-    print("# the box holds kx delta = 0 and >= %.4g, kz delta = 0 and >= %.4g (no wavelength longer than lx = %g, lz = %g delta)" %
+    print("# the box holds kx delta = 0 and >= %.4g, kz delta = 0 and >= %.4g (no wavelength "
+          "longer than lx = %g, lz = %g delta)" %
           (r["kx"][1] * r["delta"], r["kz"][1] * r["delta"], r["lx"] / r["delta"],
            r["lz"] / r["delta"]))
     print("# %5s %6s %3s %4s %10s %10s %9s %7s %9s %8s %8s %7s %7s %7s  %s" %
@@ -169,9 +171,10 @@ def main(argv, prog):
                   (d, d, ", ".join("%g" % k for k in cv["lost_k"]), d, d,
                    cv["beyond"][0] if len(cv["beyond"]) else math.nan,
                    cv["beyond"][-1] if len(cv["beyond"]) else math.nan))
-    print("# Parseval: |sum E dk / R(0) - 1|; W-K: max |E - FT(R)| / max E; /Eul: energy / the Eulerian "
-          "<u'2> profile at the level; ratio: energy / MKM <u'2>+; err: sum|E - E_MKM| / sum E_MKM over the held k; k0: share of the energy in "
-          "the k = 0 mode; MKM>L: MKM share at 0 < k < 2 pi / L (tolerances: engine %g, DNS energy %g, shape %g)" %
+    print("# Parseval: |sum E dk / R(0) - 1|; W-K: max |E - FT(R)| / max E; /Eul: energy / the "
+          "Eulerian <u'2> profile at the level; ratio: energy / MKM <u'2>+; err: sum|E - E_MKM| / "
+          "sum E_MKM over the held k; k0: share of the energy in the k = 0 mode; MKM>L: MKM share "
+          "at 0 < k < 2 pi / L (tolerances: engine %g, DNS energy %g, shape %g)" %
           (EXACT, a.tol_energy, a.tol_shape))
     if not any(levels.values()):
         raise InputError("%s: no level of group correlations is near an MKM level" % a.stats)
