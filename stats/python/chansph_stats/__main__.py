@@ -20,6 +20,10 @@ TOOLS = {
     "dns_c_table": ("dns_c_table", "write solver/dns_lm180.h from the Lee & Moser table"),
     "ckpt": ("ckpt_info", "summarise checkpoints (format, step, time, particles)"),
     "pdf_compare": ("pdf_compare", "one-point PDFs of u', v', w' against MKM Re_tau = 180"),
+    "spectra_compare": ("spectra_compare", "1-D spectra in x and z against MKM Re_tau = 180"),
+    "corr_compare": ("corr_compare", "two-point correlations in x and z against MKM Re_tau = 180"),
+    "skewflat_compare": ("skewflat_compare", "skewness and flatness profiles against MKM 180"),
+    "lagr_check": ("lagr_check", "the Lagrangian engine against exact dispersion laws"),
 }
 
 
