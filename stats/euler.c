@@ -8,6 +8,7 @@
 
 #include "alloc.h"
 #include "error.h"
+#include "euler_rs.h"
 #include "moments.h"
 #include "spar.h"
 #include "state.h"
@@ -25,7 +26,8 @@ enum {
   EU_PART_N,
   EU_PART_PL,
   EU_PART_PL1 = EU_PART_PL + 2 * HB_LEN,
-  EU_PART = EU_PART_PL1 + 2 * HB_LEN
+  EU_PART_RS = EU_PART_PL1 + 2 * HB_LEN, /* the Reynolds-stress budget (euler_rs.h) */
+  EU_PART = EU_PART_RS + RSP_LEN
 };
 
 /* Scratch of euler_sample. The columns are merged over a fixed binary tree on the global
@@ -39,6 +41,57 @@ struct euler_work {
   int *node;                /* [2 x nodes] lo, hi of the gathered subtrees, in gather order */
   size_t part_cap, mine_cap, all_cap, scr_cap, node_cap; /* capacities (records, nodes) */
 };
+
+/* The Reynolds-stress budget profiles of component c (its name in the long names: what), all
+   terms in the order of RT_*; sfx, pre: the name suffix and long-name prefix (standard errors). */
+#define RSB_META(c, what, sfx, pre)                                                            \
+  {"rsb_" c "_pressure" sfx, "m^2/s^3",                                                        \
+   pre "budget of " what                                                                       \
+       ": the fluctuating velocities times the pressure pair forces (velocity-"                \
+       "pressure-gradient term; DNS: pressure-strain + pressure diffusion)"},                  \
+      {"rsb_" c "_viscous" sfx, "m^2/s^3",                                                     \
+       pre "budget of " what                                                                   \
+           ": the fluctuating velocities times the molecular viscous pair "                    \
+           "forces (DNS: dissipation + viscous diffusion, with rsb_" c "_wall)"},              \
+      {"rsb_" c "_model" sfx, "m^2/s^3",                                                       \
+       pre "budget of " what                                                                   \
+           ": the fluctuating velocities times the eddy-viscous pair forces "                  \
+           "(LES)"},                                                                           \
+      {"rsb_" c "_wall" sfx, "m^2/s^3",                                                        \
+       pre "budget of " what                                                                   \
+           ": the fluctuating velocities times everything the walls exert "                    \
+           "(vertex pressure and viscous terms, wall law, the pair forces' non-antisymmetric " \
+           "rest)"},                                                                           \
+      {"rsb_" c "_drive" sfx, "m^2/s^3",                                                       \
+       pre "budget of " what                                                                   \
+           ": the fluctuating velocities times the body force (zero on "                       \
+           "average)"},                                                                        \
+      {"rsb_" c "_transfer" sfx, "m^2/s^3",                                                    \
+       pre "budget of " what                                                                   \
+           ": carried into the bin by the particles' displacements, with the "                 \
+           "fluctuations about the bin's mean velocity (production + turbulent transport)"},   \
+      {"rsb_" c "_production" sfx, "m^2/s^3",                                                  \
+       pre "budget of " what                                                                   \
+           ": production -<u_i'v'> dU_j/dy - <u_j'v'> dU_i/dy from the "                       \
+           "profiles"},                                                                        \
+      {"rsb_" c "_transport" sfx, "m^2/s^3",                                                   \
+       pre "budget of " what                                                                   \
+           ": turbulent transport, transfer less production (DNS: turbulent "                  \
+           "diffusion)"},                                                                      \
+      {"rsb_" c "_rate" sfx, "m^2/s^3",                                                        \
+       pre "budget of " what                                                                   \
+           ": rate of change from the first to the last sample (zero in a "                    \
+           "steady state)"},                                                                   \
+  {                                                                                            \
+    "rsb_" c "_closure" sfx, "m^2/s^3",                                                        \
+        pre "budget of " what                                                                  \
+            ": pressure + viscous + model + wall + drive + transfer - rate "                   \
+            "(round-off when sampled every step)"                                              \
+  }
+#define RSB_ALL(sfx, pre)                                                     \
+  RSB_META("uu", "<u'u'>", sfx, pre), RSB_META("vv", "<v'v'>", sfx, pre),     \
+      RSB_META("ww", "<w'w'>", sfx, pre), RSB_META("uv", "<u'v'>", sfx, pre), \
+      RSB_META("k", "k = <u_i'u_i'>/2", sfx, pre)
 
 const struct euler_meta euler_prof_meta[EP_NPROF] = {
     [EP_Y] = {"y", "m", "wall-normal bin centre (walls at 0 and 2 delta)"},
@@ -132,6 +185,8 @@ const struct euler_meta euler_prof_meta[EP_NPROF] = {
                        "standard error of advective_stress (batch means)"},
     [EP_SE_TAU + 6] = {"total_stress_stderr", "m^2/s^2",
                        "standard error of total_stress (batch means)"},
+    [EP_RSB] = RSB_ALL("", "Reynolds-stress "),
+    [EP_RSB_SE] = RSB_ALL("_stderr", "standard error (batch means) of the Reynolds-stress "),
 };
 
 double euler_centre(const struct euler_config *cfg, int i) {
@@ -149,11 +204,13 @@ static void reserve_rows(struct euler *e, size_t rows) {
   e->snp = mem_realloc(e->snp, cap * nb * SCAL_LEN, sizeof(double), "Eulerian statistics");
   e->pln = mem_realloc(e->pln, cap * nb * PL_LEN, sizeof(double), "Eulerian statistics");
   e->kin = mem_realloc(e->kin, cap * nb * KN_LEN, sizeof(double), "Eulerian statistics");
+  e->rsb = mem_realloc(e->rsb, cap * nb * RW_LEN, sizeof(double), "Eulerian statistics");
   memset(e->win + old * WIN_LEN, 0, (cap - old) * WIN_LEN * sizeof(double));
   memset(e->mom + old * nb * MOM_LEN, 0, (cap - old) * nb * MOM_LEN * sizeof(double));
   memset(e->snp + old * nb * SCAL_LEN, 0, (cap - old) * nb * SCAL_LEN * sizeof(double));
   memset(e->pln + old * nb * PL_LEN, 0, (cap - old) * nb * PL_LEN * sizeof(double));
   memset(e->kin + old * nb * KN_LEN, 0, (cap - old) * nb * KN_LEN * sizeof(double));
+  memset(e->rsb + old * nb * RW_LEN, 0, (cap - old) * nb * RW_LEN * sizeof(double));
   e->cap = cap;
 }
 
@@ -205,7 +262,7 @@ void euler_init(struct euler *e, const struct euler_config *cfg) {
 void euler_free(struct euler *e) {
   struct euler_work *k = e->work;
   if (k) free(k->part), free(k->mine), free(k->all), free(k->scr), free(k->node), free(k);
-  free(e->win), free(e->mom), free(e->snp), free(e->pln), free(e->kin);
+  free(e->win), free(e->mom), free(e->snp), free(e->pln), free(e->kin), free(e->rsb);
   memset(e, 0, sizeof *e);
 }
 
@@ -401,9 +458,9 @@ static double *budget_bin(const struct euler_config *c, double *P, double y, int
 }
 
 /* The share of a particle at y in the upper (side 1) or lower (side 0) half of the channel:
-   all of it, or half within tie of the centre delta. */
-static double side_weight(double y, double delta, double tie, int side) {
-  if (fabs(y - delta) <= tie) return 0.5;
+   all of it, or half within 1e-9 delta of the centre. */
+double euler_side_weight(double y, double delta, int side) {
+  if (fabs(y - delta) <= 1e-9 * delta) return 0.5;
   return (y > delta) == side ? 1.0 : 0.0;
 }
 
@@ -434,9 +491,8 @@ static void add_particle(const struct euler *e, const struct stats_snapshot *s, 
        within 1e-9 delta of the centre counts half in each, so that the centre layer of a
        mirror-symmetric flow, whose v is 0 up to rounding, is not sent to one side or the other
        by that rounding (its momentum and forces are on the centre side of every plane) */
-    const double tie = 1e-9 * c->delta;
     for (int side = 0; side < 2; side++) {
-      const double wf = side_weight(yf, c->delta, tie, side);
+      const double wf = euler_side_weight(yf, c->delta, side);
       if (wf > 0.0) { /* forces, body force and momentum at the positions before the step */
         double phi_f;
         const double yb = c->fold && side ? 2.0 * c->delta - yf : yf;
@@ -449,7 +505,7 @@ static void add_particle(const struct euler *e, const struct stats_snapshot *s, 
         Hf[HB_MASS] += mf, Hf1[HB_MASS] += mf * phi_f, Hf[HB_MU0] += muf,
             Hf1[HB_MU0] += muf * phi_f;
       }
-      const double wh = side_weight(s->y[a], c->delta, tie, side);
+      const double wh = euler_side_weight(s->y[a], c->delta, side);
       if (wh > 0.0) { /* the momentum of the sampled state */
         double phi;
         const double yb = c->fold && side ? 2.0 * c->delta - s->y[a] : s->y[a];
@@ -458,6 +514,7 @@ static void add_particle(const struct euler *e, const struct stats_snapshot *s, 
         H[HB_MU] += muh, H1[HB_MU] += muh * phi, H[HB_UV] += muh * vb;
       }
     }
+    if (s->dt > 0.0) euler_rs_add(c, s, a, yf, P, EU_PART, EU_PART_RS);
   }
   if (c->method == EULER_SPH) {
     /* Eq. 5.56 averaged over the plane y = y_i: every profile point within 2h takes the
@@ -552,6 +609,9 @@ void euler_sample(struct euler *e, const struct stats_snapshot *s) {
   if (s->sx)
     budget_planes(c, snap, s->fx, s->t, s->dt, e->pln + e->nwin * nb * PL_LEN,
                   e->kin + e->nwin * nb * KN_LEN);
+  if (s->sx && s->dt > 0.0)
+    euler_rs_snapshot(c, snap, EU_PART, EU_PART_RS, s->t, s->dt,
+                      euler_rs_last_time(c, e->rsb, e->nwin), e->rsb + e->nwin * nb * RW_LEN);
   win[WIN_NSNAP] += 1.0;
   win[WIN_SUM_FX] += s->fx;
   /* wall shear stress over density: minus the wall force on the fluid per unit area (the wall
@@ -563,7 +623,7 @@ void euler_sample(struct euler *e, const struct stats_snapshot *s) {
 }
 
 /* Derivative of f at point i from its neighbours (3-point Lagrange on uneven points). */
-static double deriv(const double *x, const double *f, const int *ok, int n, int i) {
+double euler_deriv(const double *x, const double *f, const int *ok, int n, int i) {
   int l = i - 1, r = i + 1;
   while (l >= 0 && !ok[l]) l--;
   while (r < n && !ok[r]) r++;
@@ -680,7 +740,7 @@ static void stress_balance(const struct euler_config *cfg, const double *mom, co
   /* shear-stress balance (Eq. 5.11-5.13): nu dU/dy - <u'v'> = tau_w/rho (1 - y/delta) */
   res->balance_error = 0.0;
   for (int b = 0; b < nb; b++) {
-    const double dudy = ok[b] ? deriv(res->prof[EP_Y_MEAN], res->prof[EP_U], ok, nb, b) : nan;
+    const double dudy = ok[b] ? euler_deriv(res->prof[EP_Y_MEAN], res->prof[EP_U], ok, nb, b) : nan;
     const double yb = res->prof[EP_Y_MEAN][b];
     /* with LES the modelled stress <nu_t> dU/dy joins the viscous one (Eq. 5.45) */
     const double nu_eff = cfg->nu + (cfg->les && ok[b] ? res->prof[EP_NUT][b] : 0.0);
@@ -701,8 +761,8 @@ static void stress_balance(const struct euler_config *cfg, const double *mom, co
 }
 
 void euler_finalise(const struct euler_config *cfg, const double *win, const double *mom,
-                    const double *snp, const double *pln, const double *kin, const int *complete,
-                    size_t r0, size_t r1, struct euler_result *res) {
+                    const double *snp, const double *pln, const double *kin, const double *rsb,
+                    const int *complete, size_t r0, size_t r1, struct euler_result *res) {
   const int nb = cfg->nb;
   memset(res, 0, sizeof *res);
   res->nb = nb;
@@ -772,6 +832,7 @@ void euler_finalise(const struct euler_config *cfg, const double *win, const dou
                           : nan;
   res->re_tau = res->u_tau * cfg->delta / cfg->nu;
   stress_balance(cfg, mom, pln, kin, complete, r0, r1, ok, tw_force, res);
+  res->rs_budget = euler_rs_profiles(cfg, rsb, complete, r0, r1, res);
   if (!(tw_force > 0.0)) res->balance_error = nan;
   free(ok), free(tot), free(bm), free(sn), free(within);
 }
@@ -816,6 +877,13 @@ static void *reserve_kin(void *owner, int rank, const size_t *dims) {
   return e->kin;
 }
 
+static void *reserve_rsb(void *owner, int rank, const size_t *dims) {
+  struct euler *e = owner;
+  if (rank != 3 || dims[1] != (size_t)e->cfg.nb || dims[2] != RW_LEN) return NULL;
+  reserve_rows(e, dims[0]);
+  return e->rsb;
+}
+
 void euler_state(struct euler *e, struct state_list *L) {
   const size_t rows = e->nwin + 1, nb = (size_t)e->cfg.nb;
   const size_t dw[2] = {rows, WIN_LEN}, dm[3] = {rows, nb, MOM_LEN}, ds[3] = {rows, nb, SCAL_LEN};
@@ -833,12 +901,16 @@ void euler_state(struct euler *e, struct state_list *L) {
   f = state_add(L, "stats/eulerian/planes_kinetic", STATE_F64, 3, dk, e->kin, NULL);
   f->reserve = reserve_kin, f->owner = e;
   f->optional = 1; /* format 1.4: before it, rows without the advective part */
+  const size_t dr[3] = {rows, nb, RW_LEN};
+  f = state_add(L, "stats/eulerian/reynolds_budget", STATE_F64, 3, dr, e->rsb, NULL);
+  f->reserve = reserve_rsb, f->owner = e;
+  f->optional = 1; /* format 1.6: before it, rows without the Reynolds-stress budget */
 }
 
 void euler_running_result(const struct euler *e, struct euler_result *res) {
   const size_t rows = euler_rows(e);
   int *complete = mem_calloc(rows ? rows : 1, sizeof *complete, "Eulerian statistics");
   for (size_t r = 0; r < rows; r++) complete[r] = r < e->nwin;
-  euler_finalise(&e->cfg, e->win, e->mom, e->snp, e->pln, e->kin, complete, 0, rows, res);
+  euler_finalise(&e->cfg, e->win, e->mom, e->snp, e->pln, e->kin, e->rsb, complete, 0, rows, res);
   free(complete);
 }

@@ -89,9 +89,33 @@ struct euler {
   double *snp;               /*!< [row][nb][SCAL_LEN] moments of the per-snapshot bin means of u */
   double *pln;               /*!< [row][nb][PL_LEN] momentum budget sums (enum above) */
   double *kin;               /*!< [row][nb][KN_LEN] kinetic flux of the budget (enum above) */
+  double *rsb;               /*!< [row][nb][RW_LEN] Reynolds-stress budget sums (euler_rs.h) */
   void *work;                /*!< scratch of euler_sample across ranks (euler.c) */
   size_t nsub;               /*!< column subtrees gathered at the last snapshot (diagnostic) */
   double w1[EULER_W1_N + 1]; /*!< plane-averaged kernel W1(q), q = |y_a - y_i| / h (SPH) */
+};
+
+/** Components of the Reynolds-stress budgets (EP_RSB + component * RS_NTERM + term). */
+enum { RS_UU, RS_VV, RS_WW, RS_UV, RS_K, RS_NCOMP };
+
+/** Terms of each budget, contributions to d<u_i'u_j'>/dt per unit mass [m^2/s^3]
+    (docs/theory.md, "Reynolds-stress budgets"): the pair parts of the acceleration (pressure,
+    molecular viscous, eddy-viscous), the walls, the body force, the transfer by the particles'
+    displacements (production + turbulent transport), the production from the profiles, the
+    transport (transfer - production), the rate of change and the closure (sum of the first
+    six less the rate). */
+enum {
+  RT_PRESSURE,
+  RT_VISCOUS,
+  RT_MODEL,
+  RT_WALL,
+  RT_DRIVE,
+  RT_TRANSFER,
+  RT_PRODUCTION,
+  RT_TRANSPORT,
+  RT_RATE,
+  RT_CLOSURE,
+  RS_NTERM
 };
 
 /** Finished profiles: names, units and long names are in euler_prof_meta. */
@@ -133,7 +157,11 @@ enum {
   EP_TAU_INERTIA,
   EP_SE_TAU, /* stderr of the six above and of total_stress, in that order */
   EP_SE_TAU_END = EP_SE_TAU + 7,
-  EP_NPROF = EP_SE_TAU_END
+  EP_RSB = EP_SE_TAU_END, /* the Reynolds-stress budgets: [component][term] (enums above) */
+  EP_RSB_END = EP_RSB + RS_NCOMP * RS_NTERM,
+  EP_RSB_SE = EP_RSB_END, /* their standard errors, in the same order */
+  EP_RSB_SE_END = EP_RSB_SE + RS_NCOMP * RS_NTERM,
+  EP_NPROF = EP_RSB_SE_END
 };
 
 /** Name, units and long name of each finished profile. */
@@ -155,6 +183,7 @@ struct euler_result {
   double balance_error;   /*!< max |total - expected| / u_tau_force^2 over interior bins */
   int budget;             /*!< 1: total_stress is the method-of-planes budget (snapshots with
                                the parts of the acceleration); 0: nu dU/dy - <u'v'> */
+  int rs_budget;          /*!< 1: the Reynolds-stress budgets (EP_RSB ..) were sampled */
   double t0, t1;          /*!< averaged interval [s] */
   double snapshots;       /*!< snapshots averaged */
   int n_batches;          /*!< complete windows used as batches for the standard errors */
@@ -193,14 +222,14 @@ void euler_sample(struct euler *e, const struct stats_snapshot *s);
  *        force), the total shear stress of Eq. 5.11-5.13.
  *        Standard errors from the batch means of the complete windows in the range.
  * @param[in] cfg configuration (bins, delta, nu, rho0, area)
- * @param[in] win,mom,snp,pln,kin raw rows, as in struct euler (pln may be NULL: no budget;
- *            kin may be NULL: no advective part)
+ * @param[in] win,mom,snp,pln,kin,rsb raw rows, as in struct euler (pln may be NULL: no budget;
+ *            kin may be NULL: no advective part; rsb may be NULL: no Reynolds-stress budget)
  * @param[in] complete per-row flag: 1 for a closed window (batch), 0 for a partial one
  * @param[out] res result (allocated; free with euler_result_free)
  */
 void euler_finalise(const struct euler_config *cfg, const double *win, const double *mom,
-                    const double *snp, const double *pln, const double *kin, const int *complete,
-                    size_t r0, size_t r1, struct euler_result *res);
+                    const double *snp, const double *pln, const double *kin, const double *rsb,
+                    const int *complete, size_t r0, size_t r1, struct euler_result *res);
 
 /** @brief Free a result. */
 void euler_result_free(struct euler_result *res);

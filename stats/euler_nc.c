@@ -14,6 +14,7 @@
 #include "alloc.h"
 #include "engine.h"
 #include "euler.h"
+#include "euler_rs.h"
 #include "moments.h"
 #include "ncout.h"
 #include "ncutil.h"
@@ -78,8 +79,10 @@ static int write_profiles(const struct euler *e, const struct euler_result *rp, 
   const size_t nb = (size_t)e->cfg.nb;
   int rc = NC_NOERR, vid;
   for (int k = 0; k < EP_NPROF; k++) {
-    const int model = k == EP_NUT || k == EP_KR || k == EP_TAU_MODEL || k == EP_SE_TAU + 2;
-    if (k == EP_Y || (model && !e->cfg.les)) continue;
+    const int rs = k >= EP_RSB && k < EP_RSB_SE_END, rt = (k - EP_RSB) % RS_NTERM;
+    const int model = k == EP_NUT || k == EP_KR || k == EP_TAU_MODEL || k == EP_SE_TAU + 2 ||
+                      (rs && rt == RT_MODEL);
+    if (k == EP_Y || (model && !e->cfg.les) || (rs && !r.rs_budget)) continue;
     const struct euler_meta *m = &euler_prof_meta[k];
     CK(ncout_def(ncid, m->name, NC_DOUBLE, 1, &dy, m->units, m->long_name, &vid));
     CK(ncout_fill(ncid, vid));
@@ -147,7 +150,7 @@ static int write_raw_windows(const struct euler *e, const struct euler_result *r
   const struct euler_result r = *rp;
   const size_t nb = (size_t)e->cfg.nb, rows = euler_rows(e);
   int rc = NC_NOERR, dy;
-  int g, dw, dwf, dm, ds, dp, dk, vw, vm, vs, vp, vk, vc, v0, v1;
+  int g, dw, dwf, dm, ds, dp, dk, dr, vw, vm, vs, vp, vk, vr, vc, v0, v1;
   CK(nc_def_grp(ncid, "eulerian", &g));
   static const char desc[] =
       "raw per-window moment records of the wall-normal bins; re-average any range of windows "
@@ -164,6 +167,7 @@ static int write_raw_windows(const struct euler *e, const struct euler_result *r
   CK(nc_def_dim(g, "snapshot_moment", SCAL_LEN, &ds));
   CK(nc_def_dim(g, "plane_field", PL_LEN, &dp));
   CK(nc_def_dim(g, "kinetic_field", KN_LEN, &dk));
+  CK(nc_def_dim(g, "reynolds_budget_field", RW_LEN, &dr));
   CK(def_y(&e->cfg, g, dy, r.prof[EP_Y], lo, hi));
   if ((rc = def_window_axis(e, g, dw, err, errlen)) != NC_NOERR) goto fail; /* names its call */
   CK(ncout_labels(g, "window_field", dwf, "fields of the window records", window_fields));
@@ -176,11 +180,15 @@ static int write_raw_windows(const struct euler *e, const struct euler_result *r
                   scal_names));
   CK(ncout_labels(g, "plane_field", dp, "fields of the momentum-budget records", plane_names));
   CK(ncout_labels(g, "kinetic_field", dk, "fields of the kinetic-flux records", kinetic_names));
+  const char *rs_names[RW_LEN];
+  for (int k = 0; k < RW_LEN; k++) rs_names[k] = euler_rs_field_name(k);
+  CK(ncout_labels(g, "reynolds_budget_field", dr, "fields of the Reynolds-stress budget records",
+                  rs_names));
   CK(ncout_def(g, "window_start", NC_DOUBLE, 1, &dw, "s", "start of the averaging window", &v0));
   CK(ncout_def(g, "window_end", NC_DOUBLE, 1, &dw, "s", "end of the averaging window", &v1));
   CK(ncout_def(g, "window_complete", NC_INT, 1, &dw, "1", "1: closed window, 0: still open", &vc));
   const int d2[2] = {dw, dwf}, d3m[3] = {dw, dy, dm}, d3s[3] = {dw, dy, ds}, d3p[3] = {dw, dy, dp},
-            d3k[3] = {dw, dy, dk};
+            d3k[3] = {dw, dy, dk}, d3r[3] = {dw, dy, dr};
   CK(ncout_def(g, "windows", NC_DOUBLE, 2, d2, NULL,
                "per window: t_start [s], t_end [s], snapshots, sum of body force [m/s^2], sums "
                "of tau_w/rho at y=0 and y=2delta [m^2/s^2]",
@@ -204,6 +212,14 @@ static int write_raw_windows(const struct euler *e, const struct euler_result *r
                "planes fields sum_pair_stress .. sum_drive and of the kinetic flux "
                "(docs/stats-format.md, momentum budget)",
                &vk));
+  CK(ncout_def(g, "reynolds_budget", NC_DOUBLE, 3, d3r, NULL,
+               "per window and bin: the sums behind the Reynolds-stress budgets, all samples "
+               "and the window's first apart, weighted by the time since the previous sample: "
+               "mass, m ub_i A_j and m A_j of each part of the acceleration, the quantities "
+               "m (1, u_i, u_i u_j) the displacements carried in; the state's quantities at the "
+               "first and last sample and their times (docs/stats-format.md, Reynolds-stress "
+               "budgets)",
+               &vr));
   for (size_t w = 0; w < rows; w++) {
     const size_t st[1] = {w}, ct[1] = {1};
     const int cpl = w < e->nwin;
@@ -217,6 +233,7 @@ static int write_raw_windows(const struct euler *e, const struct euler_result *r
     CK(nc_put_var_double(g, vs, e->snp));
     CK(nc_put_var_double(g, vp, e->pln));
     CK(nc_put_var_double(g, vk, e->kin));
+    CK(nc_put_var_double(g, vr, e->rsb));
   }
   return NC_NOERR;
 fail:
@@ -314,7 +331,9 @@ static void state(void *self, struct state_list *L) {
 static size_t bytes(const void *self) {
   const struct euler *e = self;
   const size_t nb = (size_t)e->cfg.nb;
-  return e->cap * (WIN_LEN + nb * (MOM_LEN + SCAL_LEN)) * sizeof(double) + euler_work_bytes(e);
+  return e->cap * (WIN_LEN + nb * (MOM_LEN + SCAL_LEN + PL_LEN + KN_LEN + RW_LEN)) *
+             sizeof(double) +
+         euler_work_bytes(e);
 }
 
 static int write(const void *self, double t_reached, int ncid, char *err, size_t errlen) {

@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "euler.h"
+#include "euler_rs.h"
 #include "moments.h"
 #include "ncutil.h"
 #include "pdf.h"
@@ -57,6 +58,7 @@ struct stored {
   size_t rows;
   double *win, *mom, *snp, *pln; /* pln: NULL in a file without the momentum budget */
   double *kin;                   /* NULL in a file without its kinetic flux (before 1.4) */
+  double *rsb;                   /* NULL without the Reynolds-stress budget (before 1.6) */
   int *complete;
   double t_reached; /* the run's reached time (global attribute t_reached; NaN if absent) */
 };
@@ -130,6 +132,21 @@ static int read_stored(const char *path, struct stored *s) {
         bad = 1;
       }
     }
+    int dr; /* the Reynolds-stress budget records: absent before format 1.6 (no budget) */
+    size_t nr = 0;
+    if (!bad && s->rows && nc_inq_varid(g, "reynolds_budget", &vp) == NC_NOERR &&
+        (nc_inq_dimid(g, "reynolds_budget_field", &dr) || nc_inq_dimlen(g, dr, &nr) ||
+         nr != RW_LEN)) {
+      fprintf(stderr, "error: %s: the Reynolds-stress budget records have %zu fields, not %d\n",
+              path, nr, (int)RW_LEN);
+      bad = 1;
+    } else if (!bad && s->rows && nc_inq_varid(g, "reynolds_budget", &vp) == NC_NOERR) {
+      s->rsb = mem_alloc(1, r * nb * RW_LEN * sizeof(double), "chansph extract");
+      if (!s->rsb || nc_get_var_double(g, vp, s->rsb)) {
+        fprintf(stderr, "error: %s: cannot read the raw windows (reynolds_budget)\n", path);
+        bad = 1;
+      }
+    }
     if (!bad && s->rows && nc_inq_varid(g, "planes", &vp) == NC_NOERR) {
       s->pln = mem_alloc(1, r * nb * PL_LEN * sizeof(double), "chansph extract");
       if (!s->pln || nc_get_var_double(g, vp, s->pln)) {
@@ -143,7 +160,8 @@ static int read_stored(const char *path, struct stored *s) {
 }
 
 static void free_stored(struct stored *s) {
-  free(s->win), free(s->mom), free(s->snp), free(s->pln), free(s->kin), free(s->complete);
+  free(s->win), free(s->mom), free(s->snp), free(s->pln), free(s->kin), free(s->rsb),
+      free(s->complete);
 }
 
 /* A time of --window between text and stop: empty gives dflt; anything but one finite number
@@ -423,7 +441,7 @@ int extract_main(int argc, char **argv) {
     return 1;
   }
   struct euler_result res;
-  euler_finalise(&s.cfg, s.win, s.mom, s.snp, s.pln, s.kin, s.complete, r0, r1, &res);
+  euler_finalise(&s.cfg, s.win, s.mom, s.snp, s.pln, s.kin, s.rsb, s.complete, r0, r1, &res);
   extract_header(&a, &s, &res, r0, r1, cols, rms, nc);
   extract_rows(&a, &s, &res, cols, rms, nc);
   euler_result_free(&res);

@@ -1,0 +1,222 @@
+/** @file euler_rs.c @brief Implementation of euler_rs.h. */
+#include "euler_rs.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "alloc.h"
+#include "moments.h"
+
+void euler_rs_add(const struct euler_config *c, const struct stats_snapshot *s, size_t a, double yf,
+                  double *P, size_t stride, size_t offset) {
+  const double ma = s->m ? s->m[a] : 1.0, dt = s->dt;
+  const double *sx = s->sx + a * STATS_ACC;
+  /* the parts of the acceleration by component, the body force last */
+  double A[RS_NPART][3];
+  for (int k = 0; k < STATS_PARTS; k++)
+    for (int d = 0; d < 3; d++) A[k][d] = sx[d * STATS_PARTS + k];
+  A[RS_BODY][0] = s->fx, A[RS_BODY][1] = 0.0, A[RS_BODY][2] = 0.0;
+  double tot[3] = {0.0, 0.0, 0.0};
+  for (int k = 0; k < RS_NPART; k++)
+    for (int d = 0; d < 3; d++) tot[d] += A[k][d];
+  const double u[3] = {s->u[a], s->v[a], s->w[a]};
+  const double ub[3] = {u[0] - 0.5 * dt * tot[0], u[1] - 0.5 * dt * tot[1],
+                        u[2] - 0.5 * dt * tot[2]};
+  for (int side = 0; side < 2; side++) {
+    /* before the step: the forces, and the new state's quantities by the old membership */
+    const double wf = euler_side_weight(yf, c->delta, side);
+    if (wf > 0.0) {
+      const int mirror = c->fold && side;
+      const double sg = mirror ? -1.0 : 1.0, m = wf * ma;
+      double *R = P + (size_t)euler_bin(c, mirror ? 2.0 * c->delta - yf : yf) * stride + offset;
+      const double b[3] = {ub[0], sg * ub[1], ub[2]};
+      for (int k = 0; k < RS_NPART; k++) {
+        const double f[3] = {A[k][0], sg * A[k][1], A[k][2]};
+        double *S = R + RSP_S + k * RS_NPROD, *F = R + RSP_F + k * 3;
+        S[RS_XX] += m * b[0] * f[0], S[RS_YY] += m * b[1] * f[1], S[RS_ZZ] += m * b[2] * f[2];
+        S[RS_XY] += m * b[0] * f[1], S[RS_YX] += m * b[1] * f[0];
+        F[0] += m * f[0], F[1] += m * f[1], F[2] += m * f[2];
+      }
+      const double v = sg * u[1];
+      const double q[RS_NQ] = {m,         m * u[0],        m * v,       m * u[2], m * u[0] * u[0],
+                               m * v * v, m * u[2] * u[2], m * u[0] * v};
+      for (int i = 0; i < RS_NQ; i++) R[RSP_OLD + i] += q[i];
+    }
+    /* the new state by its own positions */
+    const double wh = euler_side_weight(s->y[a], c->delta, side);
+    if (wh > 0.0) {
+      const int mirror = c->fold && side;
+      const double v = (mirror ? -1.0 : 1.0) * u[1], m = wh * ma;
+      double *R =
+          P + (size_t)euler_bin(c, mirror ? 2.0 * c->delta - s->y[a] : s->y[a]) * stride + offset;
+      const double q[RS_NQ] = {m,         m * u[0],        m * v,       m * u[2], m * u[0] * u[0],
+                               m * v * v, m * u[2] * u[2], m * u[0] * v};
+      for (int i = 0; i < RS_NQ; i++) R[RSP_NEW + i] += q[i];
+    }
+  }
+}
+
+void euler_rs_snapshot(const struct euler_config *c, const double *snap, size_t stride,
+                       size_t offset, double t, double dt, double t_prev, double *row) {
+  const double tau = isfinite(t_prev) && t > t_prev ? t - t_prev : dt;
+  for (int b = 0; b < c->nb; b++) {
+    const double *R = snap + (size_t)b * stride + offset;
+    double blk[RB_LEN];
+    blk[RB_N] = 1.0, blk[RB_TAU] = tau, blk[RB_MASS] = tau * R[RSP_NEW + RQ_M];
+    for (int i = 0; i < RS_NPART * RS_NPROD; i++) blk[RB_S + i] = tau * R[RSP_S + i];
+    for (int i = 0; i < RS_NPART * 3; i++) blk[RB_F + i] = tau * R[RSP_F + i];
+    for (int i = 0; i < RS_NQ; i++) blk[RB_K + i] = tau / dt * (R[RSP_NEW + i] - R[RSP_OLD + i]);
+    double *W = row + (size_t)b * RW_LEN;
+    if (W[RW_SUM + RB_N] == 0.0) {
+      memcpy(W + RW_FIRST, blk, sizeof blk);
+      memcpy(W + RW_Q_FIRST, R + RSP_NEW, RS_NQ * sizeof(double));
+      W[RW_T_FIRST] = t;
+    }
+    for (int i = 0; i < RB_LEN; i++) W[RW_SUM + i] += blk[i];
+    memcpy(W + RW_Q_LAST, R + RSP_NEW, RS_NQ * sizeof(double));
+    W[RW_T_LAST] = t;
+  }
+}
+
+double euler_rs_last_time(const struct euler_config *c, const double *rsb, size_t last) {
+  (void)c;
+  for (size_t r = last + 1; r-- > 0;) {
+    const double *W = rsb + r * (size_t)c->nb * RW_LEN; /* bin 0: every bin has every sample */
+    if (W[RW_SUM + RB_N] > 0.0) return W[RW_T_LAST];
+  }
+  return NAN;
+}
+
+const char *euler_rs_field_name(int k) {
+  static char name[RW_LEN][40];
+  static const char *const part[RS_NPART] = {"pressure", "viscous", "model", "wall", "body"};
+  static const char *const prod[RS_NPROD] = {"ubx_Ax", "uby_Ay", "ubz_Az", "ubx_Ay", "uby_Ax"};
+  static const char *const qn[RS_NQ] = {"m", "mu", "mv", "mw", "muu", "mvv", "mww", "muv"};
+  static const char *const xyz[3] = {"x", "y", "z"};
+  if (k < 0 || k >= RW_LEN) return "";
+  if (!name[k][0]) {
+    const char *blk = k < RW_FIRST ? "sum" : "first";
+    const int i = k < RW_FIRST ? k : k < RW_Q_FIRST ? k - RW_FIRST : -1;
+    if (i == RB_N)
+      snprintf(name[k], sizeof name[k], "%s_samples", blk);
+    else if (i == RB_TAU)
+      snprintf(name[k], sizeof name[k], "%s_tau", blk);
+    else if (i == RB_MASS)
+      snprintf(name[k], sizeof name[k], "%s_tau_mass", blk);
+    else if (i >= RB_S && i < RB_F)
+      snprintf(name[k], sizeof name[k], "%s_%s_%s", blk, part[(i - RB_S) / RS_NPROD],
+               prod[(i - RB_S) % RS_NPROD]);
+    else if (i >= RB_F && i < RB_K)
+      snprintf(name[k], sizeof name[k], "%s_%s_A%s", blk, part[(i - RB_F) / 3],
+               xyz[(i - RB_F) % 3]);
+    else if (i >= RB_K)
+      snprintf(name[k], sizeof name[k], "%s_carried_%s", blk, qn[i - RB_K]);
+    else if (k < RW_Q_LAST)
+      snprintf(name[k], sizeof name[k], "state_first_%s", qn[k - RW_Q_FIRST]);
+    else if (k < RW_T_FIRST)
+      snprintf(name[k], sizeof name[k], "state_last_%s", qn[k - RW_Q_LAST]);
+    else
+      snprintf(name[k], sizeof name[k], k == RW_T_FIRST ? "time_first" : "time_last");
+  }
+  return name[k];
+}
+
+/* The velocity indices (i, j) of each stored component, and its quantity q = m u_i u_j. */
+static const int comp_ij[4][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}};
+static const int comp_q[4] = {RQ_UU, RQ_VV, RQ_WW, RQ_UV};
+
+/* The products m ub_i A_j and m ub_j A_i of component c. */
+static const int comp_prod[4][2] = {{RS_XX, RS_XX}, {RS_YY, RS_YY}, {RS_ZZ, RS_ZZ}, {RS_XY, RS_YX}};
+
+/* The terms (RT_PRESSURE .. RT_TRANSFER, RT_RATE) of the four stored components from a block
+   of sums B and the states Q0 at t0, Q1 at t1, with the mean velocity U [3]. */
+static void terms(const double *B, const double *Q0, const double *Q1, double t0, double t1,
+                  const double U[3], double out[4][RS_NTERM]) {
+  const double mass = B[RB_MASS], mean_mass = B[RB_MASS] / B[RB_TAU];
+  for (int c = 0; c < 4; c++) {
+    const int i = comp_ij[c][0], j = comp_ij[c][1];
+    for (int k = 0; k < RS_NPART; k++) {
+      const double *S = B + RB_S + k * RS_NPROD, *F = B + RB_F + k * 3;
+      const double v = S[comp_prod[c][0]] + S[comp_prod[c][1]] - U[i] * F[j] - U[j] * F[i];
+      out[c][k == RS_BODY ? RT_DRIVE : RT_PRESSURE + k] = v / mass;
+    }
+    /* the quantity (u_i - U_i)(u_j - U_j) m carried by the displacements, and its state */
+    const double *K = B + RB_K;
+    out[c][RT_TRANSFER] =
+        (K[comp_q[c]] - U[i] * K[RQ_U + j] - U[j] * K[RQ_U + i] + U[i] * U[j] * K[RQ_M]) / mass;
+    const double e0 =
+        Q0[comp_q[c]] - U[i] * Q0[RQ_U + j] - U[j] * Q0[RQ_U + i] + U[i] * U[j] * Q0[RQ_M];
+    const double e1 =
+        Q1[comp_q[c]] - U[i] * Q1[RQ_U + j] - U[j] * Q1[RQ_U + i] + U[i] * U[j] * Q1[RQ_M];
+    out[c][RT_RATE] = t1 > t0 ? (e1 - e0) / (t1 - t0) / mean_mass : NAN;
+  }
+}
+
+/* Production from the profiles (-<u_i'v'> dU_j/dy - <u_j'v'> dU_i/dy, U = U(y) e_x), the
+   transport (transfer - production), the closure, and k from the stored components. */
+static void derived(double t[RS_NCOMP][RS_NTERM], double dudy, double uv, double vv) {
+  const double prod[4] = {-2.0 * uv * dudy, 0.0, 0.0, -vv * dudy};
+  for (int c = 0; c < 4; c++) {
+    t[c][RT_PRODUCTION] = prod[c];
+    t[c][RT_TRANSPORT] = t[c][RT_TRANSFER] - prod[c];
+    t[c][RT_CLOSURE] = t[c][RT_PRESSURE] + t[c][RT_VISCOUS] + t[c][RT_MODEL] + t[c][RT_WALL] +
+                       t[c][RT_DRIVE] + t[c][RT_TRANSFER] - t[c][RT_RATE];
+  }
+  for (int k = 0; k < RS_NTERM; k++) t[RS_K][k] = 0.5 * (t[RS_UU][k] + t[RS_VV][k] + t[RS_WW][k]);
+}
+
+int euler_rs_profiles(const struct euler_config *c, const double *rsb, const int *complete,
+                      size_t r0, size_t r1, struct euler_result *res) {
+  const int nb = c->nb;
+  int any = 0;
+  double *const *pr = res->prof;
+  int *ok = mem_alloc((size_t)nb, sizeof(int), "Eulerian statistics");
+  for (int b = 0; b < nb; b++) ok[b] = isfinite(pr[EP_U][b]);
+  for (int b = 0; b < nb; b++) {
+    double sum[RB_LEN] = {0}, batch[RS_NCOMP * RS_NTERM][SCAL_LEN];
+    memset(batch, 0, sizeof batch);
+    const double *first = NULL, *last = NULL;
+    const double U[3] = {pr[EP_U][b], pr[EP_V][b], pr[EP_W][b]};
+    const double dudy = ok[b] ? euler_deriv(pr[EP_Y_MEAN], pr[EP_U], ok, nb, b) : NAN;
+    for (size_t r = r0; r < r1 && rsb; r++) {
+      const double *W = rsb + (r * (size_t)nb + (size_t)b) * RW_LEN;
+      if (W[RW_SUM + RB_N] <= 0.0) continue;
+      if (!first) first = W;
+      last = W;
+      for (int i = 0; i < RB_LEN; i++) sum[i] += W[RW_SUM + i];
+      /* a complete window is a batch: its samples after the first, its first and last state */
+      if (!complete[r] || W[RW_SUM + RB_N] < 2.0 || !ok[b]) continue;
+      double blk[RB_LEN], t[RS_NCOMP][RS_NTERM];
+      for (int i = 0; i < RB_LEN; i++) blk[i] = W[RW_SUM + i] - W[RW_FIRST + i];
+      if (!(blk[RB_MASS] > 0.0)) continue;
+      terms(blk, W + RW_Q_FIRST, W + RW_Q_LAST, W[RW_T_FIRST], W[RW_T_LAST], U, t);
+      derived(t, dudy, pr[EP_UV][b], pr[EP_VV][b]);
+      for (int k = 0; k < RS_NCOMP * RS_NTERM; k++)
+        scal_add(batch[k], t[k / RS_NTERM][k % RS_NTERM]);
+    }
+    /* the range: its samples after the first, from the first state to the last */
+    if (first)
+      for (int i = 0; i < RB_LEN; i++) sum[i] -= first[RW_FIRST + i];
+    if (!first || sum[RB_N] < 1.0 || !(sum[RB_MASS] > 0.0) || !ok[b]) {
+      for (int k = EP_RSB; k < EP_RSB_SE_END; k++) pr[k][b] = NAN;
+      continue;
+    }
+    any = 1;
+    double t[RS_NCOMP][RS_NTERM];
+    terms(sum, first + RW_Q_FIRST, last + RW_Q_LAST, first[RW_T_FIRST], last[RW_T_LAST], U, t);
+    derived(t, dudy, pr[EP_UV][b], pr[EP_VV][b]);
+    for (int k = 0; k < RS_NCOMP * RS_NTERM; k++) {
+      pr[EP_RSB + k][b] = t[k / RS_NTERM][k % RS_NTERM];
+      const double *s = batch[k];
+      pr[EP_RSB_SE + k][b] =
+          s[SCAL_N] >= 2.0 ? sqrt(s[SCAL_M2] / (s[SCAL_N] - 1.0) / s[SCAL_N]) : NAN;
+    }
+  }
+  if (!any)
+    for (int k = EP_RSB; k < EP_RSB_SE_END; k++)
+      for (int b = 0; b < nb; b++) pr[k][b] = NAN;
+  free(ok);
+  return any;
+}
