@@ -23,6 +23,7 @@ TOOLS = {
     "spectra_compare": ("spectra_compare", "1-D spectra in x and z against MKM Re_tau = 180"),
     "corr_compare": ("corr_compare", "two-point correlations in x and z against MKM Re_tau = 180"),
     "skewflat_compare": ("skewflat_compare", "skewness and flatness profiles against MKM 180"),
+    "rs_budget": ("budget_compare", "Reynolds-stress budgets (rsb_*) against the MKM 180 balances"),
     "lagr_check": ("lagr_check", "the Lagrangian engine against exact dispersion laws"),
 }
 

@@ -22,13 +22,17 @@ of our own standard error (batch means over the averaging windows; "stderr"): a 
 larger than it is a model or resolution error, one of its size is sampling noise. Writes
 compare.csv and one PNG per quantity (ours with error bars of 2 standard errors, DNS, law of
 the wall).
+A run whose stats.nc has the Reynolds-stress budgets (rsb_*) also gets their table against the
+MKM Re_tau = 180 balances at y+ = 10, 15, 30, 50, rs_budget.csv and (without --no-plots)
+rs_budget_<c>.png in the output directory (`chansph-stats rs_budget --help`).
 """
 import math
 import os
 
 import numpy as np
 
-from . import cli
+from . import budget_compare, cli
+from .budget_compare import read_budgets
 from .cli import InputError
 from .dns import QUANTITIES, read_dns
 from .ncfile import attribute, attribute_or_nan, need, open_nc
@@ -221,6 +225,10 @@ def main(argv, prog="chansph compare"):
         plots(ours, dns, out_dir)
     print_budget(ours)
     print("wrote %s/compare.csv%s" % (out_dir, "" if args.no_plots else " and one PNG per quantity"))
+    budgets = read_budgets(args.stats, args.u_tau) if args.stats.endswith(".nc") else None
+    if budgets is not None:  # the Reynolds-stress budgets (rsb_*) against the MKM balances
+        budget_compare.report(budgets, budget_compare.read_dns(), budget_compare.DEFAULT_LEVELS,
+                              out_dir, not args.no_plots)
     if args.max_error is not None:
         worst = max((max(r[3], r[4]) for r in rows if r[2] > 0), default=math.nan)
         ok = worst <= args.max_error
