@@ -31,22 +31,16 @@ struct cons_parts {
   struct v3 m;  /*!< eddy-viscous (LES) */
 };
 
-/** m_a c_a T(a, b) - m_b c_b T(b, a) of a viscous term by component, the pair terms given. */
-static inline struct v3 antisym(double ma, struct v3 ca, struct v3 tab, double mb, struct v3 cb,
-                                struct v3 tba) {
-  return (struct v3){ma * ca.x * tab.x - mb * cb.x * tba.x, ma * ca.y * tab.y - mb * cb.y * tba.y,
-                     ma * ca.z * tab.z - mb * cb.z * tba.z};
-}
-
-/** The pair (b, a) seen from b: r_ba = -r_ab. */
-static inline struct pair pair_reversed(const struct pair *g) {
-  return (struct pair){-g->dx, -g->dy, -g->dz, g->r2, g->r, g->f};
-}
-
-/* The conservative parts of fluid particle a (CHANSPH_CLONES: one loop per instruction set). */
-static CHANSPH_CLONES struct cons_parts cons_parts_of(const struct model *M,
-                                                      const struct particles *P,
-                                                      const struct nbr *nb, size_t a) {
+/* The conservative parts of fluid particle a for the operator `op` (a constant: one loop per
+   operator). Each viscous pair term is evaluated once: reversing a pair turns r_ab and u_ab
+   into -r_ab and -u_ab, so Violeau's T(b, a) = -(V_a / V_b) T(a, b) (mu_ab symmetric) and
+   Morris' T(b, a) = -(m_a / rho_b + V_a) / (m_b / rho_a + V_b) T(a, b); then
+   m_a c_a T(a, b) - m_b c_b T(b, a) = t (w_a c_a + w_b c_b) with the common factor t and the
+   weights w of each end. */
+enum { OP_MORRIS, OP_VIOLEAU, OP_LES };
+static inline __attribute__((always_inline)) struct cons_parts cons_parts_op(
+    const struct model *M, const struct particles *P, const struct nbr *nb, size_t a,
+    const int op) {
   const struct pair_frame F = pair_frame_of(M);
   const int32_t *restrict nl = pair_list(nb, a);
   const double *restrict x = P->x, *restrict y = P->y, *restrict z = P->z;
@@ -54,45 +48,53 @@ static CHANSPH_CLONES struct cons_parts cons_parts_of(const struct model *M,
   const double *restrict m = P->m, *restrict rho = P->rho, *restrict vol = P->vol;
   const double *restrict pr2 = P->pr2, *restrict gam = P->gam;
   const double *restrict vfx = P->vfx, *restrict vfy = P->vfy, *restrict vfz = P->vfz;
-  const double *restrict nur = P->nur ? P->nur : P->rho; /* read only with LES */
-  const int violeau = M->viscous == VISCOUS_VIOLEAU, les = M->les;
+  const double *restrict nur = op == OP_LES ? P->nur : P->rho; /* read only with LES */
   const double xa = x[a], ya = y[a], za = z[a], ua = u[a], va = v[a], wa = w[a];
   const double ma = m[a], ra = rho[a], pa = pr2[a], iga = 1.0 / gam[a], vola = vol[a];
   const double nu = M->nu, np2 = M->dim + 2.0, eta2 = M->eta2;
-  const double nua = les ? nu + nur[a] : nu;
-  const struct v3 ca = {vfx[a], vfy[a], vfz[a]};
+  const double nura = op == OP_LES ? nur[a] : 0.0;
+  const double cax = vfx[a], cay = vfy[a], caz = vfz[a];
   double px = 0, py = 0, pz = 0, vx = 0, vy = 0, vz = 0, tx = 0, ty = 0, tz = 0;
   const int nf = nb->nfluid[a];
 #pragma omp simd reduction(+ : px, py, pz, vx, vy, vz, tx, ty, tz)
   for (int j = 0; j < nf; j++) {
     const int32_t b = nl[j];
-    const struct pair g = pair_at(&F, xa - x[b], ya - y[b], za - z[b]), gr = pair_reversed(&g);
+    const struct pair g = pair_at(&F, xa - x[b], ya - y[b], za - z[b]);
     const struct v3 pp = pressure_pair(&g, m[b], pa, pr2[b]); /* times -(1/gamma_a + 1/gamma_b) */
     const double ig = iga + 1.0 / gam[b];
     px += ig * pp.x, py += ig * pp.y, pz += ig * pp.z;
-    const struct v3 uab = {ua - u[b], va - v[b], wa - w[b]}, uba = {-uab.x, -uab.y, -uab.z};
-    const struct v3 cb = {vfx[b], vfy[b], vfz[b]};
-    struct v3 mol, tot = {0, 0, 0};
-    if (!violeau && !les) { /* Morris */
-      mol = antisym(ma, ca, viscous_morris_pair(&g, m[b], 1.0 / ra, vol[b], eta2, uab), m[b], cb,
-                    viscous_morris_pair(&gr, ma, 1.0 / rho[b], vola, eta2, uba));
-    } else { /* Violeau; LES: with mu = rho (nu + nu_r), prefactor 1/(gamma rho) */
-      const double mu0 = 0.5 * (ra + rho[b]) * (les ? nu : 1.0);
-      mol = antisym(ma, ca, viscous_violeau_pair(&g, vol[b], mu0, np2, eta2, uab), m[b], cb,
-                    viscous_violeau_pair(&gr, vola, mu0, np2, eta2, uba));
-      if (les) {
-        const double mu = 0.5 * (ra * nua + rho[b] * (nu + nur[b]));
-        tot = antisym(ma, ca, viscous_violeau_pair(&g, vol[b], mu, np2, eta2, uab), m[b], cb,
-                      viscous_violeau_pair(&gr, vola, mu, np2, eta2, uba));
-      }
+    const struct v3 uab = {ua - u[b], va - v[b], wa - w[b]};
+    double wa_, wb_; /* the weights of the two ends */
+    struct v3 t;     /* the common factor */
+    if (op == OP_MORRIS) {
+      t = viscous_morris_pair(&g, 1.0, 1.0, 0.0, eta2, uab); /* F r^2 / (r^2 + eta^2) u_ab */
+      wa_ = ma * (m[b] / ra + vol[b]), wb_ = m[b] * (ma / rho[b] + vola);
+    } else { /* Violeau; LES: mu = rho (nu + nu_r), prefactor 1/(gamma rho) */
+      t = viscous_violeau_pair(&g, 1.0, 1.0, np2, eta2, uab); /* without V_b mu_ab */
+      wa_ = ma * vol[b], wb_ = m[b] * vola;
     }
-    vx += mol.x, vy += mol.y, vz += mol.z;
-    tx += tot.x - (les ? mol.x : 0.0), ty += tot.y - (les ? mol.y : 0.0);
-    tz += tot.z - (les ? mol.z : 0.0);
+    const double mu0 = op == OP_MORRIS ? 1.0 : 0.5 * (ra + rho[b]) * (op == OP_LES ? nu : 1.0);
+    const double mx = mu0 * t.x * (wa_ * cax + wb_ * vfx[b]);
+    const double my = mu0 * t.y * (wa_ * cay + wb_ * vfy[b]);
+    const double mz = mu0 * t.z * (wa_ * caz + wb_ * vfz[b]);
+    vx += mx, vy += my, vz += mz;
+    if (op == OP_LES) { /* the eddy-viscous rest: mu_ab of the eddy viscosity alone */
+      const double mr = 0.5 * (ra * nura + rho[b] * nur[b]) / mu0;
+      tx += mr * mx, ty += mr * my, tz += mr * mz;
+    }
   }
   const double h = 0.5 / ma;
   return (struct cons_parts){
       {-0.5 * px, -0.5 * py, -0.5 * pz}, {h * vx, h * vy, h * vz}, {h * tx, h * ty, h * tz}};
+}
+
+/* The conservative parts of fluid particle a (CHANSPH_CLONES: one loop per instruction set). */
+static CHANSPH_CLONES struct cons_parts cons_parts_of(const struct model *M,
+                                                      const struct particles *P,
+                                                      const struct nbr *nb, size_t a) {
+  if (M->les) return cons_parts_op(M, P, nb, a, OP_LES);
+  if (M->viscous == VISCOUS_VIOLEAU) return cons_parts_op(M, P, nb, a, OP_VIOLEAU);
+  return cons_parts_op(M, P, nb, a, OP_MORRIS);
 }
 
 void sph_budget_pairs(const struct model *M, struct particles *P, const struct nbr *nb,
