@@ -666,6 +666,56 @@ static void test_budget_identity(void) {
   }
 }
 
+/* The Reynolds-stress budget on a hand-computed case (docs/theory.md, "Reynolds-stress
+   budgets"): two particles of mass 1 at rest in y in bin 0, u = (1, 3) at t = 1, then after a
+   step dt = 0.1 with pressure accelerations (2, -1) u = (1.2, 2.9) at t = 1.1. U = the mean of
+   the four samples, 2.025; the range leaves out the first sample, so the pressure term of uu
+   is (2 sum (ub - U) A) / M with ub = u - dt A / 2 = (1.1, 2.95): (2 (-0.75) - 2 U) / 2 =
+   -2.775, and the rate is ((1.2 - U)^2 + (2.9 - U)^2 - (1 - U)^2 - (3 - U)^2) / 0.1 / 2 =
+   -2.775: the closure is zero, nothing else acts. */
+static void test_rs_budget_known(void) {
+  struct euler_config cfg = config();
+  cfg.nb = 2, cfg.fold = 0, cfg.window = 10.0, cfg.y0 = 0.0, cfg.y1 = 2.0;
+  struct euler e;
+  euler_init(&e, &cfg);
+  double y[2] = {0.5, 0.5}, v[2] = {0, 0}, w[2] = {0, 0}, p[2] = {0, 0}, rho[2] = {1, 1};
+  double m[2] = {1, 1}, sx[2 * STATS_ACC] = {0};
+  double u1[2] = {1.0, 3.0}, u2[2] = {1.2, 2.9};
+  struct stats_snapshot snap = {.n = 2,
+                                .y = y,
+                                .u = u1,
+                                .v = v,
+                                .w = w,
+                                .p = p,
+                                .rho = rho,
+                                .m = m,
+                                .sx = sx,
+                                .t = 1.0,
+                                .dt = 0.1,
+                                .wall_fx = {0.0, 0.0}};
+  euler_sample(&e, &snap);
+  sx[0] = 2.0, sx[STATS_ACC] = -1.0; /* x pressure parts */
+  snap.u = u2, snap.t = 1.1;
+  euler_sample(&e, &snap);
+  struct euler_result r;
+  finalise(&e, &r);
+  const double *pr = r.prof[EP_RSB + RS_UU * RS_NTERM + RT_PRESSURE];
+  const double *rate = r.prof[EP_RSB + RS_UU * RS_NTERM + RT_RATE];
+  const double *cl = r.prof[EP_RSB + RS_UU * RS_NTERM + RT_CLOSURE];
+  const double *vv = r.prof[EP_RSB + RS_VV * RS_NTERM + RT_PRESSURE];
+  const double *k = r.prof[EP_RSB + RS_K * RS_NTERM + RT_PRESSURE];
+  printf(
+      "Reynolds-stress budget, known case: uu pressure %.12g rate %.12g closure %.3g "
+      "(expected -2.775, -2.775, 0); vv %.3g, k %.12g\n",
+      pr[0], rate[0], cl[0], vv[0], k[0]);
+  EXPECT(r.rs_budget && fabs(pr[0] + 2.775) < 1e-12 && fabs(rate[0] + 2.775) < 1e-12 &&
+             fabs(cl[0]) < 1e-12 && vv[0] == 0.0 && fabs(k[0] + 1.3875) < 1e-12,
+         "Reynolds-stress budget of the known case");
+  EXPECT(isnan(pr[1]), "an empty bin has no budget");
+  euler_result_free(&r);
+  euler_free(&e);
+}
+
 int main(void) {
   double *buf = malloc(6 * NP * sizeof(double));
   test_known_field(buf);
@@ -674,6 +724,7 @@ int main(void) {
   test_corr();
   test_quad();
   test_budget_identity();
+  test_rs_budget_known();
   test_sph_profiles();
   test_lagr_ou();
   test_lagr_pdf();
