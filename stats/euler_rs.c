@@ -9,6 +9,34 @@
 #include "alloc.h"
 #include "moments.h"
 
+/* The budget's bins are hat functions (cloud in cell): a particle at y between the centres of
+   bins b and b + 1 counts 1 - s in b and s in b + 1 (all in the end bins beyond their centres),
+   so that what a step's displacement carries into a bin changes smoothly with the positions:
+   with hard bins it would be whole particles crossing an edge, a noise the sampling of one step
+   in N does not average out (each sample stands for N steps whose crossings largely cancel).
+   Returns b; *s the share of b + 1. */
+static int hat(const struct euler_config *c, double y, double *s) {
+  const double x = (y - c->y0) * (c->nb / (c->y1 - c->y0)) - 0.5;
+  if (!(x > 0.0)) return *s = 0.0, 0;
+  if (x >= c->nb - 1) return *s = 0.0, c->nb - 1;
+  const int b = (int)x;
+  *s = x - b;
+  return b;
+}
+
+/* Add the particle values to the records of the bins of (folded) position y. */
+static void add_at(const struct euler_config *c, double y, const double *val, int n, int at,
+                   double *P, size_t stride, size_t offset) {
+  double s;
+  const int b = hat(c, y, &s);
+  double *R = P + (size_t)b * stride + offset + at;
+  for (int i = 0; i < n; i++) R[i] += (1.0 - s) * val[i];
+  if (s > 0.0) {
+    R += stride;
+    for (int i = 0; i < n; i++) R[i] += s * val[i];
+  }
+}
+
 void euler_rs_add(const struct euler_config *c, const struct stats_snapshot *s, size_t a, double yf,
                   double *P, size_t stride, size_t offset) {
   const double ma = s->m ? s->m[a] : 1.0, dt = s->dt;
@@ -25,35 +53,34 @@ void euler_rs_add(const struct euler_config *c, const struct stats_snapshot *s, 
   const double ub[3] = {u[0] - 0.5 * dt * tot[0], u[1] - 0.5 * dt * tot[1],
                         u[2] - 0.5 * dt * tot[2]};
   for (int side = 0; side < 2; side++) {
+    const int mirror = c->fold && side;
+    const double sg = mirror ? -1.0 : 1.0;
     /* before the step: the forces, and the new state's quantities by the old membership */
     const double wf = euler_side_weight(yf, c->delta, side);
     if (wf > 0.0) {
-      const int mirror = c->fold && side;
-      const double sg = mirror ? -1.0 : 1.0, m = wf * ma;
-      double *R = P + (size_t)euler_bin(c, mirror ? 2.0 * c->delta - yf : yf) * stride + offset;
-      const double b[3] = {ub[0], sg * ub[1], ub[2]};
+      const double m = wf * ma, b[3] = {ub[0], sg * ub[1], ub[2]};
+      double sf[RSP_NEW - RSP_S];
       for (int k = 0; k < RS_NPART; k++) {
         const double f[3] = {A[k][0], sg * A[k][1], A[k][2]};
-        double *S = R + RSP_S + k * RS_NPROD, *F = R + RSP_F + k * 3;
-        S[RS_XX] += m * b[0] * f[0], S[RS_YY] += m * b[1] * f[1], S[RS_ZZ] += m * b[2] * f[2];
-        S[RS_XY] += m * b[0] * f[1], S[RS_YX] += m * b[1] * f[0];
-        F[0] += m * f[0], F[1] += m * f[1], F[2] += m * f[2];
+        double *S = sf + k * RS_NPROD, *F = sf + RS_NPART * RS_NPROD + k * 3;
+        S[RS_XX] = m * b[0] * f[0], S[RS_YY] = m * b[1] * f[1], S[RS_ZZ] = m * b[2] * f[2];
+        S[RS_XY] = m * b[0] * f[1], S[RS_YX] = m * b[1] * f[0];
+        F[0] = m * f[0], F[1] = m * f[1], F[2] = m * f[2];
       }
-      const double v = sg * u[1];
+      const double yb = mirror ? 2.0 * c->delta - yf : yf, v = sg * u[1];
       const double q[RS_NQ] = {m,         m * u[0],        m * v,       m * u[2], m * u[0] * u[0],
                                m * v * v, m * u[2] * u[2], m * u[0] * v};
-      for (int i = 0; i < RS_NQ; i++) R[RSP_OLD + i] += q[i];
+      add_at(c, yb, sf, RSP_NEW - RSP_S, RSP_S, P, stride, offset);
+      add_at(c, yb, q, RS_NQ, RSP_OLD, P, stride, offset);
     }
     /* the new state by its own positions */
     const double wh = euler_side_weight(s->y[a], c->delta, side);
     if (wh > 0.0) {
-      const int mirror = c->fold && side;
-      const double v = (mirror ? -1.0 : 1.0) * u[1], m = wh * ma;
-      double *R =
-          P + (size_t)euler_bin(c, mirror ? 2.0 * c->delta - s->y[a] : s->y[a]) * stride + offset;
+      const double v = sg * u[1], m = wh * ma;
+      const double yb = mirror ? 2.0 * c->delta - s->y[a] : s->y[a];
       const double q[RS_NQ] = {m,         m * u[0],        m * v,       m * u[2], m * u[0] * u[0],
                                m * v * v, m * u[2] * u[2], m * u[0] * v};
-      for (int i = 0; i < RS_NQ; i++) R[RSP_NEW + i] += q[i];
+      add_at(c, yb, q, RS_NQ, RSP_NEW, P, stride, offset);
     }
   }
 }

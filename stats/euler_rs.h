@@ -14,13 +14,14 @@
  * E = sum m (u_i - U_i)(u_j - U_j) over the bin then changes by exactly the sum of the parts'
  * terms dt sum m ((ub_i - U_i) A^k_j + (ub_j - U_j) A^k_i) and the transfer of the
  * displacements; U enters only at the end (euler_rs_profiles), so any range of windows can be
- * re-averaged. Sampled every step the budget closes to round-off; sampled every N steps each
- * sample stands for the time since the one before.
+ * re-averaged. The budget's bins are hat functions on the bin centres (cloud in cell, euler_rs.c),
+ * so that the transfer of one step is a smooth function of the positions. Sampled every step the
+ * budget closes to round-off; sampled every N steps each sample stands for the time since the one
+ * before.
  */
 #ifndef CHANSPH_EULER_RS_H
 #define CHANSPH_EULER_RS_H
 
-#include <math.h>
 #include <stddef.h>
 
 #include "contract.h"
@@ -71,13 +72,6 @@ enum {
   RW_T_LAST,
   RW_LEN
 };
-
-/** @brief The bin of a (folded) position y: uniform bins, samples outside [y0, y1] in the end
-           bins. */
-static inline int euler_bin(const struct euler_config *c, double y) {
-  const int b = (int)floor((y - c->y0) * (c->nb / (c->y1 - c->y0)));
-  return b < 0 ? 0 : b >= c->nb ? c->nb - 1 : b;
-}
 
 /** @brief The share of a particle at y in the upper (side 1) or lower (side 0) half of the
            channel: all of it, or half within 1e-9 delta of the centre (euler.c). */
