@@ -26,7 +26,9 @@
 
 /** The conservative parts of particle a's fluid pair forces per unit mass of a. */
 struct cons_parts {
-  struct v3 p;  /*!< pressure (symmetric form) */
+  struct v3 p; /*!< pressure (symmetric form) */
+  struct v3
+      pn; /*!< its configurational part, -p_a/rho_a^2 sum_b (1/gamma_a + 1/gamma_b) m_b grad W */
   struct v3 mu; /*!< molecular viscous */
   struct v3 m;  /*!< eddy-viscous (LES) */
 };
@@ -55,14 +57,17 @@ static inline __attribute__((always_inline)) struct cons_parts cons_parts_op(
   const double nura = op == OP_LES ? nur[a] : 0.0;
   const double cax = vfx[a], cay = vfy[a], caz = vfz[a];
   double px = 0, py = 0, pz = 0, vx = 0, vy = 0, vz = 0, tx = 0, ty = 0, tz = 0;
+  double nx = 0, ny = 0, nz = 0;
   const int nf = nb->nfluid[a];
-#pragma omp simd reduction(+ : px, py, pz, vx, vy, vz, tx, ty, tz)
+#pragma omp simd reduction(+ : px, py, pz, vx, vy, vz, tx, ty, tz, nx, ny, nz)
   for (int j = 0; j < nf; j++) {
     const int32_t b = nl[j];
     const struct pair g = pair_at(&F, xa - x[b], ya - y[b], za - z[b]);
     const struct v3 pp = pressure_pair(&g, m[b], pa, pr2[b]); /* times -(1/gamma_a + 1/gamma_b) */
     const double ig = iga + 1.0 / gam[b];
     px += ig * pp.x, py += ig * pp.y, pz += ig * pp.z;
+    const struct v3 pc = pressure_pair(&g, m[b], pa, pa); /* its configurational part */
+    nx += ig * pc.x, ny += ig * pc.y, nz += ig * pc.z;
     const struct v3 uab = {ua - u[b], va - v[b], wa - w[b]};
     double wa_, wb_; /* the weights of the two ends */
     struct v3 t;     /* the common factor */
@@ -84,8 +89,10 @@ static inline __attribute__((always_inline)) struct cons_parts cons_parts_op(
     }
   }
   const double h = 0.5 / ma;
-  return (struct cons_parts){
-      {-0.5 * px, -0.5 * py, -0.5 * pz}, {h * vx, h * vy, h * vz}, {h * tx, h * ty, h * tz}};
+  return (struct cons_parts){{-0.5 * px, -0.5 * py, -0.5 * pz},
+                             {-0.5 * nx, -0.5 * ny, -0.5 * nz},
+                             {h * vx, h * vy, h * vz},
+                             {h * tx, h * ty, h * tz}};
 }
 
 /* The conservative parts of fluid particle a (CHANSPH_CLONES: one loop per instruction set). */
@@ -115,6 +122,9 @@ void sph_budget_pairs(const struct model *M, struct particles *P, const struct n
       sx[SX_PRESSURE] = cp, sx[SX_VISCOUS] = mu[k], sx[SX_MODEL] = mo[k];
       sx[SX_WALL] += rest;
       if (wall_ax && k == 0) wall_ax[a] += rest;
+      /* the pressure noise, of the symmetric form only */
+      if (P->sxn)
+        P->sxn[3 * a + k] = corrected ? 0.0 : (k == 0 ? c.pn.x : k == 1 ? c.pn.y : c.pn.z);
     }
   }
   timer_pop();

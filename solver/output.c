@@ -471,6 +471,7 @@ void output_sample(struct output *o, struct sim *S) {
                                       .ay = P->ay,
                                       .az = P->az,
                                       .sx = P->sx_live ? P->sx : NULL,
+                                      .sx_noise = P->sx_live ? P->sxn : NULL,
                                       .id = P->id,
                                       .skip = P->kind,
                                       .t = S->t,

@@ -108,6 +108,8 @@ const struct part_field part_fields[] = {
      0, 0},
     {F(sx), "stress_ax", NULL, PT_F64, SX_STRIDE, PF_PERMUTE | PF_MIGRATE, PN_EULERIAN, F(sx_live),
      0, NULL, NULL, 0, 0},
+    {F(sxn), "stress_ax_noise", NULL, PT_F64, 3, PF_PERMUTE | PF_MIGRATE, PN_EULERIAN, F(sx_live),
+     0, NULL, NULL, 0, 0},
     {F(vfx), "budget_vf_x", NULL, PT_F64, 1, 0, PN_EULERIAN, 0, 0, NULL, NULL, 0, PR_BUDGET},
     {F(vfy), "budget_vf_y", NULL, PT_F64, 1, 0, PN_EULERIAN, 0, 0, NULL, NULL, 0, PR_BUDGET},
     {F(vfz), "budget_vf_z", NULL, PT_F64, 1, 0, PN_EULERIAN, 0, 0, NULL, NULL, 0, PR_BUDGET},

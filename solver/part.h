@@ -53,6 +53,10 @@ struct particles {
       of the statistics (stats/contract.h).
      NULL without Eulerian statistics; permuted and migrated with the particles while sx_live. */
   double *sx;
+  /** The configurational part of sx's pressure part (3 per particle, x y z): the pressure pair
+      forces' 2 p_a / rho_a^2 sum_b m_b grad W_ab, which vanishes for a uniform arrangement (the
+      scheme's pressure noise; sph_budget_pairs); NULL without Eulerian statistics. */
+  double *sxn;
   int sx_live; /*!< 1: sx holds the values of the last force pass (a sampled step) */
   /** The viscous prefactor of each component (vis k_x, vis kappa, vis k_z of term_viscous.h) of
       the last sampled force pass, which the conservative split of the budget reads at the

@@ -162,7 +162,8 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
  * @brief The conservative split of the budget parts (budget_pairs.c): after a sampled force pass
  *        (P->sx_live) and the refresh PR_BUDGET, replaces the pair parts of P->sx by the
  *        antisymmetric parts of the fluid pair forces, (f_ab - f_ba)/2, and adds the rest to
- *        the walls' part and to wall_ax (if not NULL); the accelerations are not changed.
+ *        the walls' part and to wall_ax (if not NULL), and stores the configurational part of
+ *        the pressure part in P->sxn (the pressure noise); the accelerations are not changed.
  */
 void sph_budget_pairs(const struct model *M, struct particles *P, const struct nbr *nb,
                       double *wall_ax);

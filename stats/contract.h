@@ -56,6 +56,11 @@ struct stats_snapshot {
   /** Parts of the acceleration of the force pass that led to this state, STATS_ACC per
       particle (x, y, z parts, enum stats_part) [m/s^2], or NULL: the budgets. */
   const double *sx;
+  /** The configurational part of the pressure part of sx, 3 per particle (x, y, z): the
+      pressure pair forces' share 2 p_a / rho_a^2 sum_b m_b grad W_ab (with the gamma factors of
+      the symmetric form), which vanishes for a uniform particle arrangement: the scheme's
+      pressure noise [m/s^2]; NULL: not split. */
+  const double *sx_noise;
   const double *nu_t;     /*!< eddy viscosity [m^2/s], or NULL (no LES) */
   const double *k_r;      /*!< residual kinetic energy [m^2/s^2], or NULL (no LES) */
   const int64_t *id;      /*!< global ids */

@@ -44,49 +44,54 @@ struct euler_work {
 
 /* The Reynolds-stress budget profiles of component c (its name in the long names: what), all
    terms in the order of RT_*; sfx, pre: the name suffix and long-name prefix (standard errors). */
-#define RSB_META(c, what, sfx, pre)                                                            \
-  {"rsb_" c "_pressure" sfx, "m^2/s^3",                                                        \
-   pre "budget of " what                                                                       \
-       ": the fluctuating velocities times the pressure pair forces (velocity-"                \
-       "pressure-gradient term; DNS: pressure-strain + pressure diffusion)"},                  \
-      {"rsb_" c "_viscous" sfx, "m^2/s^3",                                                     \
-       pre "budget of " what                                                                   \
-           ": the fluctuating velocities times the molecular viscous pair "                    \
-           "forces (DNS: dissipation + viscous diffusion, with rsb_" c "_wall)"},              \
-      {"rsb_" c "_model" sfx, "m^2/s^3",                                                       \
-       pre "budget of " what                                                                   \
-           ": the fluctuating velocities times the eddy-viscous pair forces "                  \
-           "(LES)"},                                                                           \
-      {"rsb_" c "_wall" sfx, "m^2/s^3",                                                        \
-       pre "budget of " what                                                                   \
-           ": the fluctuating velocities times everything the walls exert "                    \
-           "(vertex pressure and viscous terms, wall law, the pair forces' non-antisymmetric " \
-           "rest)"},                                                                           \
-      {"rsb_" c "_drive" sfx, "m^2/s^3",                                                       \
-       pre "budget of " what                                                                   \
-           ": the fluctuating velocities times the body force (zero on "                       \
-           "average)"},                                                                        \
-      {"rsb_" c "_transfer" sfx, "m^2/s^3",                                                    \
-       pre "budget of " what                                                                   \
-           ": carried into the bin by the particles' displacements, with the "                 \
-           "fluctuations about the bin's mean velocity (production + turbulent transport)"},   \
-      {"rsb_" c "_production" sfx, "m^2/s^3",                                                  \
-       pre "budget of " what                                                                   \
-           ": production -<u_i'v'> dU_j/dy - <u_j'v'> dU_i/dy from the "                       \
-           "profiles"},                                                                        \
-      {"rsb_" c "_transport" sfx, "m^2/s^3",                                                   \
-       pre "budget of " what                                                                   \
-           ": turbulent transport, transfer less production (DNS: turbulent "                  \
-           "diffusion)"},                                                                      \
-      {"rsb_" c "_rate" sfx, "m^2/s^3",                                                        \
-       pre "budget of " what                                                                   \
-           ": rate of change from the first to the last sample (zero in a "                    \
-           "steady state)"},                                                                   \
-  {                                                                                            \
-    "rsb_" c "_closure" sfx, "m^2/s^3",                                                        \
-        pre "budget of " what                                                                  \
-            ": pressure + viscous + model + wall + drive + transfer - rate "                   \
-            "(round-off when sampled every step)"                                              \
+#define RSB_META(c, what, sfx, pre)                                                               \
+  {"rsb_" c "_pressure" sfx, "m^2/s^3",                                                           \
+   pre "budget of " what                                                                          \
+       ": the fluctuating velocities times the pressure pair forces (velocity-"                   \
+       "pressure-gradient term; DNS: pressure-strain + pressure diffusion)"},                     \
+      {"rsb_" c "_viscous" sfx, "m^2/s^3",                                                        \
+       pre "budget of " what                                                                      \
+           ": the fluctuating velocities times the molecular viscous pair "                       \
+           "forces (DNS: dissipation + viscous diffusion, with rsb_" c "_wall)"},                 \
+      {"rsb_" c "_model" sfx, "m^2/s^3",                                                          \
+       pre "budget of " what                                                                      \
+           ": the fluctuating velocities times the eddy-viscous pair forces "                     \
+           "(LES)"},                                                                              \
+      {"rsb_" c "_wall" sfx, "m^2/s^3",                                                           \
+       pre "budget of " what                                                                      \
+           ": the fluctuating velocities times everything the walls exert "                       \
+           "(vertex pressure and viscous terms, wall law, the pair forces' non-antisymmetric "    \
+           "rest)"},                                                                              \
+      {"rsb_" c "_drive" sfx, "m^2/s^3",                                                          \
+       pre "budget of " what                                                                      \
+           ": the fluctuating velocities times the body force (zero on "                          \
+           "average)"},                                                                           \
+      {"rsb_" c "_transfer" sfx, "m^2/s^3",                                                       \
+       pre "budget of " what                                                                      \
+           ": carried into the bin by the particles' displacements, with the "                    \
+           "fluctuations about the bin's mean velocity (production + turbulent transport)"},      \
+      {"rsb_" c "_production" sfx, "m^2/s^3",                                                     \
+       pre "budget of " what                                                                      \
+           ": production -<u_i'v'> dU_j/dy - <u_j'v'> dU_i/dy from the "                          \
+           "profiles"},                                                                           \
+      {"rsb_" c "_transport" sfx, "m^2/s^3",                                                      \
+       pre "budget of " what                                                                      \
+           ": turbulent transport, transfer less production (DNS: turbulent "                     \
+           "diffusion)"},                                                                         \
+      {"rsb_" c "_rate" sfx, "m^2/s^3",                                                           \
+       pre "budget of " what                                                                      \
+           ": rate of change from the first to the last sample (zero in a "                       \
+           "steady state)"},                                                                      \
+      {"rsb_" c "_closure" sfx, "m^2/s^3",                                                        \
+       pre "budget of " what                                                                      \
+           ": pressure + viscous + model + wall + drive + transfer - rate "                       \
+           "(round-off when sampled every step)"},                                                \
+  {                                                                                               \
+    "rsb_" c "_pressure_noise" sfx, "m^2/s^3",                                                    \
+        pre "budget of " what                                                                     \
+            ": the configurational part of the pressure term, the fluctuating "                   \
+            "velocities times the pair forces 2 p_a/rho_a^2 sum_b m_b grad W_ab that vanish for " \
+            "a uniform particle arrangement (the scheme's pressure noise; included in pressure)"  \
   }
 #define RSB_ALL(sfx, pre)                                                     \
   RSB_META("uu", "<u'u'>", sfx, pre), RSB_META("vv", "<v'v'>", sfx, pre),     \

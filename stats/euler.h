@@ -102,8 +102,8 @@ enum { RS_UU, RS_VV, RS_WW, RS_UV, RS_K, RS_NCOMP };
     (docs/theory.md, "Reynolds-stress budgets"): the pair parts of the acceleration (pressure,
     molecular viscous, eddy-viscous), the walls, the body force, the transfer by the particles'
     displacements (production + turbulent transport), the production from the profiles, the
-    transport (transfer - production), the rate of change and the closure (sum of the first
-    six less the rate). */
+    transport (transfer - production), the rate of change, the closure (sum of the first
+    six less the rate) and the configurational (noise) part of the pressure term. */
 enum {
   RT_PRESSURE,
   RT_VISCOUS,
@@ -115,6 +115,7 @@ enum {
   RT_TRANSPORT,
   RT_RATE,
   RT_CLOSURE,
+  RT_NOISE, /* the configurational part of RT_PRESSURE (pressure noise), not in the closure */
   RS_NTERM
 };
 

@@ -46,8 +46,9 @@ void euler_rs_add(const struct euler_config *c, const struct stats_snapshot *s, 
   for (int k = 0; k < STATS_PARTS; k++)
     for (int d = 0; d < 3; d++) A[k][d] = sx[d * STATS_PARTS + k];
   A[RS_BODY][0] = s->fx, A[RS_BODY][1] = 0.0, A[RS_BODY][2] = 0.0;
-  double tot[3] = {0.0, 0.0, 0.0};
-  for (int k = 0; k < RS_NPART; k++)
+  for (int d = 0; d < 3; d++) A[RS_NOISE][d] = s->sx_noise ? s->sx_noise[3 * a + d] : 0.0;
+  double tot[3] = {0.0, 0.0, 0.0}; /* the noise is inside the pressure part */
+  for (int k = 0; k <= RS_BODY; k++)
     for (int d = 0; d < 3; d++) tot[d] += A[k][d];
   const double u[3] = {s->u[a], s->v[a], s->w[a]};
   const double ub[3] = {u[0] - 0.5 * dt * tot[0], u[1] - 0.5 * dt * tot[1],
@@ -118,7 +119,8 @@ double euler_rs_last_time(const struct euler_config *c, const double *rsb, size_
 
 const char *euler_rs_field_name(int k) {
   static char name[RW_LEN][40];
-  static const char *const part[RS_NPART] = {"pressure", "viscous", "model", "wall", "body"};
+  static const char *const part[RS_NPART] = {"pressure", "viscous", "model",
+                                             "wall",     "body",    "pressure_noise"};
   static const char *const prod[RS_NPROD] = {"ubx_Ax", "uby_Ay", "ubz_Az", "ubx_Ay", "uby_Ax"};
   static const char *const qn[RS_NQ] = {"m", "mu", "mv", "mw", "muu", "mvv", "mww", "muv"};
   static const char *const xyz[3] = {"x", "y", "z"};
@@ -167,7 +169,7 @@ static void terms(const double *B, const double *Q0, const double *Q1, double t0
     for (int k = 0; k < RS_NPART; k++) {
       const double *S = B + RB_S + k * RS_NPROD, *F = B + RB_F + k * 3;
       const double v = S[comp_prod[c][0]] + S[comp_prod[c][1]] - U[i] * F[j] - U[j] * F[i];
-      out[c][k == RS_BODY ? RT_DRIVE : RT_PRESSURE + k] = v / mass;
+      out[c][k == RS_BODY ? RT_DRIVE : k == RS_NOISE ? RT_NOISE : RT_PRESSURE + k] = v / mass;
     }
     /* the quantity (u_i - U_i)(u_j - U_j) m carried by the displacements, and its state */
     const double *K = B + RB_K;

@@ -27,8 +27,10 @@
 #include "contract.h"
 #include "euler.h"
 
-/** Parts of the acceleration in the budget: the snapshot's STATS_PARTS, then the body force. */
-enum { RS_BODY = STATS_PARTS, RS_NPART };
+/** Parts of the acceleration in the budget: the snapshot's STATS_PARTS, then the body force,
+    then the configurational part of the pressure part (the pressure noise: inside the
+    pressure part, reported apart, not a term of the closure). */
+enum { RS_BODY = STATS_PARTS, RS_NOISE, RS_NPART };
 
 /** Velocity products of the sums: ub_x A_x, ub_y A_y, ub_z A_z, ub_x A_y, ub_y A_x. */
 enum { RS_XX, RS_YY, RS_ZZ, RS_XY, RS_YX, RS_NPROD };

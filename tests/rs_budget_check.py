@@ -23,7 +23,7 @@ from chansph_stats.ncfile import open_nc  # noqa: E402
 
 COMPONENTS = ("uu", "vv", "ww", "uv", "k")
 TERMS = ("pressure", "viscous", "model", "wall", "drive", "transfer", "production", "transport",
-         "rate", "closure")
+         "rate", "closure", "pressure_noise")
 
 
 def main():

@@ -46,7 +46,7 @@ from .twopoint import DNS_ROOT
 
 COMPONENTS = ("uu", "vv", "ww", "uv", "k")
 TERMS = ("pressure", "viscous", "model", "wall", "drive", "transfer", "production", "transport",
-         "rate", "closure")
+         "rate", "closure", "pressure_noise")
 SOURCES = ("pressure", "viscous", "model", "wall", "drive", "transfer")  # sum - rate = closure
 DNS_COLUMNS = ("y", "y+", "dissip", "produc", "p-strain", "p-diff", "t-diff", "v-diff", "bal")
 DEFAULT_DNS = os.path.normpath(os.path.join(DNS_ROOT, "balances"))
@@ -54,6 +54,8 @@ DEFAULT_LEVELS = (10.0, 15.0, 30.0, 50.0)
 # (row name, our terms summed, MKM columns summed; None: no MKM counterpart; (): zero)
 ROWS = (("production", ("production",), ("produc",)),
         ("pressure", ("pressure",), ("p-strain", "p-diff")),
+        ("pressure noise", ("pressure_noise",), None),
+        ("pressure+wall", ("pressure", "wall"), None),
         ("viscous+wall", ("viscous", "wall"), ("dissip", "v-diff")),
         ("viscous", ("viscous",), None),
         ("wall", ("wall",), None),
@@ -112,7 +114,9 @@ def read_budgets(path, u_tau="wall"):
         les = int(a.get("les", 0)) == 1
         fold = int(a.get("fold", 0))
         y = values(need(d, "y_mean", path, what)).astype(float)
-        terms = [t for t in TERMS if t != "model" or les]
+        # model only with LES; the pressure noise is absent in files of before 2026-12-03
+        terms = [t for t in TERMS if (t != "model" or les) and
+                 (t != "pressure_noise" or "rsb_uu_pressure_noise" in d.variables)]
         fields = {}
         for c in COMPONENTS:
             for t in terms:
