@@ -1,7 +1,7 @@
 """Reynolds-stress budgets of a run (stats.nc, rsb_*) against the MKM Re_tau = 180 balances.
 
 usage: chansph-stats rs_budget STATS.nc [--dns-dir DIR] [--u-tau wall|force|VALUE]
-                                         [--y-plus 10,15,30,50] [--out DIR]
+                                         [--y-plus 10,15,30,50] [--out DIR] [--markdown]
 
 The run's budgets are the root variables rsb_<c>_<t> and rsb_<c>_<t>_stderr on dimension y
 (docs/stats-format.md, "Reynolds-stress budgets"): c = uu, vv, ww, uv, k (k = (uu+vv+ww)/2;
@@ -253,6 +253,29 @@ def print_tables(ours, dns, levels=DEFAULT_LEVELS):
               "(%.2g of the largest term)" % (dev, dev / peak if peak > 0 else math.nan))
 
 
+def print_markdown(ours, dns, levels=DEFAULT_LEVELS):
+    """One Markdown table per component: each mapped row at the levels as ours +- 2 standard
+    errors (DNS in brackets), for a document."""
+    yp = ours["yplus"]
+    ok = np.isfinite(yp)
+    bins = [int(np.flatnonzero(ok)[np.argmin(np.abs(yp[ok] - lev))]) for lev in levels]
+    print("Wall units u_tau^4/nu of %s; ours +- 2 standard errors [MKM 180]." %
+          ours["u_tau_label"])
+    for c in COMPONENTS:
+        print("\n%s | " % c + " | ".join("y+ %.1f" % yp[i] for i in bins) + " |")
+        print("|---|" + "---|" * len(bins))
+        for row in ROWS:
+            got = row_values(ours, dns, c, row)
+            if got is None:
+                continue
+            cells = []
+            for i in bins:
+                v, s, r = (float(x[i]) for x in got)
+                cell = "%.4f" % v + (" +- %.4f" % (2 * s) if math.isfinite(s) else "")
+                cells.append(cell + (" [%.4f]" % r if math.isfinite(r) else ""))
+            print("| %s | %s |" % (row[0], " | ".join(cells)))
+
+
 def write_csv(ours, dns, path):
     """rs_budget.csv: component, term, y+, ours, stderr, dns for every bin and mapped row."""
     with open(path, "w") as f:
@@ -336,6 +359,8 @@ def main(argv, prog="chansph-stats rs_budget"):
     ap.add_argument("--y-plus", default="10,15,30,50",
                     help="y+ levels of the table (default 10,15,30,50; the nearest bin)")
     ap.add_argument("--out", help="write rs_budget.csv and rs_budget_<c>.png to this directory")
+    ap.add_argument("--markdown", action="store_true",
+                    help="print the tables as Markdown (ours +- 2 stderr [DNS]) instead")
     a = ap.parse_args(argv)
     levels = levels_arg(a.y_plus)
     dns = read_dns(a.dns_dir)
@@ -350,5 +375,8 @@ def main(argv, prog="chansph-stats rs_budget"):
             raise InputError("%s: cannot create the output directory (%s)" % (a.out, e.strerror))
     print("ours: %s, Re_tau = %.2f" % (ours["source"], ours["re_tau"]))
     print("DNS:  %s" % dns["source"])
+    if a.markdown:
+        print_markdown(ours, dns, levels)
+        return 0
     report(ours, dns, levels, a.out)
     return 0
