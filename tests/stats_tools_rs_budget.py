@@ -144,8 +144,8 @@ def table_rows(out):
 def check_table(out, dy, what):
     rows = table_rows(out)
     mapped = [k for k, r in rows.items() if math.isfinite(r[3])]
-    check(len(mapped) == len(COMP) * len(LEVELS) * 7,
-          "%s: %d table rows with a DNS value (5 components x 4 levels x 7)" % (what, len(mapped)))
+    check(len(mapped) == len(COMP) * len(LEVELS) * 9,
+          "%s: %d table rows with a DNS value (5 components x 4 levels x 9)" % (what, len(mapped)))
     worst = max((abs(rows[k][4]) / peak(k[0]) for k in mapped), default=math.inf)
     check(worst <= 1e-4, "%s: table ours - DNS at most %.1e of the peak (printed to 4 decimals)"
           % (what, worst))

@@ -54,10 +54,10 @@ DEFAULT_LEVELS = (10.0, 15.0, 30.0, 50.0)
 # (row name, our terms summed, MKM columns summed; None: no MKM counterpart; (): zero)
 ROWS = (("production", ("production",), ("produc",)),
         ("pressure", ("pressure",), ("p-strain", "p-diff")),
-        ("pressure noise", ("pressure_noise",), None),
-        ("pressure+wall", ("pressure", "wall"), None),
+        ("pressure_noise", ("pressure_noise",), None),
+        ("pressure+wall", ("pressure", "wall"), ("p-strain", "p-diff")),
         ("viscous+wall", ("viscous", "wall"), ("dissip", "v-diff")),
-        ("viscous", ("viscous",), None),
+        ("viscous", ("viscous",), ("dissip", "v-diff")),
         ("wall", ("wall",), None),
         ("model", ("model",), None),
         ("drive", ("drive",), None),
@@ -65,7 +65,10 @@ ROWS = (("production", ("production",), ("produc",)),
         ("transfer", ("transfer",), ("produc", "t-diff")),
         ("rate", ("rate",), ()),
         ("closure", ("closure",), ("bal",)))
+# the walls' part is viscous in x and z (wall shear) and mostly the normal pressure in y (the
+# vertex pressure of the wall layer): vv is plotted with it in the pressure term
 PLOTTED = ("production", "pressure", "viscous+wall", "transport", "rate", "closure")
+PLOTTED_VV = ("production", "pressure+wall", "viscous", "transport", "rate", "closure")
 
 
 def fold_halves(y, delta, fields, signs):
@@ -302,7 +305,7 @@ def plots(ours, dns, out_dir):
     names = []
     for c in COMPONENTS:
         fig, ax = plt.subplots(figsize=(7, 4.5))
-        for k, row in enumerate(r for r in ROWS if r[0] in PLOTTED):
+        for k, row in enumerate(r for r in ROWS if r[0] in (PLOTTED_VV if c == "vv" else PLOTTED)):
             got = row_values(ours, dns, c, row)
             if got is None:
                 continue
