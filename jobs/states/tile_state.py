@@ -3,14 +3,16 @@
 the span (issue 24: the converged run in lz = 2 x 0.7 delta, where the minimal unit's bursting
 is weaker).
 
-usage: python3 jobs/states/tile_state.py A.nc B.nc OUT.nc
+usage: python3 jobs/states/tile_state.py A.nc B.nc OUT.nc [--perturb EPS] [--seed N]
 
 A and B are states (jobs/states/reduce_state.py, or particles.nc) of the same scene domain and
 particle count; OUT holds A at 0 <= z < lz and B shifted by lz, ids of B offset by A's count,
 and the scene attribute with lz doubled, so that init.from of a scene with that lz takes the
-particles as they are. Take two independent realisations (two times of a run far apart): a
-copy of one state is a symmetry the dynamics would keep. The seams at z = 0 and lz join two
-unrelated fields; the mismatch is a transient of the first fraction of a turnover.
+particles as they are. With B = A the field is periodic in lz and has no seams; a copy is a
+symmetry the dynamics keep up to round-off, so --perturb adds Gaussian noise of standard
+deviation EPS [m/s] to the copy's velocities (it decorrelates within about a turnover). Two
+different states (B != A) join unrelated fields at z = 0 and lz: the particle layers there do
+not match, and in the dr+ = 6 channel that sent a particle through the wall at step 169.
 """
 import os
 import re
@@ -40,6 +42,8 @@ def main():
     p.add_argument("a", metavar="A.nc")
     p.add_argument("b", metavar="B.nc")
     p.add_argument("out", metavar="OUT.nc")
+    p.add_argument("--perturb", type=cli.number(float, 0), default=0.0, metavar="EPS")
+    p.add_argument("--seed", type=int, default=1)
     a = p.parse_args()
     with open_nc(a.a) as A, open_nc(a.b) as B:
         va = {n: np.asarray(need(A, n, a.a, "a chansph state")[:]) for n in STATE_VARS}
@@ -61,6 +65,10 @@ def main():
     out = {k: np.concatenate([va[k], vb[k]]) for k in STATE_VARS}
     out["z"][n:] += lz
     out["id"][n:] += n
+    rng = np.random.default_rng(a.seed)
+    for k in ("u", "v", "w"):
+        if a.perturb > 0:
+            out[k][n:] += rng.normal(0.0, a.perturb, n).astype(out[k].dtype)
     atts["scene"] = scene
     try:
         dst = netCDF4.Dataset(a.out, "w", format="NETCDF4")
