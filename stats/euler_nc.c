@@ -143,6 +143,37 @@ fail:
   return rc ? rc : NC_EINVAL;
 }
 
+/* The field dimensions of the raw records of group g with their labels: fd = window_field,
+   moment, snapshot_moment, plane_field, kinetic_field, reynolds_budget_field. */
+static int field_axes(int g, int fd[6], char *err, size_t errlen) {
+  int rc = NC_NOERR;
+  const char *rs_names[RW_LEN];
+  for (int k = 0; k < RW_LEN; k++) rs_names[k] = euler_rs_field_name(k);
+  const struct {
+    const char *dim;
+    size_t len;
+    const char *long_name;
+    const char *const *labels;
+  } ax[6] = {
+      {"window_field", WIN_LEN, "fields of the window records", window_fields},
+      {"moment", MOM_LEN,
+       "fields of the moment records: count, means, co-moments C2 (sums of products of "
+       "deviations), third and fourth central moments M3, M4 (sums)",
+       moment_names},
+      {"snapshot_moment", SCAL_LEN,
+       "fields of the records of per-snapshot bin means of u: count, mean, M2", scal_names},
+      {"plane_field", PL_LEN, "fields of the momentum-budget records", plane_names},
+      {"kinetic_field", KN_LEN, "fields of the kinetic-flux records", kinetic_names},
+      {"reynolds_budget_field", RW_LEN, "fields of the Reynolds-stress budget records", rs_names}};
+  for (int k = 0; k < 6; k++) {
+    CK(nc_def_dim(g, ax[k].dim, ax[k].len, &fd[k]));
+    CK(ncout_labels(g, ax[k].dim, fd[k], ax[k].long_name, ax[k].labels));
+  }
+  return NC_NOERR;
+fail:
+  return rc ? rc : NC_EINVAL;
+}
+
 /* The group eulerian: the raw per-window records (the complete accumulator state, which
    chansph extract re-averages), with a coordinate variable for every dimension. */
 static int write_raw_windows(const struct euler *e, const struct euler_result *rp, int ncid,
@@ -150,7 +181,7 @@ static int write_raw_windows(const struct euler *e, const struct euler_result *r
   const struct euler_result r = *rp;
   const size_t nb = (size_t)e->cfg.nb, rows = euler_rows(e);
   int rc = NC_NOERR, dy;
-  int g, dw, dwf, dm, ds, dp, dk, dr, vw, vm, vs, vp, vk, vr, vc, v0, v1;
+  int g, dw, vw, vm, vs, vp, vk, vr, vc, v0, v1;
   CK(nc_def_grp(ncid, "eulerian", &g));
   static const char desc[] =
       "raw per-window moment records of the wall-normal bins; re-average any range of windows "
@@ -162,28 +193,12 @@ static int write_raw_windows(const struct euler *e, const struct euler_result *r
      the fields of the records by name */
   CK(nc_def_dim(g, "window", rows, &dw));
   CK(nc_def_dim(g, "y", nb, &dy));
-  CK(nc_def_dim(g, "window_field", WIN_LEN, &dwf));
-  CK(nc_def_dim(g, "moment", MOM_LEN, &dm));
-  CK(nc_def_dim(g, "snapshot_moment", SCAL_LEN, &ds));
-  CK(nc_def_dim(g, "plane_field", PL_LEN, &dp));
-  CK(nc_def_dim(g, "kinetic_field", KN_LEN, &dk));
-  CK(nc_def_dim(g, "reynolds_budget_field", RW_LEN, &dr));
+  /* the fields of the records: dimensions with labels (field_axes) */
+  int fd[6];
+  if ((rc = field_axes(g, fd, err, errlen)) != NC_NOERR) goto fail; /* names its call */
+  const int dwf = fd[0], dm = fd[1], ds = fd[2], dp = fd[3], dk = fd[4], dr = fd[5];
   CK(def_y(&e->cfg, g, dy, r.prof[EP_Y], lo, hi));
   if ((rc = def_window_axis(e, g, dw, err, errlen)) != NC_NOERR) goto fail; /* names its call */
-  CK(ncout_labels(g, "window_field", dwf, "fields of the window records", window_fields));
-  CK(ncout_labels(g, "moment", dm,
-                  "fields of the moment records: count, means, co-moments C2 (sums of products "
-                  "of deviations), third and fourth central moments M3, M4 (sums)",
-                  moment_names));
-  CK(ncout_labels(g, "snapshot_moment", ds,
-                  "fields of the records of per-snapshot bin means of u: count, mean, M2",
-                  scal_names));
-  CK(ncout_labels(g, "plane_field", dp, "fields of the momentum-budget records", plane_names));
-  CK(ncout_labels(g, "kinetic_field", dk, "fields of the kinetic-flux records", kinetic_names));
-  const char *rs_names[RW_LEN];
-  for (int k = 0; k < RW_LEN; k++) rs_names[k] = euler_rs_field_name(k);
-  CK(ncout_labels(g, "reynolds_budget_field", dr, "fields of the Reynolds-stress budget records",
-                  rs_names));
   CK(ncout_def(g, "window_start", NC_DOUBLE, 1, &dw, "s", "start of the averaging window", &v0));
   CK(ncout_def(g, "window_end", NC_DOUBLE, 1, &dw, "s", "end of the averaging window", &v1));
   CK(ncout_def(g, "window_complete", NC_INT, 1, &dw, "1", "1: closed window, 0: still open", &vc));

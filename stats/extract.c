@@ -71,6 +71,28 @@ static int get_att(int ncid, const char *name, double *v, const char *path) {
   return 0;
 }
 
+/* The optional per-window records `var` of group g (rows x bins = len records of n fields,
+   the field count the length of dimension `dim`) into *out; absent: *out stays NULL. A field
+   count other than n is an error if strict, else the records are left out. Returns nonzero
+   on an error (printed, naming what). */
+static int read_records(int g, const char *var, const char *dim, size_t n, size_t len, int strict,
+                        const char *path, const char *what, double **out) {
+  int v, d;
+  size_t have = 0;
+  if (nc_inq_varid(g, var, &v) != NC_NOERR) return 0;
+  if (nc_inq_dimid(g, dim, &d) || nc_inq_dimlen(g, d, &have) || have != n) {
+    if (!strict) return 0;
+    fprintf(stderr, "error: %s: %s (%s) have %zu fields, not %zu\n", path, what, var, have, n);
+    return 1;
+  }
+  *out = mem_alloc(1, len * n * sizeof(double), "chansph extract");
+  if (nc_get_var_double(g, v, *out) != NC_NOERR) {
+    fprintf(stderr, "error: %s: cannot read the raw windows (%s)\n", path, var);
+    return 1;
+  }
+  return 0;
+}
+
 static int read_stored(const char *path, struct stored *s) {
   memset(s, 0, sizeof *s);
   int ncid, g, rc = nc_open(path, NC_NOWRITE, &ncid);
@@ -112,48 +134,17 @@ static int read_stored(const char *path, struct stored *s) {
       fprintf(stderr, "error: %s: cannot read the raw windows\n", path);
       bad = 1;
     }
-    int vp, dp; /* the momentum budget: absent in files of earlier versions */
-    size_t np = 0;
-    if (!bad && s->rows && nc_inq_varid(g, "planes", &vp) == NC_NOERR &&
-        (nc_inq_dimid(g, "plane_field", &dp) || nc_inq_dimlen(g, dp, &np) || np != PL_LEN)) {
-      fprintf(stderr, "error: %s: the momentum-budget records (planes) have %zu fields, not %d\n",
-              path, np, (int)PL_LEN);
-      bad = 1;
-    }
-    int dk; /* the kinetic records: absent before format 1.4, and a field count of another
-               version leaves them out (no advective part) */
-    size_t nk = 0;
-    if (!bad && s->rows && nc_inq_varid(g, "planes_kinetic", &vp) == NC_NOERR &&
-        nc_inq_dimid(g, "kinetic_field", &dk) == NC_NOERR &&
-        nc_inq_dimlen(g, dk, &nk) == NC_NOERR && nk == KN_LEN) {
-      s->kin = mem_alloc(1, r * nb * KN_LEN * sizeof(double), "chansph extract");
-      if (!s->kin || nc_get_var_double(g, vp, s->kin)) {
-        fprintf(stderr, "error: %s: cannot read the raw windows (planes_kinetic)\n", path);
-        bad = 1;
-      }
-    }
-    int dr; /* the Reynolds-stress budget records: absent before format 1.6 (no budget) */
-    size_t nr = 0;
-    if (!bad && s->rows && nc_inq_varid(g, "reynolds_budget", &vp) == NC_NOERR &&
-        (nc_inq_dimid(g, "reynolds_budget_field", &dr) || nc_inq_dimlen(g, dr, &nr) ||
-         nr != RW_LEN)) {
-      fprintf(stderr, "error: %s: the Reynolds-stress budget records have %zu fields, not %d\n",
-              path, nr, (int)RW_LEN);
-      bad = 1;
-    } else if (!bad && s->rows && nc_inq_varid(g, "reynolds_budget", &vp) == NC_NOERR) {
-      s->rsb = mem_alloc(1, r * nb * RW_LEN * sizeof(double), "chansph extract");
-      if (!s->rsb || nc_get_var_double(g, vp, s->rsb)) {
-        fprintf(stderr, "error: %s: cannot read the raw windows (reynolds_budget)\n", path);
-        bad = 1;
-      }
-    }
-    if (!bad && s->rows && nc_inq_varid(g, "planes", &vp) == NC_NOERR) {
-      s->pln = mem_alloc(1, r * nb * PL_LEN * sizeof(double), "chansph extract");
-      if (!s->pln || nc_get_var_double(g, vp, s->pln)) {
-        fprintf(stderr, "error: %s: cannot read the raw windows (planes)\n", path);
-        bad = 1;
-      }
-    }
+    /* the optional records: absent in files of earlier versions (the momentum budget; its
+       kinetic flux, before format 1.4, where another field count leaves them out: no
+       advective part; the Reynolds-stress budgets, before 1.6) */
+    const size_t len = r * nb;
+    bad =
+        bad || (s->rows && (read_records(g, "planes", "plane_field", PL_LEN, len, 1, path,
+                                         "the momentum-budget records", &s->pln) ||
+                            read_records(g, "planes_kinetic", "kinetic_field", KN_LEN, len, 0, path,
+                                         "the kinetic-flux records", &s->kin) ||
+                            read_records(g, "reynolds_budget", "reynolds_budget_field", RW_LEN, len,
+                                         1, path, "the Reynolds-stress budget records", &s->rsb)));
   }
   CHECK_NC(nc_close(ncid));
   return bad;
