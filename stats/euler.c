@@ -462,13 +462,6 @@ static double *budget_bin(const struct euler_config *c, double *P, double y, int
   return P + (size_t)hb * EU_PART + EU_PART_PL + (size_t)(!c->fold && upper) * HB_LEN;
 }
 
-/* The share of a particle at y in the upper (side 1) or lower (side 0) half of the channel:
-   all of it, or half within 1e-9 delta of the centre. */
-double euler_side_weight(double y, double delta, int side) {
-  if (fabs(y - delta) <= 1e-9 * delta) return 0.5;
-  return (y > delta) == side ? 1.0 : 0.0;
-}
-
 /* Particle a of the snapshot into its column's per-bin partials P (EU_PART a bin). */
 static void add_particle(const struct euler *e, const struct stats_snapshot *s, size_t a,
                          double *P) {
@@ -625,19 +618,6 @@ void euler_sample(struct euler *e, const struct stats_snapshot *s) {
      its body force to the wall (docs/theory.md, "Momentum at the walls") */
   win[WIN_SUM_TW0] += -s->wall_fx[0] / (c->rho0 * c->area) + s->fx * c->wall_layer;
   win[WIN_SUM_TW1] += -s->wall_fx[1] / (c->rho0 * c->area) + s->fx * c->wall_layer;
-}
-
-/* Derivative of f at point i from its neighbours (3-point Lagrange on uneven points). */
-double euler_deriv(const double *x, const double *f, const int *ok, int n, int i) {
-  int l = i - 1, r = i + 1;
-  while (l >= 0 && !ok[l]) l--;
-  while (r < n && !ok[r]) r++;
-  if (l < 0 && r >= n) return NAN;
-  if (l < 0) return (f[r] - f[i]) / (x[r] - x[i]);
-  if (r >= n) return (f[i] - f[l]) / (x[i] - x[l]);
-  const double h1 = x[i] - x[l], h2 = x[r] - x[i];
-  return (-h2 / (h1 * (h1 + h2))) * f[l] + ((h2 - h1) / (h1 * h2)) * f[i] +
-         (h1 / (h2 * (h1 + h2))) * f[r];
 }
 
 /* Profiles of the momentum budget over rows [r0, r1) (pln: the plane sums; kin: the kinetic

@@ -9,6 +9,28 @@
 #include "alloc.h"
 #include "moments.h"
 
+/* Shared with euler.c (declared in euler_rs.h), which calls into this file and not back. */
+
+/* The share of a particle at y in the upper (side 1) or lower (side 0) half of the channel:
+   all of it, or half within 1e-9 delta of the centre. */
+double euler_side_weight(double y, double delta, int side) {
+  if (fabs(y - delta) <= 1e-9 * delta) return 0.5;
+  return (y > delta) == side ? 1.0 : 0.0;
+}
+
+/* Derivative of f at point i from its neighbours (3-point Lagrange on uneven points). */
+double euler_deriv(const double *x, const double *f, const int *ok, int n, int i) {
+  int l = i - 1, r = i + 1;
+  while (l >= 0 && !ok[l]) l--;
+  while (r < n && !ok[r]) r++;
+  if (l < 0 && r >= n) return NAN;
+  if (l < 0) return (f[r] - f[i]) / (x[r] - x[i]);
+  if (r >= n) return (f[i] - f[l]) / (x[i] - x[l]);
+  const double h1 = x[i] - x[l], h2 = x[r] - x[i];
+  return (-h2 / (h1 * (h1 + h2))) * f[l] + ((h2 - h1) / (h1 * h2)) * f[i] +
+         (h1 / (h2 * (h1 + h2))) * f[r];
+}
+
 /* The budget's bins are hat functions (cloud in cell): a particle at y between the centres of
    bins b and b + 1 counts 1 - s in b and s in b + 1 (all in the end bins beyond their centres),
    so that what a step's displacement carries into a bin changes smoothly with the positions:

@@ -18,9 +18,10 @@
 #include "pdf.h"
 
 /** How a profile scales: velocity, stress, pressure, length, or not at all. */
-enum unit_class { UC_NONE, UC_VEL, UC_STRESS, UC_PRESSURE, UC_LENGTH, UC_VISC };
+enum unit_class { UC_NONE, UC_VEL, UC_STRESS, UC_PRESSURE, UC_LENGTH, UC_VISC, UC_BUDGET };
 
 static enum unit_class class_of(int k) {
+  if (k >= EP_RSB && k < EP_RSB_SE_END) return UC_BUDGET; /* m^2/s^3: u_tau^4/nu */
   switch (k) {
     case EP_Y:
     case EP_Y_MEAN:
@@ -272,6 +273,8 @@ static double extract_scale(int k, int wall, const struct euler_config *cfg, dou
       return ut / cfg->nu;
     case UC_VISC:
       return 1.0 / cfg->nu;
+    case UC_BUDGET:
+      return cfg->nu / (ut * ut * ut * ut);
     case UC_NONE:
       break;
   }
@@ -301,7 +304,7 @@ static void extract_header(const struct extract_args *a, const struct stored *s,
       res->u_tau, res->u_tau_wall, res->u_tau_force, res->u_tau_stderr, res->re_tau, res->corr_time,
       res->balance_error);
   printf("# units: %s\n", wall ? "wall (y+ = y u_tau/nu, velocities/u_tau, stresses/u_tau^2, "
-                                 "p/(rho0 u_tau^2), nu_t/nu)"
+                                 "p/(rho0 u_tau^2), nu_t/nu, budgets rsb_* / (u_tau^4/nu))"
                                : "outer (y/delta; values in SI units)");
   printf("%s%c%s", "y", sep, wall ? "y_plus" : "y_over_delta");
   for (int c = 0; c < nc; c++) {

@@ -27,7 +27,8 @@ def walk(g):
     for v in g.variables.values():
         v[:]
         # mixed quantities and string labels of record fields: no units
-        if v.name not in ("windows", "moments", "snapshot_u", "planes", "planes_kinetic") and v.dtype != str:
+        if v.name not in ("windows", "moments", "snapshot_u", "planes", "planes_kinetic",
+                          "reynolds_budget") and v.dtype != str:
             getattr(v, "units")
     for c in g.groups.values():
         walk(c)
