@@ -127,10 +127,17 @@ expect reduce_missing "missing.nc: cannot open: No such file" $py "$r" "$missing
 expect reduce_not_netcdf "text.nc: cannot open as netCDF" $py "$r" "$w/text.nc" "$w/state.nc"
 expect reduce_no_var "stats.nc: no variable 'id'" $py "$r" "$nowin" "$w/state.nc"
 expect reduce_unwritable "nodir/state.nc: cannot create" $py "$r" "$part" "$w/nodir/state.nc"
+tl=$root/jobs/states/tile_state.py
+expect tile_usage "the following arguments are required" $py "$tl" "$part"
+expect tile_missing "missing.nc: cannot open: No such file" $py "$tl" "$missing" "$part" "$w/t.nc"
+expect tile_no_var "stats.nc: no variable 'id'" $py "$tl" "$nowin" "$part" "$w/t.nc"
 
 # the good inputs are accepted (the checks refuse only what is wrong)
 "$tool" ckpt "$ckpt" > /dev/null || fail "chansph-stats ckpt refused a checkpoint"
 $py "$r" "$part" "$w/state.nc" || fail "reduce_state.py refused a particles.nc"
+$py "$r" "$ckpt" "$w/state_ckpt.nc" || fail "reduce_state.py refused a checkpoint"
+$py "$tl" "$w/state.nc" "$w/state_ckpt.nc" "$w/tiled.nc" --perturb 0.01 > /dev/null ||
+  fail "tile_state.py refused two states of one run"
 $py "$t/finite_check.py" --allow output/next_write "$ckpt" "$part" > /dev/null ||
   fail "finite_check.py refused finite files"
 "$tool" --help > /dev/null || fail "chansph-stats --help: exit $?"
