@@ -131,7 +131,6 @@ void euler_rs_snapshot(const struct euler_config *c, const double *snap, size_t 
 }
 
 double euler_rs_last_time(const struct euler_config *c, const double *rsb, size_t last) {
-  (void)c;
   for (size_t r = last + 1; r-- > 0;) {
     const double *W = rsb + r * (size_t)c->nb * RW_LEN; /* bin 0: every bin has every sample */
     if (W[RW_SUM + RB_N] > 0.0) return W[RW_T_LAST];
@@ -181,6 +180,12 @@ static const int comp_q[4] = {RQ_UU, RQ_VV, RQ_WW, RQ_UV};
 /* The products m ub_i A_j and m ub_j A_i of component c. */
 static const int comp_prod[4][2] = {{RS_XX, RS_XX}, {RS_YY, RS_YY}, {RS_ZZ, RS_ZZ}, {RS_XY, RS_YX}};
 
+/* sum m (u_i - U_i)(u_j - U_j) of component c from the quantities Q (RQ_*) of a bin. */
+static double centred(const double *Q, int c, const double U[3]) {
+  const int i = comp_ij[c][0], j = comp_ij[c][1];
+  return Q[comp_q[c]] - U[i] * Q[RQ_U + j] - U[j] * Q[RQ_U + i] + U[i] * U[j] * Q[RQ_M];
+}
+
 /* The terms (RT_PRESSURE .. RT_TRANSFER, RT_RATE) of the four stored components from a block
    of sums B and the states Q0 at t0, Q1 at t1, with the mean velocity U [3]. */
 static void terms(const double *B, const double *Q0, const double *Q1, double t0, double t1,
@@ -194,13 +199,8 @@ static void terms(const double *B, const double *Q0, const double *Q1, double t0
       out[c][k == RS_BODY ? RT_DRIVE : k == RS_NOISE ? RT_NOISE : RT_PRESSURE + k] = v / mass;
     }
     /* the quantity (u_i - U_i)(u_j - U_j) m carried by the displacements, and its state */
-    const double *K = B + RB_K;
-    out[c][RT_TRANSFER] =
-        (K[comp_q[c]] - U[i] * K[RQ_U + j] - U[j] * K[RQ_U + i] + U[i] * U[j] * K[RQ_M]) / mass;
-    const double e0 =
-        Q0[comp_q[c]] - U[i] * Q0[RQ_U + j] - U[j] * Q0[RQ_U + i] + U[i] * U[j] * Q0[RQ_M];
-    const double e1 =
-        Q1[comp_q[c]] - U[i] * Q1[RQ_U + j] - U[j] * Q1[RQ_U + i] + U[i] * U[j] * Q1[RQ_M];
+    out[c][RT_TRANSFER] = centred(B + RB_K, c, U) / mass;
+    const double e0 = centred(Q0, c, U), e1 = centred(Q1, c, U);
     out[c][RT_RATE] = t1 > t0 ? (e1 - e0) / (t1 - t0) / mean_mass : NAN;
   }
 }
