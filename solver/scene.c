@@ -314,6 +314,14 @@ static const struct key keys[] = {
      "(docs/stats-format.md); sampled every output.stats_every steps from "
      "output.t_average_start in output.n_bins bins.",
      OFF(stats_eulerian)},
+    {"stats", "budget_every", T_INT, "5", 1, 1e9, 0, NULL, "samples",
+     "Every how many Eulerian samples also carries the momentum and Reynolds-stress budgets "
+     "and the wall shear stress (u_tau_wall): every stats.budget_every x output.stats_every "
+     "steps. A budget sample splits the pair forces into their conservative parts, which "
+     "costs about one more force pass (docs/performance.md, \"The budgets\"); 1 samples them "
+     "with every snapshot (the budget identity of every step needs 1 with output.stats_every "
+     "= 1).",
+     OFF(budget_every)},
     {"stats", "window", T_DOUBLE, "0", 0, BIG, 0, NULL, "s",
      "Length of an averaging window: stats.nc keeps the sums of every window (re-average a "
      "range with `chansph extract --window`), and the window means are the batch means of "

@@ -117,6 +117,7 @@ struct scene {
   int q_criterion;        /*!< add the Q criterion to particles.nc (1) or not (0) */
   /* [stats] */
   int stats_eulerian;       /*!< Eulerian profiles on (1) or off (0) */
+  int budget_every;         /*!< Eulerian samples per budget sample (and wall-stress sample) */
   double stats_window;      /*!< averaging window (batch) length [s]; 0 = a tenth of the average */
   int stats_fold;           /*!< fold the upper half of the channel onto the lower one (1) */
   int stats_method;         /*!< 0: bin sampling (Eq. 5.54-5.55), 1: SPH interpolation (Eq. 5.56) */

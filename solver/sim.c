@@ -2,6 +2,7 @@
 #include "sim.h"
 #include "alloc.h"
 
+#include <Random123/philox.h>
 #include <math.h>
 #include <mpi.h>
 #include <stdlib.h>
@@ -264,10 +265,25 @@ static void wall_force(struct sim *S) {
   dd_sum(&S->dd, &S->nb, 2, arrs, S->wall_fx);
 }
 
+int sim_budget_sample(const struct scene *sc, long step) {
+  const long every = sc->stats_every, k = sc->budget_every;
+  if (step % every != 0) return 0;
+  if (k <= 1) return 1;
+  const long n = step / every; /* the statistics sample's number */
+  /* one budget sample in each block of k samples, at a position drawn from the block number:
+     regularly spaced samples would alias a coherent oscillation (a standing acoustic mode)
+     whose period is near a multiple of their interval into a bias */
+  philox2x64_ctr_t c = {{(uint64_t)(n / k), 0x627564676574u}}; /* "budget" */
+  philox2x64_key_t key = {{0x6368616e737068u}};                /* "chansph" */
+  const philox2x64_ctr_t r = philox2x64(c, key);
+  return n % k == (long)(r.v[0] % (uint64_t)k);
+}
+
 void sim_step(struct sim *S) {
   struct particles *P = &S->P;
-  /* the wall shear stress is gathered only on steps whose end state the statistics sample */
-  const int wall_sample = S->wall_ax && (S->step + 1) % S->sc->stats_every == 0;
+  /* the wall shear stress is gathered only on steps whose end state a budget sample of the
+     statistics takes (sim_budget_sample) */
+  const int wall_sample = S->wall_ax && sim_budget_sample(S->sc, S->step + 1);
   /* and so are the parts of the x-acceleration of the momentum budget, which then travel with
      their particles through the sort and the migration until the sample */
   P->sx_live = wall_sample && P->sx;

@@ -83,6 +83,15 @@ void sim_free(struct sim *S);
  */
 void sim_step(struct sim *S);
 
+/**
+ * @brief Whether the state after `step` steps is a budget sample of the statistics: one in each
+ *        block of stats.budget_every statistics samples (every output.stats_every steps), at a
+ *        position within the block drawn from the block's number (Philox: the same on every
+ *        rank and thread count, and after a restart); every statistics sample if
+ *        budget_every = 1. The budgets and the wall shear stress are gathered on these only.
+ */
+int sim_budget_sample(const struct scene *sc, long step);
+
 /** Checkpoint id blocks: rank r of size holds the ids [r N / size, (r+1) N / size) of the
     particle datasets (restart/layout.c). */
 static inline void sim_id_block(int r, int size, size_t N, size_t *lo, size_t *hi) {

@@ -616,6 +616,8 @@ void euler_sample(struct euler *e, const struct stats_snapshot *s) {
      terms and the non-conservative rest of the pair forces, sph_budget_pairs), plus the body
      force on the layer of fluid the wall vertices stand for, which stays at rest and so passes
      its body force to the wall (docs/theory.md, "Momentum at the walls") */
+  if (!s->sx || !isfinite(s->wall_fx[0]) || !isfinite(s->wall_fx[1]))
+    return; /* the wall stress comes with the budget samples only (counted by the planes) */
   win[WIN_SUM_TW0] += -s->wall_fx[0] / (c->rho0 * c->area) + s->fx * c->wall_layer;
   win[WIN_SUM_TW1] += -s->wall_fx[1] / (c->rho0 * c->area) + s->fx * c->wall_layer;
 }
@@ -745,6 +747,14 @@ static void stress_balance(const struct euler_config *cfg, const double *mom, co
   }
 }
 
+/* The samples of row r that carry the wall shear stress: the budget samples (every
+   stats.budget_every-th), which the planes count in each bin; every sample in files without
+   the planes (format 1.1, when each sample carried it). */
+static double wall_samples(const struct euler_config *cfg, const double *win, const double *pln,
+                           size_t r) {
+  return pln ? pln[r * (size_t)cfg->nb * PL_LEN + PL_N] : win[r * WIN_LEN + WIN_NSNAP];
+}
+
 void euler_finalise(const struct euler_config *cfg, const double *win, const double *mom,
                     const double *snp, const double *pln, const double *kin, const double *rsb,
                     const int *complete, size_t r0, size_t r1, struct euler_result *res) {
@@ -758,14 +768,15 @@ void euler_finalise(const struct euler_config *cfg, const double *win, const dou
   double *bm = mem_calloc((size_t)nb * 11 * SCAL_LEN, sizeof(double), lbl); /* batch moments */
   double *sn = mem_calloc((size_t)nb * SCAL_LEN, sizeof(double), lbl);
   double *within = mem_calloc((size_t)nb * 2, sizeof(double), lbl);
-  double snaps = 0.0, sum_fx = 0.0, sum_tw = 0.0, tw_batch[SCAL_LEN] = {0, 0, 0};
+  double snaps = 0.0, walls = 0.0, sum_fx = 0.0, sum_tw = 0.0, tw_batch[SCAL_LEN] = {0, 0, 0};
   double batch_len = 0.0;
   res->t0 = r1 > r0 ? win[r0 * WIN_LEN + WIN_T0] : NAN;
   res->t1 = r1 > r0 ? win[(r1 - 1) * WIN_LEN + WIN_T1] : NAN;
   for (size_t r = r0; r < r1; r++) {
     const double *w = win + r * WIN_LEN;
     snaps += w[WIN_NSNAP], sum_fx += w[WIN_SUM_FX];
-    sum_tw += 0.5 * (w[WIN_SUM_TW0] + w[WIN_SUM_TW1]);
+    const double nw = wall_samples(cfg, win, pln, r);
+    walls += nw, sum_tw += 0.5 * (w[WIN_SUM_TW0] + w[WIN_SUM_TW1]);
     for (int b = 0; b < nb; b++) {
       const double *m = mom + (r * (size_t)nb + (size_t)b) * MOM_LEN;
       mom_merge(tot + (size_t)b * MOM_LEN, m);
@@ -780,7 +791,7 @@ void euler_finalise(const struct euler_config *cfg, const double *win, const dou
       if (s[SCAL_N] > 0.0) scal_add(sn + (size_t)b * SCAL_LEN, s[SCAL_MEAN]);
     }
     if (complete[r] && w[WIN_NSNAP] > 0.0) {
-      scal_add(tw_batch, 0.5 * (w[WIN_SUM_TW0] + w[WIN_SUM_TW1]) / w[WIN_NSNAP]);
+      if (nw > 0.0) scal_add(tw_batch, 0.5 * (w[WIN_SUM_TW0] + w[WIN_SUM_TW1]) / nw);
       batch_len += w[WIN_T1] - w[WIN_T0];
       res->n_batches++;
     }
@@ -806,7 +817,7 @@ void euler_finalise(const struct euler_config *cfg, const double *win, const dou
   }
   res->corr_time = tau_n ? tau_sum / tau_n : nan;
   const double tw_force = snaps > 0.0 ? cfg->delta * sum_fx / snaps : nan;
-  const double tw_wall = snaps > 0.0 ? sum_tw / snaps : nan;
+  const double tw_wall = walls > 0.0 ? sum_tw / walls : nan;
   res->u_tau_force = tw_force >= 0.0 ? sqrt(tw_force) : nan;
   res->u_tau_wall = tw_wall >= 0.0 ? sqrt(tw_wall) : nan;
   res->u_tau =

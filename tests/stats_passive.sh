@@ -7,7 +7,7 @@ set -u
 chansph=$1 scene=$2 runs=$3 name=$4
 shift 4
 a=$runs/passive_${name}_on b=$runs/passive_${name}_off
-"$chansph" run "$scene" --out "$a" --overwrite "$@" --set output.stats_every=1 > "$a.log" 2>&1 ||
+"$chansph" run "$scene" --out "$a" --overwrite "$@" --set output.stats_every=1 --set stats.budget_every=1 > "$a.log" 2>&1 ||
   { tail "$a.log"; echo "FAIL: run with statistics"; exit 1; }
 "$chansph" run "$scene" --out "$b" --overwrite "$@" --set stats.eulerian=0 > "$b.log" 2>&1 ||
   { tail "$b.log"; echo "FAIL: run without statistics"; exit 1; }

@@ -85,10 +85,10 @@ int main(int argc, char **argv) {
   char les[512], qdns[512];
   snprintf(les, sizeof les, "%s/les395_smoke.ini", argv[1]);
   snprintf(qdns, sizeof qdns, "%s/qdns180_smoke.ini", argv[1]);
-  char *s1[] = {"output.stats_every=1"};
-  char *s2[] = {"output.stats_every=1", "sph.viscous=morris"};
-  int fail = run("quasi-DNS smoke (Morris)", qdns, s2, 2);
-  fail |= run("LES smoke (Violeau + eddy viscosity, wall law)", les, s1, 1);
+  char *s1[] = {"output.stats_every=1", "stats.budget_every=1"};
+  char *s2[] = {"output.stats_every=1", "stats.budget_every=1", "sph.viscous=morris"};
+  int fail = run("quasi-DNS smoke (Morris)", qdns, s2, 3);
+  fail |= run("LES smoke (Violeau + eddy viscosity, wall law)", les, s1, 2);
   printf(fail ? "FAIL\n" : "PASS\n");
   MPI_Finalize();
   return fail;

@@ -100,7 +100,7 @@ def window_profile(dirs, t0, t1, units="force"):
                and win[i, 1] <= t1 + 1e-9]
         if sel:
             span = (span[0] if span else win[sel[0], 0], win[sel[-1], 1])
-            wall += (win[sel, 4].sum() + win[sel, 5].sum(), 2 * win[sel, 2].sum())
+            wall += (win[sel, 4].sum() + win[sel, 5].sum(), 2 * r["nwall"][sel].sum())
             if pool is None:
                 pool = dict(r, mom=r["mom"][sel])
             else:

@@ -108,7 +108,7 @@ def read_windows(path):
     delta, nu, fold, t_reached (None if absent), win (windows: t0, t1, snapshots, sums of the
     body force and of the two walls' shear stress), mom (moments), pln (planes, None in files
     without the momentum budget), done (windows with samples) and ut (u_tau of the force
-    balance over them)."""
+    balance over them), nwall (the samples of each window that carried the wall stress)."""
     with open_nc(path) as nc:
         g = need_group(nc, "eulerian", path)
         delta, nu, fold = (attribute(nc, k, path) for k in ("delta", "nu", "fold"))
@@ -121,6 +121,9 @@ def read_windows(path):
         raise InputError(f"{path}: no averaging window (the run has not begun averaging?)")
     r["done"] = r["win"][:, 2] > 0
     r["ut"] = u_tau_force(r["win"], r["delta"])
+    # the samples that carried the wall stress: the budget samples (every stats.budget_every-th),
+    # counted by the planes; every sample in files without them
+    r["nwall"] = r["pln"][:, 0, 0] if r["pln"] is not None else r["win"][:, 2]
     return r
 
 
