@@ -11,6 +11,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "engine.h"
 #include "euler.h"
 #include "euler_rs.h"
 #include "moments.h"
@@ -172,34 +173,38 @@ static int parse_time(const char *text, const char *stop, double dflt, double *t
 static void usage(FILE *f) {
   fprintf(f,
           "usage: chansph extract STATS.nc [--var a,b,...] [--units wall|outer] "
-          "[--format csv|tsv] [--window T0:T1] [--pdfs]\n"
+          "[--format csv|tsv] [--window T0:T1] [--pdfs] [--nc OUT.nc]\n"
           "  variables: u_mean v_mean w_mean p_mean rho_mean uu vv ww uv uw vw u_rms v_rms "
           "w_rms\n"
           "  u_skewness ... w_flatness viscous_stress total_stress total_stress_expected "
           "n_samples y_mean nu_t_mean k_r_mean (LES)\n"
           "  (standard errors are printed next to the variables that have them)\n"
           "  --pdfs: the one-point PDFs of group pdfs instead (rows y_plus, component, bin in "
-          "units of the rms, pdf, pdf_stderr; the moments in the header)\n");
+          "units of the rms, pdf, pdf_stderr; the moments in the header)\n"
+          "  --nc OUT.nc: write the windows of --window as a stats.nc instead (the root "
+          "profiles and\n"
+          "    attributes averaged over them and their raw group eulerian; the other groups "
+          "left out):\n"
+          "    what `chansph compare` and `extract` read, e.g. a long run's developed range\n");
 }
 
 /* The options of one extract command. */
 struct extract_args {
   const char *path, *vars, *units, *fmt;
-  double t0, t1; /* --window */
-  int pdfs;      /* --pdfs */
+  double t0, t1;      /* --window */
+  int pdfs;           /* --pdfs */
+  const char *nc_out; /* --nc: write the range as a stats.nc instead of a table */
 };
 
 /* Parse the command line (argv[0]: the command name); 1: input error, -1: --help printed. */
 static int extract_parse(int argc, char **argv, struct extract_args *a) {
-  static const struct option opts[] = {{"help", no_argument, NULL, 'h'},
-                                       {"var", required_argument, NULL, 'v'},
-                                       {"units", required_argument, NULL, 'u'},
-                                       {"format", required_argument, NULL, 'f'},
-                                       {"window", required_argument, NULL, 'w'},
-                                       {"pdfs", no_argument, NULL, 'p'},
-                                       {NULL, 0, NULL, 0}};
+  static const struct option opts[] = {
+      {"help", no_argument, NULL, 'h'},         {"var", required_argument, NULL, 'v'},
+      {"units", required_argument, NULL, 'u'},  {"format", required_argument, NULL, 'f'},
+      {"window", required_argument, NULL, 'w'}, {"pdfs", no_argument, NULL, 'p'},
+      {"nc", required_argument, NULL, 'n'},     {NULL, 0, NULL, 0}};
   *a = (struct extract_args){
-      NULL, "u_mean,u_rms,v_rms,w_rms,uv", "wall", "csv", -INFINITY, INFINITY, 0};
+      NULL, "u_mean,u_rms,v_rms,w_rms,uv", "wall", "csv", -INFINITY, INFINITY, 0, NULL};
   opterr = 0, optind = 1; /* "-": positional arguments in order (code 1); ':' missing value */
   for (;;) {
     const int at = optind, code = getopt_long(argc, argv, "-:h", opts, NULL);
@@ -210,6 +215,8 @@ static int extract_parse(int argc, char **argv, struct extract_args *a) {
     }
     if (code == 'p') {
       a->pdfs = 1;
+    } else if (code == 'n') {
+      a->nc_out = optarg;
     } else if (code == 'v' || code == 'u' || code == 'f') {
       *(code == 'v' ? &a->vars : code == 'u' ? &a->units : &a->fmt) = optarg;
     } else if (code == 'w') {
@@ -412,6 +419,75 @@ static int extract_pdfs(const struct extract_args *a) {
   return none;
 }
 
+/* The global attributes the Eulerian engine writes for its averaged range (euler_nc.c), which
+   --nc must not copy from the whole run. */
+static const char *const range_attrs[] = {
+    "u_tau",       "u_tau_stderr",     "u_tau_wall",           "u_tau_force",
+    "re_tau",      "correlation_time", "stress_balance_error", "average_start",
+    "average_end", "n_windows",        "n_snapshots",          "t_reached"};
+
+/* Copy the global attributes of file in to out, less those of range_attrs. */
+static int copy_run_attrs(int in, int out) {
+  int n, rc = nc_inq_natts(in, &n);
+  for (int i = 0; rc == NC_NOERR && i < n; i++) {
+    char name[NC_MAX_NAME + 1];
+    if ((rc = nc_inq_attname(in, NC_GLOBAL, i, name)) != NC_NOERR) break;
+    int skip = 0;
+    for (size_t k = 0; k < sizeof range_attrs / sizeof range_attrs[0]; k++)
+      skip |= !strcmp(name, range_attrs[k]);
+    if (!skip) rc = nc_copy_att(in, NC_GLOBAL, name, out, NC_GLOBAL);
+  }
+  return rc;
+}
+
+/* The windows r0 .. r1-1 of s as the state of an engine that gathered only them (its last row
+   open if that window is), written by the engine's own writer to a.nc_out (through a
+   temporary file, renamed when complete). */
+static int write_range(const struct extract_args *a, const struct stored *s, size_t r0, size_t r1) {
+  if (!s->pln || !s->kin || !s->rsb) {
+    fprintf(stderr, "error: %s: --nc needs the budget records of format 1.6 or later\n", a->path);
+    return 1;
+  }
+  const size_t nb = (size_t)s->cfg.nb, n = r1 - r0;
+  struct euler e = {.cfg = s->cfg, .nwin = s->complete[r1 - 1] ? n : n - 1, .cap = n + 1};
+  struct {
+    double **to;
+    const double *from;
+    size_t len;
+  } rec[] = {{&e.win, s->win, WIN_LEN},       {&e.mom, s->mom, nb * MOM_LEN},
+             {&e.snp, s->snp, nb * SCAL_LEN}, {&e.pln, s->pln, nb * PL_LEN},
+             {&e.kin, s->kin, nb * KN_LEN},   {&e.rsb, s->rsb, nb * RW_LEN}};
+  double snaps = 0.0;
+  for (size_t r = r0; r < r1; r++) snaps += s->win[r * WIN_LEN + WIN_NSNAP];
+  for (size_t k = 0; k < sizeof rec / sizeof rec[0]; k++) {
+    *rec[k].to = mem_calloc(e.cap * rec[k].len, sizeof(double), "chansph extract");
+    memcpy(*rec[k].to, rec[k].from + r0 * rec[k].len, n * rec[k].len * sizeof(double));
+  }
+  char tmp[4096], err[512] = "";
+  snprintf(tmp, sizeof tmp, "%s.tmp", a->nc_out);
+  const double t_end = r1 == s->rows ? s->t_reached : s->win[(r1 - 1) * WIN_LEN + WIN_T1];
+  const long long ns = (long long)snaps;
+  int in = -1, out = -1, rc = nc_open(a->path, NC_NOWRITE, &in);
+  if (rc == NC_NOERR) rc = nc_create(tmp, NC_NETCDF4 | NC_CLOBBER, &out);
+  if (rc == NC_NOERR) rc = copy_run_attrs(in, out);
+  if (rc == NC_NOERR && isfinite(t_end))
+    rc = nc_put_att_double(out, NC_GLOBAL, "t_reached", NC_DOUBLE, 1, &t_end);
+  if (rc == NC_NOERR) rc = nc_put_att_longlong(out, NC_GLOBAL, "n_snapshots", NC_INT64, 1, &ns);
+  if (rc == NC_NOERR) rc = euler_engine.write(&e, t_end, out, err, sizeof err);
+  if (out >= 0 && nc_close(out) != NC_NOERR && rc == NC_NOERR) rc = NC_EHDFERR;
+  if (in >= 0) nc_close(in);
+  euler_free(&e);
+  if (rc == NC_NOERR && rename(tmp, a->nc_out) == 0) {
+    printf("chansph extract: %s: windows %zu..%zu (t = %.9g .. %.9g s, %.0f snapshots) -> %s\n",
+           a->path, r0, r1 - 1, s->win[r0 * WIN_LEN + WIN_T0], t_end, snaps, a->nc_out);
+    return 0;
+  }
+  fprintf(stderr, "error: %s: cannot write %s: %s%s%s\n", a->path, a->nc_out,
+          rc == NC_NOERR ? strerror(errno) : nc_strerror(rc), err[0] ? ": " : "", err);
+  unlink(tmp);
+  return 1;
+}
+
 int extract_main(int argc, char **argv) {
   struct extract_args a;
   const int prc = extract_parse(argc, argv, &a);
@@ -427,6 +503,11 @@ int extract_main(int argc, char **argv) {
     fprintf(stderr, "error: %s: no averaging window lies inside %g:%g\n", a.path, a.t0, a.t1);
     free_stored(&s);
     return 1;
+  }
+  if (a.nc_out) {
+    const int rc = write_range(&a, &s, r0, r1);
+    free_stored(&s);
+    return rc;
   }
   int cols[64], rms[64];
   const int nc = extract_columns(a.vars, cols, rms, 64);
