@@ -82,6 +82,50 @@ print("""  What it means: at dr+ = 4.5 this minimal-flow unit sustains resolved 
   not steady. For converged averages continue it:
   jobs/scenes/mfu180_dr45.ini (25-45 minutes per eddy turnover).""")
 EOF
+long=jobs/states/mfu180w_dr6_stats.nc
+if [ -f "$long" ]; then
+  echo
+  echo "quickstart: the shipped long run, for comparison (NOT this run; no simulation here):"
+  /usr/bin/python3 - "$long" <<'EOF'
+import sys
+
+import netCDF4
+
+with netCDF4.Dataset(sys.argv[1]) as d:
+    t0, t1, n = float(d.average_start), float(d.average_end), int(d.n_windows)
+    print("  %s: Re_tau = 180 quasi-DNS at dr+ = 6 in a box twice the minimal" % sys.argv[1])
+    print("  span (2 x 2 x 1.4 delta, %d particles), averaged over t u_tau/delta = %.3g .. %.3g"
+          % (int(d.n_fluid), t0, t1))
+    print("  (%.3g turnovers, %d windows of %.3g); made by jobs/chain.sh runs/w6"
+          % (t1 - t0, n, float(d.window_length)))
+    print("  jobs/scenes/mfu180w_dr6.ini and chansph extract --window --nc"
+          " (docs/validation/turbulent_channel.md).")
+EOF
+  build/chansph compare "$long" --dns "$dns" --out "$out/compare_long" --no-plots |
+    grep -E "^(differences in|largest error)"
+  /usr/bin/python3 - "$long" "$dns" "$here/stats/python" <<'EOF'
+import sys
+
+import numpy as np
+
+sys.path.insert(0, sys.argv[3])
+from chansph_stats.compare import read_run  # noqa: E402
+from chansph_stats.dns import read_dns  # noqa: E402
+
+ours, dns = read_run(sys.argv[1]), read_dns(sys.argv[2])
+print("  Its peaks against the DNS (chan180) in wall units of %s, with the standard error"
+      % ours["u_tau_label"])
+print("  (batch means over its windows) at the peak:")
+for q in ("-u'v'+", "u_rms+", "v_rms+", "w_rms+"):
+    k = int(np.nanargmax(ours[q]))
+    peak, se, dpk = ours[q][k], ours[q + "_se"][k], float(np.nanmax(dns[q]))
+    print("    %-7s peak %.3f +- %.3f at y+ %.0f; DNS %.3f: %+.0f%%"
+          % (q, peak, se, ours["yplus"][k], dpk, 100 * (peak / dpk - 1)))
+print("  The quick-start run above is 0.2 turnovers of a minimal unit at dr+ = 4.5: its numbers")
+print("  show that the flow is turbulent, not what it converges to; the long run's are averages")
+print("  over many turnovers, with their own (smaller) standard errors.")
+EOF
+fi
 echo
 echo "quickstart: results in $out/"
 echo "  stats.nc      profiles with standard errors, raw windows, spectra, time series"
