@@ -212,6 +212,7 @@ def main(argv, prog="chansph compare"):
             rows.append((q, name, int(sel.sum()), l2, linf, l2 / scale if scale > 0 else math.nan,
                          se_rms))
             print("%-8s %-17s %6d %12.4e %12.4e %12.4e %12.4e" % rows[-1])
+    peak_table(ours, dns, inside)
     worst = largest(rows)
     if worst:
         print("largest error: %s (wall units of %s)" % (worst, ours["u_tau_label"]))
@@ -235,6 +236,30 @@ def main(argv, prog="chansph compare"):
         print("largest error %.3e (limit %.3g): %s" % (worst, args.max_error, "PASS" if ok else "FAIL"))
         return 0 if ok else 1
     return 0
+
+
+def peak_table(ours, dns, inside, lo=10.0, hi=150.0):
+    """The deviation relative to the DNS peak over lo < y+ < hi (issue 24's measure): per
+    quantity max |ours - DNS| / max |DNS| and our largest standard error over the range
+    relative to the same peak, with the y+ of the largest deviation."""
+    sel = inside & (ours["yplus"] > lo) & (ours["yplus"] < hi)
+    if not sel.any():
+        return
+    print("deviation relative to the DNS peak over %g < y+ < %g (%d bins): max |ours - DNS| / "
+          "DNS peak, at y+; largest stderr / DNS peak" % (lo, hi, int(sel.sum())))
+    for q in QUANTITIES:
+        if dns.get(q) is None or ours.get(q) is None:
+            continue
+        peak = float(np.nanmax(np.abs(dns[q])))
+        diff = np.abs(ours[q] - np.interp(ours["yplus"], dns["yplus"], dns[q]))[sel]
+        if not np.isfinite(diff).any() or peak <= 0:
+            continue
+        k = int(np.nanargmax(diff))
+        se = ours.get(q + "_se")
+        se_max = float(np.nanmax(se[sel])) / peak if se is not None else math.nan
+        print("  %-7s %6.1f%% at y+ %5.1f   stderr %s"
+              % (q, 100 * diff[k] / peak, ours["yplus"][sel][k],
+                 "%5.1f%%" % (100 * se_max) if math.isfinite(se_max) else "    -"))
 
 
 def plot_title(ours):
