@@ -6,6 +6,7 @@ not mirrored by the Python side).
 
 usage: window_profile_check.py CHANSPH STATS_RUN_DIR T0:T1
 """
+import math
 import os
 import subprocess
 import sys
@@ -14,6 +15,7 @@ import netCDF4
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "../stats/python"))
+from chansph_stats.error_vs_time import group_profiles  # noqa: E402
 from chansph_stats.merge import window_profile  # noqa: E402
 
 
@@ -50,6 +52,18 @@ def main():
     if worst > 1e-6:  # extract prints 9 significant digits
         sys.exit(f"FAIL: the merges differ by {worst:.2e}")
     print("the Python window merge matches chansph extract")
+    # error_vs_time --cumulative T0: its last group is the running average of all the windows
+    # from T0 on, which window_profile gives directly (force units, as error_vs_time uses)
+    groups = group_profiles(run, 0.2, since=t0)
+    full, _ = window_profile(run, t0, math.inf)
+    last = groups[-1][2]
+    if len(groups) < 2 or abs(groups[-1][0] - t0) > 1e-9 or \
+            not np.allclose(last["u_rms+"], full["u_rms+"], rtol=1e-12, equal_nan=True):
+        sys.exit("FAIL: the cumulative group is not the running average from T0")
+    first = group_profiles(run, 0.2)[-1][2]  # the last group alone differs from it
+    if np.allclose(first["u_rms+"], full["u_rms+"], rtol=1e-6, equal_nan=True):
+        sys.exit("FAIL: the test cannot tell a group from the running average")
+    print(f"error_vs_time --cumulative: {len(groups)} groups, the last = the average from {t0}")
 
 
 if __name__ == "__main__":

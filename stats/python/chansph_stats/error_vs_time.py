@@ -14,6 +14,10 @@ since the start of the series (from the log's step lines and the fluid-particle 
 wall seconds (from the log's particle-steps/s of each interval: what the machine delivered,
 shared or not).
 
+With --cumulative T0 each group instead gives the running average from T0 to its end (the
+error a user gets for the run time spent: the convergence of the averages, and the bias that
+remains).
+
 Writes DIR/error_vs_time.csv (one row per series, group and DNS set) and
 DIR/error_vs_time.png (one panel per quantity, error against particle-steps), and prints the
 last group of each series. DNS files: those `chansph compare` reads (dns.py).
@@ -52,8 +56,9 @@ def log_cost(run):
     return t, psteps, np.concatenate(([0.0], np.cumsum(dwall)))
 
 
-def group_profiles(run, group):
-    """[(t0, t1, profiles dict)] of the window groups of a run."""
+def group_profiles(run, group, since=None):
+    """[(t0, t1, profiles dict)] of the window groups of a run; with since, each group's
+    profiles are the running average of the windows from since to the group's end."""
     r = read_windows(os.path.join(run, "stats.nc"))
     win, done = r["win"], r["done"]
     out = []
@@ -64,6 +69,8 @@ def group_profiles(run, group):
         sel = [i for i in range(k, len(win)) if win[i, 0] < t_lo + group - 1e-9]
         k = sel[-1] + 1
         sel = [i for i in sel if done[i]]
+        if since is not None:
+            sel = [i for i in range(k) if done[i] and win[i, 0] >= since - 1e-9]
         if not sel:
             continue
         out.append((win[sel[0], 0], win[sel[-1], 1], merged_profile(r, sel)))
@@ -77,6 +84,9 @@ def main(argv, prog):
     ap.add_argument("--group", type=cli.number(float, 0, above=True), default=0.25,
                     help="window group length [delta/u_tau]")
     ap.add_argument("--out", default=".")
+    ap.add_argument("--cumulative", type=float, default=None, metavar="T0",
+                    help="the error of the running average from T0 [delta/u_tau] to the end "
+                         "of each group (within each run directory), instead of each group's own")
     a = ap.parse_args(argv)
     dns = [read_dns(p) for p in a.dns]
     rows = []
@@ -87,7 +97,7 @@ def main(argv, prog):
         t_off = ps_off = wall_off = 0.0
         for run in dirs.split("+"):
             t, ps, wall = log_cost(run)
-            groups = group_profiles(run, a.group)
+            groups = group_profiles(run, a.group, a.cumulative)
             for t0, t1, prof in groups:
                 p1, w1 = np.interp(t1, t, ps), np.interp(t1, t, wall)
                 errs = [[rel_l2(prof, d, q) for q in QUANTITIES] for d in dns]
