@@ -25,9 +25,9 @@ interpolated to it):
    rho_ii,z^2; releases closer than twice the Lagrangian integral time T of the component
    (rho_L integrated to its first zero: the lifetime of the eddies that carry the particles;
    the file's Eulerian correlation_time when T is unknown) count as independent only in the
-   ratio release_every / (2 T). For x the term 2 U <u'> adds
-   2 U u_rms / sqrt(N_eff) when the Eulerian U stands in for the mean drift. The Eulerian standard error of
-   <u_i'^2> is added in quadrature. PASS within two standard errors.
+   ratio release_every / (2 T). For x the term 2 U <u'> adds 2 U u_rms / sqrt(N_eff) when the
+   Eulerian U stands in for the mean drift. The Eulerian standard error of <u_i'^2> is added in
+   quadrature. PASS within two standard errors.
 2. Taylor's whole curve, sigma^2(tau) = 2 <u_i'^2> int_0^tau (tau - s) rho_L(s) ds (y and z; the
    ratio at 1/4, 1/2 and all of the horizon), and the long-time law
    d sigma^2 / d tau = 2 <u_i'^2> T_L over the last third of the horizon, checked only
