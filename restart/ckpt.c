@@ -656,12 +656,12 @@ static int read_field(hid_t file, struct state_field *f, const char *path, char 
              want_rank);
   } else {
     void *dst = f->data;
-    int same = rank == want_rank;
+    int same = rank == want_rank, reserved = 0;
     for (int i = 0; same && i < rank; i++) same = dims[i] == want[i];
     if (!same && f->reserve && !f->total && rank == f->rank) {
       dst = f->reserve(f->owner, rank, dims);
       if (dst) {
-        f->data = dst, same = 1;
+        f->data = dst, same = reserved = 1;
         for (int i = 0; i < rank; i++) f->dims[i] = dims[i];
       }
     }
@@ -678,6 +678,7 @@ static int read_field(hid_t file, struct state_field *f, const char *path, char 
            f->name);
     } else {
       rc = 0;
+      if (reserved && f->after_read) f->after_read(f->owner, rank, dims);
     }
   }
   H5Sclose(sp), H5Tclose(ft), H5Dclose(ds);

@@ -131,6 +131,12 @@ const struct euler_meta euler_prof_meta[EP_NPROF] = {
     [EP_FLAT_U] = {"u_flatness", "1", "flatness (kurtosis) of u"},
     [EP_FLAT_V] = {"v_flatness", "1", "flatness (kurtosis) of v"},
     [EP_FLAT_W] = {"w_flatness", "1", "flatness (kurtosis) of w"},
+    [EP_SE_SF + 0] = {"u_skewness_stderr", "1", "standard error of u_skewness (batch means)"},
+    [EP_SE_SF + 1] = {"v_skewness_stderr", "1", "standard error of v_skewness (batch means)"},
+    [EP_SE_SF + 2] = {"w_skewness_stderr", "1", "standard error of w_skewness (batch means)"},
+    [EP_SE_SF + 3] = {"u_flatness_stderr", "1", "standard error of u_flatness (batch means)"},
+    [EP_SE_SF + 4] = {"v_flatness_stderr", "1", "standard error of v_flatness (batch means)"},
+    [EP_SE_SF + 5] = {"w_flatness_stderr", "1", "standard error of w_flatness (batch means)"},
     [EP_VISC] = {"viscous_stress", "m^2/s^2",
                  "viscous shear stress (nu + <nu_t>) dU/dy (Eq. 5.11; nu_t with LES only)"},
     [EP_TOTAL] =
@@ -692,8 +698,22 @@ static int budget_profiles(const struct euler_config *cfg, const double *mom, co
   return any;
 }
 
-/* The profiles of bin b from its merged moment record m and the batch moments B of its 5
-   means and 6 stresses; returns 1 if the bin has samples. */
+/* Batch moments per bin: 5 means, 6 stresses, the skewness and flatness of u, v, w. */
+enum { BM_SKEW = 11, BM_FLAT = 14, BM_LEN = 17 };
+
+/* Add the skewness and flatness of u, v, w of one window's moment record m (n > 0) to the
+   batch moments B (windows where a component has no variance are left out). */
+static void window_shape(const double *m, double *B) {
+  for (int i = 0; i < 3; i++) {
+    const double m2 = m[MOM_C2 + i] / m[MOM_N];
+    if (!(m2 > 0.0)) continue;
+    scal_add(B + (BM_SKEW + i) * SCAL_LEN, m[MOM_M3 + i] / m[MOM_N] / pow(m2, 1.5));
+    scal_add(B + (BM_FLAT + i) * SCAL_LEN, m[MOM_M4 + i] / m[MOM_N] / (m2 * m2));
+  }
+}
+
+/* The profiles of bin b from its merged moment record m and the batch moments B (BM_LEN);
+   returns 1 if the bin has samples. */
 static int bin_profiles(const struct euler_config *cfg, int b, const double *m, const double *B,
                         struct euler_result *res) {
   const double n = m[MOM_N], nan = NAN;
@@ -709,9 +729,9 @@ static int bin_profiles(const struct euler_config *cfg, int b, const double *m, 
     res->prof[EP_SKEW_U + i][b] = n > 0.0 && m2 > 0.0 ? m[MOM_M3 + i] / n / pow(m2, 1.5) : nan;
     res->prof[EP_FLAT_U + i][b] = n > 0.0 && m2 > 0.0 ? m[MOM_M4 + i] / n / (m2 * m2) : nan;
   }
-  for (int k = 0; k < 11; k++) {
+  for (int k = 0; k < BM_LEN; k++) {
     const double *s = B + k * SCAL_LEN;
-    res->prof[EP_SE_U + k][b] =
+    res->prof[k < BM_SKEW ? EP_SE_U + k : EP_SE_SF + k - BM_SKEW][b] =
         s[SCAL_N] >= 2.0 ? sqrt(s[SCAL_M2] / (s[SCAL_N] - 1.0) / s[SCAL_N]) : nan;
   }
   return n > 0.0;
@@ -765,7 +785,7 @@ void euler_finalise(const struct euler_config *cfg, const double *win, const dou
     res->prof[k] = mem_alloc((size_t)nb, sizeof(double), "Eulerian statistics");
   const char *lbl = "Eulerian statistics";
   double *tot = mem_calloc((size_t)nb * MOM_LEN, sizeof(double), lbl);
-  double *bm = mem_calloc((size_t)nb * 11 * SCAL_LEN, sizeof(double), lbl); /* batch moments */
+  double *bm = mem_calloc((size_t)nb * BM_LEN * SCAL_LEN, sizeof(double), lbl); /* batches */
   double *sn = mem_calloc((size_t)nb * SCAL_LEN, sizeof(double), lbl);
   double *within = mem_calloc((size_t)nb * 2, sizeof(double), lbl);
   double snaps = 0.0, walls = 0.0, sum_fx = 0.0, sum_tw = 0.0, tw_batch[SCAL_LEN] = {0, 0, 0};
@@ -785,9 +805,10 @@ void euler_finalise(const struct euler_config *cfg, const double *win, const dou
         within[2 * b] += s[SCAL_M2], within[2 * b + 1] += s[SCAL_N] - 1.0;
       }
       if (!complete[r] || m[MOM_N] <= 0.0) continue;
-      double *B = bm + (size_t)b * 11 * SCAL_LEN;
+      double *B = bm + (size_t)b * BM_LEN * SCAL_LEN;
       for (int q = 0; q < 5; q++) scal_add(B + q * SCAL_LEN, m[MOM_MEAN + q]);
       for (int c = 0; c < MOM_NC; c++) scal_add(B + (5 + c) * SCAL_LEN, m[MOM_C2 + c] / m[MOM_N]);
+      window_shape(m, B);
       if (s[SCAL_N] > 0.0) scal_add(sn + (size_t)b * SCAL_LEN, s[SCAL_MEAN]);
     }
     if (complete[r] && w[WIN_NSNAP] > 0.0) {
@@ -802,7 +823,8 @@ void euler_finalise(const struct euler_config *cfg, const double *win, const dou
   double tau_sum = 0.0;
   int tau_n = 0;
   for (int b = 0; b < nb; b++) {
-    ok[b] = bin_profiles(cfg, b, tot + (size_t)b * MOM_LEN, bm + (size_t)b * 11 * SCAL_LEN, res);
+    ok[b] =
+        bin_profiles(cfg, b, tot + (size_t)b * MOM_LEN, bm + (size_t)b * BM_LEN * SCAL_LEN, res);
     /* statistical inefficiency of the per-snapshot bin means: batch variance times batch
        size over the variance within the batches; correlation time = s dt_sample / 2 */
     const double *s = sn + (size_t)b * SCAL_LEN;

@@ -162,7 +162,9 @@ enum {
   EP_RSB_END = EP_RSB + RS_NCOMP * RS_NTERM,
   EP_RSB_SE = EP_RSB_END, /* their standard errors, in the same order */
   EP_RSB_SE_END = EP_RSB_SE + RS_NCOMP * RS_NTERM,
-  EP_NPROF = EP_RSB_SE_END
+  EP_SE_SF = EP_RSB_SE_END, /* stderr of u, v, w skewness, then u, v, w flatness (batch means) */
+  EP_SE_SF_END = EP_SE_SF + 6,
+  EP_NPROF = EP_SE_SF_END
 };
 
 /** Name, units and long name of each finished profile. */

@@ -23,6 +23,7 @@ enum unit_class { UC_NONE, UC_VEL, UC_STRESS, UC_PRESSURE, UC_LENGTH, UC_VISC, U
 
 static enum unit_class class_of(int k) {
   if (k >= EP_RSB && k < EP_RSB_SE_END) return UC_BUDGET; /* m^2/s^3: u_tau^4/nu */
+  if (k >= EP_SE_SF && k < EP_SE_SF_END) return UC_NONE;  /* of skewness and flatness */
   switch (k) {
     case EP_Y:
     case EP_Y_MEAN:
@@ -290,6 +291,7 @@ static double extract_scale(int k, int wall, const struct euler_config *cfg, dou
 
 /* The profile of the standard error of profile k, or -1. */
 static int stderr_of(int k) {
+  if (k >= EP_SKEW_U && k <= EP_FLAT_W) return EP_SE_SF + (k - EP_SKEW_U);
   return k >= EP_U && k <= EP_VW ? EP_SE_U + (k - EP_U) : -1;
 }
 

@@ -83,7 +83,7 @@ static void contribute(const double *tr, const double *p, double *R) {
     const double dv = vt[i] - v0, dv2 = dv * dv;
     R[LG_STRUCT + 3 * i] += dv2, R[LG_STRUCT + 3 * i + 1] += dv2 * dv;
     R[LG_STRUCT + 3 * i + 2] += dv2 * dv2;
-    R[LG_DISP + i] += tr[TR_DISP + i] * tr[TR_DISP + i];
+    R[LG_DISP + i] += tr[TR_DISP + i] * tr[TR_DISP + i], R[LG_DR + i] += tr[TR_DISP + i];
   }
 }
 
@@ -322,6 +322,43 @@ static void *reserve_tr(void *owner, int rank, const size_t *dims) {
   return g->tracks;
 }
 
+/* The sums of a checkpoint of format <= 1.6 (records of LG_LEN_1_6, read into the front of
+   g->sums or g->slot_sums): spread them to records of LG_LEN, from the last one back. The sums
+   of dr were not kept: NaN in a record with samples (the mean displacement of the run stays
+   NaN), 0 in one without (exact). */
+static void widen(double *a, size_t rows) {
+  for (size_t r = rows; r-- > 0;) {
+    double *R = a + r * LG_LEN;
+    memmove(R, a + r * LG_LEN_1_6, LG_LEN_1_6 * sizeof(double));
+    for (int i = LG_LEN_1_6; i < LG_LEN; i++) R[i] = R[LG_N] > 0.0 ? NAN : 0.0;
+  }
+}
+
+static void *reserve_sums(void *owner, int rank, const size_t *dims) {
+  struct lagr *g = owner;
+  const int ok = rank == 3 && dims[0] == (size_t)g->cfg.n_levels && dims[1] == g->nlag &&
+                 (dims[2] == LG_LEN || dims[2] == LG_LEN_1_6);
+  return ok ? g->sums : NULL;
+}
+
+static void *reserve_slot_sums(void *owner, int rank, const size_t *dims) {
+  struct lagr *g = owner;
+  const int ok = rank == 3 && dims[0] == (size_t)g->n_slots &&
+                 dims[1] == (size_t)g->cfg.n_levels * g->nlag &&
+                 (dims[2] == LG_LEN || dims[2] == LG_LEN_1_6);
+  return ok ? g->slot_sums : NULL;
+}
+
+static void widen_sums(void *owner, int rank, const size_t *dims) {
+  struct lagr *g = owner;
+  if (rank == 3 && dims[2] == LG_LEN_1_6) widen(g->sums, dims[0] * dims[1]);
+}
+
+static void widen_slot_sums(void *owner, int rank, const size_t *dims) {
+  struct lagr *g = owner;
+  if (rank == 3 && dims[2] == LG_LEN_1_6) widen(g->slot_sums, dims[0] * dims[1]);
+}
+
 void lagr_state(struct lagr *g, struct state_list *L) {
   if (g->cfg.n_levels <= 0) return;
   reserve_tracks(g, 1);
@@ -330,13 +367,15 @@ void lagr_state(struct lagr *g, struct state_list *L) {
   const size_t d3[3] = {nl, g->nlag, LG_LEN}, d4[3] = {ns, nl * g->nlag, LG_LEN};
   const size_t ds[2] = {ns, SL_LEN}, dt[3] = {nl, 3, SCAL_LEN};
   const size_t dp[3] = {nl, st, (size_t)g->cfg.pdf_bins + 3}, dtr[2] = {g->ntracks, TR_LEN};
-  state_add(L, "stats/lagrangian/sums", STATE_F64, 3, d3, g->sums, NULL);
-  state_add(L, "stats/lagrangian/slot_sums", STATE_F64, 3, d4, g->slot_sums, NULL);
+  /* format <= 1.6: records without the sums of dr (LG_LEN_1_6), widened after reading */
+  struct state_field *f = state_add(L, "stats/lagrangian/sums", STATE_F64, 3, d3, g->sums, NULL);
+  f->reserve = reserve_sums, f->after_read = widen_sums, f->owner = g;
+  f = state_add(L, "stats/lagrangian/slot_sums", STATE_F64, 3, d4, g->slot_sums, NULL);
+  f->reserve = reserve_slot_sums, f->after_read = widen_slot_sums, f->owner = g;
   state_add(L, "stats/lagrangian/slots", STATE_F64, 2, ds, g->slots, NULL);
   state_add(L, "stats/lagrangian/tl_batches", STATE_F64, 3, dt, g->tl, "s");
   state_add(L, "stats/lagrangian/pdf", STATE_F64, 3, dp, g->pdf, NULL);
-  struct state_field *f =
-      state_add(L, "stats/lagrangian/tracks", STATE_F64, 2, dtr, g->tracks, NULL);
+  f = state_add(L, "stats/lagrangian/tracks", STATE_F64, 2, dtr, g->tracks, NULL);
   f->reserve = reserve_tr, f->owner = g;
   state_add(L, "stats/lagrangian/next_release", STATE_F64, 0, NULL, &g->next_release, "s");
   state_add(L, "stats/lagrangian/releases", STATE_F64, 0, NULL, &g->releases, NULL);
@@ -354,6 +393,11 @@ void lagr_functions(const struct lagr *g, int level, double *out, double *tl) {
       out[(LF_S + i) * nlag + k] = n > 0 ? R[LG_STRUCT + 3 * i + 1] / n : NAN;
       out[(LF_K + i) * nlag + k] = n > 0 ? R[LG_STRUCT + 3 * i + 2] / n : NAN;
       out[(LF_SIG2 + i) * nlag + k] = n > 0 ? R[LG_DISP + i] / n : NAN;
+      const double m = n > 0 ? R[LG_DR + i] / n : NAN; /* NaN: resumed from format <= 1.6 */
+      out[(LF_U0 + i) * nlag + k] = n > 0 ? R[LG_VEL + 5 * i] / n : NAN;
+      out[(LF_UT + i) * nlag + k] = n > 0 ? R[LG_VEL + 5 * i + 1] / n : NAN;
+      out[(LF_DR + i) * nlag + k] = m;
+      out[(LF_DVAR + i) * nlag + k] = n > 0 ? R[LG_DISP + i] / n - m * m : NAN;
     }
     out[LF_N * nlag + k] = n;
   }
@@ -546,6 +590,11 @@ int lagr_nc_write(const struct lagr *g, int ncid, char *err, size_t errlen) {
       {LF_S, "S_%c", "m^3/s^3", "third-order structure function of %c (Eq. 5.64)", comp},
       {LF_K, "K_%c", "m^4/s^4", "fourth-order structure function of %c (Eq. 5.65)", comp},
       {LF_SIG2, "sigma2_%c", "m^2", "dispersion <(%c(t0 + tau) - %c(t0))^2> (Eq. 5.66)", pos},
+      {LF_U0, "%c_release_mean", "m/s", "Lagrangian mean velocity at release <%c(t0)>", comp},
+      {LF_UT, "%c_lag_mean", "m/s", "Lagrangian mean velocity at the lag <%c(t0 + tau)>", comp},
+      {LF_DR, "disp_mean_%c", "m", "mean displacement <%c(t0 + tau) - %c(t0)>", pos},
+      {LF_DVAR, "disp_var_%c", "m^2",
+       "variance of the displacement %c(t0 + tau) - %c(t0) about its mean", pos},
   };
   const int d2[2] = {dl, dk};
   for (size_t j = 0; j < sizeof q / sizeof q[0]; j++)

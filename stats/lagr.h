@@ -11,10 +11,12 @@
  *
  * Per level and lag the engine sums (n, then for u, v, w: sums of v0, vt, v0^2, vt^2, v0 vt;
  * the same for the accelerations; sums of dv^2, dv^3, dv^4 with dv = v(t0 + tau) - v(t0);
- * sums of the squared displacements). From the sums:
+ * sums of the squared displacements and of the displacements). From the sums:
  *   rho^L_ii(tau) = cov(v_i(t0), v_i(t0 + tau)) / (sd(v_i(t0)) sd(v_i(t0 + tau)))   (Eq. 5.60)
  *   T_L,i = int_0^{4 T_E,i} rho^L_ii dt, rho^L_ii(T_E,i / 2) = e^{-1/2}             (Eq. 5.61)
  *   rho^a_ii (Eq. 5.62), D_ii, S_ii, K_ii (Eq. 5.63-5.65), sigma_i^2 (Eq. 5.66),
+ * the Lagrangian mean velocities <v_i(t0)>, <v_i(t0 + tau)>, the mean displacement <dr_i>(tau)
+ * and the displacement variance <dr_i^2> - <dr_i>^2 (sigma_i^2 without the mean drift),
  * and at downstream stations x - x0 = X the histogram of y of the particles crossing it,
  * P(y; X), with mu_y and the variance of Eq. 5.67-5.68.
  * The covariance form of Eq. 5.60 measures fluctuations about the ensemble mean of the
@@ -39,8 +41,13 @@ enum {
   LG_ACC = LG_VEL + 15,    /* the same for ax, ay, az */
   LG_STRUCT = LG_ACC + 15, /* 3 x [sum dv^2, dv^3, dv^4] */
   LG_DISP = LG_STRUCT + 9, /* 3 x sum dr^2 */
-  LG_LEN = LG_DISP + 3
+  LG_DR = LG_DISP + 3,     /* 3 x sum dr (checkpoint format 1.7) */
+  LG_LEN = LG_DR + 3
 };
+
+/** Sums per level and lag in checkpoints of format <= 1.6 (without LG_DR): read into the
+    layout above with the sums of dr NaN where the record has samples (lagr.c). */
+enum { LG_LEN_1_6 = LG_DR };
 
 /** Per tracked particle. */
 enum {
@@ -122,13 +129,27 @@ void lagr_state(struct lagr *g, struct state_list *L);
  * @param[in] g engine
  * @param[in] level release level
  * @param[out] out [quantity][nlag], quantities: rho_L u v w, rho_a u v w, D u v w, S u v w,
- *             K u v w, sigma2 x y z, n (19 rows)
+ *             K u v w, sigma2 x y z, <v_i(t0)> u v w, <v_i(t0 + tau)> u v w, <dr_i> x y z,
+ *             <dr_i^2> - <dr_i>^2 x y z, n (31 rows)
  * @param[out] tl T_L of u, v, w from the merged releases (Eq. 5.61) [s]
  */
 void lagr_functions(const struct lagr *g, int level, double *out, double *tl);
 
 /** Rows of lagr_functions. */
-enum { LF_RHO_L = 0, LF_RHO_A = 3, LF_D = 6, LF_S = 9, LF_K = 12, LF_SIG2 = 15, LF_N = 18, LF_LEN };
+enum {
+  LF_RHO_L = 0,
+  LF_RHO_A = 3,
+  LF_D = 6,
+  LF_S = 9,
+  LF_K = 12,
+  LF_SIG2 = 15,
+  LF_U0 = 18,   /* Lagrangian mean velocity at release */
+  LF_UT = 21,   /* and at the lag */
+  LF_DR = 24,   /* mean displacement (NaN after a resume from format <= 1.6) */
+  LF_DVAR = 27, /* displacement variance about it (likewise) */
+  LF_N = 30,
+  LF_LEN
+};
 
 /**
  * @brief Warnings about the Lagrangian statistics (issue 13): lags left without samples (the lag

@@ -217,9 +217,11 @@ def skewflat():
           "skewflat_compare: a profile 1e-6 off the window records FAILs (exit %d)" % rc)
 
 
-def lagr_file(path, scale_y=1.0, with_corr=True):
+def lagr_file(path, scale_y=1.0, with_corr=True, means=None):
     """Ornstein-Uhlenbeck velocities: rho_L = exp(-tau/T), sigma^2 = 2 s2 T^2 (t/T - 1 + e^-t/T)
-    (Taylor 1921), releases of N tracks at y+ 30 and 100; PDFs Gaussian."""
+    (Taylor 1921), releases of N tracks at y+ 30 and 100; PDFs Gaussian. means = du: the
+    Lagrangian means of checkpoint format 1.7 (u_release_mean ... disp_var_z), the mean u
+    U + du; None: a file without them."""
     T, nlag, H = 0.02, 120, 0.12  # horizon 6 T; lag interval 0.001
     t = np.arange(nlag + 1) * H / nlag
     levels = np.array([30.0, 100.0]) * NU
@@ -255,6 +257,19 @@ def lagr_file(path, scale_y=1.0, with_corr=True):
         var(g, "sigma2_x", ("level", "lag"), np.array([disp(4.0) + (u * t) ** 2 for u in U]))
         var(g, "sigma2_y", ("level", "lag"), np.tile(scale_y * disp(0.5), (2, 1)))
         var(g, "sigma2_z", ("level", "lag"), np.tile(disp(1.0), (2, 1)))
+        if means is not None:
+            um = np.array([np.full(nlag + 1, u + means) for u in U])
+            zero = np.zeros((2, nlag + 1))
+            for kind in ("release", "lag"):
+                var(g, "u_%s_mean" % kind, ("level", "lag"), um)
+                var(g, "v_%s_mean" % kind, ("level", "lag"), zero)
+                var(g, "w_%s_mean" % kind, ("level", "lag"), zero)
+            var(g, "disp_mean_x", ("level", "lag"), um * t)
+            var(g, "disp_mean_y", ("level", "lag"), zero)
+            var(g, "disp_mean_z", ("level", "lag"), zero)
+            var(g, "disp_var_x", ("level", "lag"), np.tile(disp(4.0), (2, 1)))
+            var(g, "disp_var_y", ("level", "lag"), np.tile(scale_y * disp(0.5), (2, 1)))
+            var(g, "disp_var_z", ("level", "lag"), np.tile(disp(1.0), (2, 1)))
         for c in "uvw":
             var(g, "rho_L_" + c, ("level", "lag"), np.tile(np.exp(-t / T), (2, 1)))
         var(g, "n_tracks", ("level", "lag"), np.full((2, nlag + 1), float(nrel * N)))
@@ -299,6 +314,29 @@ def lagr():
           "lagr_check: T_L = int rho_L over the horizon for exp(-tau/T) (%s)" % tl)
     check("mean y 0.1667 m, sd 0.05 m, 1000 tracks" in out,
           "lagr_check: the dispersion PDF's mean and sd are reported")
+    check("Lagrangian mean velocity: not in stats.nc" in out and
+          "drift = Eulerian U(y0)" in out,
+          "lagr_check: a file without the Lagrangian means (before checkpoint format 1.7): the "
+          "Eulerian U stands in for the drift, the mean velocity is not checked")
+    # checkpoint format 1.7 on: the Lagrangian means in stats.nc, no --ckpt needed
+    m = os.path.join(WORK, "lagr_means.nc")
+    lagr_file(m, means=0.0)
+    rc, out, err = run("lagr_check", m)
+    short = re.findall(r"short-time (.): sigma_.\^2/tau\^2 = .*drift removed \(disp_var_.*: "
+                       r"(PASS|FAIL)", out)
+    mean = re.findall(r"Lagrangian mean u at release .* \(stats.nc\).*: (PASS|FAIL)", out)
+    ratio = re.findall(r"mean displacement <dx>.*\(ratio ([0-9.]+)\)", out)
+    check(rc == 0 and len(short) == 6 and all(x[1] == "PASS" for x in short) and
+          mean == ["PASS", "PASS"] and len(ratio) == 2 and
+          all(abs(float(x) - 1) < 1e-3 for x in ratio),
+          "lagr_check without --ckpt on a file with the Lagrangian means: the drift removed by "
+          "disp_var_*, the short-time law holds (%s), the mean velocity equals U (%s), "
+          "<dx> = U tau (%s) (exit %d) %s" % (short, mean, ratio, rc, err.strip()))
+    lagr_file(m, means=1.0)
+    rc, out, _ = run("lagr_check", m)
+    mean = re.findall(r"Lagrangian mean u at release .* \(stats.nc\).*: (PASS|FAIL)", out)
+    check(rc == 1 and mean == ["FAIL", "FAIL"],
+          "lagr_check: a Lagrangian mean velocity 1 m/s off U FAILs (%s, exit %d)" % (mean, rc))
     b = os.path.join(WORK, "lagr_broken.nc")
     lagr_file(b, scale_y=2.0, with_corr=False)
     rc, out, _ = run("lagr_check", b)
@@ -327,6 +365,15 @@ def lagr():
         h["stats/lagrangian/sums"] = sums
         h["stats/lagrangian/releases"] = np.array([400.0])
     rc, out, err = run("lagr_check", f, "--ckpt", ck)
+    ck17 = os.path.join(WORK, "lagr_ckpt17.h5")
+    with h5py.File(ck17, "w") as h:  # format 1.7: the sums of dr appended
+        h.attrs.update(format=b"chansph-checkpoint", format_version_major=1,
+                       format_version_minor=7, complete=1)
+        h["stats/lagrangian/sums"] = np.concatenate([sums, np.zeros((2, nlag + 1, 3))], axis=2)
+        h["stats/lagrangian/releases"] = np.array([400.0])
+    rc17, out17, err17 = run("lagr_check", f, "--ckpt", ck17)
+    check(rc17 == 0 and out17.count("(checkpoint)") == 2,
+          "lagr_check --ckpt reads a checkpoint of format 1.7 (exit %d) %s" % (rc17, err17.strip()))
     mean = re.findall(r"Lagrangian mean u at release .*: (PASS|FAIL)", out)
     kin = re.findall(r"short-time [yz]: .*kinematics, within 3%: (PASS|FAIL).*: (PASS|FAIL)", out)
     clock = re.findall(r"is at tau = ([0-9.e+-]+) s .* by the x clock", out)

@@ -473,6 +473,176 @@ static void test_lagr_ou(void) {
   lagr_free(&g);
 }
 
+/* Variance of dt (u_0 + ... + u_{k-1}) for a stationary AR(1) of unit variance and lag-one
+   correlation f: dt^2 (k + 2 sum_{m=1}^{k-1} (k - m) f^m). */
+static double ar1_sum_var(int k, double f, double dt) {
+  double s = k, fm = 1.0;
+  for (int m = 1; m < k; m++) fm *= f, s += 2.0 * (k - m) * fm;
+  return dt * dt * s;
+}
+
+/* The largest |value - expected| / standard error over the lags 1.. of one row. */
+static double worst_z(const double *row, const double *n, size_t nlag, double (*want)(int, int),
+                      double (*se)(int, int, double), int comp) {
+  double z = 0.0;
+  for (size_t k = 1; k < nlag; k++)
+    z = fmax(z, fabs(row[k] - want((int)k, comp)) / se((int)k, comp, n[k]));
+  return z;
+}
+
+/* The drift test's process: u = U + OU (T = 1), v = V + OU, w white (sd 0.1); dt = dtau. */
+static const double DRIFT_U[3] = {3.0, -0.2, 0.0}, DRIFT_DT = 0.125;
+static double drift_f(void) {
+  return exp(-DRIFT_DT / 1.0);
+}
+static double dvar(int k, int c) {
+  return c < 2 ? ar1_sum_var(k, drift_f(), DRIFT_DT) : 0.01 * DRIFT_DT * DRIFT_DT * k;
+}
+static double want_mean(int k, int c) {
+  return DRIFT_U[c] * k * DRIFT_DT;
+}
+static double se_mean(int k, int c, double n) {
+  return sqrt(dvar(k, c) / n);
+}
+static double se_var(int k, int c, double n) {
+  return dvar(k, c) * sqrt(2.0 / (n - 1));
+}
+
+/* Write one sums field of g as a checkpoint of format <= 1.6 stores it (records of LG_LEN_1_6)
+   into the memory its reserve() gives, widen it with after_read(); 1 if the old sums came back
+   bitwise and the sums of dr are NaN exactly in the records with samples. */
+static int widen_one(struct state_field *f, size_t rows) {
+  double *ref = malloc(rows * LG_LEN * sizeof(double)), *old = malloc(rows * LG_LEN_1_6 * 8);
+  memcpy(ref, f->data, rows * LG_LEN * sizeof(double));
+  for (size_t r = 0; r < rows; r++)
+    memcpy(old + r * LG_LEN_1_6, ref + r * LG_LEN, LG_LEN_1_6 * sizeof(double));
+  const size_t dims[3] = {f->dims[0], f->dims[1], LG_LEN_1_6}, bad[3] = {f->dims[0], 7, 44};
+  int ok = f->reserve(f->owner, 3, bad) == NULL;
+  double *dst = f->reserve(f->owner, 3, dims);
+  ok = ok && dst == f->data;
+  if (ok) {
+    memcpy(dst, old, rows * LG_LEN_1_6 * sizeof(double));
+    f->after_read(f->owner, 3, dims);
+    for (size_t r = 0; r < rows; r++) {
+      const double *R = dst + r * LG_LEN, *W = ref + r * LG_LEN;
+      ok = ok && !memcmp(R, W, LG_LEN_1_6 * sizeof(double));
+      for (int i = 0; i < 3; i++)
+        ok = ok && (R[LG_N] > 0 ? isnan(R[LG_DR + i]) : R[LG_DR + i] == 0.0);
+    }
+  }
+  free(ref), free(old);
+  return ok;
+}
+
+/* The engine's sums read from a checkpoint of format 1.6 (stats/lagrangian/sums and slot_sums
+   without the sums of dr): every other sum as stored, the mean displacement and its variance
+   NaN (not recoverable), sigma2 and the mean velocities as before. */
+static void lagr_widen_check(struct lagr *g) {
+  const size_t nlag = g->nlag;
+  double *before = malloc(LF_LEN * nlag * sizeof(double)), *after = malloc(LF_LEN * nlag * 8);
+  double tl[3];
+  lagr_functions(g, 0, before, tl);
+  struct state_list L = {0};
+  lagr_state(g, &L);
+  struct state_field *fs = state_find(&L, "stats/lagrangian/sums");
+  struct state_field *fl = state_find(&L, "stats/lagrangian/slot_sums");
+  const int ok_s = fs && widen_one(fs, nlag);
+  const int ok_l = fl && widen_one(fl, (size_t)g->n_slots * nlag);
+  lagr_functions(g, 0, after, tl);
+  int kept = 1, nan = 1;
+  for (size_t k = 0; k < nlag; k++)
+    for (int c = 0; c < 3; c++) {
+      kept = kept && after[(LF_SIG2 + c) * nlag + k] == before[(LF_SIG2 + c) * nlag + k] &&
+             after[(LF_U0 + c) * nlag + k] == before[(LF_U0 + c) * nlag + k] &&
+             after[(LF_UT + c) * nlag + k] == before[(LF_UT + c) * nlag + k];
+      nan = nan && isnan(after[(LF_DR + c) * nlag + k]) && isnan(after[(LF_DVAR + c) * nlag + k]);
+    }
+  printf(
+      "Lagrangian sums of checkpoint format 1.6: widened (sums %s, slot sums %s), sigma2 and "
+      "the mean velocities %s, mean displacement %s\n",
+      ok_s ? "ok" : "WRONG", ok_l ? "ok" : "WRONG", kept ? "kept" : "CHANGED",
+      nan ? "NaN" : "NOT NaN");
+  EXPECT(ok_s && ok_l && kept && nan, "reading the sums of format 1.6");
+  state_free(&L);
+  free(before), free(after);
+}
+
+/* Issue 25: tracks moving with a known mean velocity (U, V, 0) plus OU fluctuations give the
+   Lagrangian mean velocities (U, V, 0) at release and at every lag, the mean displacement
+   <dr_i>(tau) = U_i tau and the displacement variance of the fluctuations alone,
+   dt^2 sum_{m,n} f^|m-n| (the mean drift removed from sigma_i^2), each within 4 standard
+   errors; sigma_i^2 = variance + mean^2. Then the sums as a checkpoint of format 1.6 holds
+   them (records without the sums of dr) are widened by the state list's callbacks: the other
+   sums bitwise, the mean displacement NaN. */
+static void test_lagr_drift(void) {
+  enum { NPART = 2000, RELEASES = 24, NLAG = 40 };
+  const double horizon = NLAG * DRIFT_DT, f = drift_f();
+  const struct lagr_config cfg = {.n_levels = 1,
+                                  .y = {0.5},
+                                  .y_plus = {50},
+                                  .half = 0.05,
+                                  .lx = 10.0,
+                                  .delta = 1.0,
+                                  .horizon = horizon,
+                                  .release_every = horizon + DRIFT_DT,
+                                  .n_lags = NLAG,
+                                  .pdf_bins = 10};
+  struct lagr g;
+  lagr_init(&g, &cfg);
+  static double x[NPART], y[NPART], z[NPART], u[NPART], v[NPART], w[NPART];
+  static int64_t id[NPART];
+  for (int p = 0; p < NPART; p++) {
+    id[p] = p, u[p] = DRIFT_U[0] + gauss(8000000 + 3 * p);
+    v[p] = DRIFT_U[1] + gauss(8000001 + 3 * p), w[p] = 0.1 * gauss(8000002 + 3 * p);
+  }
+  const long steps = (long)(RELEASES * (horizon + DRIFT_DT) / DRIFT_DT) + 1;
+  for (long n = 0; n < steps; n++) {
+    const double t = n * DRIFT_DT;
+    if (t >= g.next_release) /* nothing tracked: all particles back on the release line */
+      for (int p = 0; p < NPART; p++) x[p] = 0.0, y[p] = 0.5, z[p] = 0.0;
+    const struct stats_snapshot snap = {
+        .n = NPART, .x = x, .y = y, .z = z, .u = u, .v = v, .w = w, .id = id, .t = t};
+    lagr_sample(&g, &snap);
+    for (int p = 0; p < NPART; p++) {
+      const uint64_t k = 300000000ULL + ((uint64_t)n * NPART + (uint64_t)p) * 3;
+      x[p] += u[p] * DRIFT_DT, y[p] += v[p] * DRIFT_DT, z[p] += w[p] * DRIFT_DT;
+      u[p] = DRIFT_U[0] + f * (u[p] - DRIFT_U[0]) + sqrt(1 - f * f) * gauss(k);
+      v[p] = DRIFT_U[1] + f * (v[p] - DRIFT_U[1]) + sqrt(1 - f * f) * gauss(k + 1);
+      w[p] = 0.1 * gauss(k + 2);
+    }
+  }
+  const size_t nlag = NLAG + 1;
+  static double fn[LF_LEN * (NLAG + 1)];
+  double tl[3], zm = 0, zv = 0, zu = 0, ident = 0;
+  lagr_functions(&g, 0, fn, tl);
+  const double *n = fn + LF_N * nlag;
+  for (int c = 0; c < 3; c++) {
+    zm = fmax(zm, worst_z(fn + (LF_DR + c) * nlag, n, nlag, want_mean, se_mean, c));
+    zv = fmax(zv, worst_z(fn + (LF_DVAR + c) * nlag, n, nlag, dvar, se_var, c));
+    const double sd = c < 2 ? 1.0 : 0.1;
+    for (size_t k = 0; k < nlag; k++) {
+      zu = fmax(zu, fabs(fn[(LF_U0 + c) * nlag + k] - DRIFT_U[c]) / (sd / sqrt(n[k])));
+      zu = fmax(zu, fabs(fn[(LF_UT + c) * nlag + k] - DRIFT_U[c]) / (sd / sqrt(n[k])));
+      const double m = fn[(LF_DR + c) * nlag + k];
+      ident =
+          fmax(ident, fabs(fn[(LF_SIG2 + c) * nlag + k] - fn[(LF_DVAR + c) * nlag + k] - m * m));
+    }
+  }
+  printf(
+      "Lagrangian drift tracks (%d particles x %.0f releases, U = %g, V = %g): <dx>(5 s) = %.4f "
+      "(exact %g), var dx(5 s) = %.4f (exact %.4f, sigma2_x %.3f); worst over the lags in "
+      "standard errors: mean displacement %.2f, its variance %.2f, mean velocities %.2f\n",
+      NPART, g.releases, DRIFT_U[0], DRIFT_U[1], fn[LF_DR * nlag + NLAG], want_mean(NLAG, 0),
+      fn[LF_DVAR * nlag + NLAG], dvar(NLAG, 0), fn[LF_SIG2 * nlag + NLAG], zm, zv, zu);
+  EXPECT(g.releases >= RELEASES - 1 && n[NLAG] >= NPART * (RELEASES - 1), "releases %g, n %g",
+         g.releases, n[NLAG]);
+  EXPECT(zm < 4.0 && zv < 4.0 && zu < 4.0, "Lagrangian means or displacement variance off");
+  EXPECT(ident < 1e-9 * (1.0 + fn[LF_SIG2 * nlag + NLAG]), "sigma2 != variance + mean^2 (%g)",
+         ident);
+  lagr_widen_check(&g);
+  lagr_free(&g);
+}
+
 /* Acceptance 1: tracks with a known y-distribution at a station give its PDF and moments. */
 static void test_lagr_pdf(void) {
   enum { NPART = 20000, BINS = 50 };
@@ -732,6 +902,7 @@ int main(void) {
   test_rs_budget_known();
   test_sph_profiles();
   test_lagr_ou();
+  test_lagr_drift();
   test_lagr_pdf();
   free(buf);
   printf(failures ? "FAILED (%d)\n" : "all passed\n", failures);

@@ -16,6 +16,8 @@
  * Arrays whose length is only known when reading (time series that grow during the run)
  * give a reserve() callback: the reader calls it with the stored shape and reads into the
  * memory it returns (NULL means "cannot", and the reader reports the field).
+ * Fields whose records grew in a later format accept the older shape the same way and give an
+ * after_read() callback that converts what was read into the live layout.
  */
 #ifndef CHANSPH_STATE_H
 #define CHANSPH_STATE_H
@@ -42,7 +44,10 @@ struct state_field {
   const char *units;           /*!< physical units, or NULL */
   /** For fields sized on reading: return memory for the stored shape (or NULL). */
   void *(*reserve)(void *owner, int rank, const size_t *dims);
-  void *owner;  /*!< first argument of reserve */
+  void *owner; /*!< first argument of reserve and after_read */
+  /** Called after a field was read into memory reserve() returned (dims: the stored shape):
+      converts the layout of an earlier format into the live one in place (or NULL). */
+  void (*after_read)(void *owner, int rank, const size_t *dims);
   int optional; /*!< 1: a checkpoint of an earlier format may lack it (reading leaves it) */
   /** Distributed fields (total > 0): this rank holds rows offset .. offset+dims[0]-1 of a
       dataset of total rows (the other dimensions whole); each rank reads and writes its own

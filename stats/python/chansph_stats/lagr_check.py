@@ -1,6 +1,7 @@
 """The Lagrangian engine of a run (group lagrangian) against exact laws and the Eulerian engine.
 
 usage: chansph-stats lagr_check STATS.nc [--ckpt CKPT.h5] [--out DIR] [--u-tau force|wall|V]
+       [--sample-interval S]
 
 Per release level (y of group lagrangian; the Eulerian values are the root profiles
 interpolated to it):
@@ -10,9 +11,12 @@ interpolated to it):
    sample at or after k horizon / n_lags, so the real lag is ceil(tau_k / ds) ds with ds the
    sampling interval (output.stats_every steps of dt = t_reached / steps, from the scene and
    attributes of the file; --sample-interval overrides, 0 uses the nominal lags).
-   For x the mean drift is removed: sigma_x^2 is <dx^2>, not a variance, so
-   <dx>^2 = (tau (<u(t0)> + <u(t0 + tau)>) / 2)^2 is subtracted, the Lagrangian means from the
-   checkpoint's sums (--ckpt); without one the Eulerian U(y0) stands in for them.
+   The mean drift is removed: sigma_i^2 is <dr_i^2>, not a variance. Files of this version hold
+   the displacement variance about the mean displacement (disp_var_x, _y, _z of group
+   lagrangian; since checkpoint format 1.7), which is used as it is. With --ckpt the
+   checkpoint's sums give the clock below and <dx>^2 = (tau (<u(t0)> + <u(t0 + tau)>) / 2)^2 is
+   subtracted; for older files without --ckpt (or a run resumed from a checkpoint of format
+   1.6, whose disp_var_* are fill values) the Eulerian U(y0) stands in for the mean drift of x.
    Standard error: stats.nc holds only the sums over all releases, no per-release values, so it
    is modelled: a release samples N = n_tracks / releases particles on a line along z (and
    its mirror); their u_i^2 has variance (F - 1) <u_i'^2>^2 (F the Eulerian flatness) and
@@ -21,15 +25,18 @@ interpolated to it):
    rho_ii,z^2; releases closer than twice the Lagrangian integral time T of the component
    (rho_L integrated to its first zero: the lifetime of the eddies that carry the particles;
    the file's Eulerian correlation_time when T is unknown) count as independent only in the
-   ratio release_every / (2 T). For x the term 2 U <u'> adds
-   2 U u_rms / sqrt(N_eff) unless --ckpt gives the mean. The Eulerian standard error of
-   <u_i'^2> is added in quadrature. PASS within two standard errors.
+   ratio release_every / (2 T). For x the term 2 U <u'> adds 2 U u_rms / sqrt(N_eff) when the
+   Eulerian U stands in for the mean drift. The Eulerian standard error of <u_i'^2> is added in
+   quadrature. PASS within two standard errors.
 2. Taylor's whole curve, sigma^2(tau) = 2 <u_i'^2> int_0^tau (tau - s) rho_L(s) ds (y and z; the
    ratio at 1/4, 1/2 and all of the horizon), and the long-time law
    d sigma^2 / d tau = 2 <u_i'^2> T_L over the last third of the horizon, checked only
    where the horizon exceeds 3 T_L (else "not reached"); in y the walls bound the dispersion.
 3. The Lagrangian mean velocity <u(t0)> of the releases equals the Eulerian U(y0) within two
-   standard errors (u_rms / sqrt(N_eff)): needs --ckpt (stats.nc has no Lagrangian mean).
+   standard errors (u_rms / sqrt(N_eff)): from u_release_mean and u_lag_mean of group
+   lagrangian, or from the checkpoint's sums (--ckpt; needed for files written before
+   checkpoint format 1.7, which have no Lagrangian mean). The mean displacement <dx>(tau)
+   (disp_mean_x) is reported against tau times the mean of <u(t0)> and <u(t0 + tau)>.
 4. T_L per level and component: the integral of rho_L to its first zero (or to the horizon,
    marked), the engine's T_L (e^-1/2 rule, Eq. 5.61) and its per-release mean and standard
    error (each release a batch), in s and wall units.
@@ -50,8 +57,12 @@ from .twopoint import out_dir, pick_u_tau, pyplot, save, u_tau_arg
 
 COMP = ("u", "v", "w")
 POS = ("x", "y", "z")
-# layout of stats/lagrangian/sums (stats/lagr.h): n, then per u, v, w [S0, St, S00, Stt, S0t]
-LG_N, LG_VEL, LG_LEN = 0, 1, 43
+# layout of stats/lagrangian/sums (stats/lagr.h): n, then per u, v, w [S0, St, S00, Stt, S0t];
+# records of 43 sums up to checkpoint format 1.6, 46 (the sums of dr added at the end) from 1.7
+LG_N, LG_VEL, LG_LENS = 0, 1, (43, 46)
+# Lagrangian means in group lagrangian (from checkpoint format 1.7 on)
+MEANS = ["%s_release_mean" % c for c in COMP] + ["%s_lag_mean" % c for c in COMP] + \
+    ["disp_mean_" + p for p in POS] + ["disp_var_" + p for p in POS]
 
 
 def read_run(path, how):
@@ -63,6 +74,10 @@ def read_run(path, how):
         r["releases"] = int(attribute(g, "releases", path))
         r["horizon"] = float(attribute(g, "horizon", path))
         r["release_every"] = float(attribute(g, "release_every", path))
+        r["means"] = all(k in g.variables for k in MEANS)
+        if r["means"]:
+            for k in MEANS:
+                r[k] = values(g.variables[k])
         r["stations"] = "station" in g.variables and "pdf_y" in g.variables
         if r["stations"]:
             for k in ("station", "pdf_bin", "pdf_y", "pdf_mu_y", "pdf_var_y", "pdf_count"):
@@ -108,10 +123,10 @@ def read_ckpt(path, r):
                                  "Lagrangian engine?)" % (path, k))
         sums = np.asarray(f["stats/lagrangian/sums"][()])
         rel = int(np.asarray(f["stats/lagrangian/releases"][()]).ravel()[0])
-    want = (len(r["level"]), len(r["lag"]), LG_LEN)
-    if sums.shape != want:
+    want = [(len(r["level"]), len(r["lag"]), n) for n in LG_LENS]
+    if sums.shape not in want:
         raise InputError("%s: stats/lagrangian/sums has shape %s, the stats.nc needs %s" %
-                         (path, sums.shape, want))
+                         (path, sums.shape, " or ".join(str(w) for w in want)))
     if rel != r["releases"]:
         raise InputError("%s: %d completed releases, the stats.nc %d: not the same state (use "
                          "the checkpoint written with it, e.g. the final one)" %
@@ -224,13 +239,19 @@ def short_time(r, l, sums, E, ds):
     lo, hi = tau, tau + (ds if ds > 0 else 0.0)
     for p, c in zip(POS, COMP):
         s2 = r["sigma2_" + p][l][k]
+        dvar = r["disp_var_" + p][l][k] if r["means"] else math.nan
+        if dvar == dvar:  # the variance about the mean displacement (format 1.7 on)
+            s2 = dvar
         v_hi, v_lo = s2 / lo ** 2, s2 / hi ** 2
         se, neff, how = release_se(r, l, n[k], c, E)
-        if p == "x":
+        if dvar == dvar:
+            how += "; drift removed (disp_var_%s, mean displacement %.4g m)" % (
+                p, r["disp_mean_" + p][l][k])
+        elif p == "x":
             drift = E["u_mean"]
             v_hi, v_lo = v_hi - drift ** 2, v_lo - drift ** 2
             se = math.hypot(se, 2 * abs(drift) * math.sqrt(E["uu"] / neff))
-            how += "; drift = Eulerian U(y0) %.4g m/s (no --ckpt)" % drift
+            how += "; drift = Eulerian U(y0) %.4g m/s (no --ckpt, no disp_var_x)" % drift
         se = math.hypot(se, np.nan_to_num(E[c + c + "_stderr"]))
         ok = v_lo - 2 * se <= E[c + c] <= v_hi + 2 * se
         rows.append((p, "sigma_%s^2/tau^2 = %.5g .. %.5g for the real lag between %.4g and %.4g s "
@@ -290,29 +311,49 @@ def report_level(r, l, t, sums, status):
         else:
             print("long-time %s: not reached (horizon %.3g s < 3 T_L = %.3g s)" %
                   (p, tt[-1], 3 * T))
-    # Lagrangian mean velocity
-    if sums is not None:
-        R = sums[l, 0]
-        n0 = R[LG_N]
-        ul = R[LG_VEL] / n0
-        _, neff, _ = release_se(r, l, n0, "u", E)
-        se = math.hypot(math.sqrt(E["uu"] / neff), np.nan_to_num(E["u_mean_stderr"]))
-        verdict = "PASS" if abs(ul - E["u_mean"]) <= 2 * se else "FAIL"
-        status["fail"] |= verdict == "FAIL"
-        ok = r["n_tracks"][l] > 0
-        ult = sums[l, ok, LG_VEL + 1] / sums[l, ok, LG_N]
-        print("Lagrangian mean u at release %.5g m/s, Eulerian U(y0) %.5g, difference %+.3g "
-              "(2 se %.3g): %s; <u(t0 + tau)> over the horizon %.4g .. %.4g m/s" %
-              (ul, E["u_mean"], ul - E["u_mean"], 2 * se, verdict, ult.min(), ult.max()))
-    else:
-        print("Lagrangian mean velocity: not in stats.nc (the engine writes no mean of the "
-              "tracked velocities; its sums are in the checkpoint: give --ckpt): not checked")
+    mean_velocity(r, l, t, sums, E, status)
     if r["stations"]:
         for s, x in enumerate(r["station"]):
             print("P(y; x - x0 = %g): mean y %.4g m, sd %.4g m, %d tracks" %
                   (x, r["pdf_mu_y"][l][s], math.sqrt(max(r["pdf_var_y"][l][s], 0.0))
                    if r["pdf_var_y"][l][s] == r["pdf_var_y"][l][s] else math.nan,
                    r["pdf_count"][l][s] if r["pdf_count"][l][s] == r["pdf_count"][l][s] else 0))
+
+
+def mean_velocity(r, l, t, sums, E, status):
+    """Point 3: the Lagrangian mean velocity against U(y0), and the mean displacement."""
+    ok = r["n_tracks"][l] > 0
+    n0 = r["n_tracks"][l][0]
+    if sums is not None:
+        ul, src = sums[l, 0, LG_VEL] / sums[l, 0, LG_N], "checkpoint"
+        ult = sums[l, ok, LG_VEL + 1] / sums[l, ok, LG_N]
+    elif r["means"] and n0 > 0:
+        ul, src = r["u_release_mean"][l][0], "stats.nc"
+        ult = r["u_lag_mean"][l][ok]
+    else:
+        print("Lagrangian mean velocity: not in stats.nc (a file written before checkpoint "
+              "format 1.7; the sums are in the checkpoint: give --ckpt): not checked")
+        return
+    r["mean_checked"] = True
+    _, neff, _ = release_se(r, l, n0, "u", E)
+    se = math.hypot(math.sqrt(E["uu"] / neff), np.nan_to_num(E["u_mean_stderr"]))
+    verdict = "PASS" if abs(ul - E["u_mean"]) <= 2 * se else "FAIL"
+    status["fail"] |= verdict == "FAIL"
+    print("Lagrangian mean u at release %.5g m/s (%s), Eulerian U(y0) %.5g, difference %+.3g "
+          "(2 se %.3g): %s; <u(t0 + tau)> over the horizon %.4g .. %.4g m/s" %
+          (ul, src, E["u_mean"], ul - E["u_mean"], 2 * se, verdict, ult.min(), ult.max()))
+    if not r["means"]:
+        return
+    dm = r["disp_mean_x"][l]
+    good = ok & np.isfinite(dm) & (t > 0)
+    if not good.any():
+        print("mean displacement <dx>: fill values (a run resumed from a checkpoint of format "
+              "1.6 does not know it)")
+        return
+    k = np.nonzero(good)[0][-1]
+    drift = t[k] * (r["u_release_mean"][l][k] + r["u_lag_mean"][l][k]) / 2
+    print("mean displacement <dx>(%.4g s) = %.5g m, tau (<u(t0)> + <u(t0 + tau)>) / 2 = %.5g m "
+          "(ratio %.4f)" % (t[k], dm[k], drift, dm[k] / drift if drift else math.nan))
 
 
 def plots(r, t, d):
@@ -365,7 +406,9 @@ def plots(r, t, d):
 def main(argv, prog):
     ap = cli.parser(prog, __doc__)
     ap.add_argument("stats", help="stats.nc of a run with lagrangian.y_plus set")
-    ap.add_argument("--ckpt", help="the checkpoint written with it (Lagrangian mean velocity)")
+    ap.add_argument("--ckpt", help="the checkpoint written with it: the Lagrangian sums for the "
+                    "x clock, and the mean velocity of files written before checkpoint format "
+                    "1.7 (newer files hold it)")
     ap.add_argument("--out", help="write lagr_pdf_y.png, lagr_dispersion.png, lagr_rho.png here")
     ap.add_argument("--u-tau", type=u_tau_arg, default="force",
                     help="u_tau of the wall units: force (default), wall or a value [m/s]")
@@ -396,5 +439,6 @@ def main(argv, prog):
     if a.out:
         plots(r, t, a.out)
     print("\nLagrangian checks (short-time dispersion%s): %s" %
-          (", mean velocity" if sums is not None else "", "FAIL" if status["fail"] else "PASS"))
+          (", mean velocity" if r.get("mean_checked") else "", "FAIL" if status["fail"] else
+           "PASS"))
     return 1 if status["fail"] else 0
