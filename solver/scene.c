@@ -46,6 +46,7 @@ static const char *const names_sph_wall_pressure_weight[] = {"lattice", "consist
                                                              NULL};
 static const char *const names_sph_pressure_gradient[] = {"standard", "corrected", NULL};
 static const char *const names_sph_shifting[] = {"none", "fickian", NULL};
+static const char *const names_sph_shift_velocity[] = {"keep", "taylor", NULL};
 static const char *const names_les_model[] = {"none", "smagorinsky", NULL};
 static const char *const names_les_strain[] = {"gradient", "violeau_issa", NULL};
 static const char *const names_wall_law[] = {"laminar", "log", "reichardt", NULL};
@@ -117,6 +118,14 @@ static const struct key keys[] = {
      "with h = 2 dr at CFL Ma = 0.08 (this code's cfl 0.8 at Mach 0.1) does; 0.5 is unstable "
      "in 2-D (docs/theory.md).",
      OFF(shift_coef)},
+    {"sph", "shift_velocity", T_CHOICE, "keep", 0, 0, 0, names_sph_shift_velocity, "-",
+     "What a shift does to the velocity of the shifted particle: keep it, or carry it to the "
+     "new position by the Taylor correction u_a += (delta r_a . grad) u_a (Lind et al. 2012, "
+     "Eq. 24) with the first-order corrected velocity gradient of the start of the step "
+     "(thesis Eq. 2.88-2.90). Kept, a shift across the mean shear adds dU/dy delta y to u "
+     "each step; corrected, the budgets' closure holds the correction's share (it is not a "
+     "force; docs/theory.md, \"Particle shifting\").",
+     OFF(shift_velocity)},
     {"sph", "wall_dmin", T_DOUBLE, "1", 0, BIG, LO_OPEN, NULL, "dr",
      "Lower bound delta r of the wall distance in the wall shear term (thesis Eq. 2.148), in "
      "units of dr.",

@@ -29,6 +29,7 @@ enum les_model { LES_NONE = 0, LES_SMAGORINSKY = 1 };
 enum les_strain { STRAIN_GRADIENT = 0, STRAIN_VIOLEAU_ISSA = 1 };
 enum pressure_gradient { PGRAD_STANDARD = 0, PGRAD_CORRECTED = 1 };
 enum shifting { SHIFT_NONE = 0, SHIFT_FICKIAN = 1 };
+enum shift_velocity { SHIFT_KEEP = 0, SHIFT_TAYLOR = 1 };
 
 enum { SCENE_LIST_MAX = 8 };
 
@@ -47,17 +48,18 @@ struct scene {
   double lz;    /*!< periodic length in z [m] (3-D) */
   double dr;    /*!< initial particle spacing [m] */
   /* [sph] */
-  double h_over_dr;  /*!< smoothing length over spacing [-] */
-  double xi;         /*!< volume-diffusion constant [-]; 0 selects 1000 dr / (2 delta) */
-  double wall_dmin;  /*!< delta r of Eq. 2.148 over dr [-] */
-  double eta2;       /*!< regularisation of 1/r^2 in the viscous term, over h^2 [-] */
-  int viscous;       /*!< enum viscous_form */
-  int lap_norm;      /*!< enum laplacian_norm */
-  int wall_weight;   /*!< enum wall_weight */
-  int wall_pressure; /*!< enum wall_pressure */
-  int pgrad;         /*!< enum pressure_gradient */
-  int shifting;      /*!< enum shifting: particle shifting after each step */
-  double shift_coef; /*!< shifting coefficient C of delta r = -C h^2 grad C_a [-] */
+  double h_over_dr;   /*!< smoothing length over spacing [-] */
+  double xi;          /*!< volume-diffusion constant [-]; 0 selects 1000 dr / (2 delta) */
+  double wall_dmin;   /*!< delta r of Eq. 2.148 over dr [-] */
+  double eta2;        /*!< regularisation of 1/r^2 in the viscous term, over h^2 [-] */
+  int viscous;        /*!< enum viscous_form */
+  int lap_norm;       /*!< enum laplacian_norm */
+  int wall_weight;    /*!< enum wall_weight */
+  int wall_pressure;  /*!< enum wall_pressure */
+  int pgrad;          /*!< enum pressure_gradient */
+  int shifting;       /*!< enum shifting: particle shifting after each step */
+  double shift_coef;  /*!< shifting coefficient C of delta r = -C h^2 grad C_a [-] */
+  int shift_velocity; /*!< enum shift_velocity: what the shift does to the velocities */
   /* [les] */
   int les;         /*!< enum les_model */
   double cs;       /*!< Smagorinsky constant C_S [-] */

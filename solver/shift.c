@@ -4,6 +4,7 @@
 #include <math.h>
 
 #include "pair_loop.h"
+#include "term_gradient.h"
 #include "timers.h"
 #include "wall.h"
 
@@ -80,4 +81,24 @@ void shift_apply(struct particles *P, const double *sx, const double *sy, const 
     P->y[a] += sy[a];
     P->z[a] += sz[a];
   }
+}
+
+void shift_velocity(const struct model *M, const struct particles *P, const struct nbr *nb,
+                    const double *sx, const double *sy, const double *sz, double *du, double *dv,
+                    double *dw) {
+  timer_push("shift");
+  const struct pair_view arrays = pair_view_arrays(P, NULL);
+#pragma omp parallel for schedule(dynamic, 256)
+  for (size_t a = 0; a < P->n; a++) {
+    du[a] = dv[a] = dw[a] = 0.0;
+    if (P->kind[a] != KIND_FLUID) continue;
+    double s[GRADIENT_SUMS], G[3][3];
+    gradient_sums_of(M, P, nb, a, &arrays, s);
+    for (int i = 0; i < 3; i++) sph_solve_sym(M->dim, s, s + 6 + 3 * i, G[i]); /* row i: grad u_i */
+    const double r[3] = {sx[a], sy[a], sz[a]};
+    du[a] = G[0][0] * r[0] + G[0][1] * r[1] + G[0][2] * r[2];
+    dv[a] = G[1][0] * r[0] + G[1][1] * r[1] + G[1][2] * r[2];
+    dw[a] = G[2][0] * r[0] + G[2][1] * r[1] + G[2][2] * r[2];
+  }
+  timer_pop();
 }

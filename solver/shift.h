@@ -44,4 +44,19 @@ void shift_compute(const struct model *M, const struct particles *P, const struc
  */
 void shift_apply(struct particles *P, const double *sx, const double *sy, const double *sz);
 
+/**
+ * @brief The Taylor correction of the velocities for a shift (sph.shift_velocity = taylor):
+ *        du_a = (delta r_a . grad) u_a, grad u_a the first-order corrected gradient (thesis Eq.
+ *        2.88-2.90) of the velocities at the current positions over fluid and vertex
+ *        neighbours (Lind et al. 2012, Eq. 24); zero for vertex particles.
+ * @param[in] M model
+ * @param[in] P particles (positions, velocities, volumes of owned particles and ghosts)
+ * @param[in] nb neighbour list of the current positions
+ * @param[in] sx, sy, sz the shifts (shift_compute) [m]
+ * @param[out] du, dv, dw the velocity change per owned slot [m/s]
+ */
+void shift_velocity(const struct model *M, const struct particles *P, const struct nbr *nb,
+                    const double *sx, const double *sy, const double *sz, double *du, double *dv,
+                    double *dw);
+
 #endif

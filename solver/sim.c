@@ -56,7 +56,7 @@ static void sim_reserve(void *ctx, size_t n) {
   if (S->cap >= S->P.cap) return;
   S->cap = S->P.cap;
   const size_t bytes = S->cap * sizeof(double);
-  for (int k = 0; k < 4; k++)
+  for (int k = 0; k < 5; k++)
     part_free(S->scratch[k]), S->scratch[k] = part_alloc("diag_scratch", bytes);
   part_free(S->ksum_new), S->ksum_new = part_alloc("kernel_sum_new", bytes);
   if (S->wall_ax) part_free(S->wall_ax), S->wall_ax = part_alloc("wall_ax", bytes);
@@ -175,7 +175,7 @@ int sim_init(struct sim *S, const struct scene *sc) {
 void sim_free(struct sim *S) {
   if (S->distributed) nbr_free(&S->nb), dd_free(&S->dd);
   for (int k = 0; k < SIM_GATHER; k++) free(S->gather[k]);
-  for (int k = 0; k < 4; k++) part_free(S->scratch[k]);
+  for (int k = 0; k < 5; k++) part_free(S->scratch[k]);
   part_free(S->ksum_new);
   if (S->wall_ax) part_free(S->wall_ax);
   part_destroy(&S->P, &S->W);
@@ -305,6 +305,10 @@ void sim_step(struct sim *S) {
   /* particle shifting at the positions of the neighbour list (scratch 0-1 are free here) */
   double *sx = S->scratch[0], *sz = S->scratch[1];
   if (S->M.shifting != SHIFT_NONE) shift_compute(&S->M, P, &S->nb, sx, P->shift_dy, sz);
+  /* and the velocity change that carries each velocity with its shift (scratch 2-4) */
+  double *du = S->scratch[2], *dv = S->scratch[3], *dw = S->scratch[4];
+  const int taylor = S->M.shifting != SHIFT_NONE && S->M.shift_taylor;
+  if (taylor) shift_velocity(&S->M, P, &S->nb, sx, P->shift_dy, sz, du, dv, dw);
   timer_push("integrate");
 #pragma omp parallel for schedule(static)
   for (size_t a = 0; a < P->n; a++) {
@@ -316,7 +320,11 @@ void sim_step(struct sim *S) {
     P->y[a] += dt * P->v[a];
     P->z[a] += dt * P->w[a];
   }
-  if (S->M.shifting != SHIFT_NONE) shift_apply(P, sx, P->shift_dy, sz); /* velocities kept */
+  if (S->M.shifting != SHIFT_NONE) shift_apply(P, sx, P->shift_dy, sz);
+  if (taylor) {
+#pragma omp parallel for schedule(static)
+    for (size_t a = 0; a < P->n; a++) P->u[a] += du[a], P->v[a] += dv[a], P->w[a] += dw[a];
+  }
   timer_pop();
   S->t += dt, S->dt = dt, S->fx = fx, S->step++;
   if (S->dd.size > 1 && S->sc->balance_every > 0 && S->step % S->sc->balance_every == 0)

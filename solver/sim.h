@@ -32,7 +32,7 @@ struct sim {
   double fx;                /*!< last streamwise body acceleration [m/s^2] */
   double dt_limits[4];      /*!< last limits: acoustic, viscous, force, wall [s] */
   double nu_max;            /*!< largest nu + nu_r of the current state [m^2/s] */
-  double *scratch[4];       /*!< per-particle scratch for deterministic sums */
+  double *scratch[5];       /*!< per-particle scratch for deterministic sums */
   double *ksum_new;         /*!< kernel sums at the new positions, from the neighbour pass */
   double *wall_ax;          /*!< per particle x-acceleration from the walls (statistics only) */
   double wall_fx[2];        /*!< x-force of the walls y = 0, 2 delta on the fluid, last sampled
