@@ -11,6 +11,10 @@ turbulence (-u'v') and by the pressure pair forces (the scheme's numerical stres
 and y = delta/2, with batch-means standard errors of the window values; the closure error and
 the momentum source; and the cost per eddy turnover delta/u_tau in particle-steps (wall
 seconds depend on what else the machine ran; divide by `chansph bench`'s rate). Wall units from the force balance (u_tau^2 = delta f).
+Runs whose stats.nc has the Reynolds-stress budgets get a second table over their averaging
+range (output.t_average_start on): the redistribution terms of vv (pressure + wall) and ww
+(pressure) at y+ = 15 and 40 against MKM's pressure-strain + pressure-diffusion, and the
+pressure noise of k over its viscous term at y+ = 30.
 """
 import math
 import os
@@ -81,7 +85,13 @@ def main(argv, prog):
                      ms("source"), f"{pst / 1e6:.0f}"])
         print(f"# {run}: windows {win[sel[0], 0]:.3g}-{win[sel[-1], 1]:.3g} ({len(sel)}), "
               f"u_tau {ut:.4g}", file=sys.stderr)
-    if a.markdown:
+    table(cols, rows, a.markdown)
+    budget_table(a.runs, a.markdown)
+
+
+def table(cols, rows, markdown):
+    """Print rows under cols, as markdown or aligned text."""
+    if markdown:
         print("| " + " | ".join(cols) + " |")
         print("|" + "---|" * len(cols))
         for r in rows:
@@ -91,3 +101,41 @@ def main(argv, prog):
         print("  ".join(c.rjust(w[i]) for i, c in enumerate(cols)))
         for r in rows:
             print("  ".join(x.rjust(w[i]) for i, x in enumerate(r)))
+
+
+# the budget columns (issue 24): the redistribution into v and w against MKM (pressure + wall
+# for vv, whose wall part holds the wall layer's wall-normal pressure; pressure for ww; MKM's
+# pressure-strain + pressure-diffusion), at y+ = 15 and 40, and the pressure noise as a share
+# of the viscous term of k at y+ = 30
+BUDGET_COLS = (("vv p+w 15", "vv", ("pressure", "wall"), 15.0),
+               ("vv p+w 40", "vv", ("pressure", "wall"), 40.0),
+               ("ww p 15", "ww", ("pressure",), 15.0), ("ww p 40", "ww", ("pressure",), 40.0))
+
+
+def budget_table(runs, markdown):
+    """The Reynolds-stress budget columns of the runs whose stats.nc has them (over each run's
+    averaging range, output.t_average_start to its end; wall units of the force balance):
+    ours / MKM for BUDGET_COLS, and the k pressure noise over the k viscous term at y+ = 30."""
+    from . import budget_compare as bc
+    dns, rows = None, []
+    for run in runs:
+        ours = bc.read_budgets(os.path.join(run, "stats.nc"), "force")
+        if ours is None:
+            continue
+        dns = dns or bc.read_dns()
+        yp, t, row = ours["yplus"], ours["terms"], [os.path.basename(run.rstrip("/"))]
+        for _, c, terms, level in BUDGET_COLS:
+            k = int(np.argmin(np.abs(yp - level)))
+            ref = np.interp(yp[k], dns[c]["y+"], dns[c]["p-strain"] + dns[c]["p-diff"])
+            val = sum(t[c][n][0][k] for n in terms)
+            se = math.sqrt(sum(t[c][n][1][k] ** 2 for n in terms))
+            row.append(f"{val:.4f}±{se:.4f} ({ref:.4f})")
+        k = int(np.argmin(np.abs(yp - 30.0)))
+        noise = t["k"]["pressure_noise"][0][k] if "pressure_noise" in t["k"] else math.nan
+        row.append(f"{noise / t['k']['viscous'][0][k]:.2f}")
+        rows.append(row)
+    if rows:
+        print("\nReynolds-stress budgets over each run's averaging range, u_tau^4/nu (force "
+              "balance); in brackets MKM's p-strain + p-diff at the bin's y+; noise/visc: k pressure "
+              "noise over the k viscous term at y+ = 30:")
+        table(["run"] + [c[0] for c in BUDGET_COLS] + ["noise/visc 30"], rows, markdown)

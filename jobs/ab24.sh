@@ -1,0 +1,50 @@
+#!/usr/bin/env bash
+# The A/B of issue 24 (docs/validation/turbulent_channel.md): numerical settings against the
+# reference at dr+ = 6 in the minimal unit (jobs/scenes/mfu180_dr6_dev.ini, 74 340 particles),
+# each run from a developed start for T turnovers (default 3) with the Reynolds-stress budgets,
+# averaged from t = 1 on; then the table (chansph-stats ab_table: sustain, peaks, numerical
+# stress share, cost; the redistribution terms of vv and ww against MKM at y+ = 15 and 40 and the
+# pressure noise). Two start states (two "seeds"):
+#   a  jobs/states/mfu180_dr6_t3.nc      (the dr+ = 6 field after 3 turnovers at dr+ = 6)
+#   b  jobs/states/mfu180_dr45_t10.nc    (the developed dr+ = 4.5 field, interpolated)
+# Each run is a batch job through jobs/chain.sh (checkpoints; start the script again to go on);
+# about 9 minutes a turnover with 2 threads on an idle 2-core machine, so a start state's whole
+# set is hours: pass the names of the candidates to run only those.
+# usage: jobs/ab24.sh OUTDIR START [T] [CANDIDATE...]   e.g. jobs/ab24.sh runs/ab24 a 3 reference
+set -uo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+[ $# -ge 2 ] || { sed -n 2,15p "$0" >&2; exit 1; }
+out=$1 start=$2 tend=${3:-3}
+shift $(($# >= 3 ? 3 : 2))
+case $start in
+  a) from=(--set init.from=jobs/states/mfu180_dr6_t3.nc) ;;
+  b) from=(--set init.from=jobs/states/mfu180_dr45_t10.nc) ;;
+  *) echo "error: START must be a or b (got '$start')" >&2; exit 1 ;;
+esac
+declare -A sets=(
+  [reference]=""
+  [shift_taylor]="--set sph.shifting=fickian --set sph.shift_velocity=taylor"
+  [xi_x0.5]="--set sph.xi=8.333333333333334"
+  [morris]="--set sph.viscous=morris"
+  [h_1.8]="--set sph.h_over_dr=1.8"
+  [wall_analytic]="--set sph.wall_pressure_weight=analytic"
+)
+names=("$@")
+[ ${#names[@]} -gt 0 ] || names=(reference shift_taylor xi_x0.5 morris h_1.8 wall_analytic)
+mkdir -p "$out"
+runs=()
+cd "$root"
+for name in "${names[@]}"; do
+  [ -n "${sets[$name]+x}" ] || { echo "error: unknown candidate '$name' (${!sets[*]})" >&2; exit 1; }
+  dir=$out/${name}_$start
+  runs+=("$dir")
+  grep -q "^finished" "$dir/log.txt" 2> /dev/null && continue
+  # shellcheck disable=SC2086
+  jobs/chain.sh "$dir" jobs/scenes/mfu180_dr6_dev.ini -- "${from[@]}" --set time.t_end="$tend" \
+    --set output.t_average_start=1 ${sets[$name]} > "$dir.log" 2>&1 ||
+    echo "$name ($start): the run stopped: $(grep -m1 -E '^error|through' "$dir.log")"
+done
+done_runs=()
+for r in "${runs[@]}"; do grep -q "^finished" "$r/log.txt" 2> /dev/null && done_runs+=("$r"); done
+[ ${#done_runs[@]} -gt 0 ] &&
+  "$root/stats/python/chansph-stats" ab_table "${done_runs[@]}" --from 1 --markdown
