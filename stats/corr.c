@@ -38,6 +38,7 @@ void corr_init(struct corr *c, const struct corr_config *cfg) {
   const int n[2] = {nx, nz};
   c->plan = fftw_plan_many_dft_r2c(2, n, 3, c->grid, NULL, 1, nx * nz, c->out, NULL, 1, (int)nk,
                                    FFTW_ESTIMATE);
+  corr_win_init(c);
 }
 
 void corr_free(struct corr *c) {
@@ -45,6 +46,7 @@ void corr_free(struct corr *c) {
   if (c->grid) fftw_free(c->grid);
   if (c->out) fftw_free(c->out);
   free(c->spec), free(c->samples), free(c->empty), free(c->hits), free(c->ent), free(c->all);
+  free(c->win), free(c->wsamp), free(c->wspec);
   memset(c, 0, sizeof *c);
 }
 
@@ -105,6 +107,7 @@ static int add_plane(struct corr *c, int l, size_t pl, const double *E, size_t n
     sk[CS_UV_IM] += U[k][0] * V[k][1] - U[k][1] * V[k][0];
   }
   c->samples[l] += 1.0;
+  corr_win_add(c, l, (const double(*)[2])U, (const double(*)[2])V, (const double(*)[2])W);
   return 1;
 }
 
@@ -113,6 +116,7 @@ void corr_sample(struct corr *c, const struct stats_snapshot *s) {
   const int nx = c->cfg.nx, nz = c->cfg.nz;
   const size_t np = (size_t)nx * (size_t)nz;
   const double sx = nx / c->cfg.lx, sz = nz > 1 ? nz / c->cfg.lz : 0.0;
+  corr_win_advance(c, s->t); /* the window of this snapshot (the same on every rank) */
   /* the planes: each level, and its mirror (v -> -v) if the slabs do not overlap */
   int lev[2 * CORR_MAX_LEVELS], mir[2 * CORR_MAX_LEVELS];
   double yp[2 * CORR_MAX_LEVELS];
@@ -173,6 +177,7 @@ void corr_state(struct corr *c, struct state_list *L) {
   state_add(L, "stats/correlations/spectra", STATE_F64, 3, dims3, c->spec, NULL);
   state_add(L, "stats/correlations/samples", STATE_F64, 1, d1, c->samples, NULL);
   state_add(L, "stats/correlations/empty_cells", STATE_F64, 1, d1, c->empty, NULL);
+  corr_win_state(c, L);
 }
 
 /* Weight of a stored r2c coefficient (kz column iz) in sums over the full spectrum: its
@@ -347,6 +352,57 @@ done:
   return rc;
 }
 
+/* One [level][comp][n] array of standard errors as variable name (level, dim). */
+static int put_stderr(int g, const char *name, const char *of, int dl, int dim, const char *units,
+                      const double *a, int ncomp, int q, int nl, int n) {
+  char ln[160];
+  int v, rc = NC_NOERR;
+  snprintf(ln, sizeof ln, "standard error (batch means over the complete windows) of %s", of);
+  const int d2[2] = {dl, dim};
+  if ((rc = ncout_def(g, name, NC_DOUBLE, 2, d2, units, ln, &v)) != NC_NOERR ||
+      (rc = ncout_fill(g, v)) != NC_NOERR)
+    return rc;
+  for (int l = 0; l < nl && rc == NC_NOERR; l++) {
+    const size_t st[2] = {(size_t)l, 0}, ct[2] = {1, (size_t)n};
+    rc = ncout_put_filled(g, v, st, ct, a + ((size_t)l * ncomp + q) * n, (size_t)n);
+  }
+  return rc;
+}
+
+/* The batch-means standard errors of R and E (corr_stderr) and the batches per level.
+   d: {level, separation_x, separation_z, kx, kz}. */
+static int write_stderr(const struct corr *c, int g, const int d[5], char *err, size_t errlen) {
+  const int nl = c->cfg.n_levels, nx = c->cfg.nx, nz = c->cfg.nz, nzh = c->nzh;
+  const int nxh = nx / 2 + 1;
+  double *rx = mem_alloc(1, (size_t)nl * 4 * nx * sizeof(double), "correlations");
+  double *rz = mem_alloc(1, (size_t)nl * 4 * nz * sizeof(double), "correlations");
+  double *ex = mem_alloc(1, (size_t)nl * 3 * nxh * sizeof(double), "correlations");
+  double *ez = mem_alloc(1, (size_t)nl * 3 * nzh * sizeof(double), "correlations");
+  int *nb = mem_alloc(1, (size_t)nl * sizeof(int), "correlations");
+  int rc = NC_NOERR, v;
+  corr_stderr(c, rx, rz, ex, ez, nb);
+  CK(ncout_def(g, "n_batches", NC_INT, 1, &d[0], "1",
+               "complete windows with planes at the level: the batches of the *_stderr", &v));
+  CK(nc_put_var_int(g, v, nb));
+  static const char *const comp[4] = {"uu", "vv", "ww", "uv"};
+  for (int q = 0; q < 4; q++)
+    for (int dir = 0; dir < 2; dir++) {
+      char name[64], of[32];
+      snprintf(of, sizeof of, "R_%s_%c", comp[q], dir ? 'z' : 'x');
+      snprintf(name, sizeof name, "%s_stderr", of);
+      CK(put_stderr(g, name, of, d[0], d[1 + dir], "m^2/s^2", dir ? rz : rx, 4, q, nl,
+                    dir ? nz : nx));
+      if (q == 3) continue;
+      snprintf(of, sizeof of, "E_%s_k%c", comp[q], dir ? 'z' : 'x');
+      snprintf(name, sizeof name, "%s_stderr", of);
+      CK(put_stderr(g, name, of, d[0], d[3 + dir], "m^3/s^2", dir ? ez : ex, 3, q, nl,
+                    dir ? nzh : nxh));
+    }
+done:
+  free(rx), free(rz), free(ex), free(ez), free(nb);
+  return rc;
+}
+
 int corr_nc_write(const struct corr *c, int ncid, char *err, size_t errlen) {
   const int nl = c->cfg.n_levels, nx = c->cfg.nx, nz = c->cfg.nz, nzh = c->nzh;
   const int nxh = nx / 2 + 1;
@@ -386,6 +442,8 @@ int corr_nc_write(const struct corr *c, int ncid, char *err, size_t errlen) {
         (rc = write_correlations(c, g, dc, rx, rz, tmp, err, errlen)) != NC_NOERR ||
         (rc = write_spectra(c, g, ds, ex, ez, err, errlen)) != NC_NOERR)
       goto done;
+    const int de[5] = {dl, dx, dz, dkx, dkz};
+    if ((rc = write_stderr(c, g, de, err, errlen)) != NC_NOERR) goto done;
   }
   {
     const int d3[3] = {dl, dkk, dsl};
@@ -411,6 +469,7 @@ static int config_of(const struct stats_scene *sc, struct corr_config *c) {
   c->nx = nx > 0 ? nx : (int)floor(sc->lx / sc->dr + 0.5);
   c->nz = sc->dim == 2 ? 1 : nz > 0 ? nz : (int)floor(sc->lz / sc->dr + 0.5);
   c->lx = sc->lx, c->lz = sc->lz, c->delta = sc->delta, c->t_start = sc->t_average_start;
+  c->window = stats_scene_window(sc);
   c->half = 0.5 * stats_scene_num(sc, "correlations.thickness") * sc->dr;
   return c->n_levels > 0 ? c->n_levels : 0;
 }
@@ -452,7 +511,8 @@ static size_t engine_bytes(const void *self) {
   const size_t d = sizeof(double);
   const size_t nk = (size_t)c->cfg.nx * (size_t)c->nzh, np = (size_t)c->cfg.nx * c->cfg.nz;
   return (size_t)c->cfg.n_levels * (nk * CS_LEN + 2) * d + 4 * np * d + 3 * nk * 2 * d +
-         (c->ent_cap + c->all_cap) * CORR_ENT * d + c->hits_cap * (4 * d + sizeof(size_t));
+         (c->ent_cap + c->all_cap) * CORR_ENT * d + c->hits_cap * (4 * d + sizeof(size_t)) +
+         c->cap * (CW_LEN + (size_t)c->cfg.n_levels * (1 + c->n1d * CS_LEN)) * d;
 }
 
 static int engine_write(const void *self, double t_reached, int ncid, char *err, size_t errlen) {

@@ -11,6 +11,13 @@
  *   R_ij(l) = <u_i'(r) u_j'(r + l)> = IFFT(S_ij)(l) / (N^2 samples)            (Eq. 5.57)
  *   rho_ij(l) = R_ij(l) / R_ii(0)                                               (Eq. 5.58)
  *   E_ii(k_x) one-sided, normalised so that sum_k E_ii(k) dk = <u_i'^2>       (Eq. 5.59)
+ *
+ * Per averaging window (stats.window, the windows of the Eulerian and PDF engines) the engine
+ * also keeps the 1-D sums of the same spectra (issue 25): per level, the sum over k_z of
+ * S_ij(k_x, k_z) for k_x = 0 .. nx/2 and the sum over k_x for k_z = 0 .. nz/2 (complex: the
+ * uv slots keep the phase), from which each window's own E(k_x), E(k_z), R(l_x) and R(l_z)
+ * follow exactly; over the complete windows their batch means give the standard errors. The
+ * whole-run sums are untouched (the 1-D sums are added beside them from the same transform).
  */
 #ifndef CHANSPH_CORR_H
 #define CHANSPH_CORR_H
@@ -25,6 +32,9 @@ struct stats_engine;
 enum { CORR_MAX_LEVELS = 8 };
 /** Spectrum slots per wavenumber: S_uu, S_vv, S_ww, Re S_uv, Im S_uv. */
 enum { CS_UU, CS_VV, CS_WW, CS_UV_RE, CS_UV_IM, CS_LEN };
+/** Per-window scalars: nominal interval, snapshots, and 1 if the window is partial (it holds
+    the resume of a checkpoint written without window records: not a batch). */
+enum { CW_T0, CW_T1, CW_NSNAP, CW_PARTIAL, CW_LEN };
 
 /** Configuration of the correlation engine. */
 struct corr_config {
@@ -36,6 +46,7 @@ struct corr_config {
   double half;                    /*!< half thickness of the slabs [m] */
   double delta;                   /*!< channel half-width [m] (mirror levels) */
   double t_start;                 /*!< start of the averaging [s] */
+  double window;                  /*!< length of an averaging window [s] (<= 0: one window) */
 };
 
 /** The engine. */
@@ -53,6 +64,12 @@ struct corr {
   double *all;     /*!< scratch: the same gathered from all ranks */
   size_t hits_cap, ent_cap, all_cap; /*!< capacities (particles, entries, entries) */
   size_t nall;                       /*!< entries gathered at the last snapshot */
+  /* per window: rows 0 .. nwin-1 closed, row nwin open */
+  size_t nwin, cap; /*!< closed windows, rows allocated (>= nwin + 1) */
+  size_t n1d;       /*!< 1-D entries of a level: nx/2 + 1 (k_x) then nz/2 + 1 (k_z) */
+  double *win;      /*!< [row][CW_LEN] */
+  double *wsamp;    /*!< [row][level] planes accumulated */
+  double *wspec;    /*!< [row][level][n1d][CS_LEN] 1-D sums of the spectra */
 };
 
 /** A per-(plane, column, grid point) partial sum: plane np + grid point, sums of u v w, count. */
@@ -71,6 +88,19 @@ void corr_free(struct corr *c);
  *         every rank and for any number of ranks. */
 void corr_sample(struct corr *c, const struct stats_snapshot *s);
 
+/* The per-window records (corr_win.c), used by corr.c. */
+/** @brief Allocate the window records (row 0 open at t_start). */
+void corr_win_init(struct corr *c);
+/** @brief Move the open window to the one holding time t (marks a partial window after a
+ *         resume from a checkpoint without window records); counts the snapshot. */
+void corr_win_advance(struct corr *c, double t);
+/** @brief Add one plane's transforms U, V, W (fftw_complex, nx x (nz/2+1)) of level l to the
+ *         open window's 1-D sums. */
+void corr_win_add(struct corr *c, int l, const double (*U)[2], const double (*V)[2],
+                  const double (*W)[2]);
+/** @brief Expose the window records to a state list (optional fields, format 1.8). */
+void corr_win_state(struct corr *c, struct state_list *L);
+
 /** @brief Expose the sums to a state list. */
 void corr_state(struct corr *c, struct state_list *L);
 
@@ -85,6 +115,14 @@ void corr_state(struct corr *c, struct state_list *L);
  * @param[out] ez [level][3][nz/2+1] the same over k_z
  */
 void corr_results(const struct corr *c, double *rx, double *rz, double *ex, double *ez);
+
+/**
+ * @brief Batch-means standard errors of the results of corr_results(), same layouts; each
+ *        complete window with planes at a level is one batch (its own normalised R and E).
+ *        NaN where fewer than 2 batches.
+ * @param[out] nb [level] batches used
+ */
+void corr_stderr(const struct corr *c, double *rx, double *rz, double *ex, double *ez, int *nb);
 
 /** @brief Write group "correlations" into an open netCDF-4 file; returns a netCDF status. */
 int corr_nc_write(const struct corr *c, int ncid, char *err, size_t errlen);

@@ -234,7 +234,8 @@ static struct test_stats_config config_a(void) { /* bins, not folded, LES; corr 
                                 .lz = 1.5,
                                 .half = 0.06,
                                 .delta = 1.0,
-                                .t_start = 0.1};
+                                .t_start = 0.1,
+                                .window = 0.5};
   c.lagr = (struct lagr_config){.n_levels = 2,
                                 .y = {0.25, 0.6},
                                 .y_plus = {25, 60},
@@ -436,6 +437,7 @@ static void run_check(const char *name, const struct test_stats_config *cfg, siz
     const struct pdf *pd = test_pdf(&par);
     EXPECT(pd->nwin >= 2 && pd->pow[0] > 0, "%s: PDF engine idle (%zu windows)", name, pd->nwin);
     EXPECT(co->samples[0] > 0, "%s: no correlation planes", name);
+    EXPECT(co->cfg.n_levels == 0 || co->nwin >= 2, "%s: %zu correlation windows", name, co->nwin);
     EXPECT(la->releases >= 2 && la->ntracks > 0 && pdf_n > 0,
            "%s: Lagrangian idle (%g releases, %zu tracks, %g crossings)", name, la->releases,
            la->ntracks, pdf_n);

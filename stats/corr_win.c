@@ -1,0 +1,199 @@
+/** @file corr_win.c @brief The per-window records of the correlation engine (corr.h): 1-D sums
+ *         of the spectra per averaging window, their checkpoint fields and the batch-means
+ *         standard errors of E(k_x), E(k_z), R(l_x), R(l_z) (issue 25). */
+#include "corr.h"
+
+#include <math.h>
+#include <stddef.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "alloc.h"
+#include "state.h"
+
+static const double two_pi = 6.283185307179586;
+
+/* Make room for rows windows (new rows zeroed). */
+static void win_reserve(struct corr *c, size_t rows) {
+  if (rows <= c->cap) return;
+  const size_t old = c->cap, cap = rows > 2 * old ? rows : 2 * old;
+  const size_t nl = (size_t)c->cfg.n_levels, ns = nl * c->n1d * CS_LEN;
+  c->win = mem_realloc(c->win, cap * CW_LEN, sizeof(double), "correlation engine");
+  c->wsamp = mem_realloc(c->wsamp, cap * nl, sizeof(double), "correlation engine");
+  c->wspec = mem_realloc(c->wspec, cap * ns, sizeof(double), "correlation engine");
+  memset(c->win + old * CW_LEN, 0, (cap - old) * CW_LEN * sizeof(double));
+  memset(c->wsamp + old * nl, 0, (cap - old) * nl * sizeof(double));
+  memset(c->wspec + old * ns, 0, (cap - old) * ns * sizeof(double));
+  c->cap = cap;
+}
+
+void corr_win_init(struct corr *c) {
+  c->n1d = (size_t)(c->cfg.nx / 2 + 1) + (size_t)c->nzh;
+  if (!(c->cfg.window > 0.0)) c->cfg.window = INFINITY; /* one window, never closed */
+  win_reserve(c, 1);
+  c->win[CW_T0] = c->cfg.t_start, c->win[CW_T1] = c->cfg.t_start + c->cfg.window;
+}
+
+/* Same rule as the PDF engine (pdf.c): a window with snapshots is closed and the next one
+   opened at its end; an empty one just moves by one window length. */
+void corr_win_advance(struct corr *c, double t) {
+  /* whole-run sums but no window records: resumed from a checkpoint of format 1.7 or older,
+     whose windows are unknown; the window of the resume holds only part of its snapshots */
+  double run = 0.0;
+  for (int l = 0; l < c->cfg.n_levels; l++) run += c->samples[l];
+  const int legacy = c->nwin == 0 && c->win[CW_NSNAP] == 0.0 && run > 0.0;
+  while (t >= c->win[c->nwin * CW_LEN + CW_T1]) {
+    const double t1 = c->win[c->nwin * CW_LEN + CW_T1];
+    if (c->win[c->nwin * CW_LEN + CW_NSNAP] > 0.0) win_reserve(c, ++c->nwin + 1);
+    double *o = c->win + c->nwin * CW_LEN;
+    o[CW_T0] = t1, o[CW_T1] = t1 + c->cfg.window;
+  }
+  double *o = c->win + c->nwin * CW_LEN;
+  if (legacy) o[CW_PARTIAL] = 1.0;
+  o[CW_NSNAP] += 1.0;
+}
+
+/* Weight of a stored r2c column iz in sums over the full spectrum (corr.c: weight). */
+static int self_conjugate(int iz, int nz) {
+  return iz == 0 || (nz % 2 == 0 && iz == nz / 2);
+}
+
+void corr_win_add(struct corr *c, int l, const double (*U)[2], const double (*V)[2],
+                  const double (*W)[2]) {
+  const int nx = c->cfg.nx, nz = c->cfg.nz, nzh = c->nzh, nxh = nx / 2 + 1;
+  const size_t nl = (size_t)c->cfg.n_levels, row = c->nwin;
+  double *X = c->wspec + ((row * nl + (size_t)l) * c->n1d) * CS_LEN;
+  double *Z = X + (size_t)nxh * CS_LEN;
+  for (int ix = 0; ix < nx; ix++)
+    for (int iz = 0; iz < nzh; iz++) {
+      const size_t k = (size_t)ix * (size_t)nzh + (size_t)iz;
+      const double s[CS_LEN] = {
+          U[k][0] * U[k][0] + U[k][1] * U[k][1], V[k][0] * V[k][0] + V[k][1] * V[k][1],
+          W[k][0] * W[k][0] + W[k][1] * W[k][1], U[k][0] * V[k][0] + U[k][1] * V[k][1],
+          U[k][0] * V[k][1] - U[k][1] * V[k][0]};
+      double *z = Z + (size_t)iz * CS_LEN;
+      for (int q = 0; q < CS_LEN; q++) z[q] += s[q];
+      if (ix < nxh)
+        for (int q = 0; q < CS_LEN; q++) X[(size_t)ix * CS_LEN + q] += s[q];
+      /* the partner (-kx, -kz) of a column that is not self-conjugate: conj(S) at -kx */
+      const int p = (nx - ix) % nx;
+      if (!self_conjugate(iz, nz) && p < nxh)
+        for (int q = 0; q < CS_LEN; q++) X[(size_t)p * CS_LEN + q] += q == CS_UV_IM ? -s[q] : s[q];
+    }
+  c->wsamp[row * nl + (size_t)l] += 1.0;
+}
+
+/* Checkpoint reading: make room for the stored rows (the open window is the last). */
+static void *reserve_rows(struct corr *c, int rank, const size_t *dims, size_t len, double **a) {
+  if (rank < 2 || dims[0] < 1 || dims[rank - 1] != len) return NULL;
+  win_reserve(c, dims[0]);
+  c->nwin = dims[0] - 1;
+  return *a;
+}
+
+static void *reserve_win(void *owner, int rank, const size_t *dims) {
+  struct corr *c = owner;
+  return rank == 2 ? reserve_rows(c, rank, dims, CW_LEN, &c->win) : NULL;
+}
+
+static void *reserve_samp(void *owner, int rank, const size_t *dims) {
+  struct corr *c = owner;
+  return rank == 2 ? reserve_rows(c, rank, dims, (size_t)c->cfg.n_levels, &c->wsamp) : NULL;
+}
+
+static void *reserve_spec(void *owner, int rank, const size_t *dims) {
+  struct corr *c = owner;
+  if (rank != 3 || dims[1] != (size_t)c->cfg.n_levels * c->n1d) return NULL;
+  return reserve_rows(c, rank, dims, CS_LEN, &c->wspec);
+}
+
+void corr_win_state(struct corr *c, struct state_list *L) {
+  const size_t rows = c->nwin + 1, nl = (size_t)c->cfg.n_levels;
+  const size_t dw[2] = {rows, CW_LEN}, ds[2] = {rows, nl}, dp[3] = {rows, nl * c->n1d, CS_LEN};
+  /* optional (format 1.8): a checkpoint of 1.7 or older resumes without them (corr_win_advance) */
+  struct state_field *f =
+      state_add(L, "stats/correlations/windows", STATE_F64, 2, dw, c->win, NULL);
+  f->reserve = reserve_win, f->owner = c, f->optional = 1;
+  f = state_add(L, "stats/correlations/window_samples", STATE_F64, 2, ds, c->wsamp, NULL);
+  f->reserve = reserve_samp, f->owner = c, f->optional = 1;
+  f = state_add(L, "stats/correlations/window_spectra_1d", STATE_F64, 3, dp, c->wspec, NULL);
+  f->reserve = reserve_spec, f->owner = c, f->optional = 1;
+}
+
+/* Row r's own results at level l into v: [R x 4][nx], [R z 4][nz], [E x 3][nxh], [E z 3][nzh]
+   (the layouts of corr_results for one level). */
+static void window_values(const struct corr *c, size_t r, size_t l, double *v) {
+  const int nx = c->cfg.nx, nz = c->cfg.nz, nzh = c->nzh, nxh = nx / 2 + 1;
+  const size_t nl = (size_t)c->cfg.n_levels;
+  const double N = (double)nx * (double)nz;
+  const double norm = 1.0 / (N * N * c->wsamp[r * nl + l]);
+  const double *X = c->wspec + ((r * nl + l) * c->n1d) * CS_LEN, *Z = X + (size_t)nxh * CS_LEN;
+  double *rx = v, *rz = rx + 4 * nx, *ex = rz + 4 * nz, *ez = ex + 3 * nxh;
+  static const int slot_re[4] = {CS_UU, CS_VV, CS_WW, CS_UV_RE};
+  for (int q = 0; q < 4; q++) {
+    for (int i = 0; i < nx; i++) { /* R(l_x) = sum over the full k_x of Sx e^{i k l} */
+      double s = 0.0;
+      for (int m = 0; m < nxh; m++) {
+        const double f = m == 0 || 2 * m == nx ? 1.0 : 2.0;
+        const double th = two_pi * (double)((m * i) % nx) / nx;
+        const double im = q == 3 ? X[(size_t)m * CS_LEN + CS_UV_IM] : 0.0;
+        s += f * (X[(size_t)m * CS_LEN + slot_re[q]] * cos(th) - im * sin(th));
+      }
+      rx[q * nx + i] = s * norm;
+    }
+    for (int k = 0; k < nz; k++) {
+      double s = 0.0;
+      for (int m = 0; m < nzh; m++) {
+        const double f = self_conjugate(m, nz) ? 1.0 : 2.0;
+        const double th = two_pi * (double)((m * k) % nz) / nz;
+        const double im = q == 3 ? Z[(size_t)m * CS_LEN + CS_UV_IM] : 0.0;
+        s += f * (Z[(size_t)m * CS_LEN + slot_re[q]] * cos(th) - im * sin(th));
+      }
+      rz[q * nz + k] = s * norm;
+    }
+  }
+  for (int q = 0; q < 3; q++) { /* densities over k = 2 pi m / L (corr_results) */
+    for (int m = 0; m < nxh; m++)
+      ex[q * nxh + m] = (m == 0 || 2 * m == nx ? 1.0 : 2.0) * X[(size_t)m * CS_LEN + q] * norm *
+                        c->cfg.lx / two_pi;
+    for (int m = 0; m < nzh; m++)
+      ez[q * nzh + m] = (self_conjugate(m, nz) ? 1.0 : 2.0) * Z[(size_t)m * CS_LEN + q] * norm *
+                        (nz > 1 ? c->cfg.lz / two_pi : 1.0);
+  }
+}
+
+/* The batches of level l: complete windows (closed, not partial) with planes at the level. */
+static int is_batch(const struct corr *c, size_t r, size_t l) {
+  return r < c->nwin && c->win[r * CW_LEN + CW_PARTIAL] == 0.0 &&
+         c->wsamp[r * (size_t)c->cfg.n_levels + l] > 0.0;
+}
+
+void corr_stderr(const struct corr *c, double *rx, double *rz, double *ex, double *ez, int *nb) {
+  const int nx = c->cfg.nx, nz = c->cfg.nz, nzh = c->nzh, nxh = nx / 2 + 1;
+  const size_t nv = 4 * (size_t)nx + 4 * (size_t)nz + 3 * (size_t)nxh + 3 * (size_t)nzh;
+  double *v = mem_alloc(3 * nv, sizeof(double), "correlations"), *mean = v + nv, *ss = mean + nv;
+  for (size_t l = 0; l < (size_t)c->cfg.n_levels; l++) {
+    int n = 0;
+    memset(mean, 0, 2 * nv * sizeof(double));
+    for (size_t r = 0; r < c->nwin; r++) /* two passes: the mean, then the squares about it */
+      if (is_batch(c, r, l)) {
+        window_values(c, r, l, v);
+        for (size_t j = 0; j < nv; j++) mean[j] += v[j];
+        n++;
+      }
+    for (size_t j = 0; j < nv; j++) mean[j] /= n;
+    for (size_t r = 0; r < c->nwin; r++)
+      if (is_batch(c, r, l)) {
+        window_values(c, r, l, v);
+        for (size_t j = 0; j < nv; j++) ss[j] += (v[j] - mean[j]) * (v[j] - mean[j]);
+      }
+    for (size_t j = 0; j < nv; j++) ss[j] = n < 2 ? NAN : sqrt(ss[j] / (n - 1) / n);
+    nb[l] = n;
+    memcpy(rx + l * 4 * (size_t)nx, ss, 4 * (size_t)nx * sizeof(double));
+    memcpy(rz + l * 4 * (size_t)nz, ss + 4 * nx, 4 * (size_t)nz * sizeof(double));
+    memcpy(ex + l * 3 * (size_t)nxh, ss + 4 * nx + 4 * nz, 3 * (size_t)nxh * sizeof(double));
+    memcpy(ez + l * 3 * (size_t)nzh, ss + 4 * nx + 4 * nz + 3 * nxh,
+           3 * (size_t)nzh * sizeof(double));
+  }
+  free(v);
+}
