@@ -47,6 +47,7 @@ static const char *const names_sph_wall_pressure_weight[] = {"lattice", "consist
 static const char *const names_sph_pressure_gradient[] = {"standard", "corrected", NULL};
 static const char *const names_sph_shifting[] = {"none", "fickian", NULL};
 static const char *const names_sph_shift_velocity[] = {"keep", "taylor", NULL};
+static const char *const names_sph_wall_collision[] = {"stop", "reflect", NULL};
 static const char *const names_les_model[] = {"none", "smagorinsky", NULL};
 static const char *const names_les_strain[] = {"gradient", "violeau_issa", NULL};
 static const char *const names_wall_law[] = {"laminar", "log", "reichardt", NULL};
@@ -126,6 +127,15 @@ static const struct key keys[] = {
      "each step; corrected, the budgets' closure holds the correction's share (it is not a "
      "force; docs/theory.md, \"Particle shifting\").",
      OFF(shift_velocity)},
+    {"sph", "wall_collision", T_CHOICE, "stop", 0, 0, 0, names_sph_wall_collision, "-",
+     "What a fluid particle that reaches a wall in a step does: stop the run (exit 3, the "
+     "particle named), or reflect it specularly (y -> -y at y = 0, 2 delta - y at the upper "
+     "wall; its wall-normal velocity turned into the fluid, u and w kept) and go on, each "
+     "reflection named on stderr and counted in the log line. The wall's pressure term holds "
+     "particles off the wall only while their pressure is positive; with fluid.p_background = 0 "
+     "the acoustic noise can pull one onto it, about once in 10^10 particle-steps at dr+ = 6 "
+     "(docs/theory.md, \"A particle at the wall\").",
+     OFF(wall_collision)},
     {"sph", "wall_dmin", T_DOUBLE, "1", 0, BIG, LO_OPEN, NULL, "dr",
      "Lower bound delta r of the wall distance in the wall shear term (thesis Eq. 2.148), in "
      "units of dr.",

@@ -30,6 +30,7 @@ enum les_strain { STRAIN_GRADIENT = 0, STRAIN_VIOLEAU_ISSA = 1 };
 enum pressure_gradient { PGRAD_STANDARD = 0, PGRAD_CORRECTED = 1 };
 enum shifting { SHIFT_NONE = 0, SHIFT_FICKIAN = 1 };
 enum shift_velocity { SHIFT_KEEP = 0, SHIFT_TAYLOR = 1 };
+enum wall_collision { WALL_STOP = 0, WALL_REFLECT = 1 };
 
 enum { SCENE_LIST_MAX = 8 };
 
@@ -60,6 +61,7 @@ struct scene {
   int shifting;       /*!< enum shifting: particle shifting after each step */
   double shift_coef;  /*!< shifting coefficient C of delta r = -C h^2 grad C_a [-] */
   int shift_velocity; /*!< enum shift_velocity: what the shift does to the velocities */
+  int wall_collision; /*!< enum wall_collision: a particle that reaches a wall */
   /* [les] */
   int les;         /*!< enum les_model */
   double cs;       /*!< Smagorinsky constant C_S [-] */

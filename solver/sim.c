@@ -5,6 +5,7 @@
 #include <Random123/philox.h>
 #include <math.h>
 #include <mpi.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -279,6 +280,33 @@ int sim_budget_sample(const struct scene *sc, long step) {
   return n % k == (long)(r.v[0] % (uint64_t)k);
 }
 
+/* sph.wall_collision = reflect: a fluid particle that has reached a wall in this step is
+   reflected specularly (its position mirrored in the wall, its wall-normal velocity turned
+   into the fluid; u, w kept, so the streamwise momentum is untouched), named on stderr and
+   counted; otherwise the health check stops the run on it. Per particle: independent of
+   threads and ranks. */
+static void wall_reflect(struct sim *S) {
+  struct particles *P = &S->P;
+  const double ly = S->M.ly, floor_y = 1e-9 * ly;
+  long n = 0;
+#pragma omp parallel for schedule(static) reduction(+ : n)
+  for (size_t a = 0; a < P->n; a++)
+    if (P->kind[a] == KIND_FLUID && (P->y[a] <= 0.0 || P->y[a] >= ly)) n++;
+  if (n == 0) return;
+  for (size_t a = 0; a < P->n; a++) { /* rare: serial, in index order */
+    if (P->kind[a] != KIND_FLUID || (P->y[a] > 0.0 && P->y[a] < ly)) continue;
+    const int upper = P->y[a] >= ly;
+    fprintf(stderr,
+            "warning: step %ld (t = %.9g): particle id %lld reached the %s wall at (%.9g, %.9g, "
+            "%.9g) with velocity (%.6g, %.6g, %.6g); reflected (sph.wall_collision = reflect)\n",
+            S->step, S->t, (long long)P->id[a], upper ? "upper" : "lower", P->x[a], P->y[a],
+            P->z[a], P->u[a], P->v[a], P->w[a]);
+    P->y[a] = upper ? fmin(2.0 * ly - P->y[a], ly - floor_y) : fmax(-P->y[a], floor_y);
+    P->v[a] = upper ? -fabs(P->v[a]) : fabs(P->v[a]);
+  }
+  S->reflections += n;
+}
+
 void sim_step(struct sim *S) {
   struct particles *P = &S->P;
   /* the wall shear stress is gathered only on steps whose end state a budget sample of the
@@ -327,6 +355,7 @@ void sim_step(struct sim *S) {
   }
   timer_pop();
   S->t += dt, S->dt = dt, S->fx = fx, S->step++;
+  if (S->M.wall_reflect) wall_reflect(S);
   if (S->dd.size > 1 && S->sc->balance_every > 0 && S->step % S->sc->balance_every == 0)
     dd_balance(&S->dd, &S->nb, S->sc->balance_threshold);
   dd_migrate(&S->dd, P, &S->nb);
@@ -364,6 +393,8 @@ void sim_diag(struct sim *S, struct diag *d) {
   reduce_global_min(mn, 2);
   d->u_bulk = s[0] / s[1], d->volume = s[1], d->kinetic_energy = s[2], d->mass = s[3];
   d->rho_min = mn[0], d->rho_max = mx[0], d->max_speed = sqrt(mx[1]), d->min_gamma = mn[1];
+  d->reflections = S->reflections;
+  CHECK_MPI(MPI_Allreduce(MPI_IN_PLACE, &d->reflections, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD));
 }
 
 int sim_done(const struct sim *S) {

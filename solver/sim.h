@@ -40,6 +40,8 @@ struct sim {
   char violation[320];      /*!< a fixed dt broke a stability limit: what, where (else empty) */
   int distributed;          /*!< 1 after the particles were split over the ranks */
   long qcrit_step;          /*!< step whose Q criterion P.qcrit holds (-1: none yet) */
+  long reflections;         /*!< wall reflections on this rank since the process began
+                                 (sph.wall_collision = reflect) */
   void *gather[SIM_GATHER]; /*!< this rank's id block of the state, for a checkpoint */
 };
 
@@ -52,6 +54,7 @@ struct diag {
   double rho_min, rho_max; /*!< density range [kg/m^3] */
   double max_speed;        /*!< [m/s] */
   double min_gamma;        /*!< [-] */
+  long reflections;        /*!< wall reflections since the process began, all ranks */
 };
 
 /** @brief Kinematic viscosity of the schedule at time t (fluid.nu_start ramped to fluid.nu;

@@ -52,6 +52,7 @@ struct model {
   double lat_s[LATTICE_KNOTS];
   int shifting;      /*!< enum shifting */
   int shift_taylor;  /*!< 1: the shift carries the velocity by its Taylor correction */
+  int wall_reflect;  /*!< 1: a particle that reaches a wall is reflected (else the run stops) */
   double shift_ch2;  /*!< C h^2 of delta r = -C h^2 grad C_a [m^2] */
   double shift_iwdr; /*!< 1 / w(dr), the anti-clustering term's reference [m^dim] */
   double shift_max;  /*!< largest shift per step [m] */

@@ -87,6 +87,14 @@ target_link_libraries(test_shift PRIVATE chansph_core)
 add_test(NAME unit_shift COMMAND test_shift)
 set_tests_properties(unit_shift PROPERTIES LABELS unit)
 
+#   test_wall_collision: a particle sent through each wall in one step: the health check names
+#                it (sph.wall_collision = stop), or it is mirrored in the wall, u and w kept,
+#                every other particle bit-identical (reflect)
+add_executable(test_wall_collision test_wall_collision.c)
+target_link_libraries(test_wall_collision PRIVATE chansph_core m)
+add_test(NAME unit_wall_collision COMMAND test_wall_collision)
+set_tests_properties(unit_wall_collision PROPERTIES LABELS unit)
+
 #   test_budget_parts: the budget parts of the force pass (x, y, z) add up to the acceleration,
 #                the pair parts conserve momentum in each component, the walls' part lives
 #                within 2h of the walls (docs/theory.md, "Momentum at the walls")
