@@ -296,9 +296,10 @@ static void log_progress(struct output *o, struct sim *S, const struct diag *d) 
              S->step, S->t, S->dt, d->u_bulk, S->fx, d->max_speed, d->rho_min, d->rho_max,
              d->min_gamma, rate, hms(now - o->wall0, el, sizeof el), 100.0 * frac,
              hms(eta, et, sizeof et));
-  if (d->reflections > 0)
+  if (d->reflections > o->reflections) /* new ones since the last log line */
     output_log(o, "  wall reflections since this job began: %ld (sph.wall_collision = reflect)\n",
                d->reflections);
+  o->reflections = d->reflections;
   o->last_wall = now, o->last_step = S->step;
 }
 

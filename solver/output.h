@@ -28,6 +28,7 @@ struct output {
   double t0;          /*!< simulated time at the start of the loop [s] */
   double last_wall;   /*!< wall clock of the last log line [s] */
   long last_step;     /*!< step of the last log line */
+  long reflections;   /*!< wall reflections the log has reported (sph.wall_collision) */
   long step0;         /*!< step at the start of the loop (0, or where a resume started) */
   long max_steps;     /*!< the command line's --max-steps: steps of this process (0: none) */
   int *col;           /*!< global cell column of each owned particle (statistics snapshots) */

@@ -62,6 +62,10 @@ expect window_peaks_span "A=.*@2:1: 2:1: expected T0:T1 with T0 <= T1" "$tool" w
   --dns "$dns" "A=$run@2:1"
 expect window_peaks_dns "missing.nc: no such file" "$tool" window_peaks --dns "$missing" \
   "A=$run@0:1"
+expect blocking_spec "nowin: expected LABEL=RUN_DIR" "$tool" blocking "$run"
+expect blocking_no_window "stats.nc: no averaging window" "$tool" blocking "A=$run@0:1"
+expect blocking_missing "missing/stats.nc: cannot open: No such file" "$tool" blocking \
+  "A=$w/missing@0:1"
 expect error_vs_time_group "argument --group: 0: must be larger than 0" "$tool" error_vs_time \
   --dns "$dns" --group 0 "A=$run"
 expect error_vs_time_run "missing/log.txt" "$tool" error_vs_time --dns "$dns" "A=$w/missing"

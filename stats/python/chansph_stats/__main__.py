@@ -14,6 +14,7 @@ TOOLS = {
     "window_peaks": ("window_peaks", "Reynolds-stress peaks over time ranges against a DNS"),
     "ab_table": ("ab_table", "A/B table of turbulent runs"),
     "error_vs_time": ("error_vs_time", "error against the DNS window group by window group"),
+    "blocking": ("blocking", "blocking analysis: the standard errors against the batch length"),
     "resolution_extrapolate": ("resolution_extrapolate",
                                "the resolution a series extrapolates to"),
     "plot_profile": ("plot_profile", "u_mean of a laminar run against the analytical profile"),

@@ -86,12 +86,13 @@ def merged_profile(r, sel):
             "-u'v'+": -uv / ut**2}
 
 
-def window_profile(dirs, t0, t1, units="force"):
-    """Profiles over [t0, t1] of a series: its runs' window records pooled (a later run's time
-    follows the earlier one's last window, as error_vs_time does). units: "force" (u_tau^2 =
-    delta f) or "wall" (u_tau^2 = the mean wall shear stress of the windows taken, both walls,
-    as `chansph extract --units wall`)."""
-    t_off, pool, span, wall = 0.0, None, None, np.zeros(2)
+def pooled_windows(dirs, t0, t1, units="force"):
+    """The completed windows inside [t0, t1] of a series, pooled: its runs' window records (a
+    later run's time follows the earlier one's last window, as error_vs_time does). Returns
+    (pool, times): pool a read_windows record whose "mom" holds the windows taken, with "ut" in
+    the units asked ("force": u_tau^2 = delta f; "wall": the mean wall shear stress of the
+    windows taken, both walls, as `chansph extract --units wall`), times their (start, end)."""
+    t_off, pool, times, wall = 0.0, None, [], np.zeros(2)
     for run in dirs.split("+"):
         r = read_windows(os.path.join(run, "stats.nc"))
         win = r["win"].copy()
@@ -99,7 +100,7 @@ def window_profile(dirs, t0, t1, units="force"):
         sel = [i for i in range(len(win)) if r["done"][i] and win[i, 0] >= t0 - 1e-9
                and win[i, 1] <= t1 + 1e-9]
         if sel:
-            span = (span[0] if span else win[sel[0], 0], win[sel[-1], 1])
+            times += [(win[i, 0], win[i, 1]) for i in sel]
             wall += (win[sel, 4].sum() + win[sel, 5].sum(), 2 * r["nwall"][sel].sum())
             if pool is None:
                 pool = dict(r, mom=r["mom"][sel])
@@ -112,4 +113,10 @@ def window_profile(dirs, t0, t1, units="force"):
         raise InputError(f"{dirs}: no completed window inside {t0}-{t1}")
     if units == "wall":
         pool["ut"] = math.sqrt(max(wall[0] / max(wall[1], 1), 0.0))
-    return merged_profile(pool, list(range(len(pool["mom"])))), span
+    return pool, times
+
+
+def window_profile(dirs, t0, t1, units="force"):
+    """Profiles over [t0, t1] of a series (pooled_windows), and the span of the windows taken."""
+    pool, times = pooled_windows(dirs, t0, t1, units)
+    return merged_profile(pool, list(range(len(pool["mom"])))), (times[0][0], times[-1][1])
