@@ -33,18 +33,16 @@ names=("$@")
 [ ${#names[@]} -gt 0 ] || names=(reference shift_taylor xi_x0.5 morris h_1.8 wall_analytic)
 mkdir -p "$out"
 runs=()
-cd "$root"
+cd "$root" || exit 1
+. "$root/jobs/campaign_lib.sh"
 for name in "${names[@]}"; do
   [ -n "${sets[$name]+x}" ] || { echo "error: unknown candidate '$name' (${!sets[*]})" >&2; exit 1; }
   dir=$out/${name}_$start
   runs+=("$dir")
-  grep -q "^finished" "$dir/log.txt" 2> /dev/null && continue
   # shellcheck disable=SC2086
-  jobs/chain.sh "$dir" jobs/scenes/mfu180_dr6_dev.ini -- "${from[@]}" --set time.t_end="$tend" \
-    --set output.t_average_start=1 ${sets[$name]} > "$dir.log" 2>&1 ||
-    echo "$name ($start): the run stopped: $(grep -m1 -E '^error|through' "$dir.log")"
+  campaign_run "$dir" jobs/scenes/mfu180_dr6_dev.ini "$name ($start)" "${from[@]}" \
+    --set time.t_end="$tend" --set output.t_average_start=1 ${sets[$name]}
 done
-done_runs=()
-for r in "${runs[@]}"; do grep -q "^finished" "$r/log.txt" 2> /dev/null && done_runs+=("$r"); done
+mapfile -t done_runs < <(campaign_finished "${runs[@]}")
 [ ${#done_runs[@]} -gt 0 ] &&
   "$root/stats/python/chansph-stats" ab_table "${done_runs[@]}" --from 1 --markdown

@@ -31,27 +31,22 @@ names=("$@")
 [ ${#names[@]} -gt 0 ] || names=(qdns les les_wall)
 mkdir -p "$out"
 runs=()
-cd "$root"
+cd "$root" || exit 1
+. "$root/jobs/campaign_lib.sh"
 for name in "${names[@]}"; do
   [ -n "${sets[$name]+x}" ] || { echo "error: unknown candidate '$name' (${!sets[*]})" >&2; exit 1; }
   dir=$out/${name}_ny$ny
   runs+=("$dir")
-  grep -q "^finished" "$dir/log.txt" 2> /dev/null && continue
   # shellcheck disable=SC2086
-  jobs/chain.sh "$dir" jobs/scenes/mfu180w_dr6.ini -- --set domain.dr="$dr" \
+  campaign_run "$dir" jobs/scenes/mfu180w_dr6.ini "$name (NY $ny)" --set domain.dr="$dr" \
     --set init.from=jobs/states/mfu180w_dr6_t12.nc --set time.t_end="$tend" \
     --set output.t_average_start=1 --set stats.window=0.25 --set sph.wall_collision=reflect \
-    ${sets[$name]} > "$dir.log" 2>&1 ||
-    echo "$name (NY $ny): the run stopped: $(grep -m1 -E '^error|through' "$dir.log")"
+    ${sets[$name]}
 done
-done_runs=()
-specs=()
-for r in "${runs[@]}"; do
-  grep -q "^finished" "$r/log.txt" 2> /dev/null || continue
-  done_runs+=("$r")
-  specs+=("$(basename "$r")=$r@1:$tend")
-done
+mapfile -t done_runs < <(campaign_finished "${runs[@]}")
 [ ${#done_runs[@]} -gt 0 ] || exit 0
+specs=()
+for r in "${done_runs[@]}"; do specs+=("$(basename "$r")=$r@1:$tend"); done
 "$root/stats/python/chansph-stats" ab_table "${done_runs[@]}" --from 1 --markdown
 "$root/stats/python/chansph-stats" window_peaks --dns "$root/stats/dns/mkm1999/chan180.means" \
   "${specs[@]}"

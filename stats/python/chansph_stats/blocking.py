@@ -17,7 +17,6 @@ s * window / 2 it implies, and whether se levelled off (the last two se within 2
 other). Quantities: the peaks of -u'v'+, u_rms+, v_rms+, w_rms+ (the peak of each window's
 profile), U+ at y+ = 30 and at the centre, and U_b+ (the bins' mean of U+).
 """
-import argparse
 import math
 
 import numpy as np
@@ -58,14 +57,7 @@ def main(argv, prog):
     ap.add_argument("--units", choices=("wall", "force"), default="wall")
     ap.add_argument("--min-blocks", type=int, default=4)
     a = ap.parse_args(argv)
-    label, _, rest = a.spec.partition("=")
-    dirs, _, span = rest.rpartition("@")
-    if not dirs or not span:
-        raise InputError(f"{a.spec}: expected LABEL=RUN_DIR[+RUN_DIR...]@T0:T1")
-    try:
-        t0, t1 = cli.window(span)
-    except argparse.ArgumentTypeError as e:
-        raise InputError(f"{a.spec}: {e}")
+    label, dirs, t0, t1 = cli.run_spec(a.spec)
     if a.min_blocks < 2:
         raise InputError(f"--min-blocks {a.min_blocks}: need at least 2")
     pool, times = pooled_windows(dirs, t0, t1, a.units)

@@ -79,6 +79,20 @@ def number(kind=float, low=None, above=False):
     return convert
 
 
+def run_spec(spec):
+    """A series over a time range, LABEL=RUN_DIR[+RUN_DIR...]@T0:T1: (label, dirs, t0, t1), or
+    InputError naming the spec."""
+    label, _, rest = spec.partition("=")
+    dirs, _, span = rest.rpartition("@")
+    if not dirs or not span:
+        raise InputError(f"{spec}: expected LABEL=RUN_DIR[+RUN_DIR...]@T0:T1")
+    try:
+        t0, t1 = window(span)
+    except argparse.ArgumentTypeError as e:
+        raise InputError(f"{spec}: {e}")
+    return label, dirs, t0, t1
+
+
 def window(text):
     """argparse type: a time range T0:T1 (T1 may be inf), T0 <= T1."""
     t0, _, t1 = text.partition(":")

@@ -12,12 +12,10 @@ over 20 < y+ < 150 (issue 12's acceptance measures). With --plot FILE, the profi
 u_rms+, v_rms+, w_rms+ and -u'v'+ of every spec against the DNS in one PNG. Used for the LES
 against quasi-DNS rows and the profile figure of docs/validation/turbulent_channel.md.
 """
-import argparse
 
 import numpy as np
 
 from . import cli
-from .cli import InputError
 from .dns import deviation, range_deviation, read_dns
 from .merge import window_profile
 
@@ -34,14 +32,7 @@ def main(argv, prog):
     dns = read_dns(a.dns)
     rows = []
     for spec in a.runs:
-        label, _, rest = spec.partition("=")
-        dirs, _, span = rest.rpartition("@")
-        if not dirs or not span:
-            raise InputError(f"{spec}: expected LABEL=RUN_DIR[+RUN_DIR...]@T0:T1")
-        try:
-            t0, t1 = cli.window(span)
-        except argparse.ArgumentTypeError as e:
-            raise InputError(f"{spec}: {e}")
+        label, dirs, t0, t1 = cli.run_spec(spec)
         prof, got = window_profile(dirs, t0, t1, a.units)
         rows.append((label, got, prof))
     print(f"# peaks (deviation from {dns['name']}) and the v_rms+, w_rms+ deviation over "
