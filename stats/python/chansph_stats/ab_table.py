@@ -8,7 +8,7 @@ the -u'v'+ peak, the u_rms+ peak, v_rms+ at its peak, U_b+, the correlation coef
 R_uv = -u'v' / (u_rms v_rms) over 30 <= y+ <= 100, and the momentum budget (method of
 planes; docs/stats-format.md): the shares of the total stress carried by the resolved
 turbulence (-u'v') and by the pressure pair forces (the scheme's numerical stress) at y+ = 30
-and y = delta/2, with batch-means standard errors of the window values; the closure error and
+and y = delta/2, and by the eddy viscosity (LES; 0 in a quasi-DNS) at y+ = 30, with batch-means standard errors of the window values; the closure error and
 the momentum source; and the cost per eddy turnover delta/u_tau in particle-steps (wall
 seconds depend on what else the machine ran; divide by `chansph bench`'s rate). Wall units from the force balance (u_tau^2 = delta f).
 Runs whose stats.nc has the Reynolds-stress budgets get a second table over their averaging
@@ -57,7 +57,7 @@ def main(argv, prog):
     ap.add_argument("--markdown", action="store_true")
     a = ap.parse_args(argv)
     cols = ["run", "-u'v'+ pk", "u_rms+ pk", "v_rms+ pk", "U_b+", "R_uv",
-            "res y+30", "pair y+30", "res d/2", "pair d/2", "closure", "source", "Mp-st/ETT"]
+            "res y+30", "pair y+30", "model y+30", "res d/2", "pair d/2", "closure", "source", "Mp-st/ETT"]
     rows = []
     for run in a.runs:
         r = read_windows(os.path.join(run, "stats.nc"))
@@ -80,7 +80,7 @@ def main(argv, prog):
             return f"{m:.3f}±{se:.3f}"
         pst, wall = cost(run, ut, delta)
         rows.append([os.path.basename(run.rstrip("/")), ms("uv_peak"), ms("urms"), ms("vrms"),
-                     ms("ub"), ms("ruv"), ms("res_30"), ms("pair_30"), ms("res_half"),
+                     ms("ub"), ms("ruv"), ms("res_30"), ms("pair_30"), ms("model_30"), ms("res_half"),
                      ms("pair_half"), f"{np.nanmax([v.get('closure', math.nan) for v in vals]):.3f}",
                      ms("source"), f"{pst / 1e6:.0f}"])
         print(f"# {run}: windows {win[sel[0], 0]:.3g}-{win[sel[-1], 1]:.3g} ({len(sel)}), "

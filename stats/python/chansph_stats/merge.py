@@ -53,6 +53,7 @@ def window_values(mom, pln, delta, fold, ut, nu):
                 i = int(np.nanargmin(np.abs(yp - target) + np.where(ok, 0, np.inf)))
                 r["res_" + name] = rey[i] / total[i]
                 r["pair_" + name] = parts["pair"][i] / total[i]
+                r["model_" + name] = parts["model"][i] / total[i]
             r["closure"] = np.nanmax(np.abs(total - parts["drive"])) / ut**2
             r["source"] = np.nanmean(parts["source"]) / ut**2
         out.append(r)
