@@ -8,7 +8,8 @@ the -u'v'+ peak, the u_rms+ peak, v_rms+ at its peak, U_b+, the correlation coef
 R_uv = -u'v' / (u_rms v_rms) over 30 <= y+ <= 100, and the momentum budget (method of
 planes; docs/stats-format.md): the shares of the total stress carried by the resolved
 turbulence (-u'v') and by the pressure pair forces (the scheme's numerical stress) at y+ = 30
-and y = delta/2, and by the eddy viscosity (LES; 0 in a quasi-DNS) at y+ = 30, with batch-means standard errors of the window values; the closure error and
+and y = delta/2, and by the eddy viscosity (LES; 0 in a quasi-DNS) at y+ = 30, with
+batch-means standard errors of the window values; the closure error and
 the momentum source; and the cost per eddy turnover delta/u_tau in particle-steps (wall
 seconds depend on what else the machine ran; divide by `chansph bench`'s rate). Wall units from the force balance (u_tau^2 = delta f).
 Runs whose stats.nc has the Reynolds-stress budgets get a second table over their averaging
