@@ -445,8 +445,9 @@ def main(argv, prog):
     ap = cli.parser(prog, __doc__)
     ap.add_argument("stats", help="stats.nc of a run with lagrangian.y_plus set")
     ap.add_argument("--ckpt", help="the checkpoint written with it: the Lagrangian sums for the "
-                    "x clock, and the mean velocity of files written before checkpoint format "
-                    "1.7 (newer files hold it)")
+                    "x clock (files without lag_time_mean, written before checkpoint format "
+                    "1.9), and the mean velocity of files written before checkpoint format 1.7 "
+                    "(newer files hold it)")
     ap.add_argument("--out", help="write lagr_pdf_y.png, lagr_dispersion.png, lagr_rho.png here")
     ap.add_argument("--u-tau", type=u_tau_arg, default="force",
                     help="u_tau of the wall units: force (default), wall or a value [m/s]")
