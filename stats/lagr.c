@@ -69,12 +69,12 @@ static void reserve_tracks(struct lagr *g, size_t n) {
 }
 
 /* Add a track's values at the current sample (particle record p) to record R (lag k of its
-   release). */
-static void contribute(const double *tr, const double *p, double *R) {
+   release); tau = t - t0, the actual lag of the sample (the same on every rank). */
+static void contribute(const double *tr, const double *p, double tau, double *R) {
   const double sg = tr[TR_MIRROR] != 0.0 ? -1.0 : 1.0;
   const double vt[3] = {p[LR_U], sg * p[LR_V], p[LR_W]};
   const double at[3] = {p[LR_AX], sg * p[LR_AY], p[LR_AZ]};
-  R[LG_N] += 1.0;
+  R[LG_N] += 1.0, R[LG_TAU] += tau;
   for (int i = 0; i < 3; i++) {
     const double v0 = tr[TR_V0 + i], a0 = tr[TR_A0 + i];
     double *V = R + LG_VEL + 5 * i, *A = R + LG_ACC + 5 * i;
@@ -250,7 +250,7 @@ static void release(struct lagr *g, int slot, const struct stats_snapshot *s) {
       tr[TR_V0] = p[LR_U], tr[TR_V0 + 1] = sg * p[LR_V], tr[TR_V0 + 2] = p[LR_W];
       tr[TR_A0] = p[LR_AX], tr[TR_A0 + 1] = sg * p[LR_AY], tr[TR_A0 + 2] = p[LR_AZ];
       tr[TR_LAST] = p[LR_X], tr[TR_LAST + 1] = p[LR_Y], tr[TR_LAST + 2] = p[LR_Z];
-      contribute(tr, p, slot_rec(g, slot, l, 0));
+      contribute(tr, p, 0.0, slot_rec(g, slot, l, 0));
       g->ntracks++, sl[SL_N] += 1.0;
       break;
     }
@@ -293,13 +293,13 @@ void lagr_sample(struct lagr *g, const struct stats_snapshot *s) {
   for (int sl = 0; sl < g->n_slots; sl++) {
     double *S = g->slots + (size_t)sl * SL_LEN;
     if (S[SL_ACTIVE] == 0.0) continue;
-    const double k = floor((s->t - S[SL_T0]) / dtau + 1e-9);
+    const double tau = s->t - S[SL_T0], k = floor(tau / dtau + 1e-9);
     if (k > S[SL_LAST_K] && k <= c->n_lags) {
       for (size_t r = 0; r < g->ntracks; r++) {
         const double *tr = g->tracks + r * TR_LEN;
         if (tr[TR_SLOT] != (double)sl) continue;
         const double *p = find(g, tr[TR_ID]);
-        if (p) contribute(tr, p, slot_rec(g, sl, (int)tr[TR_LEVEL], (size_t)k));
+        if (p) contribute(tr, p, tau, slot_rec(g, sl, (int)tr[TR_LEVEL], (size_t)k));
       }
       S[SL_LAST_K] = k;
     }
@@ -322,41 +322,45 @@ static void *reserve_tr(void *owner, int rank, const size_t *dims) {
   return g->tracks;
 }
 
-/* The sums of a checkpoint of format <= 1.6 (records of LG_LEN_1_6, read into the front of
-   g->sums or g->slot_sums): spread them to records of LG_LEN, from the last one back. The sums
-   of dr were not kept: NaN in a record with samples (the mean displacement of the run stays
-   NaN), 0 in one without (exact). */
-static void widen(double *a, size_t rows) {
+/* The sums of a checkpoint of format <= 1.8 (records of width LG_LEN_1_6 up to format 1.6,
+   LG_LEN_1_8 in 1.7-1.8, read into the front of g->sums or g->slot_sums): spread them to
+   records of LG_LEN, from the last one back. The sums after the stored ones (of dr before 1.7,
+   of the actual lags before 1.9) were not kept: NaN in a record with samples (the mean
+   displacement or lag time of the run stays NaN), 0 in one without (exact). */
+static void widen(double *a, size_t rows, size_t width) {
   for (size_t r = rows; r-- > 0;) {
     double *R = a + r * LG_LEN;
-    memmove(R, a + r * LG_LEN_1_6, LG_LEN_1_6 * sizeof(double));
-    for (int i = LG_LEN_1_6; i < LG_LEN; i++) R[i] = R[LG_N] > 0.0 ? NAN : 0.0;
+    memmove(R, a + r * width, width * sizeof(double));
+    for (size_t i = width; i < LG_LEN; i++) R[i] = R[LG_N] > 0.0 ? NAN : 0.0;
   }
+}
+
+static int known_width(size_t w) { /* a record width of some checkpoint format */
+  return w == LG_LEN || w == LG_LEN_1_8 || w == LG_LEN_1_6;
 }
 
 static void *reserve_sums(void *owner, int rank, const size_t *dims) {
   struct lagr *g = owner;
-  const int ok = rank == 3 && dims[0] == (size_t)g->cfg.n_levels && dims[1] == g->nlag &&
-                 (dims[2] == LG_LEN || dims[2] == LG_LEN_1_6);
+  const int ok =
+      rank == 3 && dims[0] == (size_t)g->cfg.n_levels && dims[1] == g->nlag && known_width(dims[2]);
   return ok ? g->sums : NULL;
 }
 
 static void *reserve_slot_sums(void *owner, int rank, const size_t *dims) {
   struct lagr *g = owner;
   const int ok = rank == 3 && dims[0] == (size_t)g->n_slots &&
-                 dims[1] == (size_t)g->cfg.n_levels * g->nlag &&
-                 (dims[2] == LG_LEN || dims[2] == LG_LEN_1_6);
+                 dims[1] == (size_t)g->cfg.n_levels * g->nlag && known_width(dims[2]);
   return ok ? g->slot_sums : NULL;
 }
 
 static void widen_sums(void *owner, int rank, const size_t *dims) {
   struct lagr *g = owner;
-  if (rank == 3 && dims[2] == LG_LEN_1_6) widen(g->sums, dims[0] * dims[1]);
+  if (rank == 3 && dims[2] < LG_LEN) widen(g->sums, dims[0] * dims[1], dims[2]);
 }
 
 static void widen_slot_sums(void *owner, int rank, const size_t *dims) {
   struct lagr *g = owner;
-  if (rank == 3 && dims[2] == LG_LEN_1_6) widen(g->slot_sums, dims[0] * dims[1]);
+  if (rank == 3 && dims[2] < LG_LEN) widen(g->slot_sums, dims[0] * dims[1], dims[2]);
 }
 
 void lagr_state(struct lagr *g, struct state_list *L) {
@@ -367,7 +371,8 @@ void lagr_state(struct lagr *g, struct state_list *L) {
   const size_t d3[3] = {nl, g->nlag, LG_LEN}, d4[3] = {ns, nl * g->nlag, LG_LEN};
   const size_t ds[2] = {ns, SL_LEN}, dt[3] = {nl, 3, SCAL_LEN};
   const size_t dp[3] = {nl, st, (size_t)g->cfg.pdf_bins + 3}, dtr[2] = {g->ntracks, TR_LEN};
-  /* format <= 1.6: records without the sums of dr (LG_LEN_1_6), widened after reading */
+  /* format <= 1.8: records without the sums of the actual lags (LG_LEN_1_8) or, <= 1.6, also
+     without the sums of dr (LG_LEN_1_6), widened after reading */
   struct state_field *f = state_add(L, "stats/lagrangian/sums", STATE_F64, 3, d3, g->sums, NULL);
   f->reserve = reserve_sums, f->after_read = widen_sums, f->owner = g;
   f = state_add(L, "stats/lagrangian/slot_sums", STATE_F64, 3, d4, g->slot_sums, NULL);
@@ -400,6 +405,7 @@ void lagr_functions(const struct lagr *g, int level, double *out, double *tl) {
       out[(LF_DVAR + i) * nlag + k] = n > 0 ? R[LG_DISP + i] / n - m * m : NAN;
     }
     out[LF_N * nlag + k] = n;
+    out[LF_TAU * nlag + k] = n > 0 ? R[LG_TAU] / n : NAN; /* NaN: resumed from format <= 1.8 */
   }
   for (int i = 0; i < 3; i++)
     tl[i] = lagr_tl(out + (LF_RHO_L + i) * nlag, nlag, g->cfg.horizon / g->cfg.n_lags);
@@ -610,6 +616,13 @@ int lagr_nc_write(const struct lagr *g, int ncid, char *err, size_t errlen) {
   CK(ncout_def(gr, "n_tracks", NC_DOUBLE, 2, d2, "1", "particle samples at each lag", &v));
   for (int l = 0; l < nl; l++)
     CK(put_rows(gr, v, l, nlag, fn + ((size_t)l * LF_LEN + LF_N) * nlag));
+  CK(ncout_def(gr, "lag_time_mean", NC_DOUBLE, 2, d2, "s",
+               "mean actual lag time of the samples of this lag (the nominal lag is the "
+               "coordinate lag = k horizon / n_lags)",
+               &v));
+  CK(ncout_fill(gr, v));
+  for (int l = 0; l < nl; l++)
+    CK(put_rows(gr, v, l, nlag, fn + ((size_t)l * LF_LEN + LF_TAU) * nlag));
   /* each names its own failing call in err */
   if ((rc = write_integral_times(g, gr, dl, dc, tl, err, errlen)) != NC_NOERR ||
       (ns > 0 && (rc = write_pdfs(g, gr, dl, tmp, err, errlen)) != NC_NOERR))

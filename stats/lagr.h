@@ -11,12 +11,15 @@
  *
  * Per level and lag the engine sums (n, then for u, v, w: sums of v0, vt, v0^2, vt^2, v0 vt;
  * the same for the accelerations; sums of dv^2, dv^3, dv^4 with dv = v(t0 + tau) - v(t0);
- * sums of the squared displacements and of the displacements). From the sums:
+ * sums of the squared displacements and of the displacements; the sum of the actual lags
+ * t - t0 of the samples, which fall up to one statistics sampling interval after the nominal
+ * lag). From the sums:
  *   rho^L_ii(tau) = cov(v_i(t0), v_i(t0 + tau)) / (sd(v_i(t0)) sd(v_i(t0 + tau)))   (Eq. 5.60)
  *   T_L,i = int_0^{4 T_E,i} rho^L_ii dt, rho^L_ii(T_E,i / 2) = e^{-1/2}             (Eq. 5.61)
  *   rho^a_ii (Eq. 5.62), D_ii, S_ii, K_ii (Eq. 5.63-5.65), sigma_i^2 (Eq. 5.66),
  * the Lagrangian mean velocities <v_i(t0)>, <v_i(t0 + tau)>, the mean displacement <dr_i>(tau)
- * and the displacement variance <dr_i^2> - <dr_i>^2 (sigma_i^2 without the mean drift),
+ * and the displacement variance <dr_i^2> - <dr_i>^2 (sigma_i^2 without the mean drift), the
+ * mean actual lag <t - t0> of the samples of each lag,
  * and at downstream stations x - x0 = X the histogram of y of the particles crossing it,
  * P(y; X), with mu_y and the variance of Eq. 5.67-5.68.
  * The covariance form of Eq. 5.60 measures fluctuations about the ensemble mean of the
@@ -42,12 +45,14 @@ enum {
   LG_STRUCT = LG_ACC + 15, /* 3 x [sum dv^2, dv^3, dv^4] */
   LG_DISP = LG_STRUCT + 9, /* 3 x sum dr^2 */
   LG_DR = LG_DISP + 3,     /* 3 x sum dr (checkpoint format 1.7) */
-  LG_LEN = LG_DR + 3
+  LG_TAU = LG_DR + 3,      /* sum of the actual lags t - t0 of the samples (format 1.9) */
+  LG_LEN = LG_TAU + 1
 };
 
-/** Sums per level and lag in checkpoints of format <= 1.6 (without LG_DR): read into the
-    layout above with the sums of dr NaN where the record has samples (lagr.c). */
-enum { LG_LEN_1_6 = LG_DR };
+/** Sums per level and lag in checkpoints of format <= 1.6 (without LG_DR and LG_TAU) and of
+    format 1.7-1.8 (without LG_TAU): read into the layout above with the missing sums NaN where
+    the record has samples, 0 where not (lagr.c). */
+enum { LG_LEN_1_6 = LG_DR, LG_LEN_1_8 = LG_TAU };
 
 /** Per tracked particle. */
 enum {
@@ -130,7 +135,7 @@ void lagr_state(struct lagr *g, struct state_list *L);
  * @param[in] level release level
  * @param[out] out [quantity][nlag], quantities: rho_L u v w, rho_a u v w, D u v w, S u v w,
  *             K u v w, sigma2 x y z, <v_i(t0)> u v w, <v_i(t0 + tau)> u v w, <dr_i> x y z,
- *             <dr_i^2> - <dr_i>^2 x y z, n (31 rows)
+ *             <dr_i^2> - <dr_i>^2 x y z, n, mean actual lag <t - t0> (32 rows)
  * @param[out] tl T_L of u, v, w from the merged releases (Eq. 5.61) [s]
  */
 void lagr_functions(const struct lagr *g, int level, double *out, double *tl);
@@ -148,6 +153,7 @@ enum {
   LF_DR = 24,   /* mean displacement (NaN after a resume from format <= 1.6) */
   LF_DVAR = 27, /* displacement variance about it (likewise) */
   LF_N = 30,
+  LF_TAU = 31, /* mean actual lag time of the samples (NaN after a resume from format <= 1.8) */
   LF_LEN
 };
 

@@ -11,7 +11,9 @@ usage: stats_tools_synth.py ROOT WORK PART
                    profile changed by 1e-6 FAILs
          lagr      an Ornstein-Uhlenbeck (Gaussian) dispersion with T_L, <v'^2>, <w'^2>: the
                    short-time law, Taylor's curve, the long-time law and T_L come out; a
-                   dispersion doubled FAILs; a checkpoint's Lagrangian mean equals U
+                   dispersion doubled FAILs; a checkpoint's Lagrangian mean equals U; a
+                   file with lag_time_mean (samples 0.4 lag intervals late) is checked at
+                   those real lags, one whose lag_time_mean are fill values brackets them
          errors    missing file, not netCDF, group missing, bad arguments: "error: ...", exit 1,
                    no traceback
 Prints PASS or FAIL lines; exit status 1 on any FAIL.
@@ -217,13 +219,18 @@ def skewflat():
           "skewflat_compare: a profile 1e-6 off the window records FAILs (exit %d)" % rc)
 
 
-def lagr_file(path, scale_y=1.0, with_corr=True, means=None):
+def lagr_file(path, scale_y=1.0, with_corr=True, means=None, lag_shift=None):
     """Ornstein-Uhlenbeck velocities: rho_L = exp(-tau/T), sigma^2 = 2 s2 T^2 (t/T - 1 + e^-t/T)
     (Taylor 1921), releases of N tracks at y+ 30 and 100; PDFs Gaussian. means = du: the
     Lagrangian means of checkpoint format 1.7 (u_release_mean ... disp_var_z), the mean u
-    U + du; None: a file without them."""
+    U + du; None: a file without them. lag_shift = s: the samples of every lag k > 0 were taken
+    at the real lag k dtau + s, written as lag_time_mean (checkpoint format 1.9), and the
+    functions are those of the real lags; NaN: lag_time_mean all fill values (a run resumed
+    from format 1.8); None: no lag_time_mean."""
     T, nlag, H = 0.02, 120, 0.12  # horizon 6 T; lag interval 0.001
-    t = np.arange(nlag + 1) * H / nlag
+    nominal = np.arange(nlag + 1) * H / nlag
+    t = nominal + (np.where(nominal > 0, lag_shift, 0.0) if lag_shift == lag_shift and
+                   lag_shift is not None else 0.0)
     levels = np.array([30.0, 100.0]) * NU
     nrel, N = 400, 56
     with netCDF4.Dataset(path, "w") as d:
@@ -251,7 +258,11 @@ def lagr_file(path, scale_y=1.0, with_corr=True, means=None):
         g.createDimension("pdf_bin", 50)
         var(g, "level", ("level",), levels)
         var(g, "y_plus", ("level",), levels / NU)
-        var(g, "lag", ("lag",), t)
+        var(g, "lag", ("lag",), nominal)
+        if lag_shift is not None:
+            v = var(g, "lag_time_mean", ("level", "lag"), np.tile(t, (2, 1)))
+            if lag_shift != lag_shift:
+                v[:] = np.ma.masked_all((2, nlag + 1))
         disp = lambda s2: 2 * s2 * T ** 2 * (t / T - 1 + np.exp(-t / T))
         U = 10 * levels + 5
         var(g, "sigma2_x", ("level", "lag"), np.array([disp(4.0) + (u * t) ** 2 for u in U]))
@@ -342,6 +353,30 @@ def lagr():
     rc, out, _ = run("lagr_check", b)
     check(rc == 1 and re.search(r"short-time y: .*FAIL", out) is not None,
           "lagr_check: a doubled y dispersion FAILs the short-time law (exit %d)" % rc)
+    # checkpoint format 1.9 on: the real lags in lag_time_mean. The samples 0.4 lag intervals
+    # late: bracketing [tau, tau + ds] (ds = 1e-5) would FAIL, the real lag gives the OU value
+    s = os.path.join(WORK, "lagr_lagtime.nc")
+    lagr_file(s, lag_shift=0.0004)
+    rc, out, err = run("lagr_check", s)
+    short = re.findall(r"short-time (.): sigma_.\^2/tau\^2 = ([0-9.e+-]+) \.\. ([0-9.e+-]+) at "
+                       r"the real lag ([0-9.e+-]+) s \(lag 1, nominal 0.001 s: lag_time_mean of "
+                       r"the file\).*: (PASS|FAIL)", out)
+    sy = [float(x[1]) for x in short if x[0] == "y"]
+    tau = 0.0014 / 0.02
+    check(rc == 0 and len(short) == 6 and all(x[4] == "PASS" and float(x[3]) == 0.0014
+                                              for x in short) and
+          out.count("lags: lag_time_mean of the file") == 2 and sy and
+          abs(sy[0] / 0.5 - 2 * (tau - 1 + math.exp(-tau)) / tau ** 2) < 1e-4,
+          "lagr_check: a file with lag_time_mean takes the real lags from it (0.0014 s for the "
+          "nominal 0.001): sigma_y^2/tau^2 is the OU value at the real lag, the short-time law "
+          "holds (%s, exit %d) %s" % (short, rc, err.strip()))
+    s2 = os.path.join(WORK, "lagr_lagtime_fill.nc")
+    lagr_file(s2, lag_shift=math.nan)
+    rc, out, _ = run("lagr_check", s2)
+    check(rc == 0 and out.count("lags: no lag_time_mean in the file (or fill values") == 2 and
+          out.count("for the real lag between 0.001 and 0.00101 s") == 6,
+          "lagr_check: lag_time_mean all fill values (resumed from format 1.8): the real lag "
+          "bracketed as for older files (exit %d)" % rc)
     # a checkpoint with the Lagrangian sums: mean velocity = U at every lag
     try:
         import h5py
@@ -374,6 +409,21 @@ def lagr():
     rc17, out17, err17 = run("lagr_check", f, "--ckpt", ck17)
     check(rc17 == 0 and out17.count("(checkpoint)") == 2,
           "lagr_check --ckpt reads a checkpoint of format 1.7 (exit %d) %s" % (rc17, err17.strip()))
+    ck19 = os.path.join(WORK, "lagr_ckpt19.h5")
+    with h5py.File(ck19, "w") as h:  # format 1.9: the sums of dr and of the actual lags appended
+        h.attrs.update(format=b"chansph-checkpoint", format_version_major=1,
+                       format_version_minor=9, complete=1)
+        h["stats/lagrangian/sums"] = np.concatenate([sums, np.zeros((2, nlag + 1, 4))], axis=2)
+        h["stats/lagrangian/releases"] = np.array([400.0])
+    rc19, out19, err19 = run("lagr_check", s, "--ckpt", ck19)
+    x19 = re.findall(r"short-time x: lag 1 \(nominal 0.001 s\) is at tau = 0.0014 s .* by "
+                     r"lag_time_mean of the file .*: lag_time_mean used as the lag", out19)
+    kin19 = re.findall(r"short-time [yz]: .*kinematics, within 3%: (PASS|FAIL).*: (PASS|FAIL)",
+                       out19)
+    check(rc19 == 0 and len(x19) == 2 and kin19 == [("PASS", "PASS")] * 4,
+          "lagr_check --ckpt of format 1.9 on a file with lag_time_mean: the real lag from the "
+          "file, not the x clock; the kinematics and the short-time law hold in y and z (%s, "
+          "exit %d) %s" % (kin19, rc19, err19.strip()))
     mean = re.findall(r"Lagrangian mean u at release .*: (PASS|FAIL)", out)
     kin = re.findall(r"short-time [yz]: .*kinematics, within 3%: (PASS|FAIL).*: (PASS|FAIL)", out)
     clock = re.findall(r"is at tau = ([0-9.e+-]+) s .* by the x clock", out)

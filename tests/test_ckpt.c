@@ -4,7 +4,8 @@
  *        round-trips bitwise (a field sized on reading included); a write to a full disk
  *        (/dev/full) fails with the system's reason and leaves no file; a missing dataset and a
  *        wrong shape are named; the Lagrangian sums of a format 1.6 file (records without the
- *        sums of the displacements) resume in the layout of format 1.7.
+ *        sums of the displacements and of the actual lags) and of a format 1.8 file (without
+ *        the sums of the actual lags) resume in the layout of format 1.9.
  */
 #include <math.h>
 #include <stdint.h>
@@ -32,13 +33,14 @@ static void *reserve(void *owner, int rank, const size_t *dims) {
   return rank == 2 && dims[0] * dims[1] <= 64 ? grow : NULL;
 }
 
-/* A checkpoint whose stats/lagrangian/sums and slot_sums have the records of format 1.6
-   (LG_LEN_1_6 wide) is read by an engine of format 1.7: the stored sums as they were, the sums
-   of dr NaN where a record has samples, 0 where not; a record of another width is refused,
-   naming the file and the dataset. */
-static void lagr_format_1_6(const char *dir) {
-  char path[256], err[2048];
-  snprintf(path, sizeof path, "%s/ckpt_lagr16.h5", dir);
+/* A checkpoint whose stats/lagrangian/sums and slot_sums have the records of an older format
+   (w = LG_LEN_1_6 wide in format 1.6, LG_LEN_1_8 in 1.7-1.8) is read by an engine of format
+   1.9: the stored sums as they were, the sums it lacks (of dr, of the actual lags) NaN where a
+   record has samples, 0 where not; a record of another width is refused, naming the file and
+   the dataset. */
+static void lagr_format_old(const char *dir, size_t w, const char *version) {
+  char path[256], err[2048], what[160];
+  snprintf(path, sizeof path, "%s/ckpt_lagr_old.h5", dir);
   const struct lagr_config cfg = {.n_levels = 1,
                                   .y = {0.5},
                                   .half = 0.05,
@@ -51,46 +53,48 @@ static void lagr_format_1_6(const char *dir) {
   struct lagr a, b;
   lagr_init(&a, &cfg), lagr_init(&b, &cfg);
   const size_t rows = a.nlag, srows = (size_t)a.n_slots * a.nlag;
-  double old[64 * LG_LEN_1_6], sold[64 * LG_LEN_1_6];
-  for (size_t i = 0; i < rows * LG_LEN_1_6; i++) old[i] = 0.25 * (double)i + 1.0;
-  for (size_t i = 0; i < srows * LG_LEN_1_6; i++)
-    sold[i] = (i / LG_LEN_1_6) % 2 ? 0.0 : 0.5 * i + 1.0;
+  double old[64 * LG_LEN], sold[64 * LG_LEN];
+  for (size_t i = 0; i < rows * w; i++) old[i] = 0.25 * (double)i + 1.0;
+  for (size_t i = 0; i < srows * w; i++) sold[i] = (i / w) % 2 ? 0.0 : 0.5 * i + 1.0;
   a.releases = 3.0;
   struct state_list L = {0};
   lagr_state(&a, &L);
   struct state_field *f = state_find(&L, "stats/lagrangian/sums");
-  f->data = old, f->dims[2] = LG_LEN_1_6;
+  f->data = old, f->dims[2] = w;
   f = state_find(&L, "stats/lagrangian/slot_sums");
-  f->data = sold, f->dims[2] = LG_LEN_1_6;
-  check(ckpt_write(path, &L, "[domain]\n", 1, 0.0, err, sizeof err) == 0, "write format 1.6 sums");
+  f->data = sold, f->dims[2] = w;
+  snprintf(what, sizeof what, "write format %s sums (%zu per record)", version, w);
+  check(ckpt_write(path, &L, "[domain]\n", 1, 0.0, err, sizeof err) == 0, what);
   struct state_list R = {0};
   lagr_state(&b, &R);
   const int rc = ckpt_read(path, &R, err, sizeof err);
   if (rc) printf("  %s\n", err);
-  int same = 1, dr = 1;
+  int same = 1, lack = 1;
   for (size_t r = 0; r < rows; r++) {
-    same = same && !memcmp(b.sums + r * LG_LEN, old + r * LG_LEN_1_6, LG_LEN_1_6 * 8);
-    for (int i = 0; i < 3; i++) dr = dr && isnan(b.sums[r * LG_LEN + LG_DR + i]);
+    same = same && !memcmp(b.sums + r * LG_LEN, old + r * w, w * 8);
+    for (size_t i = w; i < LG_LEN; i++) lack = lack && isnan(b.sums[r * LG_LEN + i]);
   }
   for (size_t r = 0; r < srows; r++) {
-    same = same && !memcmp(b.slot_sums + r * LG_LEN, sold + r * LG_LEN_1_6, LG_LEN_1_6 * 8);
-    for (int i = 0; i < 3; i++) {
-      const double s = b.slot_sums[r * LG_LEN + LG_DR + i];
-      dr = dr && (r % 2 ? s == 0.0 : isnan(s));
+    same = same && !memcmp(b.slot_sums + r * LG_LEN, sold + r * w, w * 8);
+    for (size_t i = w; i < LG_LEN; i++) {
+      const double s = b.slot_sums[r * LG_LEN + i];
+      lack = lack && (r % 2 ? s == 0.0 : isnan(s));
     }
   }
-  check(
-      rc == 0 && same && dr && b.releases == 3.0,
-      "Lagrangian sums of format 1.6 resume: stored sums kept, sums of dr NaN (0 without samples)");
+  snprintf(what, sizeof what,
+           "Lagrangian sums of format %s resume: stored sums kept, the %zu missing sums NaN (0 "
+           "without samples)",
+           version, (size_t)LG_LEN - w);
+  check(rc == 0 && same && lack && b.releases == 3.0, what);
   state_free(&R);
   f = state_find(&L, "stats/lagrangian/sums");
   f->dims[2] = LG_LEN_1_6 + 1;
   check(ckpt_write(path, &L, "[domain]\n", 1, 0.0, err, sizeof err) == 0, "write a wrong width");
   lagr_state(&b, &R);
-  check(ckpt_read(path, &R, err, sizeof err) != 0 && strstr(err, "ckpt_lagr16.h5") &&
+  check(ckpt_read(path, &R, err, sizeof err) != 0 && strstr(err, "ckpt_lagr_old.h5") &&
             strstr(err,
                    "dataset /stats/lagrangian/sums has shape (1, 5, 44), this run needs "
-                   "(1, 5, 46)"),
+                   "(1, 5, 47)"),
         err);
   state_free(&L), state_free(&R);
   lagr_free(&a), lagr_free(&b);
@@ -186,7 +190,8 @@ int main(void) {
   }
   check(ckpt_info(path, &info, err, sizeof err) == 0, "the earlier checkpoint is intact");
   free(info.scene);
-  lagr_format_1_6(dir);
+  lagr_format_old(dir, LG_LEN_1_6, "1.6");
+  lagr_format_old(dir, LG_LEN_1_8, "1.8");
   remove(path), rmdir(dir);
   state_free(&L), state_free(&R), state_free(&M), state_free(&S), state_free(&T);
   free(text), free(text2);

@@ -602,36 +602,37 @@ static double se_var(int k, int c, double n) {
   return dvar(k, c) * sqrt(2.0 / (n - 1));
 }
 
-/* Write one sums field of g as a checkpoint of format <= 1.6 stores it (records of LG_LEN_1_6)
-   into the memory its reserve() gives, widen it with after_read(); 1 if the old sums came back
-   bitwise and the sums of dr are NaN exactly in the records with samples. */
-static int widen_one(struct state_field *f, size_t rows) {
-  double *ref = malloc(rows * LG_LEN * sizeof(double)), *old = malloc(rows * LG_LEN_1_6 * 8);
+/* Write one sums field of g as a checkpoint of an older format stores it (records of w sums:
+   LG_LEN_1_6 up to format 1.6, LG_LEN_1_8 in 1.7-1.8) into the memory its reserve() gives,
+   widen it with after_read(); 1 if the old sums came back bitwise and the sums after them (of
+   dr, of the actual lags) are NaN exactly in the records with samples. */
+static int widen_one(struct state_field *f, size_t rows, size_t w) {
+  double *ref = malloc(rows * LG_LEN * sizeof(double)), *old = malloc(rows * w * 8);
   memcpy(ref, f->data, rows * LG_LEN * sizeof(double));
-  for (size_t r = 0; r < rows; r++)
-    memcpy(old + r * LG_LEN_1_6, ref + r * LG_LEN, LG_LEN_1_6 * sizeof(double));
-  const size_t dims[3] = {f->dims[0], f->dims[1], LG_LEN_1_6}, bad[3] = {f->dims[0], 7, 44};
-  int ok = f->reserve(f->owner, 3, bad) == NULL;
+  for (size_t r = 0; r < rows; r++) memcpy(old + r * w, ref + r * LG_LEN, w * sizeof(double));
+  const size_t dims[3] = {f->dims[0], f->dims[1], w}, bad[3] = {f->dims[0], 7, 44};
+  const size_t bad_w[3] = {f->dims[0], f->dims[1], LG_LEN_1_6 + 1};
+  int ok = f->reserve(f->owner, 3, bad) == NULL && f->reserve(f->owner, 3, bad_w) == NULL;
   double *dst = f->reserve(f->owner, 3, dims);
   ok = ok && dst == f->data;
   if (ok) {
-    memcpy(dst, old, rows * LG_LEN_1_6 * sizeof(double));
+    memcpy(dst, old, rows * w * sizeof(double));
     f->after_read(f->owner, 3, dims);
     for (size_t r = 0; r < rows; r++) {
       const double *R = dst + r * LG_LEN, *W = ref + r * LG_LEN;
-      ok = ok && !memcmp(R, W, LG_LEN_1_6 * sizeof(double));
-      for (int i = 0; i < 3; i++)
-        ok = ok && (R[LG_N] > 0 ? isnan(R[LG_DR + i]) : R[LG_DR + i] == 0.0);
+      ok = ok && !memcmp(R, W, w * sizeof(double));
+      for (size_t i = w; i < LG_LEN; i++) ok = ok && (R[LG_N] > 0 ? isnan(R[i]) : R[i] == 0.0);
     }
   }
   free(ref), free(old);
   return ok;
 }
 
-/* The engine's sums read from a checkpoint of format 1.6 (stats/lagrangian/sums and slot_sums
-   without the sums of dr): every other sum as stored, the mean displacement and its variance
-   NaN (not recoverable), sigma2 and the mean velocities as before. */
-static void lagr_widen_check(struct lagr *g) {
+/* The engine's sums read from a checkpoint of format 1.8 (records without the sums of the
+   actual lags) or 1.6 (also without the sums of dr): every other sum as stored, the mean lag
+   time NaN, and for 1.6 the mean displacement and its variance NaN (not recoverable), sigma2
+   and the mean velocities as before (and for 1.8 the mean displacement too). */
+static void lagr_widen_check(struct lagr *g, size_t w, const char *version) {
   const size_t nlag = g->nlag;
   double *before = malloc(LF_LEN * nlag * sizeof(double)), *after = malloc(LF_LEN * nlag * 8);
   double tl[3];
@@ -640,23 +641,26 @@ static void lagr_widen_check(struct lagr *g) {
   lagr_state(g, &L);
   struct state_field *fs = state_find(&L, "stats/lagrangian/sums");
   struct state_field *fl = state_find(&L, "stats/lagrangian/slot_sums");
-  const int ok_s = fs && widen_one(fs, nlag);
-  const int ok_l = fl && widen_one(fl, (size_t)g->n_slots * nlag);
+  const int ok_s = fs && widen_one(fs, nlag, w);
+  const int ok_l = fl && widen_one(fl, (size_t)g->n_slots * nlag, w);
   lagr_functions(g, 0, after, tl);
   int kept = 1, nan = 1;
-  for (size_t k = 0; k < nlag; k++)
+  for (size_t k = 0; k < nlag; k++) {
+    nan = nan && isnan(after[LF_TAU * nlag + k]);
     for (int c = 0; c < 3; c++) {
-      kept = kept && after[(LF_SIG2 + c) * nlag + k] == before[(LF_SIG2 + c) * nlag + k] &&
-             after[(LF_U0 + c) * nlag + k] == before[(LF_U0 + c) * nlag + k] &&
-             after[(LF_UT + c) * nlag + k] == before[(LF_UT + c) * nlag + k];
-      nan = nan && isnan(after[(LF_DR + c) * nlag + k]) && isnan(after[(LF_DVAR + c) * nlag + k]);
+      const int rows[] = {LF_SIG2 + c, LF_U0 + c, LF_UT + c, LF_DR + c, LF_DVAR + c};
+      for (int j = 0; j < (w == LG_LEN_1_6 ? 3 : 5); j++)
+        kept = kept && after[rows[j] * nlag + k] == before[rows[j] * nlag + k];
+      if (w == LG_LEN_1_6)
+        nan = nan && isnan(after[(LF_DR + c) * nlag + k]) && isnan(after[(LF_DVAR + c) * nlag + k]);
     }
+  }
   printf(
-      "Lagrangian sums of checkpoint format 1.6: widened (sums %s, slot sums %s), sigma2 and "
-      "the mean velocities %s, mean displacement %s\n",
-      ok_s ? "ok" : "WRONG", ok_l ? "ok" : "WRONG", kept ? "kept" : "CHANGED",
-      nan ? "NaN" : "NOT NaN");
-  EXPECT(ok_s && ok_l && kept && nan, "reading the sums of format 1.6");
+      "Lagrangian sums of checkpoint format %s: widened (sums %s, slot sums %s), the stored "
+      "functions %s, the missing ones (lag time%s) %s\n",
+      version, ok_s ? "ok" : "WRONG", ok_l ? "ok" : "WRONG", kept ? "kept" : "CHANGED",
+      w == LG_LEN_1_6 ? ", mean displacement" : "", nan ? "NaN" : "NOT NaN");
+  EXPECT(ok_s && ok_l && kept && nan, "reading the sums of format %s", version);
   state_free(&L);
   free(before), free(after);
 }
@@ -665,9 +669,10 @@ static void lagr_widen_check(struct lagr *g) {
    Lagrangian mean velocities (U, V, 0) at release and at every lag, the mean displacement
    <dr_i>(tau) = U_i tau and the displacement variance of the fluctuations alone,
    dt^2 sum_{m,n} f^|m-n| (the mean drift removed from sigma_i^2), each within 4 standard
-   errors; sigma_i^2 = variance + mean^2. Then the sums as a checkpoint of format 1.6 holds
-   them (records without the sums of dr) are widened by the state list's callbacks: the other
-   sums bitwise, the mean displacement NaN. */
+   errors; sigma_i^2 = variance + mean^2. Then the sums as a checkpoint of format 1.8 holds
+   them (records without the sums of the actual lags), and then as one of format 1.6 (also
+   without the sums of dr), are widened by the state list's callbacks: the other sums bitwise,
+   the mean lag time NaN, for 1.6 the mean displacement NaN. */
 static void test_lagr_drift(void) {
   enum { NPART = 2000, RELEASES = 24, NLAG = 40 };
   const double horizon = NLAG * DRIFT_DT, f = drift_f();
@@ -733,7 +738,61 @@ static void test_lagr_drift(void) {
   EXPECT(zm < 4.0 && zv < 4.0 && zu < 4.0, "Lagrangian means or displacement variance off");
   EXPECT(ident < 1e-9 * (1.0 + fn[LF_SIG2 * nlag + NLAG]), "sigma2 != variance + mean^2 (%g)",
          ident);
-  lagr_widen_check(&g);
+  lagr_widen_check(&g, LG_LEN_1_8, "1.8");
+  lagr_widen_check(&g, LG_LEN_1_6, "1.6");
+  lagr_free(&g);
+}
+
+/* Issue 25: with a varying sampling interval the samples of lag k fall at the first
+   statistics sample at or after t0 + k dtau, not on the nominal lag. lag_time_mean (LF_TAU)
+   is the mean over the samples of (sample time - release time), computed here from the sample
+   times alone, to 1e-12; it lies in [k dtau, k dtau + the largest sampling interval]. */
+static void test_lagr_lag_times(void) {
+  enum { NPART = 50, RELEASES = 12, NLAG = 8 };
+  /* sampling intervals: with the irrational 1e-3 sqrt(2) no sum of them is a multiple of dtau */
+  const double e = 1e-3 * sqrt(2.0), DT[5] = {0.07 + e, 0.11 + e, 0.13 + e, 0.05 + e, 0.09 + e};
+  const double horizon = 2.0, dtau = horizon / NLAG, every = 2.5, dtmax = 0.13 + 1e-3 * sqrt(2.0);
+  const struct lagr_config cfg = {.n_levels = 1,
+                                  .y = {0.5},
+                                  .half = 0.05,
+                                  .lx = 10.0,
+                                  .delta = 1.0,
+                                  .horizon = horizon,
+                                  .release_every = every,
+                                  .n_lags = NLAG,
+                                  .pdf_bins = 10};
+  struct lagr g;
+  lagr_init(&g, &cfg);
+  static double x[NPART], y[NPART], z[NPART], u[NPART];
+  static int64_t id[NPART];
+  for (int p = 0; p < NPART; p++) id[p] = p, y[p] = 0.5, u[p] = 0.01 * p;
+  double want[NLAG + 1] = {0}, t = 0.0, t0 = 0.0;
+  int r = 0, k = NLAG + 1; /* releases so far, next lag of the current one */
+  for (long n = 0; t < RELEASES * every; t += DT[n % 5], n++) {
+    if (t >= r * every) t0 = t, r++, k = 0; /* a release: the first sample at or after r every */
+    if (k <= NLAG && t >= t0 + k * dtau) want[k++] += (t - t0) / RELEASES;
+    const struct stats_snapshot snap = {
+        .n = NPART, .x = x, .y = y, .z = z, .u = u, .v = u, .w = u, .id = id, .t = t};
+    lagr_sample(&g, &snap);
+  }
+  const size_t nlag = NLAG + 1;
+  double fn[LF_LEN * (NLAG + 1)], tl[3], err = 0.0, off = 0.0;
+  int inside = 1;
+  lagr_functions(&g, 0, fn, tl);
+  for (size_t j = 0; j < nlag; j++) {
+    const double m = fn[LF_TAU * nlag + j], nominal = (double)j * dtau;
+    err = fmax(err, fabs(m - want[j]));
+    off = fmax(off, m - nominal);
+    inside =
+        inside && m >= nominal && m <= nominal + dtmax && fn[LF_N * nlag + j] == NPART * RELEASES;
+  }
+  printf(
+      "Lagrangian lag times (%d releases, sampling intervals 0.05-0.13 s, dtau %g s): "
+      "lag_time_mean - mean(t - t0) at most %.3g, largest lag_time_mean - nominal %.4f s\n",
+      (int)g.releases, dtau, err, off);
+  EXPECT(g.releases == RELEASES && k == NLAG + 1, "releases %g", g.releases);
+  EXPECT(err <= 1e-12, "lag_time_mean is not the mean actual lag (%g)", err);
+  EXPECT(inside && off > 0.01, "lag_time_mean outside [nominal, nominal + dt] or on nominal");
   lagr_free(&g);
 }
 
@@ -998,6 +1057,7 @@ int main(void) {
   test_sph_profiles();
   test_lagr_ou();
   test_lagr_drift();
+  test_lagr_lag_times();
   test_lagr_pdf();
   free(buf);
   printf(failures ? "FAILED (%d)\n" : "all passed\n", failures);

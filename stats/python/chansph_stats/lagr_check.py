@@ -8,9 +8,14 @@ interpolated to it):
 
 1. Taylor's short-time dispersion: sigma_i^2(tau) / tau^2 -> <u_i'^2> at the release height.
    Taken at the first lag with samples. The engine samples lag k at the first statistics
-   sample at or after k horizon / n_lags, so the real lag is ceil(tau_k / ds) ds with ds the
-   sampling interval (output.stats_every steps of dt = t_reached / steps, from the scene and
-   attributes of the file; --sample-interval overrides, 0 uses the nominal lags).
+   sample at or after k horizon / n_lags, so the real lag is up to one sampling interval later
+   than the nominal one. Files of checkpoint format 1.9 on hold the mean real lag of the
+   samples of each lag (lag_time_mean of group lagrangian), which is then the lag everywhere
+   (points 1-4; the output says so). For older files (or a run resumed from a checkpoint of
+   format 1.8 or older, whose lag_time_mean are fill values) the real lag lies between tau_k
+   and tau_k + ds with ds the sampling interval (output.stats_every steps of dt = t_reached /
+   steps, from the scene and attributes of the file; --sample-interval overrides, 0 uses the
+   nominal lags): point 1 brackets it, or with --ckpt takes it from the x clock below.
    The mean drift is removed: sigma_i^2 is <dr_i^2>, not a variance. Files of this version hold
    the displacement variance about the mean displacement (disp_var_x, _y, _z of group
    lagrangian; since checkpoint format 1.7), which is used as it is. With --ckpt the
@@ -58,8 +63,9 @@ from .twopoint import out_dir, pick_u_tau, pyplot, save, u_tau_arg
 COMP = ("u", "v", "w")
 POS = ("x", "y", "z")
 # layout of stats/lagrangian/sums (stats/lagr.h): n, then per u, v, w [S0, St, S00, Stt, S0t];
-# records of 43 sums up to checkpoint format 1.6, 46 (the sums of dr added at the end) from 1.7
-LG_N, LG_VEL, LG_LENS = 0, 1, (43, 46)
+# records of 43 sums up to checkpoint format 1.6, 46 (the sums of dr added at the end) in 1.7-1.8,
+# 47 (the sum of the actual lags added at the end) from 1.9
+LG_N, LG_VEL, LG_LENS = 0, 1, (43, 46, 47)
 # Lagrangian means in group lagrangian (from checkpoint format 1.7 on)
 MEANS = ["%s_release_mean" % c for c in COMP] + ["%s_lag_mean" % c for c in COMP] + \
     ["disp_mean_" + p for p in POS] + ["disp_var_" + p for p in POS]
@@ -75,6 +81,9 @@ def read_run(path, how):
         r["horizon"] = float(attribute(g, "horizon", path))
         r["release_every"] = float(attribute(g, "release_every", path))
         r["means"] = all(k in g.variables for k in MEANS)
+        # the mean real lag of the samples (checkpoint format 1.9 on)
+        r["lag_time"] = values(g.variables["lag_time_mean"]) \
+            if "lag_time_mean" in g.variables else None
         if r["means"]:
             for k in MEANS:
                 r[k] = values(g.variables[k])
@@ -143,6 +152,18 @@ def real_lags(r, ds):
     return tau
 
 
+def level_lags(r, l, t):
+    """The lags of level l: lag_time_mean of the file (the mean real lag of the samples) at the
+    lags with samples, t elsewhere; and how they were found (None: not in the file, or fill
+    values at a lag with samples: a run resumed from a checkpoint of format 1.8 or older)."""
+    if r["lag_time"] is None:
+        return t, None
+    m, has = r["lag_time"][l], r["n_tracks"][l] > 0
+    if not has.any() or not np.all(np.isfinite(m[has])):
+        return t, None
+    return np.where(has, m, t), "lag_time_mean"
+
+
 def eulerian_at(r, y):
     e = r["eul"]
     ok = e["n_samples"] > 0
@@ -208,6 +229,7 @@ def short_time(r, l, sums, E, ds):
     if not ks:
         return []
     k, tau = ks[0], r["lag"][ks[0]]
+    real = r["t_level"][k] if r["lags_from"] else math.nan  # lag_time_mean (format 1.9)
     rows = []
     if sums is not None:
         R = sums[l, k]
@@ -215,12 +237,16 @@ def short_time(r, l, sums, E, ds):
         # mean square of the interval-mean velocity (u(t0) + u(t0 + tau)) / 2
         q = [(m[2] + 2 * m[4] + m[3]) / 4 for m in mom]
         mean = [(m[0] + m[1]) / 2 for m in mom]
-        clock = math.sqrt(r["sigma2_x"][l][k] / q[0])
-        rows.append(("x", "lag %d (nominal %.4g s) is at tau = %.4g s (tau+ %.3g) by the x clock "
-                     "<dx^2> = tau^2 <((u(t0) + u(t0 + tau)) / 2)^2>; ensemble <u'^2> = %.5g, "
-                     "Eulerian %.5g (%+.1f%%)" %
-                     (k, tau, clock, clock * r["u_tau"] ** 2 / r["nu"], q[0] - mean[0] ** 2,
-                      E["uu"], 100 * ((q[0] - mean[0] ** 2) / E["uu"] - 1)), "used as the clock"))
+        xclock = math.sqrt(r["sigma2_x"][l][k] / q[0])
+        clock = real if real == real else xclock
+        how = ("by lag_time_mean of the file (the x clock <dx^2> = tau^2 <((u(t0) + u(t0 + tau)) "
+               "/ 2)^2> gives %.4g s)" % xclock if real == real else "by the x clock <dx^2> = "
+               "tau^2 <((u(t0) + u(t0 + tau)) / 2)^2>")
+        rows.append(("x", "lag %d (nominal %.4g s) is at tau = %.4g s (tau+ %.3g) %s; ensemble "
+                     "<u'^2> = %.5g, Eulerian %.5g (%+.1f%%)" %
+                     (k, tau, clock, clock * r["u_tau"] ** 2 / r["nu"], how, q[0] - mean[0] ** 2,
+                      E["uu"], 100 * ((q[0] - mean[0] ** 2) / E["uu"] - 1)),
+                     "lag_time_mean used as the lag" if real == real else "used as the clock"))
         for i, (p, c) in ((1, ("y", "v")), (2, ("z", "w"))):
             s2 = r["sigma2_" + p][l][k] / clock ** 2
             kin = s2 / q[i]
@@ -236,7 +262,10 @@ def short_time(r, l, sums, E, ds):
                           val - E[c + c], 100 * (val / E[c + c] - 1), 2 * se, neff, how),
                          "PASS" if ok and ok_kin else "FAIL"))
         return rows
-    lo, hi = tau, tau + (ds if ds > 0 else 0.0)
+    lo, hi = (real, real) if real == real else (tau, tau + (ds if ds > 0 else 0.0))
+    lag = ("at the real lag %.4g s (lag %d, nominal %.4g s: lag_time_mean of the file)" %
+           (real, k, tau) if real == real else "for the real lag between %.4g and %.4g s (lag %d; "
+           "no --ckpt for the clock)" % (lo, hi, k))
     for p, c in zip(POS, COMP):
         s2 = r["sigma2_" + p][l][k]
         dvar = r["disp_var_" + p][l][k] if r["means"] else math.nan
@@ -254,10 +283,9 @@ def short_time(r, l, sums, E, ds):
             how += "; drift = Eulerian U(y0) %.4g m/s (no --ckpt, no disp_var_x)" % drift
         se = math.hypot(se, np.nan_to_num(E[c + c + "_stderr"]))
         ok = v_lo - 2 * se <= E[c + c] <= v_hi + 2 * se
-        rows.append((p, "sigma_%s^2/tau^2 = %.5g .. %.5g for the real lag between %.4g and %.4g s "
-                     "(lag %d; no --ckpt for the clock), Eulerian <%s'^2> %.5g, 2 se %.3g "
-                     "(N_eff %.0f; %s)" % (p, v_lo, v_hi, lo, hi, k, c, E[c + c], 2 * se, neff,
-                                           how), "PASS" if ok else "FAIL"))
+        rows.append((p, "sigma_%s^2/tau^2 = %.5g .. %.5g %s, Eulerian <%s'^2> %.5g, 2 se %.3g "
+                     "(N_eff %.0f; %s)" % (p, v_lo, v_hi, lag, c, E[c + c], 2 * se, neff, how),
+                     "PASS" if ok else "FAIL"))
     return rows
 
 
@@ -266,6 +294,14 @@ def report_level(r, l, t, sums, status):
     E = eulerian_at(r, y)
     print("\n## level y+ %g (y = %.4g m; %d completed releases, %d tracks at lag 0)" %
           (r["y_plus"][l], y, r["releases"], r["n_tracks"][l][0]))
+    t, r["lags_from"] = level_lags(r, l, t)
+    r["t_level"] = t
+    print("lags: %s" % ("lag_time_mean of the file, the mean real lag of the samples (checkpoint "
+                        "format 1.9 on), largest real - nominal %.3g s" %
+                        np.max((t - r["lag"])[r["n_tracks"][l] > 0]) if r["lags_from"] else
+                        "no lag_time_mean in the file (or fill values: a run resumed from a "
+                        "checkpoint of format 1.8 or older): the nominal lags%s" %
+                        (" + half the sampling interval" if r["ds"] > 0 else "")))
     r["tl_now"] = {c: first_zero_integral(t, r["rho_L_" + c][l])[0] for c in COMP}
     rows = short_time(r, l, sums, E, r["ds"])
     if not rows:
@@ -376,13 +412,14 @@ def plots(r, t, d):
     fig, axes = plt.subplots(1, 3, figsize=(10, 3))
     for l in range(nl):
         E = eulerian_at(r, r["level"][l])
+        tl = level_lags(r, l, t)[0]
         for i, (p, c) in enumerate(zip(POS, COMP)):
-            ok = (t > 0) & np.isfinite(r["sigma2_" + p][l])
+            ok = (tl > 0) & np.isfinite(r["sigma2_" + p][l])
             col = "C%d" % l
-            axes[i].loglog(t[ok], r["sigma2_" + p][l][ok], "-", color=col,
+            axes[i].loglog(tl[ok], r["sigma2_" + p][l][ok], "-", color=col,
                            label="y+ %g" % r["y_plus"][l])
             if p != "x":
-                axes[i].loglog(t[ok], E[c + c] * t[ok] ** 2, ":", color=col, lw=0.8)
+                axes[i].loglog(tl[ok], E[c + c] * tl[ok] ** 2, ":", color=col, lw=0.8)
     for i, p in enumerate(POS):
         axes[i].set_xlabel("tau [s]")
         axes[i].set_title("sigma_%s^2 (dotted: <%s'^2> tau^2)" % (p, COMP[i]) if p != "x" else
@@ -393,7 +430,8 @@ def plots(r, t, d):
     fig, axes = plt.subplots(1, 3, figsize=(10, 3))
     for l in range(nl):
         for i, c in enumerate(COMP):
-            axes[i].plot(t, r["rho_L_" + c][l], "-", label="y+ %g" % r["y_plus"][l])
+            axes[i].plot(level_lags(r, l, t)[0], r["rho_L_" + c][l], "-",
+                         label="y+ %g" % r["y_plus"][l])
     for i, c in enumerate(COMP):
         axes[i].axhline(0, color="0.7", lw=0.5)
         axes[i].set_xlabel("tau [s]")
@@ -407,8 +445,9 @@ def main(argv, prog):
     ap = cli.parser(prog, __doc__)
     ap.add_argument("stats", help="stats.nc of a run with lagrangian.y_plus set")
     ap.add_argument("--ckpt", help="the checkpoint written with it: the Lagrangian sums for the "
-                    "x clock, and the mean velocity of files written before checkpoint format "
-                    "1.7 (newer files hold it)")
+                    "x clock (files without lag_time_mean, written before checkpoint format "
+                    "1.9), and the mean velocity of files written before checkpoint format 1.7 "
+                    "(newer files hold it)")
     ap.add_argument("--out", help="write lagr_pdf_y.png, lagr_dispersion.png, lagr_rho.png here")
     ap.add_argument("--u-tau", type=u_tau_arg, default="force",
                     help="u_tau of the wall units: force (default), wall or a value [m/s]")
@@ -430,7 +469,7 @@ def main(argv, prog):
     print("# %s: %d completed releases every %g s, horizon %g s, %d lags; wall units of u_tau = "
           "%.5g m/s; sampling interval %s; Eulerian correlation time %s s" %
           (a.stats, r["releases"], r["release_every"], r["horizon"], len(t) - 1, r["u_tau"],
-           "%.4g s (mean; lags taken as nominal + half of it)" % ds if ds > 0 else
+           "%.4g s (mean; without lag_time_mean the lags are taken as nominal + half of it)" % ds if ds > 0 else
            "unknown (nominal lags)",
            "%.3g" % r["corr_time"]))
     status = {"fail": False}
