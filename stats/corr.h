@@ -70,7 +70,14 @@ struct corr {
   double *win;      /*!< [row][CW_LEN] */
   double *wsamp;    /*!< [row][level] planes accumulated */
   double *wspec;    /*!< [row][level][n1d][CS_LEN] 1-D sums of the spectra */
+  size_t rows;      /*!< rows of an engine read back or cut to a range (corr_nc.c; the last
+                         closed too if rows == nwin); 0 in a running engine: nwin + 1 */
 };
+
+/** The window rows an engine holds. */
+static inline size_t corr_rows(const struct corr *c) {
+  return c->rows ? c->rows : c->nwin + 1;
+}
 
 /** A per-(plane, column, grid point) partial sum: plane np + grid point, sums of u v w, count. */
 enum { CORR_ENT = 5 };
@@ -100,6 +107,8 @@ void corr_win_add(struct corr *c, int l, const double (*U)[2], const double (*V)
                   const double (*W)[2]);
 /** @brief Expose the window records to a state list (optional fields, format 1.8). */
 void corr_win_state(struct corr *c, struct state_list *L);
+/** @brief Make room for rows window records (new rows zeroed; corr_nc.c reads them back). */
+void corr_win_reserve(struct corr *c, size_t rows);
 
 /** @brief Expose the sums to a state list. */
 void corr_state(struct corr *c, struct state_list *L);
@@ -124,8 +133,38 @@ void corr_results(const struct corr *c, double *rx, double *rz, double *ex, doub
  */
 void corr_stderr(const struct corr *c, double *rx, double *rz, double *ex, double *ez, int *nb);
 
-/** @brief Write group "correlations" into an open netCDF-4 file; returns a netCDF status. */
+/** @brief Values per level of corr_range_values and corr_range_stderr: R along x [4][nx],
+ *         along z [4][nz], E over k_x [3][nx/2+1], over k_z [3][nz/2+1], rho along x [4][nx],
+ *         along z [4][nz] (rho_ij = R_ij / R_ii(0), rho_uv = R_uv / R_uu(0)). */
+size_t corr_nv(const struct corr *c);
+
+/** @brief The results of the window rows r0 .. r1-1 pooled (their 1-D sums added in row
+ *         order): v [level][corr_nv]; NaN at a level without planes. The whole run's when the
+ *         rows are all of them and none is partial (to round-off: corr_results uses the 2-D
+ *         sums). */
+void corr_range_values(const struct corr *c, size_t r0, size_t r1, double *v);
+
+/** @brief Batch-means standard errors over the batches among rows r0 .. r1-1 (complete
+ *         windows with planes at the level; each its own R, E and rho): se [level][corr_nv],
+ *         NaN where fewer than 2; nb [level] batches used. */
+void corr_range_stderr(const struct corr *c, size_t r0, size_t r1, double *se, int *nb);
+
+/** @brief Write group "correlations" into an open netCDF-4 file; returns a netCDF status.
+ *         With c->spec NULL (an engine read back by corr_nc_read, or a range of its windows),
+ *         R and E come from the pooled 1-D sums of the window records and the 2-D sums
+ *         (`spectra`, `empty_cells`) are left out (corr_nc.c). */
 int corr_nc_write(const struct corr *c, int ncid, char *err, size_t errlen);
+
+/** @brief Write the window rows r0 .. r1-1 of c as group "correlations" of an engine that
+ *         gathered only them (chansph extract --window --nc); a netCDF status. */
+int corr_nc_write_range(const struct corr *c, size_t r0, size_t r1, int ncid, char *err,
+                        size_t errlen);
+
+/** @brief Read group "correlations" of stats.nc back: configuration and window records (no
+ *         2-D sums: c->spec, samples, empty are NULL). Returns 0, 1 if the file has no such
+ *         group, 2 if the group has no window records (written before they were, or a run
+ *         without snapshots: err says which), -1 on an error (err says what). */
+int corr_nc_read(struct corr *c, int ncid, char *err, size_t errlen);
 
 /** The correlation engine's table of operations (engine.h; corr.c). */
 extern const struct stats_engine corr_engine;

@@ -13,8 +13,7 @@
 
 static const double two_pi = 6.283185307179586;
 
-/* Make room for rows windows (new rows zeroed). */
-static void win_reserve(struct corr *c, size_t rows) {
+void corr_win_reserve(struct corr *c, size_t rows) {
   if (rows <= c->cap) return;
   const size_t old = c->cap, cap = rows > 2 * old ? rows : 2 * old;
   const size_t nl = (size_t)c->cfg.n_levels, ns = nl * c->n1d * CS_LEN;
@@ -30,7 +29,7 @@ static void win_reserve(struct corr *c, size_t rows) {
 void corr_win_init(struct corr *c) {
   c->n1d = (size_t)(c->cfg.nx / 2 + 1) + (size_t)c->nzh;
   if (!(c->cfg.window > 0.0)) c->cfg.window = INFINITY; /* one window, never closed */
-  win_reserve(c, 1);
+  corr_win_reserve(c, 1);
   c->win[CW_T0] = c->cfg.t_start, c->win[CW_T1] = c->cfg.t_start + c->cfg.window;
 }
 
@@ -44,7 +43,7 @@ void corr_win_advance(struct corr *c, double t) {
   const int legacy = c->nwin == 0 && c->win[CW_NSNAP] == 0.0 && run > 0.0;
   while (t >= c->win[c->nwin * CW_LEN + CW_T1]) {
     const double t1 = c->win[c->nwin * CW_LEN + CW_T1];
-    if (c->win[c->nwin * CW_LEN + CW_NSNAP] > 0.0) win_reserve(c, ++c->nwin + 1);
+    if (c->win[c->nwin * CW_LEN + CW_NSNAP] > 0.0) corr_win_reserve(c, ++c->nwin + 1);
     double *o = c->win + c->nwin * CW_LEN;
     o[CW_T0] = t1, o[CW_T1] = t1 + c->cfg.window;
   }
@@ -86,7 +85,7 @@ void corr_win_add(struct corr *c, int l, const double (*U)[2], const double (*V)
 /* Checkpoint reading: make room for the stored rows (the open window is the last). */
 static void *reserve_rows(struct corr *c, int rank, const size_t *dims, size_t len, double **a) {
   if (rank < 2 || dims[0] < 1 || dims[rank - 1] != len) return NULL;
-  win_reserve(c, dims[0]);
+  corr_win_reserve(c, dims[0]);
   c->nwin = dims[0] - 1;
   return *a;
 }
@@ -120,14 +119,31 @@ void corr_win_state(struct corr *c, struct state_list *L) {
   f->reserve = reserve_spec, f->owner = c, f->optional = 1;
 }
 
-/* Row r's own results at level l into v: [R x 4][nx], [R z 4][nz], [E x 3][nxh], [E z 3][nzh]
-   (the layouts of corr_results for one level). */
-static void window_values(const struct corr *c, size_t r, size_t l, double *v) {
+size_t corr_nv(const struct corr *c) {
+  const size_t nx = (size_t)c->cfg.nx, nz = (size_t)c->cfg.nz;
+  return 8 * nx + 8 * nz + 3 * (nx / 2 + 1) + 3 * (size_t)c->nzh;
+}
+
+/* rho along x and z from R (the v layout of corr_nv): each R over its own R(0) at l = 0, R_uv
+   over R_uu(0), as the writer does for the whole run. */
+static void rho_of(const struct corr *c, double *v) {
   const int nx = c->cfg.nx, nz = c->cfg.nz, nzh = c->nzh, nxh = nx / 2 + 1;
-  const size_t nl = (size_t)c->cfg.n_levels;
+  const double *rx = v, *rz = rx + 4 * nx;
+  double *px = v + 4 * nx + 4 * nz + 3 * nxh + 3 * nzh, *pz = px + 4 * nx;
+  for (int q = 0; q < 4; q++) {
+    const int q0 = q == 3 ? 0 : q;
+    for (int i = 0; i < nx; i++) px[q * nx + i] = rx[q * nx + i] / rx[q0 * nx];
+    for (int k = 0; k < nz; k++) pz[q * nz + k] = rz[q * nz + k] / rz[q0 * nz];
+  }
+}
+
+/* The results of one level's 1-D sums X (k_x entries, then k_z) of ns planes into v (the
+   layout of corr_nv). */
+static void values_of(const struct corr *c, const double *X, double ns, double *v) {
+  const int nx = c->cfg.nx, nz = c->cfg.nz, nzh = c->nzh, nxh = nx / 2 + 1;
   const double N = (double)nx * (double)nz;
-  const double norm = 1.0 / (N * N * c->wsamp[r * nl + l]);
-  const double *X = c->wspec + ((r * nl + l) * c->n1d) * CS_LEN, *Z = X + (size_t)nxh * CS_LEN;
+  const double norm = 1.0 / (N * N * ns);
+  const double *Z = X + (size_t)nxh * CS_LEN;
   double *rx = v, *rz = rx + 4 * nx, *ex = rz + 4 * nz, *ez = ex + 3 * nxh;
   static const int slot_re[4] = {CS_UU, CS_VV, CS_WW, CS_UV_RE};
   for (int q = 0; q < 4; q++) {
@@ -160,6 +176,29 @@ static void window_values(const struct corr *c, size_t r, size_t l, double *v) {
       ez[q * nzh + m] = (self_conjugate(m, nz) ? 1.0 : 2.0) * Z[(size_t)m * CS_LEN + q] * norm *
                         (nz > 1 ? c->cfg.lz / two_pi : 1.0);
   }
+  rho_of(c, v);
+}
+
+/* Row r's own results at level l into v. */
+static void window_values(const struct corr *c, size_t r, size_t l, double *v) {
+  const size_t nl = (size_t)c->cfg.n_levels;
+  values_of(c, c->wspec + ((r * nl + l) * c->n1d) * CS_LEN, c->wsamp[r * nl + l], v);
+}
+
+void corr_range_values(const struct corr *c, size_t r0, size_t r1, double *v) {
+  const size_t nl = (size_t)c->cfg.n_levels, len = c->n1d * CS_LEN, nv = corr_nv(c);
+  double *sum = mem_alloc(len, sizeof(double), "correlations");
+  for (size_t l = 0; l < nl; l++) {
+    double ns = 0.0;
+    memset(sum, 0, len * sizeof(double));
+    for (size_t r = r0; r < r1; r++) { /* row order: the same sums on every rank and rerun */
+      const double *X = c->wspec + (r * nl + l) * len;
+      for (size_t j = 0; j < len; j++) sum[j] += X[j];
+      ns += c->wsamp[r * nl + l];
+    }
+    values_of(c, sum, ns > 0 ? ns : NAN, v + l * nv);
+  }
+  free(sum);
 }
 
 /* The batches of level l: complete windows (closed, not partial) with planes at the level. */
@@ -168,32 +207,44 @@ static int is_batch(const struct corr *c, size_t r, size_t l) {
          c->wsamp[r * (size_t)c->cfg.n_levels + l] > 0.0;
 }
 
-void corr_stderr(const struct corr *c, double *rx, double *rz, double *ex, double *ez, int *nb) {
-  const int nx = c->cfg.nx, nz = c->cfg.nz, nzh = c->nzh, nxh = nx / 2 + 1;
-  const size_t nv = 4 * (size_t)nx + 4 * (size_t)nz + 3 * (size_t)nxh + 3 * (size_t)nzh;
-  double *v = mem_alloc(3 * nv, sizeof(double), "correlations"), *mean = v + nv, *ss = mean + nv;
+void corr_range_stderr(const struct corr *c, size_t r0, size_t r1, double *se, int *nb) {
+  const size_t nv = corr_nv(c);
+  double *v = mem_alloc(2 * nv, sizeof(double), "correlations"), *mean = v + nv;
   for (size_t l = 0; l < (size_t)c->cfg.n_levels; l++) {
     int n = 0;
-    memset(mean, 0, 2 * nv * sizeof(double));
-    for (size_t r = 0; r < c->nwin; r++) /* two passes: the mean, then the squares about it */
+    double *ss = se + l * nv;
+    memset(mean, 0, nv * sizeof(double));
+    memset(ss, 0, nv * sizeof(double));
+    for (size_t r = r0; r < r1; r++) /* two passes: the mean, then the squares about it */
       if (is_batch(c, r, l)) {
         window_values(c, r, l, v);
         for (size_t j = 0; j < nv; j++) mean[j] += v[j];
         n++;
       }
     for (size_t j = 0; j < nv; j++) mean[j] /= n;
-    for (size_t r = 0; r < c->nwin; r++)
+    for (size_t r = r0; r < r1; r++)
       if (is_batch(c, r, l)) {
         window_values(c, r, l, v);
         for (size_t j = 0; j < nv; j++) ss[j] += (v[j] - mean[j]) * (v[j] - mean[j]);
       }
     for (size_t j = 0; j < nv; j++) ss[j] = n < 2 ? NAN : sqrt(ss[j] / (n - 1) / n);
     nb[l] = n;
+  }
+  free(v);
+}
+
+void corr_stderr(const struct corr *c, double *rx, double *rz, double *ex, double *ez, int *nb) {
+  const int nx = c->cfg.nx, nz = c->cfg.nz, nzh = c->nzh, nxh = nx / 2 + 1;
+  const size_t nv = corr_nv(c);
+  double *se = mem_alloc((size_t)c->cfg.n_levels * nv, sizeof(double), "correlations");
+  corr_range_stderr(c, 0, c->nwin, se, nb);
+  for (size_t l = 0; l < (size_t)c->cfg.n_levels; l++) {
+    const double *ss = se + l * nv;
     memcpy(rx + l * 4 * (size_t)nx, ss, 4 * (size_t)nx * sizeof(double));
     memcpy(rz + l * 4 * (size_t)nz, ss + 4 * nx, 4 * (size_t)nz * sizeof(double));
     memcpy(ex + l * 3 * (size_t)nxh, ss + 4 * nx + 4 * nz, 3 * (size_t)nxh * sizeof(double));
     memcpy(ez + l * 3 * (size_t)nzh, ss + 4 * nx + 4 * nz + 3 * nxh,
            3 * (size_t)nzh * sizeof(double));
   }
-  free(v);
+  free(se);
 }

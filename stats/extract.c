@@ -11,6 +11,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "corr.h"
 #include "engine.h"
 #include "euler.h"
 #include "euler_rs.h"
@@ -184,8 +185,11 @@ static void usage(FILE *f) {
           "units of the rms, pdf, pdf_stderr; the moments in the header)\n"
           "  --nc OUT.nc: write the windows of --window as a stats.nc instead (the root "
           "profiles and\n"
-          "    attributes averaged over them and their raw group eulerian; the other groups "
-          "left out):\n"
+          "    attributes averaged over them and their raw group eulerian; group correlations "
+          "re-averaged\n"
+          "    over its windows in the range, or copied whole from a file without its window "
+          "records;\n"
+          "    the other groups left out):\n"
           "    what `chansph compare` and `extract` read, e.g. a long run's developed range\n");
 }
 
@@ -442,6 +446,108 @@ static int copy_run_attrs(int in, int out) {
   return rc;
 }
 
+/* Copy variable v of group gi (its dimensions defined in go by name) with its attributes and
+   values to group go. */
+static int copy_var(int gi, int v, int go) {
+  char name[NC_MAX_NAME + 1], dn[NC_MAX_NAME + 1];
+  nc_type t;
+  int nd, dims[NC_MAX_VAR_DIMS], na, w, rc = nc_inq_var(gi, v, name, &t, &nd, dims, &na);
+  size_t n = 1, len, size = 0;
+  for (int i = 0; rc == NC_NOERR && i < nd; i++)
+    if ((rc = nc_inq_dim(gi, dims[i], dn, &len)) == NC_NOERR)
+      rc = nc_inq_dimid(go, dn, &dims[i]), n *= len;
+  if (rc == NC_NOERR) rc = nc_def_var(go, name, t, nd, dims, &w);
+  for (int i = 0; rc == NC_NOERR && i < na; i++)
+    if ((rc = nc_inq_attname(gi, v, i, dn)) == NC_NOERR) rc = nc_copy_att(gi, v, dn, go, w);
+  if (rc == NC_NOERR) rc = nc_inq_type(gi, t, NULL, &size);
+  void *buf = rc == NC_NOERR && n
+                  ? mem_alloc(n, t == NC_STRING ? sizeof(char *) : size, "chansph extract")
+                  : NULL;
+  if (buf && (rc = nc_get_var(gi, v, buf)) == NC_NOERR) rc = nc_put_var(go, w, buf);
+  if (buf && t == NC_STRING) nc_free_string(n, buf);
+  free(buf);
+  return rc;
+}
+
+/* Copy group name of file in, dimensions, attributes and variables, to file out (a file whose
+   group was written before the window records: extract cannot restrict it to a range). */
+static int copy_group(int in, int out, const char *name) {
+  int gi, go, nd, nv, na, dims[NC_MAX_DIMS], *vars = NULL, rc = nc_inq_ncid(in, name, &gi);
+  if (rc == NC_NOERR) rc = nc_def_grp(out, name, &go);
+  if (rc == NC_NOERR) rc = nc_inq_dimids(gi, &nd, dims, 0);
+  for (int i = 0; rc == NC_NOERR && i < nd; i++) {
+    char dn[NC_MAX_NAME + 1];
+    size_t len;
+    int d;
+    if ((rc = nc_inq_dim(gi, dims[i], dn, &len)) == NC_NOERR) rc = nc_def_dim(go, dn, len, &d);
+  }
+  if (rc == NC_NOERR) rc = nc_inq_natts(gi, &na);
+  for (int i = 0; rc == NC_NOERR && i < na; i++) {
+    char an[NC_MAX_NAME + 1];
+    if ((rc = nc_inq_attname(gi, NC_GLOBAL, i, an)) == NC_NOERR)
+      rc = nc_copy_att(gi, NC_GLOBAL, an, go, NC_GLOBAL);
+  }
+  if (rc == NC_NOERR) rc = nc_inq_varids(gi, &nv, NULL);
+  if (rc == NC_NOERR) vars = mem_alloc((size_t)nv + 1, sizeof(int), "chansph extract");
+  if (rc == NC_NOERR) rc = nc_inq_varids(gi, &nv, vars);
+  for (int i = 0; rc == NC_NOERR && i < nv; i++) rc = copy_var(gi, vars[i], go);
+  free(vars);
+  return rc;
+}
+
+/* Group correlations of --nc: how it goes to the range file. */
+struct corr_range {
+  int have; /* 0: no group; 1: window records, rows q0 .. q1-1 re-averaged; 2: copied whole */
+  struct corr c;
+  size_t q0, q1;
+};
+
+/* Read group correlations of file in (a.path) and choose the rows of --window; nonzero on an
+   input error (printed, naming the file). */
+static int corr_prepare(const struct extract_args *a, int in, struct corr_range *k) {
+  char err[256] = "";
+  memset(k, 0, sizeof *k);
+  const int rc = corr_nc_read(&k->c, in, err, sizeof err);
+  if (rc == 1) return 0; /* the engine was off */
+  if (rc == 2) {
+    fprintf(stderr,
+            "note: %s: %s (written before stats.nc held them): group correlations is copied "
+            "whole, the run's average, not restricted to --window\n",
+            a->path, err);
+    k->have = 2;
+    return 0;
+  }
+  if (rc) {
+    fprintf(stderr, "error: %s: %s\n", a->path, err);
+    return 1;
+  }
+  k->have = 1;
+  if (window_range(a, k->c.win, CW_LEN, corr_rows(&k->c), k->c.cfg.window, &k->q0, &k->q1)) {
+    fprintf(stderr, "error: %s: no averaging window of group correlations lies inside %g:%g\n",
+            a->path, a->t0, a->t1);
+    corr_free(&k->c);
+    return 1;
+  }
+  for (size_t r = k->q0; r < k->q1; r++)
+    if (k->c.win[r * CW_LEN + CW_PARTIAL] != 0.0)
+      fprintf(stderr,
+              "note: %s: correlations window %zu holds only the snapshots after a resume from a "
+              "checkpoint without window records (the earlier ones are in no window)\n",
+              a->path, r);
+  return 0;
+}
+
+/* Write group correlations of k to file out (in: the input file); a netCDF status. */
+static int corr_output(struct corr_range *k, int in, int out, char *err, size_t errlen) {
+  int rc = NC_NOERR;
+  if (k->have == 1) rc = corr_nc_write_range(&k->c, k->q0, k->q1, out, err, errlen);
+  if (k->have == 2 && (rc = copy_group(in, out, "correlations")) != NC_NOERR)
+    snprintf(err, errlen, "copying group correlations");
+  if (k->have == 1) corr_free(&k->c);
+  k->have = 0;
+  return rc;
+}
+
 /* The windows r0 .. r1-1 of s as the state of an engine that gathered only them (its last row
    open if that window is), written by the engine's own writer to a.nc_out (through a
    temporary file, renamed when complete). */
@@ -469,19 +575,29 @@ static int write_range(const struct extract_args *a, const struct stored *s, siz
   snprintf(tmp, sizeof tmp, "%s.tmp", a->nc_out);
   const double t_end = r1 == s->rows ? s->t_reached : s->win[(r1 - 1) * WIN_LEN + WIN_T1];
   const long long ns = (long long)snaps;
+  struct corr_range k = {0};
   int in = -1, out = -1, rc = nc_open(a->path, NC_NOWRITE, &in);
+  if (rc == NC_NOERR && corr_prepare(a, in, &k)) {
+    nc_close(in), euler_free(&e);
+    return 1;
+  }
   if (rc == NC_NOERR) rc = nc_create(tmp, NC_NETCDF4 | NC_CLOBBER, &out);
   if (rc == NC_NOERR) rc = copy_run_attrs(in, out);
   if (rc == NC_NOERR && isfinite(t_end))
     rc = nc_put_att_double(out, NC_GLOBAL, "t_reached", NC_DOUBLE, 1, &t_end);
   if (rc == NC_NOERR) rc = nc_put_att_longlong(out, NC_GLOBAL, "n_snapshots", NC_INT64, 1, &ns);
   if (rc == NC_NOERR) rc = euler_engine.write(&e, t_end, out, err, sizeof err);
+  if (rc == NC_NOERR) rc = corr_output(&k, in, out, err, sizeof err);
+  if (k.have == 1) corr_free(&k.c);
   if (out >= 0 && nc_close(out) != NC_NOERR && rc == NC_NOERR) rc = NC_EHDFERR;
   if (in >= 0) nc_close(in);
   euler_free(&e);
   if (rc == NC_NOERR && rename(tmp, a->nc_out) == 0) {
     printf("chansph extract: %s: windows %zu..%zu (t = %.9g .. %.9g s, %.0f snapshots) -> %s\n",
            a->path, r0, r1 - 1, s->win[r0 * WIN_LEN + WIN_T0], t_end, snaps, a->nc_out);
+    if (k.q1 > k.q0)
+      printf("chansph extract: %s: group correlations re-averaged over its windows %zu..%zu\n",
+             a->path, k.q0, k.q1 - 1);
     return 0;
   }
   fprintf(stderr, "error: %s: cannot write %s: %s%s%s\n", a->path, a->nc_out,

@@ -10,8 +10,10 @@
 #     give: lag_time_mean (and for 1.6 disp_mean_*, disp_var_*), fill values where the stored
 #     sums had samples (at least one) and otherwise equal.
 #   corr17: group correlations bit for bit, except n_batches, which counts only the complete
-#     windows after the one of the resume (fewer than the uninterrupted run's), and the
-#     *_stderr, which are fill values with fewer than 2 batches and finite otherwise.
+#     windows after the one of the resume (fewer than the uninterrupted run's), the
+#     *_stderr, which are fill values with fewer than 2 batches and finite otherwise, and the
+#     window records of stats.nc (dimension window), which start at the window of the resume
+#     (flagged partial, not complete) and then equal the uninterrupted run's rows bit for bit.
 # usage: restart_old_format.sh lagr16|lagr18|corr17 CHANSPH SCENE RUNS N1 [--set k=v ...]
 set -u
 export CHANSPH_RUN_ID=compare-test
@@ -86,11 +88,30 @@ def lagr(a, b, unknown):
     return ok
 
 
-def corr(a, b):
+def corr_windows(a, b):
+    """The window records of the resumed run b: one partial window (the resume's), then the
+    rows of the uninterrupted run a from the same start on, bit for bit."""
+    wa, wb = a["windows"][:], b["windows"][:]
+    part = np.nonzero(wb[:, 3])[0]
+    if len(part) != 1 or b["window_complete"][part[0]] != 0:
+        return ["windows (partial flags %s)" % list(wb[:, 3])]
+    j = part[0] + 1
+    i = int(np.searchsorted(wa[:, 0], wb[j, 0])) if j < len(wb) else len(wa)
+    if len(wa) - i != len(wb) - j or j == len(wb):
+        return ["windows (rows %d of %d after the resume)" % (len(wb) - j, len(wa) - i)]
     bad = []
+    for k in ("windows", "window_samples", "window_spectra_kx", "window_spectra_kz",
+              "window_complete", "window_bounds"):
+        if not np.array_equal(a[k][i:], b[k][j:]):
+            bad.append(k)
+    return bad
+
+
+def corr(a, b):
+    bad = corr_windows(a, b)
     na, nb = a.variables["n_batches"][:], b.variables["n_batches"][:]
     for k, v in a.variables.items():
-        if k == "n_batches":
+        if k == "n_batches" or "window" in v.dimensions:
             continue
         x, y = v[:], b.variables[k][:]
         if x.dtype.kind != "f":
