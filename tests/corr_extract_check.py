@@ -17,6 +17,8 @@ Checks, on a run with at least 3 complete windows (restart_bitwise_all_stats):
    sub-range file (1e-12 relative of the row's largest value).
 5. a file whose group has no window records (its configuration attributes removed, as in a
    file written before them): extract copies the group whole and says so on stderr.
+6. window records of another layout (more closed windows than rows): exit 1, an error naming
+   the file and the group, no output file.
 
 usage: corr_extract_check.py CHANSPH STATS.nc WORK
 """
@@ -183,6 +185,19 @@ def equal(x, y):
 same = sorted(cp.variables) == sorted(run.variables) and all(
     equal(cp[k], run[k]) for k in run.variables)
 check(same, "a file without window records: group correlations copied whole")
+
+# 6: window records of another layout: an input error naming the file and the group
+bad = work + "/bad.nc"
+subprocess.run(["cp", stats, bad], check=True)
+os.chmod(bad, 0o644)
+with h5py.File(bad, "a") as h:
+    h["correlations"].attrs["closed_windows"] = np.int32(rows + 1)
+r = subprocess.run([chansph, "extract", bad, "--nc", work + "/bad_range.nc"], capture_output=True,
+                   text=True)
+print(r.stderr.strip())
+check(r.returncode == 1 and bad in r.stderr and "group 'correlations'" in r.stderr and
+      not os.path.exists(work + "/bad_range.nc"),
+      "damaged window records: exit %d, an error naming file and group, no output" % r.returncode)
 
 if failures:
     sys.exit("FAIL: %d check(s): %s" % (len(failures), "; ".join(failures)))
