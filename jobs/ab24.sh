@@ -7,19 +7,30 @@
 # pressure noise). Two start states (two "seeds"):
 #   a  jobs/states/mfu180_dr6_t3.nc      (the dr+ = 6 field after 3 turnovers at dr+ = 6)
 #   b  jobs/states/mfu180_dr45_t10.nc    (the developed dr+ = 4.5 field, interpolated)
+# and, to screen candidates cheaply first, the box twice the span at dr+ = 9 (NY = 40, 43 680
+# particles, about 2 minutes a turnover with 2 threads; the set-up of jobs/les24.sh), from two
+# developed wide-box dr+ = 6 states interpolated onto its lattice:
+#   w9a  jobs/states/mfu180w_dr6_t12.nc  (t = 12.1 of the converged run)
+#   w9b  jobs/states/mfu180w_dr6_t17.nc  (t = 17.8 of the same run, 5.7 turnovers later)
 # Each run is a batch job through jobs/chain.sh (checkpoints; start the script again to go on);
 # about 9 minutes a turnover with 2 threads on an idle 2-core machine, so a start state's whole
 # set is hours: pass the names of the candidates to run only those.
 # usage: jobs/ab24.sh OUTDIR START [T] [CANDIDATE...]   e.g. jobs/ab24.sh runs/ab24 a 3 reference
 set -uo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-[ $# -ge 2 ] || { sed -n 2,15p "$0" >&2; exit 1; }
+[ $# -ge 2 ] || { sed -n 2,18p "$0" >&2; exit 1; }
 out=$1 start=$2 tend=${3:-3}
 shift $(($# >= 3 ? 3 : 2))
+scene=jobs/scenes/mfu180_dr6_dev.ini
 case $start in
   a) from=(--set init.from=jobs/states/mfu180_dr6_t3.nc) ;;
   b) from=(--set init.from=jobs/states/mfu180_dr45_t10.nc) ;;
-  *) echo "error: START must be a or b (got '$start')" >&2; exit 1 ;;
+  w9a | w9b)
+    state=jobs/states/mfu180w_dr6_t12.nc
+    [ "$start" = w9b ] && state=jobs/states/mfu180w_dr6_t17.nc
+    scene=jobs/scenes/mfu180w_dr6.ini
+    from=(--set init.from=$state --set domain.dr=0.05 --set stats.window=0.25) ;;
+  *) echo "error: START must be a, b, w9a or w9b (got '$start')" >&2; exit 1 ;;
 esac
 declare -A sets=(
   [reference]=""
@@ -28,9 +39,14 @@ declare -A sets=(
   [morris]="--set sph.viscous=morris"
   [h_1.8]="--set sph.h_over_dr=1.8"
   [wall_analytic]="--set sph.wall_pressure_weight=analytic"
+  [corrected]="--set sph.pressure_gradient=corrected --set sph.wall_collision=reflect"
+  [xi_x0.25]="--set sph.xi=4.166666666666667"
+  [h_2.0]="--set sph.h_over_dr=2.0"
+  [c4]="--set sph.kernel=wendland_c4"
+  [c4_h2.0]="--set sph.kernel=wendland_c4 --set sph.h_over_dr=2.0"
 )
 names=("$@")
-[ ${#names[@]} -gt 0 ] || names=(reference shift_taylor xi_x0.5 morris h_1.8 wall_analytic)
+[ ${#names[@]} -gt 0 ] || names=(reference xi_x0.5 morris h_1.8 wall_analytic corrected)
 mkdir -p "$out"
 runs=()
 cd "$root" || exit 1
@@ -40,7 +56,7 @@ for name in "${names[@]}"; do
   dir=$out/${name}_$start
   runs+=("$dir")
   # shellcheck disable=SC2086
-  campaign_run "$dir" jobs/scenes/mfu180_dr6_dev.ini "$name ($start)" "${from[@]}" \
+  campaign_run "$dir" "$scene" "$name ($start)" "${from[@]}" \
     --set time.t_end="$tend" --set output.t_average_start=1 ${sets[$name]}
 done
 mapfile -t done_runs < <(campaign_finished "${runs[@]}")

@@ -1,10 +1,20 @@
 /**
  * @file kernel.h
- * @brief Wendland (quintic, C2) kernel. Implements: thesis Eq. 2.63-2.66.
+ * @brief Wendland kernels, support radius 2h, q = r/h (`sph.kernel`):
  *
- * w(r, h) = alpha_m / h^m (1 - q/2)^4 (1 + 2q) for q = r/h <= 2, support radius 2h.
- * The gradient is written as grad_a w_ab = F(r) r_ab with F = w'(r)/r = -5 alpha_m / h^(m+2)
- * (1 - q/2)^3, which has no 1/r singularity.
+ * - C2 (default; thesis Eq. 2.63-2.66): w = alpha_m / h^m (1 - q/2)^4 (1 + 2q),
+ *   F = w'(r)/r = -5 alpha_m / h^(m+2) (1 - q/2)^3;
+ * - C4 (Wendland 1995; Dehnen & Aly 2012, Table 1, with their support H = 2h):
+ *   w = alpha_m / h^m (1 - q/2)^6 (1 + 3q + 35/12 q^2),
+ *   F = -14/3 alpha_m / h^(m+2) (1 - q/2)^5 (1 + 5q/2), alpha_3 = 495/(256 pi),
+ *   alpha_2 = 9/(4 pi).
+ *
+ * The gradient is written as grad_a w_ab = F(r) r_ab, which has no 1/r singularity. Both
+ * shapes are evaluated by one branch-free expression (t = 1 - q/2):
+ *   w = wfac t^4 (e t^2 + ce) (1 + q (a1 + a2 q)),  F = ffac t^3 (e t^2 + ce) (1 + b1 q)
+ * with e = 0, ce = 1, a1 = 2, a2 = 0, b1 = 0 for C2 (bit for bit the C2 formula: every extra
+ * factor is exactly 1) and e = 1, ce = 0, a1 = 3, a2 = 35/12, b1 = 5/2 for C4 (the extra factor
+ * exactly t^2, no cancellation near the edge), so that the vectorised pair loops need no branch.
  */
 #ifndef CHANSPH_KERNEL_H
 #define CHANSPH_KERNEL_H
@@ -15,49 +25,80 @@
 #define M_PI 3.14159265358979323846
 #endif
 
-/** Precomputed kernel constants for one smoothing length and dimension. */
+/** The kernel's shape (`sph.kernel`). */
+enum kernel_shape { KERNEL_C2 = 0, KERNEL_C4 = 1 };
+
+/** Precomputed kernel constants for one smoothing length, dimension and shape. */
 struct kernel {
   int dim;         /*!< 1, 2 or 3 */
   double h;        /*!< smoothing length [m] */
   double inv_h;    /*!< 1/h [1/m] */
   double wfac;     /*!< alpha_m / h^m [1/m^m] */
-  double ffac;     /*!< -5 alpha_m / h^(m+2) [1/m^(m+2)] */
+  double ffac;     /*!< C2: -5 alpha_m / h^(m+2); C4: -14/3 alpha_m / h^(m+2) [1/m^(m+2)] */
   double support2; /*!< (2h)^2 [m^2] */
+  int shape;       /*!< enum kernel_shape */
+  double e, ce;    /*!< 0, 1 (C2) or 1, 0 (C4): the extra factor e (1 - q/2)^2 + ce */
+  double a1, a2;   /*!< the polynomial 1 + q (a1 + a2 q) of w */
+  double b1;       /*!< the polynomial 1 + b1 q of F */
 };
 
 /**
- * @brief Normalisation constant alpha_m of the Wendland kernel.
- * @param[in] dim dimension 1, 2 or 3
- * @return alpha_m. Implements: thesis Eq. 2.64-2.66.
+ * @brief Normalisation constant alpha_m of a Wendland kernel of support 2h.
+ * @param[in] dim dimension 1, 2 or 3 (C4: 2 or 3)
+ * @param[in] shape enum kernel_shape
+ * @return alpha_m. Implements: thesis Eq. 2.64-2.66 (C2); Dehnen & Aly (2012) Table 1 (C4).
  */
-static inline double kernel_alpha(const int dim) {
+static inline double kernel_alpha_of(const int dim, const int shape) {
+  if (shape == KERNEL_C4) return dim == 2 ? 9.0 / (4.0 * M_PI) : 495.0 / (256.0 * M_PI);
   return dim == 1 ? 0.75 : dim == 2 ? 7.0 / (4.0 * M_PI) : 21.0 / (16.0 * M_PI);
+}
+
+/** alpha_m of the Wendland C2 kernel (thesis Eq. 2.64-2.66). */
+static inline double kernel_alpha(const int dim) {
+  return kernel_alpha_of(dim, KERNEL_C2);
 }
 
 /**
  * @brief Set up the kernel constants.
  * @param[in] dim dimension
  * @param[in] h smoothing length [m]
+ * @param[in] shape enum kernel_shape
  * @return the kernel constants
  */
-static inline struct kernel kernel_make(const int dim, const double h) {
-  const double a = kernel_alpha(dim);
-  struct kernel k = {dim, h, 1.0 / h, a / pow(h, dim), -5.0 * a / pow(h, dim + 2), 4.0 * h * h};
+static inline struct kernel kernel_make_shape(const int dim, const double h, const int shape) {
+  const double a = kernel_alpha_of(dim, shape), c4 = shape == KERNEL_C4;
+  struct kernel k = {.dim = dim,
+                     .h = h,
+                     .inv_h = 1.0 / h,
+                     .wfac = a / pow(h, dim),
+                     .ffac = (c4 ? -14.0 / 3.0 : -5.0) * a / pow(h, dim + 2),
+                     .support2 = 4.0 * h * h,
+                     .shape = shape,
+                     .e = c4 ? 1.0 : 0.0,
+                     .ce = c4 ? 0.0 : 1.0,
+                     .a1 = c4 ? 3.0 : 2.0,
+                     .a2 = c4 ? 35.0 / 12.0 : 0.0,
+                     .b1 = c4 ? 2.5 : 0.0};
   return k;
+}
+
+/** The Wendland C2 kernel of smoothing length h (thesis Eq. 2.63-2.66). */
+static inline struct kernel kernel_make(const int dim, const double h) {
+  return kernel_make_shape(dim, h, KERNEL_C2);
 }
 
 /**
  * @brief Kernel value w(r, h).
  * @param[in] k kernel constants
  * @param[in] r distance [m]
- * @return w [1/m^dim]. Implements: thesis Eq. 2.63.
+ * @return w [1/m^dim]. Implements: thesis Eq. 2.63 (C2).
  */
 static inline double kernel_w(const struct kernel *k, const double r) {
   const double q = r * k->inv_h;
   if (q >= 2.0) return 0.0;
   const double t = 1.0 - 0.5 * q;
   const double t2 = t * t;
-  return k->wfac * t2 * t2 * (1.0 + 2.0 * q);
+  return k->wfac * t2 * t2 * (k->e * t2 + k->ce) * (1.0 + q * (k->a1 + k->a2 * q));
 }
 
 /**
@@ -70,7 +111,7 @@ static inline double kernel_f(const struct kernel *k, const double r) {
   const double q = r * k->inv_h;
   if (q >= 2.0) return 0.0;
   const double t = 1.0 - 0.5 * q;
-  return k->ffac * t * t * t;
+  return k->ffac * t * t * t * (k->e * t * t + k->ce) * (1.0 + k->b1 * q);
 }
 
 #endif

@@ -60,17 +60,17 @@ static inline struct pair pair_geom(const struct kernel *K, double lx, double lz
   g.dz = (d3 ? 1.0 : 0.0) * pair_wrap(dz, lz, 0.5 * lz); /* branch-free: vectorises */
   g.r2 = g.dx * g.dx + g.dy * g.dy + g.dz * g.dz;
   g.r = sqrt(g.r2);
-  const double t = 1.0 - 0.5 * g.r * K->inv_h; /* thesis Eq. 2.63: (1 - q/2)^3 for F */
+  const double q = g.r * K->inv_h, t = 1.0 - 0.5 * q; /* kernel.h: F of C2 or C4 */
   const double tp = t > 0.0 ? t : 0.0;
-  g.f = K->ffac * tp * tp * tp;
+  g.f = K->ffac * tp * tp * tp * (K->e * tp * tp + K->ce) * (1.0 + K->b1 * q);
   return g;
 }
 
-/** Kernel value w(r) of a pair inside the support (thesis Eq. 2.63). */
+/** Kernel value w(r) of a pair inside the support (kernel.h; thesis Eq. 2.63 for C2). */
 static inline double pair_w(const struct kernel *K, double r) {
   const double q = r * K->inv_h, t = 1.0 - 0.5 * q;
   const double tp = t > 0.0 ? t : 0.0, t2 = tp * tp;
-  return K->wfac * t2 * t2 * (1.0 + 2.0 * q);
+  return K->wfac * t2 * t2 * (K->e * t2 + K->ce) * (1.0 + q * (K->a1 + K->a2 * q));
 }
 
 #endif

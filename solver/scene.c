@@ -5,6 +5,7 @@
 #define _XOPEN_SOURCE 700 /* realpath */
 #include "scene.h"
 #include "alloc.h"
+#include "kernel.h"
 
 #include <ctype.h>
 #include <ini.h>
@@ -40,6 +41,7 @@ struct key {
 /* The names of the choice keys, in the order of their enums (scene.h): the value stored is
    the index. */
 static const char *const names_sph_viscous[] = {"morris", "violeau", NULL};
+static const char *const names_sph_kernel[] = {"wendland_c2", "wendland_c4", NULL};
 static const char *const names_sph_laplacian_norm[] = {"wall_normal", "trace", "none", NULL};
 static const char *const names_sph_wall_shear_weight[] = {"discrete", "analytic", NULL};
 static const char *const names_sph_wall_pressure_weight[] = {"lattice", "consistent", "analytic",
@@ -71,6 +73,13 @@ static const struct key keys[] = {
      "Initial particle spacing; 2 delta, lx and lz must be multiples of it.", OFF(dr)},
     {"sph", "h_over_dr", T_DOUBLE, "1.3", 1.0, 2.5, 0, NULL, "-",
      "Smoothing length over particle spacing (kernel support radius is 2h).", OFF(h_over_dr)},
+    {"sph", "kernel", T_CHOICE, "wendland_c2", 0, 0, 0, names_sph_kernel, "-",
+     "Kernel, support 2h: the Wendland C2 (thesis Eq. 2.63) or the Wendland C4 of Dehnen & Aly "
+     "(2012), smoother (its gradient vanishes as (1 - q/2)^5 at the edge), with smaller "
+     "zeroth-order errors than C2 at larger h/dr; C4 is 3-D only (its closed-form wall integrals "
+     "are, "
+     "solver/wall.h; docs/theory.md \"Kernels\").",
+     OFF(kernel)},
     {"sph", "xi", T_DOUBLE, "0", 0, BIG, 0, NULL, "-",
      "Volume-diffusion constant xi of thesis Eq. 3.34; 0 selects the mixing-length value "
      "1000 dr / (2 delta) (thesis Sec. 3.2, 6.1.1).",
@@ -818,6 +827,9 @@ static void validate(struct parse_state *ps) {
   } else if (s->lz != 0.0) {
     inconsistent(ps, "domain.lz", "lz = %g is given for a 2-D scene (dimension = %g)", s->lz, 2.0);
   }
+  if (s->kernel == KERNEL_C4 && s->dim != 3)
+    inconsistent(ps, "sph.kernel", "wendland_c4 needs a 3-D scene (dimension = %g)",
+                 (double)s->dim);
   if (s->drive_mode == DRIVE_FLUX && s->u_bulk == 0.0)
     inconsistent(ps, "drive.mode", "flux mode needs drive.u_bulk != 0 (got %g)", s->u_bulk);
   if (s->les != LES_NONE && s->viscous != VISCOUS_VIOLEAU)

@@ -50,6 +50,7 @@ struct scene {
   double dr;    /*!< initial particle spacing [m] */
   /* [sph] */
   double h_over_dr;   /*!< smoothing length over spacing [-] */
+  int kernel;         /*!< enum kernel_shape (kernel.h) */
   double xi;          /*!< volume-diffusion constant [-]; 0 selects 1000 dr / (2 delta) */
   double wall_dmin;   /*!< delta r of Eq. 2.148 over dr [-] */
   double eta2;        /*!< regularisation of 1/r^2 in the viscous term, over h^2 [-] */

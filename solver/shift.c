@@ -36,7 +36,7 @@ static struct v3 shift_finish(const struct model *M, double ya, struct v3 g) {
     const double d = wall ? M->ly - ya : ya, q = d * ih;
     dist[wall] = d;
     if (q >= 2.0) continue;
-    const double dg = wall_dgamma(M->dim, q) * ih; /* |grad gamma_as| */
+    const double dg = wall_dgamma_of(&M->k, q) * ih; /* |grad gamma_as| */
     const double ny = wall ? -1.0 : 1.0;           /* inward normal */
     /* the wall's part of grad C_a, -W_as n_s: the region behind the wall counts as filled, with
        the weight of the pressure wall term (lattice: |grad gamma_as| plus the lattice excess of

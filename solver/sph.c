@@ -22,7 +22,7 @@ void sph_model_init(struct model *M, const struct scene *s) {
   M->viscous = s->viscous;
   M->h = scene_h(s);
   M->dr = s->dr;
-  M->k = kernel_make(s->dim, M->h);
+  M->k = kernel_make_shape(s->dim, M->h, s->kernel);
   M->e.rho0 = s->rho0, M->e.c0 = s->c0, M->e.zeta = s->zeta;
   M->e.pb = s->p_background * s->rho0 * s->c0 * s->c0;
   M->lx = s->lx, M->ly = 2.0 * s->delta, M->lz = s->dim == 3 ? s->lz : 1.0;
@@ -56,9 +56,9 @@ void sph_model_init(struct model *M, const struct scene *s) {
 
 /** Integral over the half-space y > q (units of h) of y^2 F(r) ((n+2) x_t^2 / r^2 + 1), with
     x_t^2 the mean square of one wall-parallel component (r^2 - y^2)/(n - 1). */
-static double violeau_wall_moment(int dim, double q) {
+static double violeau_wall_moment(int dim, int shape, double q) {
   if (q >= 2.0) return 0.0;
-  const struct kernel K = kernel_make(dim, 1.0);
+  const struct kernel K = kernel_make_shape(dim, 1.0, shape);
   const double n = dim, gp = (n + 2.0) / (n - 1.0);
   enum { PANELS = 8 };
   double sum = 0.0;
@@ -82,7 +82,7 @@ static double violeau_wall_moment(int dim, double q) {
 
 void sph_violeau_table(struct model *M) {
   for (int k = 0; k <= VIOLEAU_KNOTS; k++)
-    M->vio_m2[k] = violeau_wall_moment(M->dim, 2.0 * k / VIOLEAU_KNOTS);
+    M->vio_m2[k] = violeau_wall_moment(M->dim, M->k.shape, 2.0 * k / VIOLEAU_KNOTS);
 }
 
 double sph_violeau_moment(const struct model *M, double q) {
@@ -114,8 +114,8 @@ void sph_lattice_excess_table(struct model *M) {
     }
     const double q = j * dr * ih;
     M->lat_q[n] = q;
-    M->lat_e[n] = fmax(0.0, mom1 - wall_dgamma(M->dim, q) * ih);
-    M->lat_s[n] = mom1s - wall_dgamma(M->dim, q) * ih;
+    M->lat_e[n] = fmax(0.0, mom1 - wall_dgamma_of(&M->k, q) * ih);
+    M->lat_s[n] = mom1s - wall_dgamma_of(&M->k, q) * ih;
     n++;
   }
   M->lat_q[n] = 2.0, M->lat_e[n] = M->lat_s[n] = 0.0;
@@ -134,7 +134,7 @@ double sph_lattice_table(const struct model *M, const double *e, double q) {
 /** gamma of the channel: both walls' missing parts subtracted (they never overlap). */
 static inline double channel_gamma(const struct model *M, double y) {
   const double ih = M->k.inv_h;
-  return wall_gamma(M->dim, y * ih) + wall_gamma(M->dim, (M->ly - y) * ih) - 1.0;
+  return wall_gamma_of(&M->k, y * ih) + wall_gamma_of(&M->k, (M->ly - y) * ih) - 1.0;
 }
 
 void sph_density(const struct model *M, struct particles *P, const double *ksum_new, double dt) {

@@ -185,7 +185,7 @@ static inline int sph_wall_near(const struct model *M, double ya, int wall, stru
   w->d = wall ? M->ly - ya : ya;
   w->q = w->d * ih;
   if (w->q >= 2.0) return 0;
-  w->dg = wall_dgamma(M->dim, w->q) * ih;
+  w->dg = wall_dgamma_of(&M->k, w->q) * ih;
   w->ny = wall ? -1.0 : 1.0;
   return 1;
 }

@@ -282,7 +282,7 @@ static double eddy_viscosity(const struct model *M, struct particles *P, const s
       double wterm = 0.0; /* power of the wall shear: 2/gamma sum_s u_tau,s^2 |v_t| |grad gamma| */
       if (d < two_h)
         wterm =
-            2.0 * ig * utau2 * sqrt(u[a] * u[a] + w[a] * w[a]) * wall_dgamma(M->dim, d * ih) * ih;
+            2.0 * ig * utau2 * sqrt(u[a] * u[a] + w[a] * w[a]) * wall_dgamma_of(&M->k, d * ih) * ih;
       S = ls2 > 0.0 ? strain_cubic(sum, wterm / ls2) : sqrt(sum);
     }
     smagorinsky(M, ls2, damp, S, &nur[a], &kr[a]);

@@ -2,7 +2,8 @@
  * @file wall.h
  * @brief Renormalisation gamma and its gradient for a plane wall (line wall in 2-D), closed form.
  *
- * For a particle at distance d = q h from an infinite plane wall, with the Wendland kernel:
+ * For a particle at distance d = q h from an infinite plane wall, with the Wendland C2 kernel
+ * (the C4 forms and the *_of functions that pick the model's kernel follow below):
  * - 3-D: gamma(q) = 1 - (2 - q)^6 (4 + 6q + 3q^2) / 512 and |grad gamma| = I_full(q) / h with
  *   I_full(q) = 3/8 (2 + 5q + 4q^2)(1 - q/2)^5 (thesis Eq. 4.9-4.11, alpha_3 = 21/(16 pi)).
  * - 2-D (derived for chansph, see docs/theory.md; checked against Ferrand Eq. 51-52 summed over
@@ -19,6 +20,8 @@
 #define CHANSPH_WALL_H
 
 #include <math.h>
+
+#include "kernel.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -126,6 +129,60 @@ static inline double wall_moment_yy(const int dim, const double q) {
   return (-3.0 / 128.0 * q4 * q * (5.0 * q2 + 112.0) * l +
           q * s * (235.0 * q4 + 272.0 * q2 - 48.0) / 192.0 + asin(0.5 * q) - 0.5 * M_PI) /
          M_PI;
+}
+
+/*
+ * The Wendland C4 kernel (kernel.h), 3-D only (derived for chansph with a computer-algebra
+ * integration of the same integrals; checked against quadrature in tests/test_wall.c):
+ *   |grad gamma| h = 55/65536 (2 - q)^7 (3q + 2)(7q^2 + 8q + 4)
+ *   gamma  = 1 - (2 - q)^8 (105 q^3 + 272 q^2 + 292 q + 128) / 65536 (1/2 at q = 0)
+ *   M      = (q - 2)^7 (105 q^4 + 238 q^3 + 287 q^2 + 226 q + 96) / 8192
+ *   M_yy   = (q - 2)^7 (525 q^4 + 1014 q^3 + 896 q^2 + 448 q + 128) / 32768
+ */
+
+/** gamma of a plane wall for the Wendland C4 kernel in 3-D. */
+static inline double wall_gamma_c4(const double q) {
+  if (q >= 2.0) return 1.0;
+  const double t = 2.0 - q, t2 = t * t, t4 = t2 * t2;
+  return 1.0 - t4 * t4 * (((105.0 * q + 272.0) * q + 292.0) * q + 128.0) / 65536.0;
+}
+
+/** h |grad gamma| of a plane wall for the Wendland C4 kernel in 3-D. */
+static inline double wall_dgamma_c4(const double q) {
+  if (q >= 2.0) return 0.0;
+  const double t = 2.0 - q, t2 = t * t, t3 = t2 * t;
+  return 55.0 / 65536.0 * t3 * t3 * t * (3.0 * q + 2.0) * ((7.0 * q + 8.0) * q + 4.0);
+}
+
+/** M(q) (wall_moment2) for the Wendland C4 kernel in 3-D; M(0) = -3/2. */
+static inline double wall_moment2_c4(const double q) {
+  if (q >= 2.0) return 0.0;
+  const double t = q - 2.0, t2 = t * t, t3 = t2 * t;
+  return t3 * t3 * t * ((((105.0 * q + 238.0) * q + 287.0) * q + 226.0) * q + 96.0) / 8192.0;
+}
+
+/** M_yy(q) (wall_moment_yy) for the Wendland C4 kernel in 3-D; M_yy(0) = -1/2. */
+static inline double wall_moment_yy_c4(const double q) {
+  if (q >= 2.0) return 0.0;
+  const double t = q - 2.0, t2 = t * t, t3 = t2 * t;
+  return t3 * t3 * t * ((((525.0 * q + 1014.0) * q + 896.0) * q + 448.0) * q + 128.0) / 32768.0;
+}
+
+/** The wall functions of the kernel K's shape and dimension (C4: 3-D only, sph.kernel). */
+static inline double wall_gamma_of(const struct kernel *K, const double q) {
+  return K->shape == KERNEL_C4 ? wall_gamma_c4(q) : wall_gamma(K->dim, q);
+}
+/** h |grad gamma| of the kernel K (wall_dgamma, wall_dgamma_c4). */
+static inline double wall_dgamma_of(const struct kernel *K, const double q) {
+  return K->shape == KERNEL_C4 ? wall_dgamma_c4(q) : wall_dgamma(K->dim, q);
+}
+/** M(q) of the kernel K (wall_moment2, wall_moment2_c4). */
+static inline double wall_moment2_of(const struct kernel *K, const double q) {
+  return K->shape == KERNEL_C4 ? wall_moment2_c4(q) : wall_moment2(K->dim, q);
+}
+/** M_yy(q) of the kernel K (wall_moment_yy, wall_moment_yy_c4). */
+static inline double wall_moment_yy_of(const struct kernel *K, const double q) {
+  return K->shape == KERNEL_C4 ? wall_moment_yy_c4(q) : wall_moment_yy(K->dim, q);
 }
 
 /**

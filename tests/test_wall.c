@@ -7,7 +7,10 @@
  *    (r_ab . grad_a w_ab = F r^2 = r w'(r)); all to 1e-10 relative for q on a grid in (0, 2);
  *  - 2-D: the sum of wall_segment_2d (Ferrand Eq. 51-52) over consecutive segments of length
  *    0.3 and 0.77 with random offsets covering the whole line equals wall_dgamma to 1e-12;
- *  - endpoints gamma(0) = 1/2, gamma(2) = 1, dgamma(2) = 0, moment2(0) = -dim/2, moment2(2) = 0.
+ *  - endpoints gamma(0) = 1/2, gamma(2) = 1, dgamma(2) = 0, moment2(0) = -dim/2, moment2(2) = 0;
+ *  - the Wendland C4 forms (3-D): gamma, h |grad gamma|, moment2 and moment_yy (the integral
+ *    of F r_y^2 behind the wall) against the same quadrature of the C4 kernel to 1e-10
+ *    relative, and the *_of functions pick the forms of the kernel's shape.
  *
  * Quadrature. 3-D: the region y > d meets the sphere of radius r > d in a cap of area
  * 2 pi r (r - d), the plane y = d in a disc, so every integral is radial with a polynomial
@@ -108,6 +111,52 @@ static void reference(int dim, double q, int np, double *gam, double *dgam, doub
 
 static double rel_err(double a, double ref) {
   return fabs(a - ref) / fabs(ref);
+}
+
+/* F r_y^2 over the cap behind the wall: int_cap y^2 dA = 2 pi r (r^3 - q^3) / 3 */
+static double myy3_behind(double r, double q, const struct kernel *k) {
+  return kernel_f(k, r) * 2.0 * M_PI * r * (r * r * r - q * q * q) / 3.0;
+}
+
+/** The C4 closed forms of wall.h against quadrature of the C4 kernel (3-D); returns failures. */
+static int check_c4(void) {
+  const struct kernel k = kernel_make_shape(3, 1.0, KERNEL_C4), k2 = kernel_make(3, 1.0);
+  double e_max[4] = {0.0, 0.0, 0.0, 0.0};
+  int fail = 0;
+  for (int iq = 0; iq <= 100; iq++) {
+    const double q = 0.02 * iq;
+    const double ref[4] = {
+        q > 0.0 ? integrate(w3_ball, 0.0, q, 4, q, &k) + integrate(w3_fluid, q, 2.0, 4, q, &k)
+                : integrate(w3_fluid, 0.0, 2.0, 4, q, &k),
+        integrate(w3_plane, q, 2.0, 4, q, &k), integrate(m3_behind, q, 2.0, 4, q, &k),
+        integrate(myy3_behind, q, 2.0, 4, q, &k)};
+    const double val[4] = {wall_gamma_of(&k, q), wall_dgamma_of(&k, q), wall_moment2_of(&k, q),
+                           wall_moment_yy_of(&k, q)};
+    for (int j = 0; j < 4; j++) {
+      const double ea = fabs(val[j] - ref[j]), scale = j == 0 ? 1.0 : fabs(ref[j]);
+      if (q < 2.0 && ea / scale > e_max[j]) e_max[j] = ea / scale;
+      if (!(ea <= 1e-10 * scale + (q >= 2.0 ? 1e-300 : 0.0))) {
+        printf("FAIL: C4 q %.2f: function %d = %.17g, quadrature %.17g\n", q, j, val[j], ref[j]);
+        fail = 1;
+      }
+    }
+    /* the dispatch: a C2 kernel still gets the C2 forms */
+    if (wall_gamma_of(&k2, q) != wall_gamma(3, q) || wall_dgamma_of(&k2, q) != wall_dgamma(3, q)) {
+      printf("FAIL: q %.2f: wall_*_of of a C2 kernel differs from the C2 forms\n", q);
+      fail = 1;
+    }
+  }
+  if (!(fabs(wall_gamma_c4(0.0) - 0.5) <= 1e-15 && fabs(wall_moment2_c4(0.0) + 1.5) <= 1e-15 &&
+        fabs(wall_moment_yy_c4(0.0) + 0.5) <= 1e-15)) {
+    printf("FAIL: C4 endpoints gamma(0) %.17g, moment2(0) %.17g, moment_yy(0) %.17g\n",
+           wall_gamma_c4(0.0), wall_moment2_c4(0.0), wall_moment_yy_c4(0.0));
+    fail = 1;
+  }
+  printf(
+      "wall C4 3-D: max rel error (tol 1e-10) gamma %.3e, h|grad gamma| %.3e, moment2 %.3e, "
+      "moment_yy %.3e\n",
+      e_max[0], e_max[1], e_max[2], e_max[3]);
+  return fail;
 }
 
 /** Minimal fixed-seed LCG in [0, 1). */
@@ -242,6 +291,7 @@ int main(int argc, char **argv) {
       "tol 1e-12), max abs error %.3e (atol %.0e)\n",
       e_seg, q_seg, a_seg, ATOL_2D);
 
+  fail |= check_c4();
   printf("%s\n", fail ? "test_wall: FAILED" : "test_wall: passed");
   MPI_Finalize();
   return fail;
