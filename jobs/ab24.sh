@@ -44,6 +44,7 @@ declare -A sets=(
   [h_2.0]="--set sph.h_over_dr=2.0"
   [c4]="--set sph.kernel=wendland_c4"
   [c4_h2.0]="--set sph.kernel=wendland_c4 --set sph.h_over_dr=2.0"
+  [tvf]="--set sph.shifting=fickian --set sph.shift_velocity=conservative"
 )
 names=("$@")
 [ ${#names[@]} -gt 0 ] || names=(reference xi_x0.5 morris h_1.8 wall_analytic corrected)

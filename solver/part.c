@@ -127,8 +127,12 @@ const struct part_field part_fields[] = {
     {F(kr_next), "k_r_next", NULL, PT_F64, 1, 0, PN_STRAIN_LAG, 0, 0, NULL, NULL, 0, 0},
     {F(twx), "wall_law_tx", NULL, PT_F64, 1, 0, PN_WALL_TAU, 0, 0, NULL, NULL, 0, 0},
     {F(twz), "wall_law_tz", NULL, PT_F64, 1, 0, PN_WALL_TAU, 0, 0, NULL, NULL, 0, 0},
+    {F(shift_dx), "shift_dx", NULL, PT_F64, 1, PF_PERMUTE | PF_MIGRATE, PN_SHIFTING, 0, 0, NULL,
+     NULL, 0, PR_SHIFT},
     {F(shift_dy), "shift_dy", NULL, PT_F64, 1, PF_PERMUTE | PF_MIGRATE, PN_SHIFTING, 0, 0, NULL,
-     NULL, 0, 0},
+     NULL, 0, PR_SHIFT},
+    {F(shift_dz), "shift_dz", NULL, PT_F64, 1, PF_PERMUTE | PF_MIGRATE, PN_SHIFTING, 0, 0, NULL,
+     NULL, 0, PR_SHIFT},
     {F(qcrit), "q_criterion", "q_criterion", PT_F64, 1, PF_WRITE, PN_QCRIT, 0, 0, "1/s^2",
      "Q criterion (|Omega|^2 - |S|^2)/2 of the corrected velocity gradient", 0, 0},
 };

@@ -73,10 +73,12 @@ struct particles {
   int nur_live;
   double *twx, *twz; /*!< wall-law stress rho u_tau^2 e_t of the nearest wall [Pa] */
   /** particle shifting (shift.h), allocated only when used, NULL otherwise: the wall-normal
-      shift of the last step [m], the y-part of the wall-normal momentum flux m u delta y that
-      shifting adds (docs/theory.md); computed before the re-sort, so permuted and migrated
-      with the particles; not checkpointed (every step sets it before anything reads it) */
-  double *shift_dy;
+      shift of the last step [m] (shift_dy: the y-part of the wall-normal momentum flux
+      m u delta y that shifting adds, docs/theory.md; all three: the neighbours' shifts that
+      the conservative transport reads, ghosts refreshed at PR_SHIFT); computed before the
+      re-sort, so permuted and migrated with the particles; not checkpointed (every step sets
+      them before anything reads them) */
+  double *shift_dx, *shift_dy, *shift_dz;
   /** output.q_criterion: Q = (|Omega|^2 - |S|^2)/2 of the corrected velocity gradient, set just
       before particles.nc is written (turb_q_criterion) [1/s^2]; NULL otherwise */
   double *qcrit;
@@ -150,8 +152,9 @@ enum part_refresh {
   PR_WALL_LAW = 4, /*!< after turb_wall_law: the wall stresses at the vertices */
   PR_MODEL = 8,    /*!< after turb_eddy_viscosity: nu_r and k_r */
   PR_KR = 16,      /*!< after sph_kr_pressure: p/rho^2 and the wall pressure with 2/3 rho k_r */
-  PR_BUDGET = 32   /*!< after a sampled force pass: gamma and the viscous prefactors that the
+  PR_BUDGET = 32,  /*!< after a sampled force pass: gamma and the viscous prefactors that the
                         conservative split of the budget reads (sph_budget_pairs) */
+  PR_SHIFT = 64    /*!< after shift_compute: the shifts that shift_velocity_conservative reads */
 };
 
 /** One per-particle array of struct particles. Adding a field: the member in struct particles

@@ -48,7 +48,7 @@ static const char *const names_sph_wall_pressure_weight[] = {"lattice", "consist
                                                              NULL};
 static const char *const names_sph_pressure_gradient[] = {"standard", "corrected", NULL};
 static const char *const names_sph_shifting[] = {"none", "fickian", NULL};
-static const char *const names_sph_shift_velocity[] = {"keep", "taylor", NULL};
+static const char *const names_sph_shift_velocity[] = {"keep", "taylor", "conservative", NULL};
 static const char *const names_sph_wall_collision[] = {"stop", "reflect", NULL};
 static const char *const names_les_model[] = {"none", "smagorinsky", NULL};
 static const char *const names_les_strain[] = {"gradient", "violeau_issa", NULL};
@@ -129,12 +129,15 @@ static const struct key keys[] = {
      "in 2-D (docs/theory.md).",
      OFF(shift_coef)},
     {"sph", "shift_velocity", T_CHOICE, "keep", 0, 0, 0, names_sph_shift_velocity, "-",
-     "What a shift does to the velocity of the shifted particle: keep it, or carry it to the "
+     "What a shift does to the velocity of the shifted particle: keep it, carry it to the "
      "new position by the Taylor correction u_a += (delta r_a . grad) u_a (Lind et al. 2012, "
      "Eq. 24) with the first-order corrected velocity gradient of the start of the step "
      "(thesis Eq. 2.88-2.90). Kept, a shift across the mean shear adds dU/dy delta y to u "
      "each step; corrected, the budgets' closure holds the correction's share (it is not a "
-     "force; docs/theory.md, \"Particle shifting\").",
+     "force; docs/theory.md, \"Particle shifting\"). conservative: the momentum transport "
+     "of the transport-velocity formulation (Adami, Hu & Adams 2013, the divergence of "
+     "A = rho u (u~ - u) with dr = dt (u~ - u)), du_a = sum_b m_b [u_a (dr_a . grad w_ab) / "
+     "rho_a + u_b (dr_b . grad w_ab) / rho_b] over fluid pairs, which conserves momentum.",
      OFF(shift_velocity)},
     {"sph", "wall_collision", T_CHOICE, "stop", 0, 0, 0, names_sph_wall_collision, "-",
      "What a fluid particle that reaches a wall in a step does: stop the run (exit 3, the "

@@ -29,7 +29,7 @@ enum les_model { LES_NONE = 0, LES_SMAGORINSKY = 1 };
 enum les_strain { STRAIN_GRADIENT = 0, STRAIN_VIOLEAU_ISSA = 1 };
 enum pressure_gradient { PGRAD_STANDARD = 0, PGRAD_CORRECTED = 1 };
 enum shifting { SHIFT_NONE = 0, SHIFT_FICKIAN = 1 };
-enum shift_velocity { SHIFT_KEEP = 0, SHIFT_TAYLOR = 1 };
+enum shift_velocity { SHIFT_KEEP = 0, SHIFT_TAYLOR = 1, SHIFT_CONSERVATIVE = 2 };
 enum wall_collision { WALL_STOP = 0, WALL_REFLECT = 1 };
 
 enum { SCENE_LIST_MAX = 8 };

@@ -37,7 +37,7 @@ static struct v3 shift_finish(const struct model *M, double ya, struct v3 g) {
     dist[wall] = d;
     if (q >= 2.0) continue;
     const double dg = wall_dgamma_of(&M->k, q) * ih; /* |grad gamma_as| */
-    const double ny = wall ? -1.0 : 1.0;           /* inward normal */
+    const double ny = wall ? -1.0 : 1.0;             /* inward normal */
     /* the wall's part of grad C_a, -W_as n_s: the region behind the wall counts as filled, with
        the weight of the pressure wall term (lattice: |grad gamma_as| plus the lattice excess of
        this sum, so that the initial lattice is at rest under the shift) */
@@ -99,6 +99,43 @@ void shift_velocity(const struct model *M, const struct particles *P, const stru
     du[a] = G[0][0] * r[0] + G[0][1] * r[1] + G[0][2] * r[2];
     dv[a] = G[1][0] * r[0] + G[1][1] * r[1] + G[1][2] * r[2];
     dw[a] = G[2][0] * r[0] + G[2][1] * r[1] + G[2][2] * r[2];
+  }
+  timer_pop();
+}
+
+/** du_a of shift_velocity_conservative: a gather over the fluid neighbours of a. */
+static CHANSPH_CLONES struct v3 conservative_sum(const struct model *M, const struct particles *P,
+                                                 const struct nbr *nb, size_t a) {
+  const struct pair_frame F = pair_frame_of(M);
+  const double *restrict x = P->x, *restrict y = P->y, *restrict z = P->z;
+  const double *restrict u = P->u, *restrict v = P->v, *restrict w = P->w;
+  const double *restrict m = P->m, *restrict rho = P->rho;
+  const double *restrict sx = P->shift_dx, *restrict sy = P->shift_dy, *restrict sz = P->shift_dz;
+  const uint8_t *restrict kind = P->kind;
+  const int32_t *restrict nl = pair_list(nb, a);
+  const double xa = x[a], ya = y[a], za = z[a], ira = 1.0 / rho[a];
+  double ca = 0.0, bx = 0.0, by = 0.0, bz = 0.0; /* sum_b m_b dr_a.grad w, sum_b m_b u_b (..) */
+#pragma omp simd reduction(+ : ca, bx, by, bz)
+  for (int j = 0; j < nb->count[a]; j++) {
+    const int32_t b = nl[j];
+    const struct pair g = pair_at(&F, xa - x[b], ya - y[b], za - z[b]);
+    const double fm = (kind[b] == KIND_FLUID ? 1.0 : 0.0) * m[b] * g.f; /* fluid pairs only */
+    ca += fm * (sx[a] * g.dx + sy[a] * g.dy + sz[a] * g.dz);
+    const double cb = fm * (sx[b] * g.dx + sy[b] * g.dy + sz[b] * g.dz) / rho[b];
+    bx += cb * u[b], by += cb * v[b], bz += cb * w[b];
+  }
+  return (struct v3){u[a] * ca * ira + bx, v[a] * ca * ira + by, w[a] * ca * ira + bz};
+}
+
+void shift_velocity_conservative(const struct model *M, const struct particles *P,
+                                 const struct nbr *nb, double *du, double *dv, double *dw) {
+  timer_push("shift");
+#pragma omp parallel for schedule(dynamic, 256)
+  for (size_t a = 0; a < P->n; a++) {
+    du[a] = dv[a] = dw[a] = 0.0;
+    if (P->kind[a] != KIND_FLUID) continue;
+    const struct v3 d = conservative_sum(M, P, nb, a);
+    du[a] = d.x, dv[a] = d.y, dw[a] = d.z;
   }
   timer_pop();
 }

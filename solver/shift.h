@@ -59,4 +59,25 @@ void shift_velocity(const struct model *M, const struct particles *P, const stru
                     const double *sx, const double *sy, const double *sz, double *du, double *dv,
                     double *dw);
 
+/**
+ * @brief The conservative momentum transport of a shift (sph.shift_velocity = conservative):
+ *
+ *          du_a = sum_{b fluid} m_b [u_a (dr_a . grad_a w_ab) / rho_a
+ *                                    + u_b (dr_b . grad_a w_ab) / rho_b],
+ *
+ *        the symmetric SPH divergence dt (1/rho) div(rho u (u~ - u)) of the A term of the
+ *        transport-velocity formulation (Adami, Hu & Adams 2013, J. Comput. Phys. 241, Eq. 9)
+ *        with the shift dr = dt (u~ - u) as the transport velocity's displacement; in the
+ *        interior it is (dr . grad) u + u div dr. Each pair's share is antisymmetric, so
+ *        sum_a m_a du_a = 0 to round-off: the shift moves momentum between fluid particles
+ *        only (vertex particles, which do not move, take none); zero for vertex particles.
+ * @param[in] M model
+ * @param[in] P particles (positions, velocities, masses, densities and the shifts shift_dx,
+ *              shift_dy, shift_dz of owned particles and ghosts: dd_refresh PR_SHIFT)
+ * @param[in] nb neighbour list of the current positions
+ * @param[out] du, dv, dw the velocity change per owned slot [m/s]
+ */
+void shift_velocity_conservative(const struct model *M, const struct particles *P,
+                                 const struct nbr *nb, double *du, double *dv, double *dw);
+
 #endif

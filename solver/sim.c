@@ -330,13 +330,18 @@ void sim_step(struct sim *S) {
   fi.amax = maxima[0], fi.gvmax = maxima[1];
   const double dt = time_step(S, &fi);
   const double fx = drive_force(&S->drive, ub, dt);
-  /* particle shifting at the positions of the neighbour list (scratch 0-1 are free here) */
-  double *sx = S->scratch[0], *sz = S->scratch[1];
-  if (S->M.shifting != SHIFT_NONE) shift_compute(&S->M, P, &S->nb, sx, P->shift_dy, sz);
+  /* particle shifting at the positions of the neighbour list */
+  const int shifting = S->M.shifting != SHIFT_NONE;
+  double *sx = P->shift_dx, *sy = P->shift_dy, *sz = P->shift_dz;
+  if (shifting) shift_compute(&S->M, P, &S->nb, sx, sy, sz);
   /* and the velocity change that carries each velocity with its shift (scratch 2-4) */
   double *du = S->scratch[2], *dv = S->scratch[3], *dw = S->scratch[4];
-  const int taylor = S->M.shifting != SHIFT_NONE && S->M.shift_taylor;
-  if (taylor) shift_velocity(&S->M, P, &S->nb, sx, P->shift_dy, sz, du, dv, dw);
+  const int carry = shifting ? S->M.shift_velocity : SHIFT_KEEP;
+  if (carry == SHIFT_TAYLOR) shift_velocity(&S->M, P, &S->nb, sx, sy, sz, du, dv, dw);
+  if (carry == SHIFT_CONSERVATIVE) { /* it reads the neighbours' shifts */
+    dd_refresh(&S->dd, P, &S->W, PR_SHIFT);
+    shift_velocity_conservative(&S->M, P, &S->nb, du, dv, dw);
+  }
   timer_push("integrate");
 #pragma omp parallel for schedule(static)
   for (size_t a = 0; a < P->n; a++) {
@@ -348,8 +353,8 @@ void sim_step(struct sim *S) {
     P->y[a] += dt * P->v[a];
     P->z[a] += dt * P->w[a];
   }
-  if (S->M.shifting != SHIFT_NONE) shift_apply(P, sx, P->shift_dy, sz);
-  if (taylor) {
+  if (shifting) shift_apply(P, sx, sy, sz);
+  if (carry != SHIFT_KEEP) {
 #pragma omp parallel for schedule(static)
     for (size_t a = 0; a < P->n; a++) P->u[a] += du[a], P->v[a] += dv[a], P->w[a] += dw[a];
   }

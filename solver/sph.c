@@ -44,7 +44,7 @@ void sph_model_init(struct model *M, const struct scene *s) {
   M->law = wall_law_make(s->wall_law, s->kappa, s->log_b);
   M->wall_tau = scene_wall_tau(s);
   M->shifting = s->shifting;
-  M->shift_taylor = s->shift_velocity == SHIFT_TAYLOR;
+  M->shift_velocity = s->shift_velocity;
   M->wall_reflect = s->wall_collision == WALL_REFLECT;
   M->shift_ch2 = s->shift_coef * M->h * M->h;
   M->shift_iwdr = 1.0 / kernel_w(&M->k, s->dr);

@@ -51,7 +51,7 @@ struct model {
       anti-clustering factor 1 + R (w_ab / w(dr))^n (shift.h) [1/m] */
   double lat_s[LATTICE_KNOTS];
   int shifting;      /*!< enum shifting */
-  int shift_taylor;  /*!< 1: the shift carries the velocity by its Taylor correction */
+  int shift_velocity; /*!< enum shift_velocity: what a shift does to the velocities */
   int wall_reflect;  /*!< 1: a particle that reaches a wall is reflected (else the run stops) */
   double shift_ch2;  /*!< C h^2 of delta r = -C h^2 grad C_a [m^2] */
   double shift_iwdr; /*!< 1 / w(dr), the anti-clustering term's reference [m^dim] */

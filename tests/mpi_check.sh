@@ -8,7 +8,8 @@
 #              synthetic), 20 steps: 1 rank = 2 ranks = 1 rank x 2 threads = 2 ranks x 2 threads
 #   migration  fast 2-D flow (Mach 0.5) on 3 and 4 ranks, ids checked after every step,
 #              load checks every 7 steps (4 ranks start from a skewed partition); equals 1 rank
-#   shift      fast 2-D flow with particle shifting (sph.shifting = fickian), 200 steps, ids
+#   shift      fast 2-D flow with particle shifting (sph.shifting = fickian; velocities kept,
+#              and carried by the conservative transport), 200 steps, ids
 #              checked after every step: 2 ranks equal 1 rank
 #   too_many   more ranks than the slabs allow: a message naming domain.lx, exit 1
 #   resume_too_many  a 1-rank checkpoint resumed on more ranks than its slabs allow: the same
@@ -157,17 +158,21 @@ case $case in
     done
     echo "ids of all particles checked after each of the 300 steps (run.check_ids = 1)"
     ;;
-  shift) # particle shifting (sph.shifting = fickian): migrating particles carry shift_dy
+  shift) # particle shifting (sph.shifting = fickian): migrating particles carry shift_dy; the
+    # conservative momentum transport reads the ghosts' shifts (dd_refresh PR_SHIFT)
     scene=$scenes/poiseuille2d.ini
-    args=(--set domain.lx=2.0 --set time.t_end=1000 --set time.max_steps=200 --set init.profile=laminar
-      --set drive.force=4 --set init.noise=0.5 --set run.check_ids=1 --set output.log_every=100
-      --set sph.shifting=fickian)
-    for np in 1 2; do
-      mpi "$np" run "$scene" --out r$np --overwrite "${args[@]}" > r$np.txt 2>&1 ||
-        { tail -20 r$np.txt; echo "FAIL: $np ranks exited with $?"; exit 1; }
+    for carry in keep conservative; do
+      args=(--set domain.lx=2.0 --set time.t_end=1000 --set time.max_steps=200 --set init.profile=laminar
+        --set drive.force=4 --set init.noise=0.5 --set run.check_ids=1 --set output.log_every=100
+        --set sph.shifting=fickian --set sph.shift_velocity=$carry)
+      for np in 1 2; do
+        mpi "$np" run "$scene" --out r$np --overwrite "${args[@]}" > r$np.txt 2>&1 ||
+          { tail -20 r$np.txt; echo "FAIL: $np ranks exited with $?"; exit 1; }
+      done
+      grep -h "^decomposition: 2 ranks" r2.txt
+      echo "sph.shift_velocity = $carry:"
+      compare r1 r2 200
     done
-    grep -h "^decomposition: 2 ranks" r2.txt
-    compare r1 r2 200
     ;;
   too_many)
     if mpi 4 run "$scenes/les395_smoke.ini" --out r4 --overwrite > r4.txt 2>&1; then

@@ -10,6 +10,9 @@
  *    and above 0.7 of it without (0.83: the background pressure alone orders slowly).
  * 3. The Taylor correction of the velocities (sph.shift_velocity = taylor) is exact for a
  *    velocity linear in y on a disordered arrangement, away from the walls.
+ * 4. The conservative momentum transport (sph.shift_velocity = conservative) of a random
+ *    velocity field on a disordered 3-D arrangement conserves momentum: |sum_a m_a du_a| is
+ *    below 1e-12 of sum_a m_a |du_a| in each component, and du is not zero.
  */
 #include <math.h>
 #include <mpi.h>
@@ -144,6 +147,41 @@ static int taylor_linear(char **set, int nset) {
   return !(n > 0 && largest > 0.0 && worst <= 1e-10 * largest);
 }
 
+/* Part 4: the conservative transport (sph.shift_velocity = conservative) moves momentum between
+   fluid particles only: sum_a m_a du_a = 0 to round-off for any velocity field. */
+static int conservative_sum_zero(char **set, int nset) {
+  struct scene sc;
+  if (scene_load(&sc, NULL, nset, set)) return 1;
+  struct sim S;
+  if (sim_init(&S, &sc)) return 1;
+  struct particles *P = &S.P;
+  for (size_t a = 0; a < P->n; a++) {
+    if (P->kind[a] != KIND_FLUID) continue;
+    P->x[a] += 0.2 * sc.dr * hash_unit(P->id[a], 0);
+    P->y[a] += 0.2 * sc.dr * hash_unit(P->id[a], 1);
+    P->z[a] += 0.2 * sc.dr * hash_unit(P->id[a], 2);
+    P->u[a] = 1.0 + hash_unit(P->id[a], 3), P->v[a] = 0.3 * hash_unit(P->id[a], 4);
+    P->w[a] = 0.3 * hash_unit(P->id[a], 5);
+  }
+  sim_restored(&S);
+  double *du = S.scratch[2], *dv = S.scratch[3], *dw = S.scratch[4];
+  shift_compute(&S.M, P, &S.nb, P->shift_dx, P->shift_dy, P->shift_dz);
+  shift_velocity_conservative(&S.M, P, &S.nb, du, dv, dw);
+  double sum[3] = {0, 0, 0}, mag[3] = {0, 0, 0};
+  for (size_t a = 0; a < P->n; a++) {
+    const double d[3] = {du[a], dv[a], dw[a]};
+    for (int c = 0; c < 3; c++) sum[c] += P->m[a] * d[c], mag[c] += P->m[a] * fabs(d[c]);
+  }
+  int bad = 0;
+  for (int c = 0; c < 3; c++) bad |= !(mag[c] > 0.0 && fabs(sum[c]) <= 1e-12 * mag[c]);
+  printf(
+      "conservative transport on a disordered lattice: |sum m du| / sum m |du| = %.3e, %.3e, "
+      "%.3e (tol 1e-12)\n",
+      fabs(sum[0]) / mag[0], fabs(sum[1]) / mag[1], fabs(sum[2]) / mag[2]);
+  sim_free(&S);
+  return bad;
+}
+
 int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
   int fail = 0;
@@ -171,6 +209,8 @@ int main(int argc, char **argv) {
                 "drive.force=0",        "time.t_end=1",
                 "sph.shifting=fickian", "sph.shift_velocity=taylor"};
   fail |= taylor_linear(t3, 10);
+  t3[9] = "sph.shift_velocity=conservative";
+  fail |= conservative_sum_zero(t3, 10);
   printf(fail ? "FAIL\n" : "PASS\n");
   MPI_Finalize();
   return fail;
