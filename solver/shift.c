@@ -27,26 +27,32 @@ static CHANSPH_CLONES struct v3 shift_gradient(const struct model *M, const stru
   return (struct v3){gx, gy, gz};
 }
 
-/** Shift of fluid particle a from the particle part g of grad C_a: the walls' part, the factor
-    -C h^2, the cap |delta r| <= shift_max and the wall guard. */
-static struct v3 shift_finish(const struct model *M, double ya, struct v3 g) {
-  const double ih = M->k.inv_h, gy0 = g.y;
-  double dist[2];
+/** The walls' part of grad C_a at height ya, sum_walls W_as n_s (y-component), given the y-part
+    gy0 of the particle sum: the region behind the wall counts as filled, with the weight of the
+    pressure wall term (lattice: |grad gamma_as| plus the lattice excess of the sum, so that the
+    initial lattice is at rest under the shift). */
+static double shift_wall_part(const struct model *M, double ya, double gy0) {
+  const double ih = M->k.inv_h;
+  double sum = 0.0;
   for (int wall = 0; wall < 2; wall++) {
-    const double d = wall ? M->ly - ya : ya, q = d * ih;
-    dist[wall] = d;
+    const double q = (wall ? M->ly - ya : ya) * ih;
     if (q >= 2.0) continue;
     const double dg = wall_dgamma_of(&M->k, q) * ih; /* |grad gamma_as| */
     const double ny = wall ? -1.0 : 1.0;             /* inward normal */
-    /* the wall's part of grad C_a, -W_as n_s: the region behind the wall counts as filled, with
-       the weight of the pressure wall term (lattice: |grad gamma_as| plus the lattice excess of
-       this sum, so that the initial lattice is at rest under the shift) */
     const double pw = M->wall_pressure == WALL_PRESSURE_LATTICE
                           ? dg + sph_lattice_table(M, M->lat_s, q)
                       : M->wall_pressure == WALL_PRESSURE_CONSISTENT ? fmax(dg, ny * gy0)
                                                                      : dg;
-    g.y -= pw * ny;
+    sum += pw * ny;
   }
+  return sum;
+}
+
+/** Shift of fluid particle a from the particle part g of grad C_a: the walls' part, the factor
+    -C h^2, the cap |delta r| <= shift_max and the wall guard. */
+static struct v3 shift_finish(const struct model *M, double ya, struct v3 g) {
+  const double dist[2] = {ya, M->ly - ya};
+  g.y -= shift_wall_part(M, ya, g.y);
   struct v3 s = {-M->shift_ch2 * g.x, -M->shift_ch2 * g.y, -M->shift_ch2 * g.z};
   const double len = sqrt(s.x * s.x + s.y * s.y + s.z * s.z);
   if (len > M->shift_max) { /* at most 0.1 dr per step */
@@ -113,18 +119,27 @@ static CHANSPH_CLONES struct v3 conservative_sum(const struct model *M, const st
   const double *restrict sx = P->shift_dx, *restrict sy = P->shift_dy, *restrict sz = P->shift_dz;
   const uint8_t *restrict kind = P->kind;
   const int32_t *restrict nl = pair_list(nb, a);
-  const double xa = x[a], ya = y[a], za = z[a], ira = 1.0 / rho[a];
-  double ca = 0.0, bx = 0.0, by = 0.0, bz = 0.0; /* sum_b m_b dr_a.grad w, sum_b m_b u_b (..) */
-#pragma omp simd reduction(+ : ca, bx, by, bz)
+  const double xa = x[a], ya = y[a], za = z[a], ira = 1.0 / rho[a], iwdr = M->shift_iwdr;
+  double gx = 0.0, gy = 0.0, gz = 0.0; /* sum_b m_b phi_ab grad_a w_ab, all neighbours */
+  double bx = 0.0, by = 0.0, bz = 0.0; /* sum_b m_b phi_ab u_b (dr_b . grad_a w_ab) / rho_b */
+#pragma omp simd reduction(+ : gx, gy, gz, bx, by, bz)
   for (int j = 0; j < nb->count[a]; j++) {
     const int32_t b = nl[j];
     const struct pair g = pair_at(&F, xa - x[b], ya - y[b], za - z[b]);
-    const double fm = (kind[b] == KIND_FLUID ? 1.0 : 0.0) * m[b] * g.f; /* fluid pairs only */
-    ca += fm * (sx[a] * g.dx + sy[a] * g.dy + sz[a] * g.dz);
-    const double cb = fm * (sx[b] * g.dx + sy[b] * g.dy + sz[b] * g.dz) / rho[b];
+    /* the shift's weight phi_ab = 1 + R (w_ab / w(dr))^n: symmetric in a and b */
+    const double fm = m[b] * (1.0 + sph_anticluster(pair_w(&F.K, g.r), iwdr)) * g.f;
+    gx += fm * g.dx, gy += fm * g.dy, gz += fm * g.dz;
+    /* vertex particles: no shift (and at rest), so only fluid b count here */
+    const double cb = (kind[b] == KIND_FLUID ? 1.0 : 0.0) * fm *
+                      (sx[b] * g.dx + sy[b] * g.dy + sz[b] * g.dz) / rho[b];
     bx += cb * u[b], by += cb * v[b], bz += cb * w[b];
   }
-  return (struct v3){u[a] * ca * ira + bx, v[a] * ca * ira + by, w[a] * ca * ira + bz};
+  /* dr_a . grad C_a with the walls' part, as the shift sees it (with m_b / rho_a for V_b, which
+     keeps each pair's share antisymmetric): zero on the initial lattice, walls included, where
+     the particle sum alone is grad gamma_a; elsewhere -C h^2 |grad C_a|^2 <= 0 (uncapped) */
+  gy *= ira;
+  const double ca = sx[a] * gx * ira + sy[a] * (gy - shift_wall_part(M, ya, gy)) + sz[a] * gz * ira;
+  return (struct v3){u[a] * ca + bx, v[a] * ca + by, w[a] * ca + bz};
 }
 
 void shift_velocity_conservative(const struct model *M, const struct particles *P,

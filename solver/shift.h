@@ -62,15 +62,18 @@ void shift_velocity(const struct model *M, const struct particles *P, const stru
 /**
  * @brief The conservative momentum transport of a shift (sph.shift_velocity = conservative):
  *
- *          du_a = sum_{b fluid} m_b [u_a (dr_a . grad_a w_ab) / rho_a
- *                                    + u_b (dr_b . grad_a w_ab) / rho_b],
+ *          du_a = u_a dr_a . G_a + sum_{b fluid} m_b phi_ab u_b (dr_b . grad_a w_ab) / rho_b,
+ *          G_a = sum_b m_b phi_ab grad_a w_ab / rho_a - sum_walls W_as n_s,
  *
  *        the symmetric SPH divergence dt (1/rho) div(rho u (u~ - u)) of the A term of the
  *        transport-velocity formulation (Adami, Hu & Adams 2013, J. Comput. Phys. 241, Eq. 9)
- *        with the shift dr = dt (u~ - u) as the transport velocity's displacement; in the
- *        interior it is (dr . grad) u + u div dr. Each pair's share is antisymmetric, so
- *        sum_a m_a du_a = 0 to round-off: the shift moves momentum between fluid particles
- *        only (vertex particles, which do not move, take none); zero for vertex particles.
+ *        with the shift dr = dt (u~ - u) as the transport velocity's displacement and the
+ *        kernel gradient weighted by the shift's phi_ab = 1 + R (w_ab / w(dr))^n; G_a is the
+ *        shift's grad C_a (its walls' part counting the region behind a wall as filled), so
+ *        the first term vanishes on the initial lattice, walls included. In the interior it
+ *        is (dr . grad) u + u div dr. Each fluid pair's share is antisymmetric; the walls'
+ *        part and the vertex neighbours of the first term act on u_a alone (the wall takes
+ *        m_a u_a dr_a . (their part), zero where u_a = 0). Zero for vertex particles.
  * @param[in] M model
  * @param[in] P particles (positions, velocities, masses, densities and the shifts shift_dx,
  *              shift_dy, shift_dz of owned particles and ghosts: dd_refresh PR_SHIFT)

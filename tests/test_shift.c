@@ -11,8 +11,9 @@
  * 3. The Taylor correction of the velocities (sph.shift_velocity = taylor) is exact for a
  *    velocity linear in y on a disordered arrangement, away from the walls.
  * 4. The conservative momentum transport (sph.shift_velocity = conservative) of a random
- *    velocity field on a disordered 3-D arrangement conserves momentum: |sum_a m_a du_a| is
- *    below 1e-12 of sum_a m_a |du_a| in each component, and du is not zero.
+ *    velocity field on a disordered 3-D arrangement conserves momentum between fluid
+ *    particles: with the velocities zero within 2h of the walls (where the wall takes its
+ *    part), |sum_a m_a du_a| is below 1e-12 of sum_a m_a |du_a| in each component, du != 0.
  */
 #include <math.h>
 #include <mpi.h>
@@ -162,6 +163,8 @@ static int conservative_sum_zero(char **set, int nset) {
     P->z[a] += 0.2 * sc.dr * hash_unit(P->id[a], 2);
     P->u[a] = 1.0 + hash_unit(P->id[a], 3), P->v[a] = 0.3 * hash_unit(P->id[a], 4);
     P->w[a] = 0.3 * hash_unit(P->id[a], 5);
+    const double y = P->y[a]; /* the walls' part acts where u_a != 0: none there */
+    if (y < 2.0 * S.M.h || y > 2.0 * sc.delta - 2.0 * S.M.h) P->u[a] = P->v[a] = P->w[a] = 0.0;
   }
   sim_restored(&S);
   double *du = S.scratch[2], *dv = S.scratch[3], *dw = S.scratch[4];
