@@ -38,7 +38,7 @@ static int non_finite(const struct checked *c, size_t a) {
 static int classify(const struct model *M, const struct particles *P, const struct checked *c,
                     size_t a) {
   if (non_finite(c, a) >= 0) return NOT_FINITE;
-  if (P->y[a] <= 0.0 || P->y[a] >= M->ly) return THROUGH_WALL;
+  if (sph_at_wall(P->y[a], M->ly)) return THROUGH_WALL;
   const double s2 = P->u[a] * P->u[a] + P->v[a] * P->v[a] + P->w[a] * P->w[a];
   if (s2 >= M->e.c0 * M->e.c0) return SUPERSONIC;
   return OK;

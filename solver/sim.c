@@ -291,10 +291,10 @@ static void wall_reflect(struct sim *S) {
   long n = 0;
 #pragma omp parallel for schedule(static) reduction(+ : n)
   for (size_t a = 0; a < P->n; a++)
-    if (P->kind[a] == KIND_FLUID && (P->y[a] <= 0.0 || P->y[a] >= ly)) n++;
+    if (P->kind[a] == KIND_FLUID && sph_at_wall(P->y[a], ly)) n++;
   if (n == 0) return;
   for (size_t a = 0; a < P->n; a++) { /* rare: serial, in index order */
-    if (P->kind[a] != KIND_FLUID || (P->y[a] > 0.0 && P->y[a] < ly)) continue;
+    if (P->kind[a] != KIND_FLUID || !sph_at_wall(P->y[a], ly)) continue;
     const int upper = P->y[a] >= ly;
     fprintf(stderr,
             "warning: step %ld (t = %.9g): particle id %lld reached the %s wall at (%.9g, %.9g, "

@@ -50,13 +50,19 @@ struct model {
   /** the same (signed, not clipped) for the particle shift's moment, whose pair weight has the
       anti-clustering factor 1 + R (w_ab / w(dr))^n (shift.h) [1/m] */
   double lat_s[LATTICE_KNOTS];
-  int shifting;      /*!< enum shifting */
+  int shifting;       /*!< enum shifting */
   int shift_velocity; /*!< enum shift_velocity: what a shift does to the velocities */
-  int wall_reflect;  /*!< 1: a particle that reaches a wall is reflected (else the run stops) */
-  double shift_ch2;  /*!< C h^2 of delta r = -C h^2 grad C_a [m^2] */
-  double shift_iwdr; /*!< 1 / w(dr), the anti-clustering term's reference [m^dim] */
-  double shift_max;  /*!< largest shift per step [m] */
+  int wall_reflect;   /*!< 1: a particle that reaches a wall is reflected (else the run stops) */
+  double shift_ch2;   /*!< C h^2 of delta r = -C h^2 grad C_a [m^2] */
+  double shift_iwdr;  /*!< 1 / w(dr), the anti-clustering term's reference [m^dim] */
+  double shift_max;   /*!< largest shift per step [m] */
 };
+
+/** 1 if height y lies on or behind a wall (y <= 0 or y >= ly): a fluid particle there has
+    crossed it (the health check stops the run, sph.wall_collision = reflect mirrors it). */
+static inline int sph_at_wall(double y, double ly) {
+  return y <= 0.0 || y >= ly;
+}
 
 /** Anti-clustering term of the particle shift (Skillen et al. 2013; Sun et al. 2017):
     R (w_ab / w(dr))^n with R = 0.2, n = 4. */
