@@ -14,7 +14,9 @@
  *   w = wfac t^4 (e t^2 + ce) (1 + q (a1 + a2 q)),  F = ffac t^3 (e t^2 + ce) (1 + b1 q)
  * with e = 0, ce = 1, a1 = 2, a2 = 0, b1 = 0 for C2 (bit for bit the C2 formula: every extra
  * factor is exactly 1) and e = 1, ce = 0, a1 = 3, a2 = 35/12, b1 = 5/2 for C4 (the extra factor
- * exactly t^2, no cancellation near the edge), so that the vectorised pair loops need no branch.
+ * exactly t^2, no cancellation near the edge). The pair loops (pair.h) evaluate the same
+ * products, with the C4 factors behind a loop-invariant test on the shape, so that the C2
+ * loops do no extra work.
  */
 #ifndef CHANSPH_KERNEL_H
 #define CHANSPH_KERNEL_H

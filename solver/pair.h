@@ -62,7 +62,10 @@ static inline struct pair pair_geom(const struct kernel *K, double lx, double lz
   g.r = sqrt(g.r2);
   const double q = g.r * K->inv_h, t = 1.0 - 0.5 * q; /* kernel.h: F of C2 or C4 */
   const double tp = t > 0.0 ? t : 0.0;
-  g.f = K->ffac * tp * tp * tp * (K->e * tp * tp + K->ce) * (1.0 + K->b1 * q);
+  g.f = K->ffac * tp * tp * tp;
+  /* C4: a loop-invariant test, which the compiler takes out of the pair loops (unswitching),
+     so the C2 loops do no extra work */
+  if (K->shape == KERNEL_C4) g.f = g.f * (tp * tp) * (1.0 + K->b1 * q);
   return g;
 }
 
@@ -70,7 +73,8 @@ static inline struct pair pair_geom(const struct kernel *K, double lx, double lz
 static inline double pair_w(const struct kernel *K, double r) {
   const double q = r * K->inv_h, t = 1.0 - 0.5 * q;
   const double tp = t > 0.0 ? t : 0.0, t2 = tp * tp;
-  return K->wfac * t2 * t2 * (K->e * t2 + K->ce) * (1.0 + q * (K->a1 + K->a2 * q));
+  if (K->shape == KERNEL_C4) return K->wfac * t2 * t2 * t2 * (1.0 + q * (K->a1 + K->a2 * q));
+  return K->wfac * t2 * t2 * (1.0 + 2.0 * q);
 }
 
 #endif
