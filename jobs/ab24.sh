@@ -13,8 +13,9 @@
 #   w9a  jobs/states/mfu180w_dr6_t12.nc  (t = 12.1 of the converged run)
 #   w9b  jobs/states/mfu180w_dr6_t17.nc  (t = 17.8 of the same run, 5.7 turnovers later)
 # Each run is a batch job through jobs/chain.sh (checkpoints; start the script again to go on);
-# about 9 minutes a turnover with 2 threads on an idle 2-core machine, so a start state's whole
-# set is hours: pass the names of the candidates to run only those.
+# about 4 minutes a turnover at dr+ = 6 and 1.6 at dr+ = 9 (w9*) with 2 threads on an idle
+# 2-core machine (h = 2 dr: 1.5 times that): pass the names of the candidates to run only those.
+# Results: docs/validation/turbulent_channel.md, "the A/B screened at dr+ = 9".
 # usage: jobs/ab24.sh OUTDIR START [T] [CANDIDATE...]   e.g. jobs/ab24.sh runs/ab24 a 3 reference
 set -uo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
