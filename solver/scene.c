@@ -804,6 +804,31 @@ static void check_counts(struct parse_state *ps) {
                  n, 0x1p53);
 }
 
+/** The checks of init.profile = synthetic (validate). */
+static void validate_synthetic(struct parse_state *ps) {
+  const struct scene *s = ps->s;
+  const double sig = s->init_eddy_size * s->delta;
+  if (s->dim != 3)
+    inconsistent(ps, "init.profile", "synthetic needs a 3-D scene (dimension = %g)",
+                 (double)s->dim);
+  else if (sig > 0.5 * s->lx || sig > 0.5 * s->lz)
+    inconsistent(ps, "init.eddy_size",
+                 "eddy size sigma = %g (eddy_size delta) is more than half of min(lx, lz) = %g",
+                 sig, fmin(s->lx, s->lz));
+  if (!(s->nu > 0.0))
+    inconsistent(ps, "fluid.nu", "profile = synthetic needs nu > 0 (got %g)", s->nu);
+  /* the field is normalised by sqrt(box / sigma^3 / N): beyond a few times the default N it
+     is the same Gaussian field, while the work grows as N times the particles (1e8 eddies
+     in qdns180_smoke.ini ran for over 10 minutes at 5.5 GB before this limit) */
+  const double box = s->lx * (2.0 * s->delta + 2.0 * sig) * s->lz / (sig * sig * sig);
+  if (s->dim == 3 && sig > 0.0 && (double)s->init_eddies > 100.0 * box + 1000.0)
+    inconsistent(ps, "init.eddies",
+                 "%g synthetic eddies is more than 100 times the box volume / sigma^3 "
+                 "(%.4g) plus 1000: no different a field, at a cost that grows with the "
+                 "eddies (0 = the box volume / sigma^3)",
+                 (double)s->init_eddies, box);
+}
+
 static void validate(struct parse_state *ps) {
   const struct scene *s = ps->s;
   check_counts(ps);
@@ -862,28 +887,7 @@ static void validate(struct parse_state *ps) {
                  "y+ levels need stats.u_tau_ref > 0 unless a positive drive.force gives it "
                  "(u_tau_ref = %g, force = %g)",
                  s->u_tau_ref, s->force);
-  if (s->init_profile == INIT_SYNTHETIC) {
-    const double sig = s->init_eddy_size * s->delta;
-    if (s->dim != 3)
-      inconsistent(ps, "init.profile", "synthetic needs a 3-D scene (dimension = %g)",
-                   (double)s->dim);
-    else if (sig > 0.5 * s->lx || sig > 0.5 * s->lz)
-      inconsistent(ps, "init.eddy_size",
-                   "eddy size sigma = %g (eddy_size delta) is more than half of min(lx, lz) = %g",
-                   sig, fmin(s->lx, s->lz));
-    if (!(s->nu > 0.0))
-      inconsistent(ps, "fluid.nu", "profile = synthetic needs nu > 0 (got %g)", s->nu);
-    /* the field is normalised by sqrt(box / sigma^3 / N): beyond a few times the default N it
-       is the same Gaussian field, while the work grows as N times the particles (1e8 eddies
-       in qdns180_smoke.ini ran for over 10 minutes at 5.5 GB before this limit) */
-    const double box = s->lx * (2.0 * s->delta + 2.0 * sig) * s->lz / (sig * sig * sig);
-    if (s->dim == 3 && sig > 0.0 && (double)s->init_eddies > 100.0 * box + 1000.0)
-      inconsistent(ps, "init.eddies",
-                   "%g synthetic eddies is more than 100 times the box volume / sigma^3 "
-                   "(%.4g) plus 1000: no different a field, at a cost that grows with the "
-                   "eddies (0 = the box volume / sigma^3)",
-                   (double)s->init_eddies, box);
-  }
+  if (s->init_profile == INIT_SYNTHETIC) validate_synthetic(ps);
   if (s->dt_fixed > 0.0 && s->dt_fixed > s->t_end)
     inconsistent(ps, "time.dt", "fixed dt = %g is larger than t_end = %g", s->dt_fixed, s->t_end);
 }

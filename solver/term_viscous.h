@@ -85,8 +85,8 @@ static inline struct viscous_norm viscous_norm(const struct model *M, const stru
   if (M->lap_norm != LAPNORM_NONE) { /* discrete + analytic part behind the walls */
     const double qb = ya * ih, qt = (M->ly - ya) * ih;
     if (M->lap_norm == LAPNORM_TRACE) {
-      kappa =
-          -M->dim / (s->mom.x + sv->mom.x + wall_moment2_of(&M->k, qb) + wall_moment2_of(&M->k, qt));
+      kappa = -M->dim /
+              (s->mom.x + sv->mom.x + wall_moment2_of(&M->k, qb) + wall_moment2_of(&M->k, qt));
       kx = kz = kappa;
     } else if (violeau) { /* its own y-y moments: -2 in the full space */
       const double wm = sph_violeau_moment(M, qb) + sph_violeau_moment(M, qt);
@@ -94,8 +94,8 @@ static inline struct viscous_norm viscous_norm(const struct model *M, const stru
       kz = M->dim == 3 ? -2.0 / (s->m2z + sv->m2z + wm) : kx;
       kappa = 0.5 * (kx + kz);
     } else {
-      kappa =
-          -1.0 / (s->mom.y + sv->mom.y + wall_moment_yy_of(&M->k, qb) + wall_moment_yy_of(&M->k, qt));
+      kappa = -1.0 /
+              (s->mom.y + sv->mom.y + wall_moment_yy_of(&M->k, qb) + wall_moment_yy_of(&M->k, qt));
       kx = kz = kappa;
     }
   }
