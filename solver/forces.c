@@ -59,12 +59,15 @@ struct fsums {
 
 /** Sums over the neighbours j0 .. j1-1 of particle a (view V) for the operator `visc`, the
     corrected (`corr`) or symmetric pressure gradient, with (`fluid`) or without the volume
-    diffusion; `gathered` as for the view. VK_LES_LAG keeps F_ab and r_ab in geo (enum GEO_F ...,
-    ld apart) for the velocity-gradient sums. Always inlined with constant flags: one
-    specialised loop per combination. */
-static inline __attribute__((always_inline)) void pair_sums(
-    const struct fctx *C, size_t a, const struct pair_view *V, double *geo, int ld, int j0, int j1,
-    const int gathered, const int fluid, const int visc, const int corr, struct fsums *out) {
+    diffusion, the kernel `shape`; `gathered` as for the view. VK_LES_LAG keeps F_ab and r_ab in
+    geo (enum GEO_F ..., ld apart) for the velocity-gradient sums. Always inlined with constant
+    flags: one specialised loop per combination. */
+static inline __attribute__((always_inline)) void pair_sums(const struct fctx *C, size_t a,
+                                                            const struct pair_view *V, double *geo,
+                                                            int ld, int j0, int j1,
+                                                            const int gathered, const int fluid,
+                                                            const int visc, const int corr,
+                                                            const int shape, struct fsums *out) {
   const struct model *M = C->M;
   const struct particles *P = C->P;
   const struct pair_frame F = pair_frame_of(M);
@@ -89,7 +92,7 @@ static inline __attribute__((always_inline)) void pair_sums(
                                m2z, axx, axy, axz, ayy, ayz, azz, gcx, gcy, gcz)
   for (int j = j0; j < j1; j++) {
     const int32_t b = pair_index(gathered, nl, j);
-    const struct pair g = pair_at(&F, xa - x[b], ya - y[b], za - z[b]);
+    const struct pair g = pair_at_shape(&F, shape, xa - x[b], ya - y[b], za - z[b]);
     const double vb = vol[b], rb = rho[b];
     if (keep) gf[j] = g.f, gx[j] = g.dx, gy[j] = g.dy, gz[j] = g.dz;
     if (corr) { /* term_pressure.h, corrected form */
@@ -160,12 +163,12 @@ static void force_finish(const struct fctx *C, size_t a, const struct fsums *s,
 }
 
 /** The force pass over particles a0 .. a1-1 (one chunk) for the operator `visc`, the pressure
-    form `corr` and the data path `gathered`; VK_LES_LAG then forms the chunk's eddy viscosity
-    of the next step from its velocity-gradient sums (turb_model_chunk). */
+    form `corr`, the kernel `shape` and the data path `gathered`; VK_LES_LAG then forms the chunk's
+   eddy viscosity of the next step from its velocity-gradient sums (turb_model_chunk). */
 static inline __attribute__((always_inline)) void force_range(const struct fctx *C, size_t a0,
                                                               size_t a1, double mx[2],
                                                               const int visc, const int corr,
-                                                              const int gathered) {
+                                                              const int shape, const int gathered) {
   const struct nbr *nb = C->nb;
   const struct particles *P = C->P;
   const int ld = nb->pairbuf_ld;
@@ -189,8 +192,8 @@ static inline __attribute__((always_inline)) void force_range(const struct fctx 
       V = pair_view_gathered(bf, ld);
     }
     struct fsums s, sv;
-    pair_sums(C, a, &V, geo, ld, 0, nf, gathered, 1, visc, corr, &s);
-    pair_sums(C, a, &V, geo, ld, nf, n, gathered, 0, visc, corr, &sv);
+    pair_sums(C, a, &V, geo, ld, 0, nf, gathered, 1, visc, corr, shape, &s);
+    pair_sums(C, a, &V, geo, ld, nf, n, gathered, 0, visc, corr, shape, &sv);
     force_finish(C, a, &s, &sv, mx);
     if (visc == VK_LES_LAG) { /* the velocity-gradient sums of this state, for the next step */
       const struct gradient_src src = {
@@ -205,63 +208,53 @@ static inline __attribute__((always_inline)) void force_range(const struct fctx 
                      C->nur_next + a0, C->kr_next + a0);
 }
 
-/** force_range for one operator and data path, with the pressure form of the run. */
+/** force_range for one operator, kernel shape and data path, with the pressure form of the run. */
 static inline __attribute__((always_inline)) void force_chunk(const struct fctx *C, size_t a0,
                                                               size_t a1, double mx[2],
-                                                              const int visc, const int gathered) {
+                                                              const int visc, const int shape,
+                                                              const int gathered) {
   if (C->corrected)
-    force_range(C, a0, a1, mx, visc, 1, gathered);
+    force_range(C, a0, a1, mx, visc, 1, shape, gathered);
   else
-    force_range(C, a0, a1, mx, visc, 0, gathered);
+    force_range(C, a0, a1, mx, visc, 0, shape, gathered);
 }
 
 /** One force loop over the particles a0 .. a1-1; each is built for several instruction sets
-    (pair.h). The two data paths are separate functions: inlined into one, GCC 12 leaves the
-    gathered pair loops unvectorised at run time (measured 3-4 times slower). */
+    (pair.h). Each operator, kernel shape and data path is a function of its own: inlined into
+    one, GCC 12 leaves the gathered pair loops unvectorised at run time (measured 3-4 times
+    slower for the two data paths; 2.3 times for the two shapes). */
 typedef void (*force_loop)(const struct fctx *C, size_t a0, size_t a1, double mx[2]);
 
-/** Morris' operator (sph.viscous = morris), gathered records (AVX-512). */
-static CHANSPH_CLONES void forces_morris(const struct fctx *C, size_t a0, size_t a1, double mx[2]) {
-  force_chunk(C, a0, a1, mx, VK_MORRIS, 1);
-}
+/** Defines forces_NAME_SHAPE_PATH: operator VISC, kernel KERNEL_SHAPE, gathered records (1,
+    AVX-512) or the particle arrays through the list (0). */
+#define FORCE_LOOP(NAME, VISC, SHAPE, PATH, GATHERED)                                          \
+  static CHANSPH_CLONES void forces_##NAME##_##SHAPE##_##PATH(const struct fctx *C, size_t a0, \
+                                                              size_t a1, double mx[2]) {       \
+    force_chunk(C, a0, a1, mx, VISC, KERNEL_##SHAPE, GATHERED);                                \
+  }
+/** The four loops of one operator (sph.viscous = morris or violeau; the LES operator with nu_r
+    of this step, les.strain_lag = 0 or its first step; the LES operator forming the eddy
+    viscosity of the next step, les.strain_lag). */
+#define FORCE_LOOPS(NAME, VISC)           \
+  FORCE_LOOP(NAME, VISC, C2, gathered, 1) \
+  FORCE_LOOP(NAME, VISC, C2, arrays, 0)   \
+  FORCE_LOOP(NAME, VISC, C4, gathered, 1) \
+  FORCE_LOOP(NAME, VISC, C4, arrays, 0)
+FORCE_LOOPS(morris, VK_MORRIS)
+FORCE_LOOPS(violeau, VK_VIOLEAU)
+FORCE_LOOPS(les, VK_LES)
+FORCE_LOOPS(les_lag, VK_LES_LAG)
 
-/** Violeau's operator (sph.viscous = violeau), gathered records. */
-static CHANSPH_CLONES void forces_violeau(const struct fctx *C, size_t a0, size_t a1,
-                                          double mx[2]) {
-  force_chunk(C, a0, a1, mx, VK_VIOLEAU, 1);
-}
-
-/** The LES operator with nu_r of this step (les.strain_lag = 0, or its first step), gathered. */
-static CHANSPH_CLONES void forces_les(const struct fctx *C, size_t a0, size_t a1, double mx[2]) {
-  force_chunk(C, a0, a1, mx, VK_LES, 1);
-}
-
-/** The LES operator forming the eddy viscosity of the next step (les.strain_lag), gathered. */
-static CHANSPH_CLONES void forces_les_lag(const struct fctx *C, size_t a0, size_t a1,
-                                          double mx[2]) {
-  force_chunk(C, a0, a1, mx, VK_LES_LAG, 1);
-}
-
-/** The same four reading the particle arrays through the list (no AVX-512). */
-static CHANSPH_CLONES void forces_morris_arrays(const struct fctx *C, size_t a0, size_t a1,
-                                                double mx[2]) {
-  force_chunk(C, a0, a1, mx, VK_MORRIS, 0);
-}
-
-static CHANSPH_CLONES void forces_violeau_arrays(const struct fctx *C, size_t a0, size_t a1,
-                                                 double mx[2]) {
-  force_chunk(C, a0, a1, mx, VK_VIOLEAU, 0);
-}
-
-static CHANSPH_CLONES void forces_les_arrays(const struct fctx *C, size_t a0, size_t a1,
-                                             double mx[2]) {
-  force_chunk(C, a0, a1, mx, VK_LES, 0);
-}
-
-static CHANSPH_CLONES void forces_les_lag_arrays(const struct fctx *C, size_t a0, size_t a1,
-                                                 double mx[2]) {
-  force_chunk(C, a0, a1, mx, VK_LES_LAG, 0);
-}
+/** The force loops by [enum visc_kind][kernel shape][gathered]. */
+static const force_loop force_loops[4][2][2] = {
+    {{forces_morris_C2_arrays, forces_morris_C2_gathered},
+     {forces_morris_C4_arrays, forces_morris_C4_gathered}},
+    {{forces_violeau_C2_arrays, forces_violeau_C2_gathered},
+     {forces_violeau_C4_arrays, forces_violeau_C4_gathered}},
+    {{forces_les_C2_arrays, forces_les_C2_gathered},
+     {forces_les_C4_arrays, forces_les_C4_gathered}},
+    {{forces_les_lag_C2_arrays, forces_les_lag_C2_gathered},
+     {forces_les_lag_C4_arrays, forces_les_lag_C4_gathered}}};
 
 /** The force loop of a model and data path: the one switch over the viscous operators. */
 static force_loop force_loop_of(const struct model *M, int gathered) {
@@ -269,16 +262,7 @@ static force_loop force_loop_of(const struct model *M, int gathered) {
                    : M->les                        ? VK_LES
                    : M->viscous == VISCOUS_VIOLEAU ? VK_VIOLEAU
                                                    : VK_MORRIS;
-  switch (visc) {
-    case VK_LES_LAG:
-      return gathered ? forces_les_lag : forces_les_lag_arrays;
-    case VK_LES:
-      return gathered ? forces_les : forces_les_arrays;
-    case VK_VIOLEAU:
-      return gathered ? forces_violeau : forces_violeau_arrays;
-    default:
-      return gathered ? forces_morris : forces_morris_arrays;
-  }
+  return force_loops[visc][M->k.shape == KERNEL_C4][gathered != 0];
 }
 
 /** Particles per task of the force loop. */

@@ -9,14 +9,11 @@
  *   F = -14/3 alpha_m / h^(m+2) (1 - q/2)^5 (1 + 5q/2), alpha_3 = 495/(256 pi),
  *   alpha_2 = 9/(4 pi).
  *
- * The gradient is written as grad_a w_ab = F(r) r_ab, which has no 1/r singularity. Both
- * shapes are evaluated by one branch-free expression (t = 1 - q/2):
- *   w = wfac t^4 (e t^2 + ce) (1 + q (a1 + a2 q)),  F = ffac t^3 (e t^2 + ce) (1 + b1 q)
- * with e = 0, ce = 1, a1 = 2, a2 = 0, b1 = 0 for C2 (bit for bit the C2 formula: every extra
- * factor is exactly 1) and e = 1, ce = 0, a1 = 3, a2 = 35/12, b1 = 5/2 for C4 (the extra factor
- * exactly t^2, no cancellation near the edge). The pair loops (pair.h) evaluate the same
- * products, with the C4 factors behind a loop-invariant test on the shape, so that the C2
- * loops do no extra work.
+ * The gradient is written as grad_a w_ab = F(r) r_ab, which has no 1/r singularity. With
+ * t = 1 - q/2 both shapes share the factors wfac t^4 of w and ffac t^3 of F; C4 multiplies them
+ * by t^2 (1 + 3q + 35/12 q^2) / (1 + 2q) and t^2 (1 + 5q/2). kernel_w() and kernel_f() below
+ * are the reference forms; the pair loops evaluate the same products in pair.h (kernel_w_of,
+ * kernel_f_of with the shape a compile-time constant of each specialised loop).
  */
 #ifndef CHANSPH_KERNEL_H
 #define CHANSPH_KERNEL_H
@@ -39,9 +36,6 @@ struct kernel {
   double ffac;     /*!< C2: -5 alpha_m / h^(m+2); C4: -14/3 alpha_m / h^(m+2) [1/m^(m+2)] */
   double support2; /*!< (2h)^2 [m^2] */
   int shape;       /*!< enum kernel_shape */
-  double e, ce;    /*!< 0, 1 (C2) or 1, 0 (C4): the extra factor e (1 - q/2)^2 + ce */
-  double a1, a2;   /*!< the polynomial 1 + q (a1 + a2 q) of w */
-  double b1;       /*!< the polynomial 1 + b1 q of F */
 };
 
 /**
@@ -75,18 +69,38 @@ static inline struct kernel kernel_make_shape(const int dim, const double h, con
                      .wfac = a / pow(h, dim),
                      .ffac = (c4 ? -14.0 / 3.0 : -5.0) * a / pow(h, dim + 2),
                      .support2 = 4.0 * h * h,
-                     .shape = shape,
-                     .e = c4 ? 1.0 : 0.0,
-                     .ce = c4 ? 0.0 : 1.0,
-                     .a1 = c4 ? 3.0 : 2.0,
-                     .a2 = c4 ? 35.0 / 12.0 : 0.0,
-                     .b1 = c4 ? 2.5 : 0.0};
+                     .shape = shape};
   return k;
 }
 
 /** The Wendland C2 kernel of smoothing length h (thesis Eq. 2.63-2.66). */
 static inline struct kernel kernel_make(const int dim, const double h) {
   return kernel_make_shape(dim, h, KERNEL_C2);
+}
+
+/**
+ * @brief w of shape `shape` at q = r/h (any q >= 0: t is clamped at 0 beyond the support).
+ * @param[in] k kernel constants
+ * @param[in] shape k->shape, or that value as a compile-time constant of a specialised loop
+ * @param[in] q r/h
+ * @return w [1/m^dim]. Implements: thesis Eq. 2.63 (C2); Dehnen & Aly (2012) Table 1 (C4).
+ */
+static inline double kernel_w_of(const struct kernel *k, const int shape, const double q) {
+  const double t = 1.0 - 0.5 * q, tp = t > 0.0 ? t : 0.0, t2 = tp * tp;
+  if (shape == KERNEL_C4) return k->wfac * t2 * t2 * t2 * (1.0 + q * (3.0 + 35.0 / 12.0 * q));
+  return k->wfac * t2 * t2 * (1.0 + 2.0 * q);
+}
+
+/**
+ * @brief F = w'(r)/r of shape `shape` at q = r/h (0 beyond the support).
+ * @param[in] k kernel constants
+ * @param[in] shape as for kernel_w_of
+ * @param[in] q r/h
+ * @return F [1/m^(dim+2)], negative inside the support.
+ */
+static inline double kernel_f_of(const struct kernel *k, const int shape, const double q) {
+  const double t = 1.0 - 0.5 * q, tp = t > 0.0 ? t : 0.0, f = k->ffac * tp * tp * tp;
+  return shape == KERNEL_C4 ? f * (tp * tp) * (1.0 + 2.5 * q) : f;
 }
 
 /**
@@ -97,10 +111,7 @@ static inline struct kernel kernel_make(const int dim, const double h) {
  */
 static inline double kernel_w(const struct kernel *k, const double r) {
   const double q = r * k->inv_h;
-  if (q >= 2.0) return 0.0;
-  const double t = 1.0 - 0.5 * q;
-  const double t2 = t * t;
-  return k->wfac * t2 * t2 * (k->e * t2 + k->ce) * (1.0 + q * (k->a1 + k->a2 * q));
+  return q >= 2.0 ? 0.0 : kernel_w_of(k, k->shape, q);
 }
 
 /**
@@ -111,9 +122,7 @@ static inline double kernel_w(const struct kernel *k, const double r) {
  */
 static inline double kernel_f(const struct kernel *k, const double r) {
   const double q = r * k->inv_h;
-  if (q >= 2.0) return 0.0;
-  const double t = 1.0 - 0.5 * q;
-  return k->ffac * t * t * t * (k->e * t * t + k->ce) * (1.0 + k->b1 * q);
+  return q >= 2.0 ? 0.0 : kernel_f_of(k, k->shape, q);
 }
 
 #endif

@@ -247,16 +247,16 @@ scan_blocks_avx512(const struct particles *restrict P, size_t a, const struct nb
 #endif
 
 /* Kernel sum S_a = m_a w(0) + sum_b m_b w_ab over the list found (vectorised; the order of the
-   list is the same on any decomposition and the scratch list is aligned, so the sum is too). */
-static inline __attribute__((always_inline)) double kernel_sum(const struct kernel *K,
-                                                               const double *restrict m, size_t a,
-                                                               const int32_t *restrict lb,
-                                                               const double *restrict r2b,
-                                                               int cnt) {
+   list is the same on any decomposition and the scratch list is aligned, so the sum is too);
+   the kernel shape is a constant of each inlined copy (pair.h). */
+static inline __attribute__((always_inline)) double kernel_sum(
+    const struct kernel *K, const int shape, const double *restrict m, size_t a,
+    const int32_t *restrict lb, const double *restrict r2b, int cnt) {
   double s = 0.0;
+  const double ih = K->inv_h;
 #pragma omp simd reduction(+ : s)
-  for (int j = 0; j < cnt; j++) s += m[lb[j]] * pair_w(K, sqrt(r2b[j]));
-  return m[a] * pair_w(K, 0.0) + s;
+  for (int j = 0; j < cnt; j++) s += m[lb[j]] * kernel_w_of(K, shape, sqrt(r2b[j]) * ih);
+  return m[a] * kernel_w_of(K, shape, 0.0) + s;
 }
 
 /* Copy the list lb[0 .. cnt-1] to out, fluid particles first, then the vertices, each in the
@@ -429,7 +429,8 @@ static inline __attribute__((always_inline)) int build_cell_t(struct nbr *nb,
       if (cnt > overflow) overflow = cnt;
       continue;
     }
-    ksum[a] = kernel_sum(K, P->m, a, lb, r2b, cnt);
+    ksum[a] = K->shape == KERNEL_C4 ? kernel_sum(K, KERNEL_C4, P->m, a, lb, r2b, cnt)
+                                    : kernel_sum(K, KERNEL_C2, P->m, a, lb, r2b, cnt);
     int32_t *out = nb->list + a * (size_t)stride;
     if (wall_rows) {
       nb->nfluid[a] = fluid_first(P->kind, lb, out, cnt);

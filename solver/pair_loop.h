@@ -39,6 +39,12 @@ static inline struct pair pair_at(const struct pair_frame *F, double dx, double 
   return pair_geom(&F->K, F->lx, F->lz, F->d3, dx, dy, dz);
 }
 
+/** pair_at() for a loop specialised on the kernel shape (a compile-time constant: pair.h). */
+static inline struct pair pair_at_shape(const struct pair_frame *F, const int shape, double dx,
+                                        double dy, double dz) {
+  return pair_geom_shape(&F->K, shape, F->lx, F->lz, F->d3, dx, dy, dz);
+}
+
 /** The neighbours of one particle as a pair loop reads them (see the file comment). */
 struct pair_view {
   const double *f[REC_FIELDS]; /*!< field k (enum rec_field) of the neighbours */
