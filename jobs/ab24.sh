@@ -15,11 +15,14 @@
 # Each run is a batch job through jobs/chain.sh (checkpoints; start the script again to go on);
 # about 4 minutes a turnover at dr+ = 6 and 1.6 at dr+ = 9 (w9*) with 2 threads on an idle
 # 2-core machine (h = 2 dr: 1.5 times that): pass the names of the candidates to run only those.
-# Results: docs/validation/turbulent_channel.md, "the A/B screened at dr+ = 9".
+# A finished run is continued with jobs/chain.sh DIR -- --set time.t_end=T (the comparison at
+# dr+ = 6 ran c4_h2.0 and the references of both starts to T = 5).
+# Results: docs/validation/turbulent_channel.md, "the A/B screened at dr+ = 9" (the best
+# setting at dr+ = 6: c4_h2.0).
 # usage: jobs/ab24.sh OUTDIR START [T] [CANDIDATE...]   e.g. jobs/ab24.sh runs/ab24 a 3 reference
 set -uo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-[ $# -ge 2 ] || { sed -n 2,18p "$0" >&2; exit 1; }
+[ $# -ge 2 ] || { sed -n 2,23p "$0" >&2; exit 1; }
 out=$1 start=$2 tend=${3:-3}
 shift $(($# >= 3 ? 3 : 2))
 scene=jobs/scenes/mfu180_dr6_dev.ini
