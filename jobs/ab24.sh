@@ -22,7 +22,7 @@
 # usage: jobs/ab24.sh OUTDIR START [T] [CANDIDATE...]   e.g. jobs/ab24.sh runs/ab24 a 3 reference
 set -uo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-[ $# -ge 2 ] || { sed -n 2,23p "$0" >&2; exit 1; }
+[ $# -ge 2 ] || { sed -n 2,22p "$0" >&2; exit 1; }
 out=$1 start=$2 tend=${3:-3}
 shift $(($# >= 3 ? 3 : 2))
 scene=jobs/scenes/mfu180_dr6_dev.ini
