@@ -164,7 +164,7 @@ static void force_finish(const struct fctx *C, size_t a, const struct fsums *s,
 
 /** The force pass over particles a0 .. a1-1 (one chunk) for the operator `visc`, the pressure
     form `corr`, the kernel `shape` and the data path `gathered`; VK_LES_LAG then forms the chunk's
-   eddy viscosity of the next step from its velocity-gradient sums (turb_model_chunk). */
+    eddy viscosity of the next step from its velocity-gradient sums (turb_model_chunk). */
 static inline __attribute__((always_inline)) void force_range(const struct fctx *C, size_t a0,
                                                               size_t a1, double mx[2],
                                                               const int visc, const int corr,

@@ -11,9 +11,9 @@
  *
  * The gradient is written as grad_a w_ab = F(r) r_ab, which has no 1/r singularity. With
  * t = 1 - q/2 both shapes share the factors wfac t^4 of w and ffac t^3 of F; C4 multiplies them
- * by t^2 (1 + 3q + 35/12 q^2) / (1 + 2q) and t^2 (1 + 5q/2). kernel_w() and kernel_f() below
- * are the reference forms; the pair loops evaluate the same products in pair.h (kernel_w_of,
- * kernel_f_of with the shape a compile-time constant of each specialised loop).
+ * by t^2 (1 + 3q + 35/12 q^2) / (1 + 2q) and t^2 (1 + 5q/2). kernel_w_of() and kernel_f_of()
+ * take the shape as an argument, a compile-time constant in the specialised hot loops (pair.h);
+ * kernel_w() and kernel_f() read it from the kernel.
  */
 #ifndef CHANSPH_KERNEL_H
 #define CHANSPH_KERNEL_H
@@ -110,8 +110,7 @@ static inline double kernel_f_of(const struct kernel *k, const int shape, const 
  * @return w [1/m^dim]. Implements: thesis Eq. 2.63 (C2).
  */
 static inline double kernel_w(const struct kernel *k, const double r) {
-  const double q = r * k->inv_h;
-  return q >= 2.0 ? 0.0 : kernel_w_of(k, k->shape, q);
+  return kernel_w_of(k, k->shape, r * k->inv_h); /* exactly +0 beyond the support */
 }
 
 /**

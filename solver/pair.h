@@ -73,9 +73,4 @@ static inline struct pair pair_geom(const struct kernel *K, double lx, double lz
   return pair_geom_shape(K, K->shape, lx, lz, d3, dx, dy, dz);
 }
 
-/** Kernel value w(r) of a pair inside the support (kernel.h; thesis Eq. 2.63 for C2). */
-static inline double pair_w(const struct kernel *K, double r) {
-  return kernel_w_of(K, K->shape, r * K->inv_h);
-}
-
 #endif

@@ -21,7 +21,7 @@ static CHANSPH_CLONES struct v3 shift_gradient(const struct model *M, const stru
   for (int j = 0; j < nb->count[a]; j++) {
     const int32_t b = nl[j];
     const struct pair g = pair_at(&F, xa - x[b], ya - y[b], za - z[b]);
-    const double s = V[b] * (1.0 + sph_anticluster(pair_w(&F.K, g.r), iwdr)) * g.f;
+    const double s = V[b] * (1.0 + sph_anticluster(kernel_w(&F.K, g.r), iwdr)) * g.f;
     gx += s * g.dx, gy += s * g.dy, gz += s * g.dz;
   }
   return (struct v3){gx, gy, gz};
@@ -127,7 +127,7 @@ static CHANSPH_CLONES struct v3 conservative_sum(const struct model *M, const st
     const int32_t b = nl[j];
     const struct pair g = pair_at(&F, xa - x[b], ya - y[b], za - z[b]);
     /* the shift's weight phi_ab = 1 + R (w_ab / w(dr))^n: symmetric in a and b */
-    const double fm = m[b] * (1.0 + sph_anticluster(pair_w(&F.K, g.r), iwdr)) * g.f;
+    const double fm = m[b] * (1.0 + sph_anticluster(kernel_w(&F.K, g.r), iwdr)) * g.f;
     gx += fm * g.dx, gy += fm * g.dy, gz += fm * g.dz;
     /* vertex particles: no shift (and at rest), so only fluid b count here */
     const double cb = (kind[b] == KIND_FLUID ? 1.0 : 0.0) * fm *

@@ -169,7 +169,7 @@ static CHANSPH_CLONES void vertex_shepard(const struct model *M, const struct pa
   for (int j = 0; j < nb->nfluid[v]; j++) {
     const int32_t b = nl[j];
     const struct pair g = pair_at(&F, xv - x[b], yv - y[b], zv - z[b]);
-    const double wvb = pair_w(&F.K, g.r), vol = V[b]; /* m_b / rho_b, set by sph_density */
+    const double wvb = kernel_w(&F.K, g.r), vol = V[b]; /* m_b / rho_b, set by sph_density */
     alpha += vol * wvb;
     mw += m[b] * wvb;
     pw += vol * (p[b] / rho[b] + gy * g.dy) * wvb;
@@ -211,7 +211,7 @@ CHANSPH_CLONES double sph_vertex_sums(const struct model *M, const struct partic
   for (int j = 0; j < nb->nfluid[s]; j++) {
     const int32_t b = nl[j];
     const struct pair g = pair_at(&F, xs - x[b], ys - y[b], zs - z[b]);
-    const double vw = vol[b] * pair_w(&F.K, g.r);
+    const double vw = vol[b] * kernel_w(&F.K, g.r);
     alpha += vw, s0 += vw * f0[b], s1 += vw * f1[b];
   }
   out[0] = s0;
