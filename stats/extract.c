@@ -159,6 +159,91 @@ static void free_stored(struct stored *s) {
       free(s->complete);
 }
 
+/* Whether segment b (path pb) was gathered as segment a (pa) was; prints what differs. */
+static int same_gathering(const struct stored *a, const struct stored *b, const char *pa,
+                          const char *pb) {
+  const struct {
+    const char *name;
+    double x, y;
+  } key[] = {{"delta", a->cfg.delta, b->cfg.delta},
+             {"nu", a->cfg.nu, b->cfg.nu},
+             {"rho0", a->cfg.rho0, b->cfg.rho0},
+             {"bin_lower", a->cfg.y0, b->cfg.y0},
+             {"bin_upper", a->cfg.y1, b->cfg.y1},
+             {"wall_area", a->cfg.area, b->cfg.area},
+             {"fold", a->cfg.fold, b->cfg.fold},
+             {"window_length", a->cfg.window, b->cfg.window},
+             {"les", a->cfg.les, b->cfg.les},
+             {"bins (dimension y)", a->cfg.nb, b->cfg.nb},
+             {"budget records", !a->pln, !b->pln},
+             {"kinetic-flux records", !a->kin, !b->kin},
+             {"Reynolds-stress budget records", !a->rsb, !b->rsb}};
+  for (size_t k = 0; k < sizeof key / sizeof key[0]; k++)
+    if (key[k].x != key[k].y) {
+      fprintf(stderr,
+              "error: %s: %s %.9g, but %s has %.9g: not a later segment of the same run "
+              "(the same scene continued with init.from)\n",
+              pb, key[k].name, key[k].y, pa, key[k].x);
+      return 0;
+    }
+  return 1;
+}
+
+/* Append the rows of b (rows_b of len doubles) to *a (rows_a rows); *a stays NULL if NULL. */
+static void append_rows(double **a, size_t rows_a, const double *b, size_t rows_b, size_t len) {
+  if (!*a) return;
+  *a = mem_realloc(*a, (rows_a + rows_b) * len, sizeof(double), "chansph extract");
+  memcpy(*a + rows_a * len, b, rows_b * len * sizeof(double));
+}
+
+/* The segments seg[0..n-1] (paths) of one run, each started from the final state of the one
+   before (init.from), joined into seg[0] as the windows of one run: each segment's times
+   shifted by the sum of the reached times of those before it (each starts at t = 0). The
+   others are freed. Nonzero on an input error (printed, naming the file). */
+static int join_stored(struct stored *seg, int n, char *const *paths) {
+  struct stored *s = &seg[0];
+  double offset = 0.0;
+  int bad = 0;
+  for (int k = 1; k < n && !bad; k++) {
+    const struct stored *b = &seg[k];
+    offset += seg[k - 1].t_reached;
+    if (!isfinite(seg[k - 1].t_reached)) {
+      fprintf(stderr, "error: %s: no attribute t_reached: cannot place the next segment\n",
+              paths[k - 1]);
+      bad = 1;
+    } else if (!same_gathering(s, b, paths[0], paths[k])) {
+      bad = 1;
+    }
+    if (bad) break;
+    /* the open last window of the segment before: whole if the segment ran to its end (the
+       snapshot that would have closed it is the next segment's first); else left out */
+    const double *last = s->win + (s->rows ? s->rows - 1 : 0) * WIN_LEN;
+    if (s->rows && !s->complete[s->rows - 1]) {
+      if (last[WIN_T1] <= offset + 1e-6 * s->cfg.window)
+        s->complete[s->rows - 1] = 1;
+      else
+        fprintf(stderr,
+                "note: %s: its last window (t = %.9g .. %.9g) is open, the segment ended at "
+                "%.9g: left out of the averages (end a segment at a window boundary)\n",
+                paths[k - 1], last[WIN_T0], last[WIN_T1], offset);
+    }
+    const size_t nb = (size_t)s->cfg.nb, ra = s->rows, rb = b->rows;
+    append_rows(&s->win, ra, b->win, rb, WIN_LEN);
+    for (size_t r = ra; r < ra + rb; r++)
+      s->win[r * WIN_LEN + WIN_T0] += offset, s->win[r * WIN_LEN + WIN_T1] += offset;
+    append_rows(&s->mom, ra, b->mom, rb, nb * MOM_LEN);
+    append_rows(&s->snp, ra, b->snp, rb, nb * SCAL_LEN);
+    append_rows(&s->pln, ra, b->pln, rb, nb * PL_LEN);
+    append_rows(&s->kin, ra, b->kin, rb, nb * KN_LEN);
+    append_rows(&s->rsb, ra, b->rsb, rb, nb * RW_LEN);
+    s->complete = mem_realloc(s->complete, ra + rb, sizeof(int), "chansph extract");
+    memcpy(s->complete + ra, b->complete, rb * sizeof(int));
+    s->rows = ra + rb, s->t_reached = offset + b->t_reached;
+  }
+  for (int k = 1; k < n; k++) free_stored(&seg[k]);
+  return bad;
+}
+
 /* A time of --window between text and stop: empty gives dflt; anything but one finite number
    is an error (nonzero). */
 static int parse_time(const char *text, const char *stop, double dflt, double *t) {
@@ -174,8 +259,14 @@ static int parse_time(const char *text, const char *stop, double dflt, double *t
 
 static void usage(FILE *f) {
   fprintf(f,
-          "usage: chansph extract STATS.nc [--var a,b,...] [--units wall|outer] "
+          "usage: chansph extract STATS.nc [LATER.nc ...] [--var a,b,...] [--units wall|outer] "
           "[--format csv|tsv] [--window T0:T1] [--pdfs] [--nc OUT.nc]\n"
+          "  LATER.nc ...: the stats.nc of later segments of the same run, each started from the "
+          "final\n"
+          "    state of the one before (init.from, e.g. on another machine): their windows are "
+          "joined\n"
+          "    on one time axis (each segment's times shifted by the reached times of those "
+          "before it)\n"
           "  variables: u_mean v_mean w_mean p_mean rho_mean uu vv ww uv uw vw u_rms v_rms "
           "w_rms\n"
           "  u_skewness ... w_flatness viscous_stress total_stress total_stress_expected "
@@ -193,9 +284,14 @@ static void usage(FILE *f) {
           "    what `chansph compare` and `extract` read, e.g. a long run's developed range\n");
 }
 
+/* The most segments extract joins. */
+enum { EXTRACT_MAX_SEGMENTS = 64 };
+
 /* The options of one extract command. */
 struct extract_args {
-  const char *path, *vars, *units, *fmt;
+  const char *path, *vars, *units, *fmt; /* path: the first of paths */
+  char *paths[EXTRACT_MAX_SEGMENTS];     /* the segments of one run, in order */
+  int npaths;
   double t0, t1;      /* --window */
   int pdfs;           /* --pdfs */
   const char *nc_out; /* --nc: write the range as a stats.nc instead of a table */
@@ -208,8 +304,11 @@ static int extract_parse(int argc, char **argv, struct extract_args *a) {
       {"units", required_argument, NULL, 'u'},  {"format", required_argument, NULL, 'f'},
       {"window", required_argument, NULL, 'w'}, {"pdfs", no_argument, NULL, 'p'},
       {"nc", required_argument, NULL, 'n'},     {NULL, 0, NULL, 0}};
-  *a = (struct extract_args){
-      NULL, "u_mean,u_rms,v_rms,w_rms,uv", "wall", "csv", -INFINITY, INFINITY, 0, NULL};
+  *a = (struct extract_args){.vars = "u_mean,u_rms,v_rms,w_rms,uv",
+                             .units = "wall",
+                             .fmt = "csv",
+                             .t0 = -INFINITY,
+                             .t1 = INFINITY};
   opterr = 0, optind = 1; /* "-": positional arguments in order (code 1); ':' missing value */
   for (;;) {
     const int at = optind, code = getopt_long(argc, argv, "-:h", opts, NULL);
@@ -234,15 +333,21 @@ static int extract_parse(int argc, char **argv, struct extract_args *a) {
                 w);
         return 1;
       }
-    } else if (code == 1 && !a->path) {
-      a->path = optarg;
+    } else if (code == 1 && a->npaths < EXTRACT_MAX_SEGMENTS) {
+      a->paths[a->npaths++] = optarg;
     } else {
       fprintf(stderr, "error: unexpected argument '%s'\n", code == 1 ? optarg : argv[at]);
       usage(stderr);
       return 1;
     }
   }
-  if (optind < argc && !a->path) a->path = argv[optind++]; /* after "--" */
+  while (optind < argc && a->npaths < EXTRACT_MAX_SEGMENTS) /* after "--" */
+    a->paths[a->npaths++] = argv[optind++];
+  a->path = a->npaths ? a->paths[0] : NULL;
+  if (a->pdfs && a->npaths > 1) {
+    fprintf(stderr, "error: --pdfs reads one stats.nc, not the %d given\n", a->npaths);
+    return 1;
+  }
   if (!a->path || optind < argc || (strcmp(a->units, "wall") && strcmp(a->units, "outer")) ||
       (strcmp(a->fmt, "csv") && strcmp(a->fmt, "tsv"))) {
     usage(stderr);
@@ -308,9 +413,10 @@ static void extract_header(const struct extract_args *a, const struct stored *s,
   /* a run that stopped inside its last window reached t_reached, not the window's end */
   const double t_last = isnan(s->t_reached) ? res->t1 : fmin(res->t1, s->t_reached);
   printf(
-      "# chansph extract %s: windows %zu..%zu, t = %.9g .. %.9g s, %.0f snapshots, %d "
+      "# chansph extract %s%s: windows %zu..%zu, t = %.9g .. %.9g s, %.0f snapshots, %d "
       "batches\n",
-      a->path, r0, r1 - 1, res->t0, t_last, res->snapshots, res->n_batches);
+      a->path, a->npaths > 1 ? " and its later segments" : "", r0, r1 - 1, res->t0, t_last,
+      res->snapshots, res->n_batches);
   printf(
       "# u_tau = %.9g m/s (wall shear %.9g, force balance %.9g, stderr %.3g), Re_tau = %.6g, "
       "correlation time %.4g s, stress balance error %.4g\n",
@@ -548,6 +654,18 @@ static int corr_output(struct corr_range *k, int in, int out, char *err, size_t 
   return rc;
 }
 
+/* The global attribute segments of a joined file: the files joined, in order. */
+static int put_segments(const struct extract_args *a, int out) {
+  size_t len = 1;
+  for (int k = 0; k < a->npaths; k++) len += strlen(a->paths[k]) + 2;
+  char *text = mem_alloc(len, 1, "chansph extract");
+  text[0] = '\0';
+  for (int k = 0; k < a->npaths; k++) strcat(strcat(text, k ? "; " : ""), a->paths[k]);
+  const int rc = nc_put_att_text(out, NC_GLOBAL, "segments", strlen(text), text);
+  free(text);
+  return rc;
+}
+
 /* The windows r0 .. r1-1 of s as the state of an engine that gathered only them (its last row
    open if that window is), written by the engine's own writer to a.nc_out (through a
    temporary file, renamed when complete). */
@@ -577,7 +695,11 @@ static int write_range(const struct extract_args *a, const struct stored *s, siz
   const long long ns = (long long)snaps;
   struct corr_range k = {0};
   int in = -1, out = -1, rc = nc_open(a->path, NC_NOWRITE, &in);
-  if (rc == NC_NOERR && corr_prepare(a, in, &k)) {
+  if (a->npaths > 1)
+    fprintf(stderr,
+            "note: %d segments joined: group eulerian only (the other groups are left out)\n",
+            a->npaths);
+  else if (rc == NC_NOERR && corr_prepare(a, in, &k)) {
     nc_close(in), euler_free(&e);
     return 1;
   }
@@ -586,6 +708,7 @@ static int write_range(const struct extract_args *a, const struct stored *s, siz
   if (rc == NC_NOERR && isfinite(t_end))
     rc = nc_put_att_double(out, NC_GLOBAL, "t_reached", NC_DOUBLE, 1, &t_end);
   if (rc == NC_NOERR) rc = nc_put_att_longlong(out, NC_GLOBAL, "n_snapshots", NC_INT64, 1, &ns);
+  if (rc == NC_NOERR && a->npaths > 1) rc = put_segments(a, out);
   if (rc == NC_NOERR) rc = euler_engine.write(&e, t_end, out, err, sizeof err);
   if (rc == NC_NOERR) rc = corr_output(&k, in, out, err, sizeof err);
   if (k.have == 1) corr_free(&k.c);
@@ -593,8 +716,9 @@ static int write_range(const struct extract_args *a, const struct stored *s, siz
   if (in >= 0) nc_close(in);
   euler_free(&e);
   if (rc == NC_NOERR && rename(tmp, a->nc_out) == 0) {
-    printf("chansph extract: %s: windows %zu..%zu (t = %.9g .. %.9g s, %.0f snapshots) -> %s\n",
-           a->path, r0, r1 - 1, s->win[r0 * WIN_LEN + WIN_T0], t_end, snaps, a->nc_out);
+    printf("chansph extract: %s%s: windows %zu..%zu (t = %.9g .. %.9g s, %.0f snapshots) -> %s\n",
+           a->path, a->npaths > 1 ? " and its later segments" : "", r0, r1 - 1,
+           s->win[r0 * WIN_LEN + WIN_T0], t_end, snaps, a->nc_out);
     if (k.q1 > k.q0)
       printf("chansph extract: %s: group correlations re-averaged over its windows %zu..%zu\n",
              a->path, k.q0, k.q1 - 1);
@@ -611,8 +735,15 @@ int extract_main(int argc, char **argv) {
   const int prc = extract_parse(argc, argv, &a);
   if (prc) return prc < 0 ? 0 : 1;
   if (a.pdfs) return extract_pdfs(&a);
-  struct stored s;
-  if (read_stored(a.path, &s)) {
+  struct stored seg[EXTRACT_MAX_SEGMENTS], s;
+  int bad = 0, n = 0;
+  for (; n < a.npaths && !bad; n++) bad = read_stored(a.paths[n], &seg[n]);
+  if (bad) {
+    while (n--) free_stored(&seg[n]);
+    return 1;
+  }
+  bad = join_stored(seg, n, a.paths), s = seg[0];
+  if (bad) {
     free_stored(&s);
     return 1;
   }
