@@ -506,21 +506,7 @@ static double engine_estimate(const struct stats_scene *sc) {
   return sizeof(double) * (c.n_levels * nk * CS_LEN + 4.0 * c.nx * c.nz + 6.0 * nk);
 }
 
-static void engine_init(void *self, const void *cfg) {
-  corr_init(self, cfg);
-}
-
-static void engine_free(void *self) {
-  corr_free(self);
-}
-
-static void engine_sample(void *self, const struct stats_snapshot *s) {
-  corr_sample(self, s);
-}
-
-static void engine_state(void *self, struct state_list *L) {
-  corr_state(self, L);
-}
+STATS_ENGINE_ADAPTERS(corr)
 
 static size_t engine_bytes(const void *self) {
   const struct corr *c = self;

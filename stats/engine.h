@@ -51,6 +51,23 @@ struct stats_engine {
 
 enum { STATS_MAX_ENGINES = 16 }; /*!< room in struct stats (engines.c checks the list) */
 
+/** The adapters from the table's void pointers to an engine's typed functions PREFIX_init,
+    _free, _sample and _state (calling a function through a pointer of another type would be
+    undefined): defines engine_init, engine_free, engine_sample and engine_state. */
+#define STATS_ENGINE_ADAPTERS(PREFIX)                                     \
+  static void engine_init(void *self, const void *cfg) {                  \
+    PREFIX##_init(self, cfg);                                             \
+  }                                                                       \
+  static void engine_free(void *self) {                                   \
+    PREFIX##_free(self);                                                  \
+  }                                                                       \
+  static void engine_sample(void *self, const struct stats_snapshot *s) { \
+    PREFIX##_sample(self, s);                                             \
+  }                                                                       \
+  static void engine_state(void *self, struct state_list *L) {            \
+    PREFIX##_state(self, L);                                              \
+  }
+
 /** The engines, in the order they are initialised, sampled, checkpointed and written. */
 extern const struct stats_engine *const stats_engines[];
 /** How many there are. */

@@ -651,21 +651,7 @@ static int engine_init_scene(void *self, const struct stats_scene *sc) {
   return 1;
 }
 
-static void engine_init(void *self, const void *cfg) {
-  lagr_init(self, cfg);
-}
-
-static void engine_free(void *self) {
-  lagr_free(self);
-}
-
-static void engine_sample(void *self, const struct stats_snapshot *s) {
-  lagr_sample(self, s);
-}
-
-static void engine_state(void *self, struct state_list *L) {
-  lagr_state(self, L);
-}
+STATS_ENGINE_ADAPTERS(lagr)
 
 static size_t engine_bytes(const void *self) {
   const struct lagr *g = self;

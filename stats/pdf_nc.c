@@ -254,21 +254,7 @@ static int engine_init_scene(void *self, const struct stats_scene *sc) {
   return 1;
 }
 
-static void engine_init(void *self, const void *cfg) {
-  pdf_init(self, cfg);
-}
-
-static void engine_free(void *self) {
-  pdf_free(self);
-}
-
-static void engine_sample(void *self, const struct stats_snapshot *s) {
-  pdf_sample(self, s);
-}
-
-static void engine_state(void *self, struct state_list *L) {
-  pdf_state(self, L);
-}
+STATS_ENGINE_ADAPTERS(pdf)
 
 static size_t engine_bytes(const void *self) {
   const struct pdf *p = self;

@@ -186,21 +186,7 @@ static int engine_init_scene(void *self, const struct stats_scene *sc) {
   return 1;
 }
 
-static void engine_init(void *self, const void *cfg) {
-  quad_init(self, cfg);
-}
-
-static void engine_free(void *self) {
-  quad_free(self);
-}
-
-static void engine_sample(void *self, const struct stats_snapshot *s) {
-  quad_sample(self, s);
-}
-
-static void engine_state(void *self, struct state_list *L) {
-  quad_state(self, L);
-}
+STATS_ENGINE_ADAPTERS(quad)
 
 static size_t engine_bytes(const void *self) {
   const struct quad *q = self;
