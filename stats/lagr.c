@@ -84,6 +84,8 @@ static void contribute(const double *tr, const double *p, double tau, double *R)
     R[LG_STRUCT + 3 * i] += dv2, R[LG_STRUCT + 3 * i + 1] += dv2 * dv;
     R[LG_STRUCT + 3 * i + 2] += dv2 * dv2;
     R[LG_DISP + i] += tr[TR_DISP + i] * tr[TR_DISP + i], R[LG_DR + i] += tr[TR_DISP + i];
+    const double rate = tau > 0.0 ? tr[TR_DISP + i] / tau : 0.0; /* lag 0: no displacement */
+    R[LG_RATE + 2 * i] += rate, R[LG_RATE + 2 * i + 1] += rate * rate;
   }
 }
 
@@ -322,11 +324,12 @@ static void *reserve_tr(void *owner, int rank, const size_t *dims) {
   return g->tracks;
 }
 
-/* The sums of a checkpoint of format <= 1.8 (records of width LG_LEN_1_6 up to format 1.6,
-   LG_LEN_1_8 in 1.7-1.8, read into the front of g->sums or g->slot_sums): spread them to
-   records of LG_LEN, from the last one back. The sums after the stored ones (of dr before 1.7,
-   of the actual lags before 1.9) were not kept: NaN in a record with samples (the mean
-   displacement or lag time of the run stays NaN), 0 in one without (exact). */
+/* The sums of a checkpoint of format <= 1.9 (records of width LG_LEN_1_6 up to format 1.6,
+   LG_LEN_1_8 in 1.7-1.8, LG_LEN_1_9 in 1.9, read into the front of g->sums or g->slot_sums):
+   spread them to records of LG_LEN, from the last one back. The sums after the stored ones (of
+   dr before 1.7, of the actual lags before 1.9, of the interval-mean velocities before 1.10)
+   were not kept: NaN in a record with samples (the mean displacement, lag time or
+   interval-mean velocity variance of the run stays NaN), 0 in one without (exact). */
 static void widen(double *a, size_t rows, size_t width) {
   for (size_t r = rows; r-- > 0;) {
     double *R = a + r * LG_LEN;
@@ -336,7 +339,7 @@ static void widen(double *a, size_t rows, size_t width) {
 }
 
 static int known_width(size_t w) { /* a record width of some checkpoint format */
-  return w == LG_LEN || w == LG_LEN_1_8 || w == LG_LEN_1_6;
+  return w == LG_LEN || w == LG_LEN_1_9 || w == LG_LEN_1_8 || w == LG_LEN_1_6;
 }
 
 static void *reserve_sums(void *owner, int rank, const size_t *dims) {
@@ -371,8 +374,9 @@ void lagr_state(struct lagr *g, struct state_list *L) {
   const size_t d3[3] = {nl, g->nlag, LG_LEN}, d4[3] = {ns, nl * g->nlag, LG_LEN};
   const size_t ds[2] = {ns, SL_LEN}, dt[3] = {nl, 3, SCAL_LEN};
   const size_t dp[3] = {nl, st, (size_t)g->cfg.pdf_bins + 3}, dtr[2] = {g->ntracks, TR_LEN};
-  /* format <= 1.8: records without the sums of the actual lags (LG_LEN_1_8) or, <= 1.6, also
-     without the sums of dr (LG_LEN_1_6), widened after reading */
+  /* format <= 1.9: records without the sums of the interval-mean velocities (LG_LEN_1_9),
+     <= 1.8 also without those of the actual lags (LG_LEN_1_8) and, <= 1.6, of dr (LG_LEN_1_6),
+     widened after reading */
   struct state_field *f = state_add(L, "stats/lagrangian/sums", STATE_F64, 3, d3, g->sums, NULL);
   f->reserve = reserve_sums, f->after_read = widen_sums, f->owner = g;
   f = state_add(L, "stats/lagrangian/slot_sums", STATE_F64, 3, d4, g->slot_sums, NULL);
@@ -403,6 +407,8 @@ void lagr_functions(const struct lagr *g, int level, double *out, double *tl) {
       out[(LF_UT + i) * nlag + k] = n > 0 ? R[LG_VEL + 5 * i + 1] / n : NAN;
       out[(LF_DR + i) * nlag + k] = m;
       out[(LF_DVAR + i) * nlag + k] = n > 0 ? R[LG_DISP + i] / n - m * m : NAN;
+      const double r1 = n > 0 ? R[LG_RATE + 2 * i] / n : NAN; /* NaN: from format <= 1.9 */
+      out[(LF_RVAR + i) * nlag + k] = n > 0 ? R[LG_RATE + 2 * i + 1] / n - r1 * r1 : NAN;
     }
     out[LF_N * nlag + k] = n;
     out[LF_TAU * nlag + k] = n > 0 ? R[LG_TAU] / n : NAN; /* NaN: resumed from format <= 1.8 */
@@ -601,6 +607,10 @@ int lagr_nc_write(const struct lagr *g, int ncid, char *err, size_t errlen) {
       {LF_DR, "disp_mean_%c", "m", "mean displacement <%c(t0 + tau) - %c(t0)>", pos},
       {LF_DVAR, "disp_var_%c", "m^2",
        "variance of the displacement %c(t0 + tau) - %c(t0) about its mean", pos},
+      {LF_RVAR, "rate_var_%c", "m^2/s^2",
+       "variance of the interval-mean velocity (%c(t0 + tau) - %c(t0)) / tau, each sample over "
+       "its own actual lag tau (Taylor: <u_i'^2> at release as tau -> 0)",
+       pos},
   };
   const int d2[2] = {dl, dk};
   for (size_t j = 0; j < sizeof q / sizeof q[0]; j++)

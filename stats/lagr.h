@@ -46,13 +46,15 @@ enum {
   LG_DISP = LG_STRUCT + 9, /* 3 x sum dr^2 */
   LG_DR = LG_DISP + 3,     /* 3 x sum dr (checkpoint format 1.7) */
   LG_TAU = LG_DR + 3,      /* sum of the actual lags t - t0 of the samples (format 1.9) */
-  LG_LEN = LG_TAU + 1
+  LG_RATE = LG_TAU + 1,    /* 3 x [sum dr / tau, sum (dr / tau)^2], each sample over its own
+                              actual lag: the interval-mean velocity (format 1.10) */
+  LG_LEN = LG_RATE + 6
 };
 
-/** Sums per level and lag in checkpoints of format <= 1.6 (without LG_DR and LG_TAU) and of
-    format 1.7-1.8 (without LG_TAU): read into the layout above with the missing sums NaN where
-    the record has samples, 0 where not (lagr.c). */
-enum { LG_LEN_1_6 = LG_DR, LG_LEN_1_8 = LG_TAU };
+/** Sums per level and lag in checkpoints of format <= 1.6 (without LG_DR, LG_TAU and LG_RATE),
+    of format 1.7-1.8 (without LG_TAU and LG_RATE) and 1.9 (without LG_RATE): read into the
+    layout above with the missing sums NaN where the record has samples, 0 where not (lagr.c). */
+enum { LG_LEN_1_6 = LG_DR, LG_LEN_1_8 = LG_TAU, LG_LEN_1_9 = LG_RATE };
 
 /** Per tracked particle. */
 enum {
@@ -154,7 +156,8 @@ enum {
   LF_DVAR = 27, /* displacement variance about it (likewise) */
   LF_N = 30,
   LF_TAU = 31, /* mean actual lag time of the samples (NaN after a resume from format <= 1.8) */
-  LF_LEN
+  LF_RVAR = 32, /* variance of the interval-mean velocity dr / tau (NaN: from format <= 1.9) */
+  LF_LEN = 35
 };
 
 /**

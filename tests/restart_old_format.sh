@@ -2,19 +2,20 @@
 # Issue 25: a run cut at step N1 whose checkpoint is rewritten (h5py) as an older checkpoint
 # format writes it resumes to the end, and one group of stats.nc is compared with the
 # uninterrupted run's (restart_bitwise_all_stats, fixture ckpt_allstats). The rewrite removes
-# what the older format lacks: format <= 1.8 the sums of the actual lags (stats/lagrangian/sums
-# and slot_sums: 47 -> 46 per record), <= 1.7 the correlation engine's window records
-# (stats/correlations/windows, window_samples, window_spectra_1d), <= 1.6 the sums of the
-# displacements (46 -> 43 per record).
-#   lagr16, lagr18: group lagrangian bit for bit, except the variables the old records cannot
-#     give: lag_time_mean (and for 1.6 disp_mean_*, disp_var_*), fill values where the stored
-#     sums had samples (at least one) and otherwise equal.
+# what the older format lacks: format <= 1.9 the sums of the interval-mean velocities
+# (stats/lagrangian/sums and slot_sums: 53 -> 47 per record), <= 1.8 also those of the actual
+# lags (-> 46), <= 1.7 the correlation engine's window records (stats/correlations/windows,
+# window_samples, window_spectra_1d), <= 1.6 the sums of the displacements (-> 43).
+#   lagr16, lagr18, lagr19: group lagrangian bit for bit, except the variables the old records
+#     cannot give: rate_var_* (and for 1.8 lag_time_mean, for 1.6 also disp_mean_*,
+#     disp_var_*), fill values where the stored sums had samples (at least one) and otherwise
+#     equal.
 #   corr17: group correlations bit for bit, except n_batches, which counts only the complete
 #     windows after the one of the resume (fewer than the uninterrupted run's), the
 #     *_stderr, which are fill values with fewer than 2 batches and finite otherwise, and the
 #     window records of stats.nc (dimension window), which start at the window of the resume
 #     (flagged partial, not complete) and then equal the uninterrupted run's rows bit for bit.
-# usage: restart_old_format.sh lagr16|lagr18|corr17 CHANSPH SCENE RUNS N1 [--set k=v ...]
+# usage: restart_old_format.sh lagr16|lagr18|lagr19|corr17 CHANSPH SCENE RUNS N1 [--set k=v ...]
 set -u
 export CHANSPH_RUN_ID=compare-test
 mode=$1 chansph=$2 scene=$3 runs=$4 n1=$5
@@ -22,8 +23,9 @@ shift 5
 case $mode in
   lagr16) minor=6 part=$runs/lagr_format16_part ;;
   lagr18) minor=8 part=$runs/lagr_format18_part ;;
+  lagr19) minor=9 part=$runs/lagr_format19_part ;;
   corr17) minor=7 part=$runs/corr_format17_part ;;
-  *) echo "usage: $0 lagr16|lagr18|corr17 CHANSPH SCENE RUNS N1 [--set k=v ...]"; exit 2 ;;
+  *) echo "usage: $0 lagr16|lagr18|lagr19|corr17 CHANSPH SCENE RUNS N1 [--set k=v ...]"; exit 2 ;;
 esac
 full=$runs/bitwise_allstats_full
 rm -rf "$part"
@@ -37,11 +39,11 @@ import numpy as np
 path, minor = sorted(glob.glob(sys.argv[1] + "/checkpoints/ckpt_*.h5"))[-1], int(sys.argv[2])
 done = []
 with h5py.File(path, "a") as h:
-    assert h.attrs["format_version_minor"] == 9, h.attrs["format_version_minor"]
-    width = 46 if minor >= 7 else 43  # sums per record
+    assert h.attrs["format_version_minor"] == 10, h.attrs["format_version_minor"]
+    width = 47 if minor == 9 else 46 if minor >= 7 else 43  # sums per record
     for k in ("stats/lagrangian/sums", "stats/lagrangian/slot_sums"):
         a = h[k][()]
-        assert a.shape[2] == 47, (k, a.shape)
+        assert a.shape[2] == 53, (k, a.shape)
         del h[k]
         h.create_dataset(k, data=a[:, :, :width], chunks=a[:, :, :width].shape, fletcher32=True)
     done.append("Lagrangian sums %d per record" % width)
@@ -137,7 +139,8 @@ fa, fb = netCDF4.Dataset(sys.argv[1]), netCDF4.Dataset(sys.argv[2])
 if mode == "corr17":
     ok = corr(fa.groups["correlations"], fb.groups["correlations"])
 else:
-    unknown = ["lag_time_mean"] + (["disp_mean_", "disp_var_"] if mode == "lagr16" else [])
+    unknown = ["rate_var_"] + (["lag_time_mean"] if mode != "lagr19" else []) + \
+        (["disp_mean_", "disp_var_"] if mode == "lagr16" else [])
     ok = lagr(fa.groups["lagrangian"], fb.groups["lagrangian"], unknown)
 sys.exit(0 if ok else 1)
 PYEOF

@@ -219,14 +219,15 @@ def skewflat():
           "skewflat_compare: a profile 1e-6 off the window records FAILs (exit %d)" % rc)
 
 
-def lagr_file(path, scale_y=1.0, with_corr=True, means=None, lag_shift=None):
+def lagr_file(path, scale_y=1.0, with_corr=True, means=None, lag_shift=None, rate=None):
     """Ornstein-Uhlenbeck velocities: rho_L = exp(-tau/T), sigma^2 = 2 s2 T^2 (t/T - 1 + e^-t/T)
     (Taylor 1921), releases of N tracks at y+ 30 and 100; PDFs Gaussian. means = du: the
     Lagrangian means of checkpoint format 1.7 (u_release_mean ... disp_var_z), the mean u
     U + du; None: a file without them. lag_shift = s: the samples of every lag k > 0 were taken
     at the real lag k dtau + s, written as lag_time_mean (checkpoint format 1.9), and the
     functions are those of the real lags; NaN: lag_time_mean all fill values (a run resumed
-    from format 1.8); None: no lag_time_mean."""
+    from format 1.8); None: no lag_time_mean. rate = (fx, fy, fz): rate_var_x, _y, _z of
+    checkpoint format 1.10, the OU variance of dr / tau at the real lags times f."""
     T, nlag, H = 0.02, 120, 0.12  # horizon 6 T; lag interval 0.001
     nominal = np.arange(nlag + 1) * H / nlag
     t = nominal + (np.where(nominal > 0, lag_shift, 0.0) if lag_shift == lag_shift and
@@ -281,6 +282,10 @@ def lagr_file(path, scale_y=1.0, with_corr=True, means=None, lag_shift=None):
             var(g, "disp_var_x", ("level", "lag"), np.tile(disp(4.0), (2, 1)))
             var(g, "disp_var_y", ("level", "lag"), np.tile(scale_y * disp(0.5), (2, 1)))
             var(g, "disp_var_z", ("level", "lag"), np.tile(disp(1.0), (2, 1)))
+        if rate is not None:
+            for p, s2, f in zip("xyz", (4.0, 0.5, 1.0), rate):
+                rv = np.where(t > 0, f * disp(s2) / np.where(t > 0, t, 1.0) ** 2, 0.0)
+                var(g, "rate_var_" + p, ("level", "lag"), np.tile(rv, (2, 1)))
         for c in "uvw":
             var(g, "rho_L_" + c, ("level", "lag"), np.tile(np.exp(-t / T), (2, 1)))
         var(g, "n_tracks", ("level", "lag"), np.full((2, nlag + 1), float(nrel * N)))
@@ -370,6 +375,22 @@ def lagr():
           "lagr_check: a file with lag_time_mean takes the real lags from it (0.0014 s for the "
           "nominal 0.001): sigma_y^2/tau^2 is the OU value at the real lag, the short-time law "
           "holds (%s, exit %d) %s" % (short, rc, err.strip()))
+    # checkpoint format 1.10 on: var(dr / tau) with each sample over its own real lag
+    s3 = os.path.join(WORK, "lagr_rate.nc")
+    lagr_file(s3, means=0.0, lag_shift=0.0004, rate=(1.0, 1.0, 1.0))
+    rc, out, err = run("lagr_check", s3)
+    rows = re.findall(r"short-time (.): var\(\(.\(t0 \+ tau\) - .\(t0\)\) / tau\) = "
+                      r"([0-9.e+-]+) at the real lag 0.0014 s .*: (PASS|FAIL)", out)
+    rx = [float(x[1]) for x in rows if x[0] == "x"]
+    check(rc == 0 and len(rows) == 6 and all(x[2] == "PASS" for x in rows) and rx and
+          abs(rx[0] / 4.0 - 2 * (tau - 1 + math.exp(-tau)) / tau ** 2) < 1e-4,
+          "lagr_check: a file with rate_var_* compares var(dr / tau) with <u_i'^2> directly, "
+          "x included (the OU value at the real lag; %s, exit %d) %s" % (rows, rc, err.strip()))
+    lagr_file(s3, means=0.0, lag_shift=0.0004, rate=(2.0, 1.0, 1.0))
+    rc, out, _ = run("lagr_check", s3)
+    check(rc == 1 and re.search(r"short-time x: var.*FAIL", out) is not None and
+          re.search(r"short-time y: var.*PASS", out) is not None,
+          "lagr_check: a doubled rate_var_x FAILs the short-time law in x (exit %d)" % rc)
     s2 = os.path.join(WORK, "lagr_lagtime_fill.nc")
     lagr_file(s2, lag_shift=math.nan)
     rc, out, _ = run("lagr_check", s2)

@@ -4,8 +4,9 @@
  *        round-trips bitwise (a field sized on reading included); a write to a full disk
  *        (/dev/full) fails with the system's reason and leaves no file; a missing dataset and a
  *        wrong shape are named; the Lagrangian sums of a format 1.6 file (records without the
- *        sums of the displacements and of the actual lags) and of a format 1.8 file (without
- *        the sums of the actual lags) resume in the layout of format 1.9.
+ *        sums of the displacements, the actual lags and the interval-mean velocities), of a
+ *        format 1.8 file (without the last two) and of a 1.9 file (without the last) resume in
+ *        the layout of format 1.10.
  */
 #include <math.h>
 #include <stdint.h>
@@ -34,9 +35,9 @@ static void *reserve(void *owner, int rank, const size_t *dims) {
 }
 
 /* A checkpoint whose stats/lagrangian/sums and slot_sums have the records of an older format
-   (w = LG_LEN_1_6 wide in format 1.6, LG_LEN_1_8 in 1.7-1.8) is read by an engine of format
-   1.9: the stored sums as they were, the sums it lacks (of dr, of the actual lags) NaN where a
-   record has samples, 0 where not; a record of another width is refused, naming the file and
+   (w = LG_LEN_1_6 wide in format 1.6, LG_LEN_1_8 in 1.7-1.8, LG_LEN_1_9 in 1.9) is read by an
+   engine of format 1.10: the stored sums as they were, the sums it lacks (of dr, of the actual
+   lags, of the interval-mean velocities) NaN where a record has samples, 0 where not; a record of another width is refused, naming the file and
    the dataset. */
 static void lagr_format_old(const char *dir, size_t w, const char *version) {
   char path[256], err[2048], what[160];
@@ -94,7 +95,7 @@ static void lagr_format_old(const char *dir, size_t w, const char *version) {
   check(ckpt_read(path, &R, err, sizeof err) != 0 && strstr(err, "ckpt_lagr_old.h5") &&
             strstr(err,
                    "dataset /stats/lagrangian/sums has shape (1, 5, 44), this run needs "
-                   "(1, 5, 47)"),
+                   "(1, 5, 53)"),
         err);
   state_free(&L), state_free(&R);
   lagr_free(&a), lagr_free(&b);
@@ -192,6 +193,7 @@ int main(void) {
   free(info.scene);
   lagr_format_old(dir, LG_LEN_1_6, "1.6");
   lagr_format_old(dir, LG_LEN_1_8, "1.8");
+  lagr_format_old(dir, LG_LEN_1_9, "1.9");
   remove(path), rmdir(dir);
   state_free(&L), state_free(&R), state_free(&M), state_free(&S), state_free(&T);
   free(text), free(text2);

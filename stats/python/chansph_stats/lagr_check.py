@@ -22,6 +22,14 @@ interpolated to it):
    checkpoint's sums give the clock below and <dx>^2 = (tau (<u(t0)> + <u(t0 + tau)>) / 2)^2 is
    subtracted; for older files without --ckpt (or a run resumed from a checkpoint of format
    1.6, whose disp_var_* are fill values) the Eulerian U(y0) stands in for the mean drift of x.
+   lag_time_mean is the mean real lag; each release has its own (all its particles are sampled
+   at one step), within one sampling interval ds of the nominal lag, so the variance about the
+   mean displacement also holds D^2 var(tau_r) (D the mean drift velocity: U(y0) in x, about
+   0 in y and z), which the check bounds by D^2 (m - tau_k)(tau_k + ds - m), m the mean real
+   lag, and removes as a range (it matters in x only: 17^2 x 1e-6 s^2 against tau^2 = 4e-5 s^2).
+   Files of checkpoint format 1.10 on hold the variance of the interval-mean velocity
+   (r_i(t0 + tau) - r_i(t0)) / tau with each sample over its own real lag (rate_var_x, _y, _z):
+   drift and lag spread both gone, it is compared with <u_i'^2> directly (a sharp test in x).
    Standard error: stats.nc holds only the sums over all releases, no per-release values, so it
    is modelled: a release samples N = n_tracks / releases particles on a line along z (and
    its mirror); their u_i^2 has variance (F - 1) <u_i'^2>^2 (F the Eulerian flatness) and
@@ -65,7 +73,7 @@ POS = ("x", "y", "z")
 # layout of stats/lagrangian/sums (stats/lagr.h): n, then per u, v, w [S0, St, S00, Stt, S0t];
 # records of 43 sums up to checkpoint format 1.6, 46 (the sums of dr added at the end) in 1.7-1.8,
 # 47 (the sum of the actual lags added at the end) from 1.9
-LG_N, LG_VEL, LG_LENS = 0, 1, (43, 46, 47)
+LG_N, LG_VEL, LG_LENS = 0, 1, (43, 46, 47, 53)
 # Lagrangian means in group lagrangian (from checkpoint format 1.7 on)
 MEANS = ["%s_release_mean" % c for c in COMP] + ["%s_lag_mean" % c for c in COMP] + \
     ["disp_mean_" + p for p in POS] + ["disp_var_" + p for p in POS]
@@ -84,6 +92,9 @@ def read_run(path, how):
         # the mean real lag of the samples (checkpoint format 1.9 on)
         r["lag_time"] = values(g.variables["lag_time_mean"]) \
             if "lag_time_mean" in g.variables else None
+        # the variance of the interval-mean velocity dr / tau (checkpoint format 1.10 on)
+        r["rate_var"] = {p: values(g.variables["rate_var_" + p]) for p in POS} \
+            if all("rate_var_" + p in g.variables for p in POS) else None
         if r["means"]:
             for k in MEANS:
                 r[k] = values(g.variables[k])
@@ -222,6 +233,23 @@ def release_se(r, l, nper, c, E):
     return E[c + c] * math.sqrt(max(F - 1.0, 0.0) / neff), neff, how + ", releases / %.2g" % g
 
 
+def lag_jitter(r, l, k, p, real):
+    """The most that the spread of the real lags can add to the displacement variance of axis p
+    at lag k of level l. All particles of a release are sampled at one step, so each release
+    has its own real lag tau_r in [tau_k, tau_k + ds); the displacement about the ensemble mean
+    then holds D^2 var(tau_r), D the mean drift velocity, and a variable on that interval with
+    mean m = lag_time_mean has var <= (m - tau_k)(tau_k + ds - m) (Bhatia-Davis). ds: the
+    larger of the file's mean sampling interval and the largest real - nominal lag seen; 0
+    without lag_time_mean."""
+    if real != real:
+        return 0.0
+    has = r["n_tracks"][l] > 0
+    ds = max(np.nan_to_num(r["ds"]), float(np.max((r["t_level"] - r["lag"])[has])))
+    a = r["lag"][k]
+    drift = r["disp_mean_" + p][l][k] / real
+    return drift ** 2 * max(0.0, (real - a) * (a + ds - real))
+
+
 def short_time(r, l, sums, E, ds):
     """Rows of point 1 for level l: (axis, text, verdict)."""
     n = r["n_tracks"][l]
@@ -267,12 +295,28 @@ def short_time(r, l, sums, E, ds):
            (real, k, tau) if real == real else "for the real lag between %.4g and %.4g s (lag %d; "
            "no --ckpt for the clock)" % (lo, hi, k))
     for p, c in zip(POS, COMP):
+        rate = r["rate_var"][p][l][k] if r["rate_var"] else math.nan
+        if rate == rate:  # format 1.10 on: var(dr / tau), each sample over its own real lag
+            se, neff, how = release_se(r, l, n[k], c, E)
+            se = math.hypot(se, np.nan_to_num(E[c + c + "_stderr"]))
+            ok = abs(rate - E[c + c]) <= 2 * se
+            rows.append((p, "var((%s(t0 + tau) - %s(t0)) / tau) = %.5g at the real lag %.4g s "
+                         "(lag %d, each sample over its own lag: rate_var_%s), Eulerian <%s'^2> "
+                         "%.5g, difference %+.1f%%, 2 se %.3g (N_eff %.0f; %s)" %
+                         (p, p, rate, real, k, p, c, E[c + c], 100 * (rate / E[c + c] - 1),
+                          2 * se, neff, how), "PASS" if ok else "FAIL"))
+            continue
         s2 = r["sigma2_" + p][l][k]
         dvar = r["disp_var_" + p][l][k] if r["means"] else math.nan
         if dvar == dvar:  # the variance about the mean displacement (format 1.7 on)
             s2 = dvar
-        v_hi, v_lo = s2 / lo ** 2, s2 / hi ** 2
+        jitter = lag_jitter(r, l, k, p, real) if dvar == dvar else 0.0
+        v_hi, v_lo = s2 / lo ** 2, (s2 - jitter) / hi ** 2
         se, neff, how = release_se(r, l, n[k], c, E)
+        if jitter > 0:
+            how += ("; lag jitter: the releases' real lags differ within a sampling interval, "
+                    "which the mean drift turns into up to %.3g of sigma^2/tau^2 (the range)"
+                    % (jitter / hi ** 2))
         if dvar == dvar:
             how += "; drift removed (disp_var_%s, mean displacement %.4g m)" % (
                 p, r["disp_mean_" + p][l][k])
