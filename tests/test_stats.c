@@ -746,7 +746,11 @@ static void test_lagr_drift(void) {
 /* Issue 25: with a varying sampling interval the samples of lag k fall at the first
    statistics sample at or after t0 + k dtau, not on the nominal lag. lag_time_mean (LF_TAU)
    is the mean over the samples of (sample time - release time), computed here from the sample
-   times alone, to 1e-12; it lies in [k dtau, k dtau + the largest sampling interval]. */
+   times alone, to 1e-12; it lies in [k dtau, k dtau + the largest sampling interval]. The
+   particles move along x at fixed speeds u_p = 0.01 p: each sample's interval-mean velocity
+   dx / tau is u_p whatever its actual lag, so rate_var_x (LF_RVAR) is the variance of the u_p
+   at every lag > 0, to 1e-12, while disp_var_x / lag_time_mean^2 is not (the releases' lags
+   differ, and the mean drift turns that into displacement variance). */
 static void test_lagr_lag_times(void) {
   enum { NPART = 50, RELEASES = 12, NLAG = 8 };
   /* sampling intervals: with the irrational 1e-3 sqrt(2) no sum of them is a multiple of dtau */
@@ -769,19 +773,28 @@ static void test_lagr_lag_times(void) {
   double want[NLAG + 1] = {0}, t = 0.0, t0 = 0.0;
   int r = 0, k = NLAG + 1; /* releases so far, next lag of the current one */
   for (long n = 0; t < RELEASES * every; t += DT[n % 5], n++) {
-    if (t >= r * every) t0 = t, r++, k = 0; /* a release: the first sample at or after r every */
+    if (t >= r * every) { /* a release: the first sample at or after r every, from x = 0 */
+      t0 = t, r++, k = 0;
+      for (int p = 0; p < NPART; p++) x[p] = 0.0;
+    }
     if (k <= NLAG && t >= t0 + k * dtau) want[k++] += (t - t0) / RELEASES;
     const struct stats_snapshot snap = {
         .n = NPART, .x = x, .y = y, .z = z, .u = u, .v = u, .w = u, .id = id, .t = t};
     lagr_sample(&g, &snap);
+    for (int p = 0; p < NPART; p++) x[p] += u[p] * DT[n % 5];
   }
   const size_t nlag = NLAG + 1;
-  double fn[LF_LEN * (NLAG + 1)], tl[3], err = 0.0, off = 0.0;
+  const double var_u = 1e-4 * (NPART * NPART - 1) / 12.0; /* of 0.01 p, p = 0 .. NPART - 1 */
+  double fn[LF_LEN * (NLAG + 1)], tl[3], err = 0.0, off = 0.0, rerr = 0.0, naive = 0.0;
   int inside = 1;
   lagr_functions(&g, 0, fn, tl);
   for (size_t j = 0; j < nlag; j++) {
     const double m = fn[LF_TAU * nlag + j], nominal = (double)j * dtau;
     err = fmax(err, fabs(m - want[j]));
+    if (j > 0) {
+      rerr = fmax(rerr, fabs(fn[LF_RVAR * nlag + j] - var_u));
+      naive = fmax(naive, fabs(fn[LF_DVAR * nlag + j] / (m * m) - var_u));
+    }
     off = fmax(off, m - nominal);
     inside =
         inside && m >= nominal && m <= nominal + dtmax && fn[LF_N * nlag + j] == NPART * RELEASES;
@@ -792,6 +805,12 @@ static void test_lagr_lag_times(void) {
       (int)g.releases, dtau, err, off);
   EXPECT(g.releases == RELEASES && k == NLAG + 1, "releases %g", g.releases);
   EXPECT(err <= 1e-12, "lag_time_mean is not the mean actual lag (%g)", err);
+  printf(
+      "  rate_var_x - var(u_p) at most %.3g (var %.5g); disp_var_x / lag_time_mean^2 off by up "
+      "to %.3g\n",
+      rerr, var_u, naive);
+  EXPECT(rerr <= 1e-12 && naive > 1e-4, "rate_var_x is not var(dx / tau) (%g, naive %g)", rerr,
+         naive);
   EXPECT(inside && off > 0.01, "lag_time_mean outside [nominal, nominal + dt] or on nominal");
   lagr_free(&g);
 }
