@@ -155,7 +155,7 @@ enum {
   LF_DR = 24,   /* mean displacement (NaN after a resume from format <= 1.6) */
   LF_DVAR = 27, /* displacement variance about it (likewise) */
   LF_N = 30,
-  LF_TAU = 31, /* mean actual lag time of the samples (NaN after a resume from format <= 1.8) */
+  LF_TAU = 31,  /* mean actual lag time of the samples (NaN after a resume from format <= 1.8) */
   LF_RVAR = 32, /* variance of the interval-mean velocity dr / tau (NaN: from format <= 1.9) */
   LF_LEN = 35
 };

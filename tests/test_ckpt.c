@@ -37,8 +37,8 @@ static void *reserve(void *owner, int rank, const size_t *dims) {
 /* A checkpoint whose stats/lagrangian/sums and slot_sums have the records of an older format
    (w = LG_LEN_1_6 wide in format 1.6, LG_LEN_1_8 in 1.7-1.8, LG_LEN_1_9 in 1.9) is read by an
    engine of format 1.10: the stored sums as they were, the sums it lacks (of dr, of the actual
-   lags, of the interval-mean velocities) NaN where a record has samples, 0 where not; a record of another width is refused, naming the file and
-   the dataset. */
+   lags, of the interval-mean velocities) NaN where a record has samples, 0 where not; a record of
+   another width is refused, naming the file and the dataset. */
 static void lagr_format_old(const char *dir, size_t w, const char *version) {
   char path[256], err[2048], what[160];
   snprintf(path, sizeof path, "%s/ckpt_lagr_old.h5", dir);
