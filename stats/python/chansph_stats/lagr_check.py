@@ -233,6 +233,14 @@ def release_se(r, l, nper, c, E):
     return E[c + c] * math.sqrt(max(F - 1.0, 0.0) / neff), neff, how + ", releases / %.2g" % g
 
 
+def release_test(r, l, nper, c, E, value):
+    """The modelled standard error of value (a release-ensemble <u_i'^2>) with the Eulerian one
+    in quadrature, and whether value is within two of them of the Eulerian <u_i'^2>."""
+    se, neff, how = release_se(r, l, nper, c, E)
+    se = math.hypot(se, np.nan_to_num(E[c + c + "_stderr"]))
+    return se, neff, how, abs(value - E[c + c]) <= 2 * se
+
+
 def lag_jitter(r, l, k, p, real):
     """The most that the spread of the real lags can add to the displacement variance of axis p
     at lag k of level l. All particles of a release are sampled at one step, so each release
@@ -280,9 +288,7 @@ def short_time(r, l, sums, E, ds):
             kin = s2 / q[i]
             ok_kin = abs(kin - 1) <= 0.03
             val = s2 - mean[i] ** 2
-            se, neff, how = release_se(r, l, n[k], c, E)
-            se = math.hypot(se, np.nan_to_num(E[c + c + "_stderr"]))
-            ok = abs(val - E[c + c]) <= 2 * se
+            se, neff, how, ok = release_test(r, l, n[k], c, E, val)
             rows.append((p, "sigma_%s^2/tau^2 = %.5g = %.4f x <((%s(t0) + %s(t0 + tau)) / 2)^2> "
                          "(kinematics, within 3%%: %s); minus the mean drift %.5g, Eulerian "
                          "<%s'^2> %.5g, difference %+.4g (%+.1f%%), 2 se %.3g (N_eff %.0f; %s)" %
@@ -297,9 +303,7 @@ def short_time(r, l, sums, E, ds):
     for p, c in zip(POS, COMP):
         rate = r["rate_var"][p][l][k] if r["rate_var"] else math.nan
         if rate == rate:  # format 1.10 on: var(dr / tau), each sample over its own real lag
-            se, neff, how = release_se(r, l, n[k], c, E)
-            se = math.hypot(se, np.nan_to_num(E[c + c + "_stderr"]))
-            ok = abs(rate - E[c + c]) <= 2 * se
+            se, neff, how, ok = release_test(r, l, n[k], c, E, rate)
             rows.append((p, "var((%s(t0 + tau) - %s(t0)) / tau) = %.5g at the real lag %.4g s "
                          "(lag %d, each sample over its own lag: rate_var_%s), Eulerian <%s'^2> "
                          "%.5g, difference %+.1f%%, 2 se %.3g (N_eff %.0f; %s)" %
