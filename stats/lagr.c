@@ -558,6 +558,32 @@ done:
   return rc;
 }
 
+/* The per-level, per-lag functions of group lagrangian, three components each: their row of
+   lagr_functions(), name and long-name patterns (%c: the component letter) and units. */
+static const char LAGR_COMP[] = "uvw", LAGR_POS[] = "xyz";
+static const struct {
+  int row;
+  const char *fmt, *units, *lfmt;
+  const char *letters;
+} lagr_rows[] = {
+    {LF_RHO_L, "rho_L_%c", "1", "Lagrangian velocity autocorrelation of %c (Eq. 5.60)", LAGR_COMP},
+    {LF_RHO_A, "rho_a_%c", "1", "Lagrangian acceleration autocorrelation of a_%c (Eq. 5.62)",
+     LAGR_COMP},
+    {LF_D, "D_%c", "m^2/s^2", "second-order structure function of %c (Eq. 5.63)", LAGR_COMP},
+    {LF_S, "S_%c", "m^3/s^3", "third-order structure function of %c (Eq. 5.64)", LAGR_COMP},
+    {LF_K, "K_%c", "m^4/s^4", "fourth-order structure function of %c (Eq. 5.65)", LAGR_COMP},
+    {LF_SIG2, "sigma2_%c", "m^2", "dispersion <(%c(t0 + tau) - %c(t0))^2> (Eq. 5.66)", LAGR_POS},
+    {LF_U0, "%c_release_mean", "m/s", "Lagrangian mean velocity at release <%c(t0)>", LAGR_COMP},
+    {LF_UT, "%c_lag_mean", "m/s", "Lagrangian mean velocity at the lag <%c(t0 + tau)>", LAGR_COMP},
+    {LF_DR, "disp_mean_%c", "m", "mean displacement <%c(t0 + tau) - %c(t0)>", LAGR_POS},
+    {LF_DVAR, "disp_var_%c", "m^2",
+     "variance of the displacement %c(t0 + tau) - %c(t0) about its mean", LAGR_POS},
+    {LF_RVAR, "rate_var_%c", "m^2/s^2",
+     "variance of the interval-mean velocity (%c(t0 + tau) - %c(t0)) / tau, each sample over "
+     "its own actual lag tau (Taylor: <u_i'^2> at release as tau -> 0)",
+     LAGR_POS},
+};
+
 int lagr_nc_write(const struct lagr *g, int ncid, char *err, size_t errlen) {
   const struct lagr_config *c = &g->cfg;
   const int nl = c->n_levels, ns = c->n_stations, nb = c->pdf_bins;
@@ -589,39 +615,17 @@ int lagr_nc_write(const struct lagr *g, int ncid, char *err, size_t errlen) {
   CK(nc_put_var_double(gr, v, tmp));
   static const char *const components[3] = {"u", "v", "w"};
   CK(ncout_labels(gr, "component", dc, "velocity component", components));
-  static const char *const comp = "uvw", *const pos = "xyz";
-  const struct {
-    int row;
-    const char *fmt, *units, *lfmt;
-    const char *letters;
-  } q[] = {
-      {LF_RHO_L, "rho_L_%c", "1", "Lagrangian velocity autocorrelation of %c (Eq. 5.60)", comp},
-      {LF_RHO_A, "rho_a_%c", "1", "Lagrangian acceleration autocorrelation of a_%c (Eq. 5.62)",
-       comp},
-      {LF_D, "D_%c", "m^2/s^2", "second-order structure function of %c (Eq. 5.63)", comp},
-      {LF_S, "S_%c", "m^3/s^3", "third-order structure function of %c (Eq. 5.64)", comp},
-      {LF_K, "K_%c", "m^4/s^4", "fourth-order structure function of %c (Eq. 5.65)", comp},
-      {LF_SIG2, "sigma2_%c", "m^2", "dispersion <(%c(t0 + tau) - %c(t0))^2> (Eq. 5.66)", pos},
-      {LF_U0, "%c_release_mean", "m/s", "Lagrangian mean velocity at release <%c(t0)>", comp},
-      {LF_UT, "%c_lag_mean", "m/s", "Lagrangian mean velocity at the lag <%c(t0 + tau)>", comp},
-      {LF_DR, "disp_mean_%c", "m", "mean displacement <%c(t0 + tau) - %c(t0)>", pos},
-      {LF_DVAR, "disp_var_%c", "m^2",
-       "variance of the displacement %c(t0 + tau) - %c(t0) about its mean", pos},
-      {LF_RVAR, "rate_var_%c", "m^2/s^2",
-       "variance of the interval-mean velocity (%c(t0 + tau) - %c(t0)) / tau, each sample over "
-       "its own actual lag tau (Taylor: <u_i'^2> at release as tau -> 0)",
-       pos},
-  };
   const int d2[2] = {dl, dk};
-  for (size_t j = 0; j < sizeof q / sizeof q[0]; j++)
+  for (size_t j = 0; j < sizeof lagr_rows / sizeof lagr_rows[0]; j++)
     for (int i = 0; i < 3; i++) {
       char name[32], ln[160];
-      snprintf(name, sizeof name, q[j].fmt, q[j].letters[i]);
-      snprintf(ln, sizeof ln, q[j].lfmt, q[j].letters[i], q[j].letters[i]);
-      CK(ncout_def(gr, name, NC_DOUBLE, 2, d2, q[j].units, ln, &v));
+      snprintf(name, sizeof name, lagr_rows[j].fmt, lagr_rows[j].letters[i]);
+      snprintf(ln, sizeof ln, lagr_rows[j].lfmt, lagr_rows[j].letters[i], lagr_rows[j].letters[i]);
+      CK(ncout_def(gr, name, NC_DOUBLE, 2, d2, lagr_rows[j].units, ln, &v));
       CK(ncout_fill(gr, v));
       for (int l = 0; l < nl; l++)
-        CK(put_rows(gr, v, l, nlag, fn + ((size_t)l * LF_LEN + (size_t)(q[j].row + i)) * nlag));
+        CK(put_rows(gr, v, l, nlag,
+                    fn + ((size_t)l * LF_LEN + (size_t)(lagr_rows[j].row + i)) * nlag));
     }
   CK(ncout_def(gr, "n_tracks", NC_DOUBLE, 2, d2, "1", "particle samples at each lag", &v));
   for (int l = 0; l < nl; l++)
