@@ -204,21 +204,22 @@ static int join_stored(struct stored *seg, int n, char *const *paths) {
   struct stored *s = &seg[0];
   double offset = 0.0;
   int bad = 0;
-  for (int k = 1; k < n && !bad; k++) {
+  for (int k = 1; k < n; k++) {
     const struct stored *b = &seg[k];
     offset += seg[k - 1].t_reached;
     if (!isfinite(seg[k - 1].t_reached)) {
       fprintf(stderr, "error: %s: no attribute t_reached: cannot place the next segment\n",
               paths[k - 1]);
       bad = 1;
-    } else if (!same_gathering(s, b, paths[0], paths[k])) {
-      bad = 1;
     }
-    if (bad) break;
+    if (bad || !same_gathering(s, b, paths[0], paths[k])) {
+      bad = 1;
+      break;
+    }
     /* the open last window of the segment before: whole if the segment ran to its end (the
        snapshot that would have closed it is the next segment's first); else left out */
-    const double *last = s->win + (s->rows ? s->rows - 1 : 0) * WIN_LEN;
     if (s->rows && !s->complete[s->rows - 1]) {
+      const double *last = s->win + (s->rows - 1) * WIN_LEN;
       if (last[WIN_T1] <= offset + 1e-6 * s->cfg.window)
         s->complete[s->rows - 1] = 1;
       else
@@ -296,6 +297,11 @@ struct extract_args {
   int pdfs;           /* --pdfs */
   const char *nc_out; /* --nc: write the range as a stats.nc instead of a table */
 };
+
+/* What follows the first file's name in messages: the later segments, if any. */
+static const char *later_segments(const struct extract_args *a) {
+  return a->npaths > 1 ? " and its later segments" : "";
+}
 
 /* Parse the command line (argv[0]: the command name); 1: input error, -1: --help printed. */
 static int extract_parse(int argc, char **argv, struct extract_args *a) {
@@ -415,8 +421,7 @@ static void extract_header(const struct extract_args *a, const struct stored *s,
   printf(
       "# chansph extract %s%s: windows %zu..%zu, t = %.9g .. %.9g s, %.0f snapshots, %d "
       "batches\n",
-      a->path, a->npaths > 1 ? " and its later segments" : "", r0, r1 - 1, res->t0, t_last,
-      res->snapshots, res->n_batches);
+      a->path, later_segments(a), r0, r1 - 1, res->t0, t_last, res->snapshots, res->n_batches);
   printf(
       "# u_tau = %.9g m/s (wall shear %.9g, force balance %.9g, stderr %.3g), Re_tau = %.6g, "
       "correlation time %.4g s, stress balance error %.4g\n",
@@ -717,8 +722,8 @@ static int write_range(const struct extract_args *a, const struct stored *s, siz
   euler_free(&e);
   if (rc == NC_NOERR && rename(tmp, a->nc_out) == 0) {
     printf("chansph extract: %s%s: windows %zu..%zu (t = %.9g .. %.9g s, %.0f snapshots) -> %s\n",
-           a->path, a->npaths > 1 ? " and its later segments" : "", r0, r1 - 1,
-           s->win[r0 * WIN_LEN + WIN_T0], t_end, snaps, a->nc_out);
+           a->path, later_segments(a), r0, r1 - 1, s->win[r0 * WIN_LEN + WIN_T0], t_end, snaps,
+           a->nc_out);
     if (k.q1 > k.q0)
       printf("chansph extract: %s: group correlations re-averaged over its windows %zu..%zu\n",
              a->path, k.q0, k.q1 - 1);
