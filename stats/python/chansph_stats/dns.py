@@ -146,6 +146,35 @@ def read_dns(path):
                      "or LM_Channel_RetauNNN.txt (Lee & Moser 2015)" % path)
 
 
+def through_bins(dns, lo, hi, at, n=400):
+    """The DNS as a particle-binned profile sees it (chansph compare --binned). A bin's
+    estimate averages its particles, which spread over the bin, so its mean velocity is the
+    bin average of U+ and its u'u' the bin average of <u'u'> plus the spread of the mean
+    velocity over the bin, var(U+) (the mean shear broadens it: (dU+/dy+)^2 w+^2 / 12 for a
+    bin of width w+ in a linear profile); v, w and u'v' gain nothing (V = 0). The particles are
+    taken as uniform over the widest interval inside the bin [lo, hi] centred on their mean
+    position `at` (the wall bin's particles keep off the wall). lo, hi, at: arrays in y+.
+    Returns {quantity: values at the bins} for the QUANTITIES the set has."""
+    half = np.maximum(np.minimum(at - lo, hi - at), 0.0)
+    t = (np.arange(n) + 0.5) / n * 2.0 - 1.0  # midpoint rule over [-1, 1]
+    y = at[:, None] + half[:, None] * t[None, :]
+
+    def over(v):
+        return np.interp(y, dns["yplus"], v)
+    out = {}
+    if dns.get("U+") is not None:
+        u = over(dns["U+"])
+        out["U+"] = u.mean(axis=1)
+        spread = u.var(axis=1)
+    for q in ("u_rms+", "v_rms+", "w_rms+"):
+        if dns.get(q) is not None:
+            s2 = (over(dns[q]) ** 2).mean(axis=1)
+            out[q] = np.sqrt(s2 + (spread if q == "u_rms+" and "U+" in out else 0.0))
+    if dns.get("-u'v'+") is not None:
+        out["-u'v'+"] = over(dns["-u'v'+"]).mean(axis=1)
+    return out
+
+
 def rel_l2(prof, dns, q):
     """Relative L2 error rms(prof - DNS) / rms(DNS) of quantity q over the bins of profile prof
     inside the DNS's y+ range (NaN where there are none)."""
