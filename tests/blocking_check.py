@@ -23,14 +23,7 @@ ROOT, RUN, SPAN = sys.argv[1], sys.argv[2], sys.argv[3]
 sys.path.insert(0, os.path.join(ROOT, "stats", "python"))
 from chansph_stats.blocking import QUANTITIES, blocking, window_quantities  # noqa: E402
 from chansph_stats.merge import pooled_windows, window_profile  # noqa: E402
-
-FAILS = []
-
-
-def check(ok, what):
-    print("%s: %s" % ("PASS" if ok else "FAIL", what))
-    if not ok:
-        FAILS.append(what)
+from passfail import check, finish  # noqa: E402
 
 
 rng = np.random.default_rng(1)
@@ -65,4 +58,4 @@ out = subprocess.run([os.path.join(ROOT, "stats", "python", "chansph-stats"), "b
 print(out.stdout, end="")
 check(out.returncode == 0 and all(q in out.stdout for q in QUANTITIES),
       f"the command (exit {out.returncode}) prints all {len(QUANTITIES)} quantities {out.stderr}")
-sys.exit(1 if FAILS else 0)
+finish()

@@ -20,14 +20,7 @@ import numpy as np
 ROOT, CHANSPH, STATS, OUT = sys.argv[1:5]
 sys.path.insert(0, os.path.join(ROOT, "stats", "python"))
 from chansph_stats.dns import through_bins  # noqa: E402
-
-FAILS = []
-
-
-def check(ok, what):
-    print("%s: %s" % ("PASS" if ok else "FAIL", what))
-    if not ok:
-        FAILS.append(what)
+from passfail import check, finish  # noqa: E402
 
 
 a, n = 0.5, 400
@@ -71,4 +64,4 @@ check(rc == 0 and any(k[0] == "u_rms+" for k in changed),
 rc, out = compare(mkm, "--dns", mkm, "--out", OUT + "/dns", "--binned")
 check(rc == 1 and "no bin bounds" in out and "Traceback" not in out,
       "a DNS file with --binned: refused, exit 1 (%d: %s)" % (rc, out.strip()[-120:]))
-sys.exit(1 if FAILS else 0)
+finish()

@@ -31,6 +31,7 @@ import numpy as np
 ROOT, WORK, PART = sys.argv[1], sys.argv[2], sys.argv[3]
 sys.path.insert(0, os.path.join(ROOT, "stats", "python"))
 from chansph_stats import budget_compare as bc  # noqa: E402
+from passfail import check, finish  # noqa: E402
 
 TOOL = os.path.join(ROOT, "stats", "python", "chansph-stats")
 BAL = os.path.join(ROOT, "stats", "dns", "mkm1999", "balances")
@@ -41,13 +42,6 @@ SCALE = UT ** 4 / NU  # physical = wall units * SCALE
 LEVELS = (10.0, 15.0, 30.0, 50.0)
 COMP = ("uu", "vv", "ww", "uv", "k")
 TOL = 1e-6
-FAILS = []
-
-
-def check(ok, what):
-    print("%s: %s" % ("PASS" if ok else "FAIL", what))
-    if not ok:
-        FAILS.append(what)
 
 
 def run(*args):
@@ -299,5 +293,4 @@ def errors():
 
 os.makedirs(WORK, exist_ok=True)
 {"folded": folded, "unfolded": unfolded, "compare": compare, "errors": errors}[PART]()
-print("%s: %s" % (PART, "FAIL (%d)" % len(FAILS) if FAILS else "PASS"))
-sys.exit(1 if FAILS else 0)
+finish(PART)

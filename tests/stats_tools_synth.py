@@ -26,19 +26,13 @@ import sys
 
 import netCDF4
 import numpy as np
+from passfail import check, finish  # noqa: E402
 
 ROOT, WORK, PART = sys.argv[1], sys.argv[2], sys.argv[3]
 TOOL = os.path.join(ROOT, "stats", "python", "chansph-stats")
 MKM = os.path.join(ROOT, "stats", "dns", "mkm1999")
 NU, DELTA, LX, LZ, DR = 1 / 180.0, 1.0, 2.0, 0.7, 0.025
 NX, NZ = 80, 28
-FAILS = []
-
-
-def check(ok, what):
-    print("%s: %s" % ("PASS" if ok else "FAIL", what))
-    if not ok:
-        FAILS.append(what)
 
 
 def run(*args):
@@ -502,5 +496,4 @@ def errors():
 
 os.makedirs(WORK, exist_ok=True)
 {"spectra": spectra, "skewflat": skewflat, "lagr": lagr, "errors": errors}[PART]()
-print("%s: %s" % (PART, "FAIL (%d)" % len(FAILS) if FAILS else "PASS"))
-sys.exit(1 if FAILS else 0)
+finish(PART)
