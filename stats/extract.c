@@ -196,6 +196,21 @@ static void append_rows(double **a, size_t rows_a, const double *b, size_t rows_
   memcpy(*a + rows_a * len, b, rows_b * len * sizeof(double));
 }
 
+/* Shift by offset the times of rows r0 .. r1-1 of s: the windows' bounds, and the times of the
+   first and last budget snapshot that the momentum and Reynolds-stress budgets keep (their
+   rates of change divide by the span between them; rows without a snapshot keep zeros). */
+static void shift_times(struct stored *s, size_t r0, size_t r1, double offset) {
+  const size_t nb = (size_t)s->cfg.nb;
+  for (size_t r = r0; r < r1; r++) {
+    s->win[r * WIN_LEN + WIN_T0] += offset, s->win[r * WIN_LEN + WIN_T1] += offset;
+    for (size_t b = 0; b < nb; b++) {
+      double *P = s->pln + (r * nb + b) * PL_LEN, *W = s->rsb + (r * nb + b) * RW_LEN;
+      if (P[PL_N] > 0.0) P[PL_T_FIRST] += offset, P[PL_T_LAST] += offset;
+      if (W[RW_SUM + RB_N] > 0.0) W[RW_T_FIRST] += offset, W[RW_T_LAST] += offset;
+    }
+  }
+}
+
 /* The segments seg[0..n-1] (paths) of one run, each started from the final state of the one
    before (init.from), joined into seg[0] as the windows of one run: each segment's times
    shifted by the sum of the reached times of those before it (each starts at t = 0). The
@@ -230,13 +245,12 @@ static int join_stored(struct stored *seg, int n, char *const *paths) {
     }
     const size_t nb = (size_t)s->cfg.nb, ra = s->rows, rb = b->rows;
     append_rows(&s->win, ra, b->win, rb, WIN_LEN);
-    for (size_t r = ra; r < ra + rb; r++)
-      s->win[r * WIN_LEN + WIN_T0] += offset, s->win[r * WIN_LEN + WIN_T1] += offset;
     append_rows(&s->mom, ra, b->mom, rb, nb * MOM_LEN);
     append_rows(&s->snp, ra, b->snp, rb, nb * SCAL_LEN);
     append_rows(&s->pln, ra, b->pln, rb, nb * PL_LEN);
     append_rows(&s->kin, ra, b->kin, rb, nb * KN_LEN);
     append_rows(&s->rsb, ra, b->rsb, rb, nb * RW_LEN);
+    shift_times(s, ra, ra + rb, offset);
     s->complete = mem_realloc(s->complete, ra + rb, sizeof(int), "chansph extract");
     memcpy(s->complete + ra, b->complete, rb * sizeof(int));
     s->rows = ra + rb, s->t_reached = offset + b->t_reached;

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # chansph extract A.nc B.nc --nc J.nc: the segments of one run (B started from A's final state
 # with init.from, as a long run continued on another machine) joined into one stats.nc. Its raw
-# windows are A's then B's, B's times shifted by A's reached time and A's last window (open at
-# A's end) counted; the profiles of each part of J equal those of its segment alone, to the
+# windows are A's then B's, B's times (window bounds, the budgets' first and last snapshot
+# times) shifted by A's reached time and A's last window (open at A's end) counted; the profiles of each part of J equal those of its segment alone, to the
 # printed digit; `chansph compare` reads J; a segment gathered otherwise (another window length)
 # is an input error naming the file and the key (exit 1, no J left).
 # usage: extract_join_check.sh CHANSPH SCENE STATS_RUN DNS WORK
@@ -35,9 +35,18 @@ shifted[:, :2] += ta
 bad = []
 if not np.array_equal(wj, np.concatenate([wa, shifted])):
     bad.append("windows are not A's then B's shifted by A's t_reached")
-for v in ("moments", "snapshot_u", "planes", "planes_kinetic", "reynolds_budget"):
+for v in ("moments", "snapshot_u", "planes_kinetic"):
     if not np.array_equal(gj[v][:], np.concatenate([ga[v][:], gb[v][:]])):
         bad.append(f"{v} is not A's then B's")
+# the budgets keep the times of their first and last snapshot (their rates of change divide by
+# the span): B's are shifted too, where a row has snapshots (planes: count 0, times 9, 10;
+# reynolds_budget: count 0, times 134, 135, the last two fields)
+for v, n, times in (("planes", 0, (9, 10)), ("reynolds_budget", 0, (-2, -1))):
+    pb = np.array(gb[v][:])
+    for k in times:
+        pb[..., k] = np.where(pb[..., n] > 0, pb[..., k] + ta, pb[..., k])
+    if not (pb[..., n] > 0).any() or not np.array_equal(gj[v][:], np.concatenate([ga[v][:], pb])):
+        bad.append(f"{v} is not A's then B's with B's snapshot times shifted by {ta}")
 cj, ca, cb = gj["window_complete"][:], ga["window_complete"][:], gb["window_complete"][:]
 if ca[-1] != 0 or cj[na - 1] != 1 or not np.array_equal(cj[na:], cb):
     bad.append(f"completeness: A's last {ca[-1]} -> {cj[na - 1]}, B's {list(cb)} -> {list(cj[na:])}")
