@@ -82,7 +82,7 @@ print("""  What it means: at dr+ = 4.5 this minimal-flow unit sustains resolved 
   not steady. For converged averages continue it:
   jobs/scenes/mfu180_dr45.ini (25-45 minutes per eddy turnover).""")
 EOF
-long=jobs/states/mfu180w_dr6_stats.nc
+long=jobs/states/mfu180w_dr6c4_stats.nc
 if [ -f "$long" ]; then
   echo
   echo "quickstart: the shipped long run, for comparison (NOT this run; no simulation here):"
@@ -93,13 +93,14 @@ import netCDF4
 
 with netCDF4.Dataset(sys.argv[1]) as d:
     t0, t1, n = float(d.average_start), float(d.average_end), int(d.n_windows)
-    print("  %s: Re_tau = 180 quasi-DNS at dr+ = 6 in a box twice the minimal" % sys.argv[1])
-    print("  span (2 x 2 x 1.4 delta, %d particles), averaged over t u_tau/delta = %.3g .. %.3g"
+    print("  %s: Re_tau = 180 quasi-DNS at dr+ = 6 (Wendland C4, h = 2 dr) in a box" % sys.argv[1])
+    print("  twice the minimal span (2 x 2 x 1.4 delta, %d particles), averaged over"
+          " t u_tau/delta = %.3g .. %.3g"
           % (int(d.n_fluid), t0, t1))
-    print("  (%.3g turnovers, %d windows of %.3g); made by jobs/chain.sh runs/w6"
+    print("  (%.3g turnovers, %d windows of %.3g); two segments of jobs/chain.sh with"
           % (t1 - t0, n, float(d.window_length)))
-    print("  jobs/scenes/mfu180w_dr6.ini and chansph extract --window --nc"
-          " (docs/validation/turbulent_channel.md).")
+    print("  jobs/scenes/mfu180w_dr6_c4.ini joined by chansph extract A.nc B.nc --nc"
+          " (docs/validation/turbulent_channel.md, issue 24 point 2).")
 EOF
   build/chansph compare "$long" --dns "$dns" --out "$out/compare_long" --no-plots |
     grep -E "^(differences in|largest error)"
