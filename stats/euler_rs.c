@@ -46,17 +46,55 @@ static int hat(const struct euler_config *c, double y, double *s) {
   return b;
 }
 
-/* Add the particle values to the records of the bins of (folded) position y. */
-static void add_at(const struct euler_config *c, double y, const double *val, int n, int at,
-                   double *P, size_t stride, size_t offset) {
+/* The hat bins b, b + 1 of (folded) position y with their shares phi[0..1], and the weights
+   psi[0..1] of the nodes b and b + 1 (the bin centres) in the local mean U(y): linear between
+   the nodes; from the wall (U = 0 at y = 0, and at 2 delta unfolded) to the end node; all to
+   the last node beyond it in a folded profile (U' = 0 at the centre). Returns b. */
+static int weights(const struct euler_config *c, double y, double phi[2], double psi[2]) {
   double s;
   const int b = hat(c, y, &s);
-  double *R = P + (size_t)b * stride + offset + at;
-  for (int i = 0; i < n; i++) R[i] += (1.0 - s) * val[i];
-  if (s > 0.0) {
-    R += stride;
-    for (int i = 0; i < n; i++) R[i] += s * val[i];
+  phi[0] = psi[0] = 1.0 - s, phi[1] = psi[1] = s;
+  const double w = (c->y1 - c->y0) / c->nb, lo = c->y0 + 0.5 * w, hi = c->y1 - 0.5 * w;
+  const double top = 2.0 * c->delta;
+  if (y < lo)
+    psi[0] = fmax(y, 0.0) / lo;
+  else if (y > hi && !c->fold)
+    psi[0] = fmax(top - y, 0.0) / (top - hi);
+  return b;
+}
+
+/* Add a particle's values to the records of the bins of (folded) position y, each bin b its
+   share phi_b of: np plain values at plain_at; nn values times the weight psi_n of each node n
+   of U(y), at noded_at + (n - b + 1) nn; if pairs_at >= 0, m psi_n psi_n' (RQ_PP). */
+static void add_at(const struct euler_config *c, double y, const double *plain, int np,
+                   int plain_at, const double *noded, int nn, int noded_at, int pairs_at, double m,
+                   double *P, size_t stride, size_t offset) {
+  double phi[2], psi[2];
+  const int b = weights(c, y, phi, psi);
+  for (int t = 0; t < 2 && (t == 0 || phi[1] > 0.0); t++) {
+    double *R = P + (size_t)(b + t) * stride + offset;
+    for (int i = 0; i < np; i++) R[plain_at + i] += phi[t] * plain[i];
+    for (int n = 0; n < 2; n++) {
+      const double wn = phi[t] * psi[n];
+      double *N = R + noded_at + (n - t + 1) * nn;
+      if (wn != 0.0)
+        for (int i = 0; i < nn; i++) N[i] += wn * noded[i];
+    }
+    if (pairs_at >= 0) {
+      const int n0 = 1 - t; /* node index of node b seen from bin b + t */
+      R[pairs_at + 2 * n0] += phi[t] * m * psi[0] * psi[0];
+      R[pairs_at + 2 * n0 + 1] += phi[t] * m * psi[0] * psi[1];
+      R[pairs_at + 2 * n0 + 2] += phi[t] * m * psi[1] * psi[1];
+    }
   }
+}
+
+/* Add the quantities q (RQ_*) of mass m and velocity u at (folded) y, at record offset at. */
+static void add_state(const struct euler_config *c, double y, double m, const double u[3], int at,
+                      double *P, size_t stride, size_t offset) {
+  const double q[RQ_MU] = {m, m * u[0] * u[0], m * u[1] * u[1], m * u[2] * u[2], m * u[0] * u[1]};
+  const double mu[3] = {m * u[0], m * u[1], m * u[2]};
+  add_at(c, y, q, RQ_MU, at, mu, 3, at + RQ_MU, at + RQ_PP, m, P, stride, offset);
 }
 
 void euler_rs_add(const struct euler_config *c, const struct stats_snapshot *s, size_t a, double yf,
@@ -78,33 +116,29 @@ void euler_rs_add(const struct euler_config *c, const struct stats_snapshot *s, 
   for (int side = 0; side < 2; side++) {
     const int mirror = c->fold && side;
     const double sg = mirror ? -1.0 : 1.0;
+    const double um[3] = {u[0], sg * u[1], u[2]};
     /* before the step: the forces, and the new state's quantities by the old membership */
     const double wf = euler_side_weight(yf, c->delta, side);
     if (wf > 0.0) {
       const double m = wf * ma, b[3] = {ub[0], sg * ub[1], ub[2]};
-      double sf[RSP_NEW - RSP_S];
+      double sp[RS_NPART * RS_NPROD], mf[RS_NPART * 3];
       for (int k = 0; k < RS_NPART; k++) {
         const double f[3] = {A[k][0], sg * A[k][1], A[k][2]};
-        double *S = sf + k * RS_NPROD, *F = sf + RS_NPART * RS_NPROD + k * 3;
+        double *S = sp + k * RS_NPROD;
         S[RS_XX] = m * b[0] * f[0], S[RS_YY] = m * b[1] * f[1], S[RS_ZZ] = m * b[2] * f[2];
         S[RS_XY] = m * b[0] * f[1], S[RS_YX] = m * b[1] * f[0];
-        F[0] = m * f[0], F[1] = m * f[1], F[2] = m * f[2];
+        mf[3 * k] = m * f[0], mf[3 * k + 1] = m * f[1], mf[3 * k + 2] = m * f[2];
       }
-      const double yb = mirror ? 2.0 * c->delta - yf : yf, v = sg * u[1];
-      const double q[RS_NQ] = {m,         m * u[0],        m * v,       m * u[2], m * u[0] * u[0],
-                               m * v * v, m * u[2] * u[2], m * u[0] * v};
-      add_at(c, yb, sf, RSP_NEW - RSP_S, RSP_S, P, stride, offset);
-      add_at(c, yb, q, RS_NQ, RSP_OLD, P, stride, offset);
+      const double yb = mirror ? 2.0 * c->delta - yf : yf;
+      add_at(c, yb, sp, RS_NPART * RS_NPROD, RSP_S, mf, RS_NPART * 3, RSP_F, -1, 0.0, P, stride,
+             offset);
+      add_state(c, yb, m, um, RSP_OLD, P, stride, offset);
     }
     /* the new state by its own positions */
     const double wh = euler_side_weight(s->y[a], c->delta, side);
-    if (wh > 0.0) {
-      const double v = sg * u[1], m = wh * ma;
-      const double yb = mirror ? 2.0 * c->delta - s->y[a] : s->y[a];
-      const double q[RS_NQ] = {m,         m * u[0],        m * v,       m * u[2], m * u[0] * u[0],
-                               m * v * v, m * u[2] * u[2], m * u[0] * v};
-      add_at(c, yb, q, RS_NQ, RSP_NEW, P, stride, offset);
-    }
+    if (wh > 0.0)
+      add_state(c, mirror ? 2.0 * c->delta - s->y[a] : s->y[a], wh * ma, um, RSP_NEW, P, stride,
+                offset);
   }
 }
 
@@ -116,7 +150,7 @@ void euler_rs_snapshot(const struct euler_config *c, const double *snap, size_t 
     double blk[RB_LEN];
     blk[RB_N] = 1.0, blk[RB_TAU] = tau, blk[RB_MASS] = tau * R[RSP_NEW + RQ_M];
     for (int i = 0; i < RS_NPART * RS_NPROD; i++) blk[RB_S + i] = tau * R[RSP_S + i];
-    for (int i = 0; i < RS_NPART * 3; i++) blk[RB_F + i] = tau * R[RSP_F + i];
+    for (int i = 0; i < RS_NPART * RS_NODE * 3; i++) blk[RB_F + i] = tau * R[RSP_F + i];
     for (int i = 0; i < RS_NQ; i++) blk[RB_K + i] = tau / dt * (R[RSP_NEW + i] - R[RSP_OLD + i]);
     double *W = row + (size_t)b * RW_LEN;
     if (W[RW_SUM + RB_N] == 0.0) {
@@ -143,7 +177,17 @@ const char *euler_rs_field_name(int k) {
   static const char *const part[RS_NPART] = {"pressure", "viscous", "model",
                                              "wall",     "body",    "pressure_noise"};
   static const char *const prod[RS_NPROD] = {"ubx_Ax", "uby_Ay", "ubz_Az", "ubx_Ay", "uby_Ax"};
-  static const char *const qn[RS_NQ] = {"m", "mu", "mv", "mw", "muu", "mvv", "mww", "muv"};
+  static const char *const qn[RS_NQ] = {"m",           "muu",
+                                        "mvv",         "mww",
+                                        "muv",         "mu_lower",
+                                        "mv_lower",    "mw_lower",
+                                        "mu_own",      "mv_own",
+                                        "mw_own",      "mu_upper",
+                                        "mv_upper",    "mw_upper",
+                                        "mpsi_lower2", "mpsi_lower_own",
+                                        "mpsi_own2",   "mpsi_own_upper",
+                                        "mpsi_upper2"};
+  static const char *const node[RS_NODE] = {"lower", "own", "upper"};
   static const char *const xyz[3] = {"x", "y", "z"};
   if (k < 0 || k >= RW_LEN) return "";
   if (!name[k][0]) {
@@ -159,8 +203,8 @@ const char *euler_rs_field_name(int k) {
       snprintf(name[k], sizeof name[k], "%s_%s_%s", blk, part[(i - RB_S) / RS_NPROD],
                prod[(i - RB_S) % RS_NPROD]);
     else if (i >= RB_F && i < RB_K)
-      snprintf(name[k], sizeof name[k], "%s_%s_A%s", blk, part[(i - RB_F) / 3],
-               xyz[(i - RB_F) % 3]);
+      snprintf(name[k], sizeof name[k], "%s_%s_A%s_%s", blk, part[(i - RB_F) / 3 % RS_NPART],
+               xyz[(i - RB_F) % 3], node[(i - RB_F) / (3 * RS_NPART)]);
     else if (i >= RB_K)
       snprintf(name[k], sizeof name[k], "%s_carried_%s", blk, qn[i - RB_K]);
     else if (k < RW_Q_LAST)
@@ -180,29 +224,91 @@ static const int comp_q[4] = {RQ_UU, RQ_VV, RQ_WW, RQ_UV};
 /* The products m ub_i A_j and m ub_j A_i of component c. */
 static const int comp_prod[4][2] = {{RS_XX, RS_XX}, {RS_YY, RS_YY}, {RS_ZZ, RS_ZZ}, {RS_XY, RS_YX}};
 
-/* sum m (u_i - U_i)(u_j - U_j) of component c from the quantities Q (RQ_*) of a bin. */
-static double centred(const double *Q, int c, const double U[3]) {
+/* sum phi m (u_i - U_i(y))(u_j - U_j(y)) of component c from the quantities Q (RQ_*) of a bin,
+   Un [node][component] the local mean's node values b - 1, b, b + 1. */
+static double centred(const double *Q, int c, double Un[RS_NODE][3]) {
   const int i = comp_ij[c][0], j = comp_ij[c][1];
-  return Q[comp_q[c]] - U[i] * Q[RQ_U + j] - U[j] * Q[RQ_U + i] + U[i] * U[j] * Q[RQ_M];
+  double e = Q[comp_q[c]];
+  for (int n = 0; n < RS_NODE; n++) {
+    const double *mu = Q + RQ_MU + 3 * n;
+    e -= Un[n][i] * mu[j] + Un[n][j] * mu[i];
+    e += Un[n][i] * Un[n][j] * Q[RQ_PP + 2 * n];
+    if (n + 1 < RS_NODE)
+      e += (Un[n][i] * Un[n + 1][j] + Un[n + 1][i] * Un[n][j]) * Q[RQ_PP + 2 * n + 1];
+  }
+  return e;
 }
 
 /* The terms (RT_PRESSURE .. RT_TRANSFER, RT_RATE) of the four stored components from a block
-   of sums B and the states Q0 at t0, Q1 at t1, with the mean velocity U [3]. */
+   of sums B and the states Q0 at t0, Q1 at t1, with the local mean's node values Un. */
 static void terms(const double *B, const double *Q0, const double *Q1, double t0, double t1,
-                  const double U[3], double out[4][RS_NTERM]) {
+                  double Un[RS_NODE][3], double out[4][RS_NTERM]) {
   const double mass = B[RB_MASS], mean_mass = B[RB_MASS] / B[RB_TAU];
   for (int c = 0; c < 4; c++) {
     const int i = comp_ij[c][0], j = comp_ij[c][1];
     for (int k = 0; k < RS_NPART; k++) {
-      const double *S = B + RB_S + k * RS_NPROD, *F = B + RB_F + k * 3;
-      const double v = S[comp_prod[c][0]] + S[comp_prod[c][1]] - U[i] * F[j] - U[j] * F[i];
+      const double *S = B + RB_S + k * RS_NPROD;
+      double v = S[comp_prod[c][0]] + S[comp_prod[c][1]];
+      for (int n = 0; n < RS_NODE; n++) {
+        const double *F = B + RB_F + (n * RS_NPART + k) * 3;
+        v -= Un[n][i] * F[j] + Un[n][j] * F[i];
+      }
       out[c][k == RS_BODY ? RT_DRIVE : k == RS_NOISE ? RT_NOISE : RT_PRESSURE + k] = v / mass;
     }
     /* the quantity (u_i - U_i)(u_j - U_j) m carried by the displacements, and its state */
-    out[c][RT_TRANSFER] = centred(B + RB_K, c, U) / mass;
-    const double e0 = centred(Q0, c, U), e1 = centred(Q1, c, U);
+    out[c][RT_TRANSFER] = centred(B + RB_K, c, Un) / mass;
+    const double e0 = centred(Q0, c, Un), e1 = centred(Q1, c, Un);
     out[c][RT_RATE] = t1 > t0 ? (e1 - e0) / (t1 - t0) / mean_mass : NAN;
   }
+}
+
+/* The local mean's node values (bin centres), out[nb][3]: those whose U(y) passes through
+   each usable bin's point (y_mean, U) (a tridiagonal system: a bin's mean position lies
+   between its centre and a neighbour's), so that a bin whose particles sit at one height sees
+   no spread of the mean; a bin without samples (or a singular system) keeps the linear
+   interpolation of the points, zero at the walls (y = 0; 2 delta unfolded). */
+static void node_values(const struct euler_config *c, double *const *pr, const int *ok,
+                        double (*out)[3]) {
+  const int nb = c->nb, comp[3] = {EP_U, EP_V, EP_W};
+  double *x = mem_alloc(5 * ((size_t)nb + 2), sizeof(double), "Eulerian statistics");
+  double *f = x + nb + 2, *lo = f + nb + 2, *di = lo + nb + 2, *up = di + nb + 2;
+  const double w = (c->y1 - c->y0) / nb;
+  for (int d = 0; d < 3; d++) {
+    int n = 0; /* the linear interpolation of the points */
+    x[n] = 0.0, f[n++] = 0.0;
+    for (int b = 0; b < nb; b++)
+      if (ok[b]) x[n] = pr[EP_Y_MEAN][b], f[n++] = pr[comp[d]][b];
+    if (!c->fold) x[n] = 2.0 * c->delta, f[n++] = 0.0;
+    for (int b = 0, k = 0; b < nb; b++) {
+      const double y = c->y0 + (b + 0.5) * w;
+      while (k + 1 < n && x[k + 1] < y) k++;
+      const double h = k + 1 < n ? x[k + 1] - x[k] : 0.0;
+      out[b][d] = h > 0.0 ? f[k] + (f[k + 1] - f[k]) * fmin(fmax((y - x[k]) / h, 0.0), 1.0) : f[k];
+    }
+    /* the system: row b, U(y_mean_b) = U_b, or node b = its interpolated value */
+    for (int b = 0; b < nb; b++) {
+      double phi[2], psi[2];
+      const int k = ok[b] ? weights(c, pr[EP_Y_MEAN][b], phi, psi) : -2;
+      lo[b] = up[b] = 0.0, di[b] = 1.0, f[b] = out[b][d];
+      if (k == b)
+        di[b] = psi[0], up[b] = psi[1], f[b] = pr[comp[d]][b];
+      else if (k == b - 1)
+        lo[b] = psi[0], di[b] = psi[1], f[b] = pr[comp[d]][b];
+    }
+    int good = 1; /* Thomas algorithm */
+    for (int b = 1; b < nb && good; b++) {
+      good = fabs(di[b - 1]) > 1e-9;
+      const double r = good ? lo[b] / di[b - 1] : 0.0;
+      di[b] -= r * up[b - 1], f[b] -= r * f[b - 1];
+    }
+    good = good && fabs(di[nb - 1]) > 1e-9;
+    for (int b = nb - 1; b >= 0 && good; b--) {
+      x[b] = (f[b] - (b + 1 < nb ? up[b] * x[b + 1] : 0.0)) / di[b];
+      good = isfinite(x[b]);
+    }
+    for (int b = 0; b < nb && good; b++) out[b][d] = x[b];
+  }
+  free(x);
 }
 
 /* Production from the profiles (-<u_i'v'> dU_j/dy - <u_j'v'> dU_i/dy, U = U(y) e_x), the
@@ -225,11 +331,16 @@ int euler_rs_profiles(const struct euler_config *c, const double *rsb, const int
   double *const *pr = res->prof;
   int *ok = mem_alloc((size_t)nb, sizeof(int), "Eulerian statistics");
   for (int b = 0; b < nb; b++) ok[b] = isfinite(pr[EP_U][b]);
+  double(*Uc)[3] = mem_alloc((size_t)nb, sizeof *Uc, "Eulerian statistics");
+  node_values(c, pr, ok, Uc);
   for (int b = 0; b < nb; b++) {
     double sum[RB_LEN] = {0}, batch[RS_NCOMP * RS_NTERM][SCAL_LEN];
     memset(batch, 0, sizeof batch);
     const double *first = NULL, *last = NULL;
-    const double U[3] = {pr[EP_U][b], pr[EP_V][b], pr[EP_W][b]};
+    double Un[RS_NODE][3];
+    for (int n = 0; n < RS_NODE; n++)
+      for (int d = 0; d < 3; d++)
+        Un[n][d] = b + n - 1 >= 0 && b + n - 1 < nb ? Uc[b + n - 1][d] : 0.0;
     const double dudy = ok[b] ? euler_deriv(pr[EP_Y_MEAN], pr[EP_U], ok, nb, b) : NAN;
     for (size_t r = r0; r < r1 && rsb; r++) {
       const double *W = rsb + (r * (size_t)nb + (size_t)b) * RW_LEN;
@@ -242,7 +353,7 @@ int euler_rs_profiles(const struct euler_config *c, const double *rsb, const int
       double blk[RB_LEN], t[RS_NCOMP][RS_NTERM];
       for (int i = 0; i < RB_LEN; i++) blk[i] = W[RW_SUM + i] - W[RW_FIRST + i];
       if (!(blk[RB_MASS] > 0.0)) continue;
-      terms(blk, W + RW_Q_FIRST, W + RW_Q_LAST, W[RW_T_FIRST], W[RW_T_LAST], U, t);
+      terms(blk, W + RW_Q_FIRST, W + RW_Q_LAST, W[RW_T_FIRST], W[RW_T_LAST], Un, t);
       derived(t, dudy, pr[EP_UV][b], pr[EP_VV][b]);
       for (int k = 0; k < RS_NCOMP * RS_NTERM; k++)
         scal_add(batch[k], t[k / RS_NTERM][k % RS_NTERM]);
@@ -256,7 +367,7 @@ int euler_rs_profiles(const struct euler_config *c, const double *rsb, const int
     }
     any = 1;
     double t[RS_NCOMP][RS_NTERM];
-    terms(sum, first + RW_Q_FIRST, last + RW_Q_LAST, first[RW_T_FIRST], last[RW_T_LAST], U, t);
+    terms(sum, first + RW_Q_FIRST, last + RW_Q_LAST, first[RW_T_FIRST], last[RW_T_LAST], Un, t);
     derived(t, dudy, pr[EP_UV][b], pr[EP_VV][b]);
     for (int k = 0; k < RS_NCOMP * RS_NTERM; k++) {
       pr[EP_RSB + k][b] = t[k / RS_NTERM][k % RS_NTERM];
@@ -268,6 +379,6 @@ int euler_rs_profiles(const struct euler_config *c, const double *rsb, const int
   if (!any)
     for (int k = EP_RSB; k < EP_RSB_SE_END; k++)
       for (int b = 0; b < nb; b++) pr[k][b] = NAN;
-  free(ok);
+  free(ok), free(Uc);
   return any;
 }

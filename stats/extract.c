@@ -85,9 +85,9 @@ static int read_records(int g, const char *var, const char *dim, size_t n, size_
   size_t have = 0;
   if (nc_inq_varid(g, var, &v) != NC_NOERR) return 0;
   if (nc_inq_dimid(g, dim, &d) || nc_inq_dimlen(g, d, &have) || have != n) {
-    if (!strict) return 0;
-    fprintf(stderr, "error: %s: %s (%s) have %zu fields, not %zu\n", path, what, var, have, n);
-    return 1;
+    fprintf(stderr, "%s: %s: %s (%s) have %zu fields, not %zu%s\n", strict ? "error" : "note", path,
+            what, var, have, n, strict ? "" : " (an earlier format): left out");
+    return strict;
   }
   *out = mem_alloc(1, len * n * sizeof(double), "chansph extract");
   if (nc_get_var_double(g, v, *out) != NC_NOERR) {
@@ -140,7 +140,8 @@ static int read_stored(const char *path, struct stored *s) {
     }
     /* the optional records: absent in files of earlier versions (the momentum budget; its
        kinetic flux, before format 1.4, where another field count leaves them out: no
-       advective part; the Reynolds-stress budgets, before 1.6) */
+       advective part; the Reynolds-stress budgets, before 1.6, and those of 1.6, whose
+       fluctuations were about the bin's mean, not the local mean of 1.7) */
     const size_t len = r * nb;
     bad =
         bad || (s->rows && (read_records(g, "planes", "plane_field", PL_LEN, len, 1, path,
@@ -148,7 +149,7 @@ static int read_stored(const char *path, struct stored *s) {
                             read_records(g, "planes_kinetic", "kinetic_field", KN_LEN, len, 0, path,
                                          "the kinetic-flux records", &s->kin) ||
                             read_records(g, "reynolds_budget", "reynolds_budget_field", RW_LEN, len,
-                                         1, path, "the Reynolds-stress budget records", &s->rsb)));
+                                         0, path, "the Reynolds-stress budget records", &s->rsb)));
   }
   CHECK_NC(nc_close(ncid));
   return bad;
@@ -165,19 +166,12 @@ static int same_gathering(const struct stored *a, const struct stored *b, const 
   const struct {
     const char *name;
     double x, y;
-  } key[] = {{"delta", a->cfg.delta, b->cfg.delta},
-             {"nu", a->cfg.nu, b->cfg.nu},
-             {"rho0", a->cfg.rho0, b->cfg.rho0},
-             {"bin_lower", a->cfg.y0, b->cfg.y0},
-             {"bin_upper", a->cfg.y1, b->cfg.y1},
-             {"wall_area", a->cfg.area, b->cfg.area},
-             {"fold", a->cfg.fold, b->cfg.fold},
-             {"window_length", a->cfg.window, b->cfg.window},
-             {"les", a->cfg.les, b->cfg.les},
-             {"bins (dimension y)", a->cfg.nb, b->cfg.nb},
-             {"budget records", !a->pln, !b->pln},
-             {"kinetic-flux records", !a->kin, !b->kin},
-             {"Reynolds-stress budget records", !a->rsb, !b->rsb}};
+  } key[] = {{"delta", a->cfg.delta, b->cfg.delta}, {"nu", a->cfg.nu, b->cfg.nu},
+             {"rho0", a->cfg.rho0, b->cfg.rho0},    {"bin_lower", a->cfg.y0, b->cfg.y0},
+             {"bin_upper", a->cfg.y1, b->cfg.y1},   {"wall_area", a->cfg.area, b->cfg.area},
+             {"fold", a->cfg.fold, b->cfg.fold},    {"window_length", a->cfg.window, b->cfg.window},
+             {"les", a->cfg.les, b->cfg.les},       {"bins (dimension y)", a->cfg.nb, b->cfg.nb},
+             {"budget records", !a->pln, !b->pln},  {"kinetic-flux records", !a->kin, !b->kin}};
   for (size_t k = 0; k < sizeof key / sizeof key[0]; k++)
     if (key[k].x != key[k].y) {
       fprintf(stderr,
@@ -204,9 +198,10 @@ static void shift_times(struct stored *s, size_t r0, size_t r1, double offset) {
   for (size_t r = r0; r < r1; r++) {
     s->win[r * WIN_LEN + WIN_T0] += offset, s->win[r * WIN_LEN + WIN_T1] += offset;
     for (size_t b = 0; b < nb; b++) {
-      double *P = s->pln + (r * nb + b) * PL_LEN, *W = s->rsb + (r * nb + b) * RW_LEN;
-      if (P[PL_N] > 0.0) P[PL_T_FIRST] += offset, P[PL_T_LAST] += offset;
-      if (W[RW_SUM + RB_N] > 0.0) W[RW_T_FIRST] += offset, W[RW_T_LAST] += offset;
+      double *P = s->pln ? s->pln + (r * nb + b) * PL_LEN : NULL;
+      double *W = s->rsb ? s->rsb + (r * nb + b) * RW_LEN : NULL;
+      if (P && P[PL_N] > 0.0) P[PL_T_FIRST] += offset, P[PL_T_LAST] += offset;
+      if (W && W[RW_SUM + RB_N] > 0.0) W[RW_T_FIRST] += offset, W[RW_T_LAST] += offset;
     }
   }
 }
@@ -242,6 +237,13 @@ static int join_stored(struct stored *seg, int n, char *const *paths) {
                 "note: %s: its last window (t = %.9g .. %.9g) is open, the segment ended at "
                 "%.9g: left out of the averages (end a segment at a window boundary)\n",
                 paths[k - 1], last[WIN_T0], last[WIN_T1], offset);
+    }
+    if (s->rsb && !b->rsb) {
+      fprintf(stderr,
+              "note: %s: no Reynolds-stress budget records of this format: the joined "
+              "range has none\n",
+              paths[k]);
+      free(s->rsb), s->rsb = NULL;
     }
     const size_t nb = (size_t)s->cfg.nb, ra = s->rows, rb = b->rows;
     append_rows(&s->win, ra, b->win, rb, WIN_LEN);
@@ -689,8 +691,8 @@ static int put_segments(const struct extract_args *a, int out) {
    open if that window is), written by the engine's own writer to a.nc_out (through a
    temporary file, renamed when complete). */
 static int write_range(const struct extract_args *a, const struct stored *s, size_t r0, size_t r1) {
-  if (!s->pln || !s->kin || !s->rsb) {
-    fprintf(stderr, "error: %s: --nc needs the budget records of format 1.6 or later\n", a->path);
+  if (!s->pln || !s->kin) {
+    fprintf(stderr, "error: %s: --nc needs the budget records of format 1.4 or later\n", a->path);
     return 1;
   }
   const size_t nb = (size_t)s->cfg.nb, n = r1 - r0;
@@ -706,7 +708,8 @@ static int write_range(const struct extract_args *a, const struct stored *s, siz
   for (size_t r = r0; r < r1; r++) snaps += s->win[r * WIN_LEN + WIN_NSNAP];
   for (size_t k = 0; k < sizeof rec / sizeof rec[0]; k++) {
     *rec[k].to = mem_calloc(e.cap * rec[k].len, sizeof(double), "chansph extract");
-    memcpy(*rec[k].to, rec[k].from + r0 * rec[k].len, n * rec[k].len * sizeof(double));
+    if (rec[k].from) /* no Reynolds-stress budget records (an earlier format): none sampled */
+      memcpy(*rec[k].to, rec[k].from + r0 * rec[k].len, n * rec[k].len * sizeof(double));
   }
   char tmp[4096], err[512] = "";
   snprintf(tmp, sizeof tmp, "%s.tmp", a->nc_out);

@@ -66,7 +66,7 @@ for rec in ("planes", "planes_kinetic"):
 # the Reynolds-stress records: each sample's sums are weighted by the time since the previous
 # budget sample (tau, field 1 of each block), so they agree per unit tau
 ra, rc = ea["reynolds_budget"][:][on], ec["reynolds_budget"][:][on]
-rb = (ra.shape[2] - 2 - 16) // 2  # RB_LEN: a record is 2 blocks, 2 x 8 quantities, 2 times
+rb = sum(1 for f in ea["reynolds_budget_field"][:] if f.startswith("sum_"))  # RB_LEN
 for blk in (0, rb):
     da, dc = ra[..., blk:blk + rb].copy(), rc[..., blk:blk + rb].copy()
     da[..., 2:] /= da[..., 1:2]
