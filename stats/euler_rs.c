@@ -46,20 +46,25 @@ static int hat(const struct euler_config *c, double y, double *s) {
   return b;
 }
 
-/* The hat bins b, b + 1 of (folded) position y with their shares phi[0..1], and the weights
-   psi[0..1] of the nodes b and b + 1 (the bin centres) in the local mean U(y): linear between
-   the nodes; from the wall (U = 0 at y = 0, and at 2 delta unfolded) to the end node; all to
-   the last node beyond it in a folded profile (U' = 0 at the centre). Returns b. */
-static int weights(const struct euler_config *c, double y, double phi[2], double psi[2]) {
+/* The hat bins b, b + 1 of (folded) position y with their shares phi[0..1], and the first node
+   k of the two (k, k + 1: the bin centres) that make the local mean U(y) at y, with their
+   weights psi[0..1]: linear between the nodes, extrapolated linearly from the two end nodes
+   towards a wall (the particles' own near-wall profile: no U = 0 imposed at y = 0, which the
+   particles nearest the wall, as the walls let them slip, do not follow), the last node's value
+   beyond it in a folded profile (U' = 0 at the centre). Returns b. */
+static int weights(const struct euler_config *c, double y, double phi[2], int *k, double psi[2]) {
   double s;
   const int b = hat(c, y, &s);
-  phi[0] = psi[0] = 1.0 - s, phi[1] = psi[1] = s;
+  phi[0] = psi[0] = 1.0 - s, phi[1] = psi[1] = s, *k = b;
   const double w = (c->y1 - c->y0) / c->nb, lo = c->y0 + 0.5 * w, hi = c->y1 - 0.5 * w;
-  const double top = 2.0 * c->delta;
-  if (y < lo)
-    psi[0] = fmax(y, 0.0) / lo;
-  else if (y > hi && !c->fold)
-    psi[0] = fmax(top - y, 0.0) / (top - hi);
+  if (c->nb < 2) return b;
+  if (y < lo) {
+    const double r = (lo - y) / w;
+    psi[0] = 1.0 + r, psi[1] = -r;
+  } else if (y > hi && !c->fold) {
+    const double r = (y - hi) / w;
+    *k = b - 1, psi[0] = -r, psi[1] = 1.0 + r;
+  }
   return b;
 }
 
@@ -70,18 +75,19 @@ static void add_at(const struct euler_config *c, double y, const double *plain, 
                    int plain_at, const double *noded, int nn, int noded_at, int pairs_at, double m,
                    double *P, size_t stride, size_t offset) {
   double phi[2], psi[2];
-  const int b = weights(c, y, phi, psi);
+  int k;
+  const int b = weights(c, y, phi, &k, psi);
   for (int t = 0; t < 2 && (t == 0 || phi[1] > 0.0); t++) {
     double *R = P + (size_t)(b + t) * stride + offset;
+    const int n0 = k - (b + t) + 1; /* node index (RS_NODE) of node k seen from bin b + t */
     for (int i = 0; i < np; i++) R[plain_at + i] += phi[t] * plain[i];
     for (int n = 0; n < 2; n++) {
       const double wn = phi[t] * psi[n];
-      double *N = R + noded_at + (n - t + 1) * nn;
+      double *N = R + noded_at + (n0 + n) * nn;
       if (wn != 0.0)
         for (int i = 0; i < nn; i++) N[i] += wn * noded[i];
     }
     if (pairs_at >= 0) {
-      const int n0 = 1 - t; /* node index of node b seen from bin b + t */
       R[pairs_at + 2 * n0] += phi[t] * m * psi[0] * psi[0];
       R[pairs_at + 2 * n0 + 1] += phi[t] * m * psi[0] * psi[1];
       R[pairs_at + 2 * n0 + 2] += phi[t] * m * psi[1] * psi[1];
@@ -288,7 +294,8 @@ static void node_values(const struct euler_config *c, double *const *pr, const i
     /* the system: row b, U(y_mean_b) = U_b, or node b = its interpolated value */
     for (int b = 0; b < nb; b++) {
       double phi[2], psi[2];
-      const int k = ok[b] ? weights(c, pr[EP_Y_MEAN][b], phi, psi) : -2;
+      int k = -2;
+      if (ok[b]) weights(c, pr[EP_Y_MEAN][b], phi, &k, psi);
       lo[b] = up[b] = 0.0, di[b] = 1.0, f[b] = out[b][d];
       if (k == b)
         di[b] = psi[0], up[b] = psi[1], f[b] = pr[comp[d]][b];

@@ -7,8 +7,8 @@
  * The step u^{n+1} = u^n + dt A (A: every part of the acceleration and the body force) changes
  * m u_i u_j by exactly dt m (ub_i A_j + ub_j A_i), ub = u^{n+1} - dt A / 2 the midpoint
  * velocity. The fluctuation of a particle at y is u - U(y), U(y) the local mean velocity:
- * linear between the bin centres (nodes), from zero at a wall to the first node, constant
- * beyond the last node of a folded profile. A bin's E = sum phi_b m (u_i - U_i)(u_j - U_j)
+ * linear between the bin centres (nodes), extrapolated linearly from the two end nodes towards
+ * a wall, constant beyond the last node of a folded profile. A bin's E = sum phi_b m (u_i - U_i)(u_j - U_j)
  * (phi_b: the bin's hat function) then holds no spread of the mean across the bin. Per bin and
  * sampled step the engine sums, for each part k of A (pressure, viscous, model, wall pair parts
  * and the body force), m ub_i A^k_j and the node-weighted m A^k_j psi_c (psi_c: the weight of
