@@ -8,11 +8,11 @@
  * m u_i u_j by exactly dt m (ub_i A_j + ub_j A_i), ub = u^{n+1} - dt A / 2 the midpoint
  * velocity. The fluctuation of a particle at y is u - U(y), U(y) the local mean velocity:
  * linear between the bin centres (nodes), extrapolated linearly from the two end nodes towards
- * a wall, constant beyond the last node of a folded profile. A bin's E = sum phi_b m (u_i - U_i)(u_j - U_j)
- * (phi_b: the bin's hat function) then holds no spread of the mean across the bin. Per bin and
- * sampled step the engine sums, for each part k of A (pressure, viscous, model, wall pair parts
- * and the body force), m ub_i A^k_j and the node-weighted m A^k_j psi_c (psi_c: the weight of
- * node c = b - 1, b, b + 1 in U(y)), at the particles' positions before the step, and the
+ * a wall, constant beyond the last node of a folded profile. A bin's E = sum phi_b m (u_i -
+ * U_i)(u_j - U_j) (phi_b: the bin's hat function) then holds no spread of the mean across the bin.
+ * Per bin and sampled step the engine sums, for each part k of A (pressure, viscous, model, wall
+ * pair parts and the body force), m ub_i A^k_j and the node-weighted m A^k_j psi_c (psi_c: the
+ * weight of node c = b - 1, b, b + 1 in U(y)), at the particles' positions before the step, and the
  * quantities q = m (1, u_i u_j, u_i psi_c, psi_c psi_d) of the new state once by the new and
  * once by the old positions: their difference is what the step's displacements carried into
  * the bin. E then changes by exactly the sum of the parts' terms dt sum phi_b m ((ub_i - U_i)
