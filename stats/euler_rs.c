@@ -51,32 +51,37 @@ static int hat(const struct euler_config *c, double y, double *s) {
    weights psi[0..1]: linear between the nodes, extrapolated linearly from the two end nodes
    towards a wall (the particles' own near-wall profile: no U = 0 imposed at y = 0, which the
    particles nearest the wall, as the walls let them slip, do not follow), the last node's value
-   beyond it in a folded profile (U' = 0 at the centre). Returns b. */
-static int weights(const struct euler_config *c, double y, double phi[2], int *k, double psi[2]) {
+   beyond it in a folded profile (U' = 0 at the centre). */
+struct rs_at {
+  int b, k;
+  double phi[2], psi[2];
+};
+
+static struct rs_at weights(const struct euler_config *c, double y) {
   double s;
-  const int b = hat(c, y, &s);
-  phi[0] = psi[0] = 1.0 - s, phi[1] = psi[1] = s, *k = b;
+  struct rs_at a;
+  a.b = a.k = hat(c, y, &s);
+  a.phi[0] = a.psi[0] = 1.0 - s, a.phi[1] = a.psi[1] = s;
   const double w = (c->y1 - c->y0) / c->nb, lo = c->y0 + 0.5 * w, hi = c->y1 - 0.5 * w;
-  if (c->nb < 2) return b;
+  if (c->nb < 2) return a;
   if (y < lo) {
     const double r = (lo - y) / w;
-    psi[0] = 1.0 + r, psi[1] = -r;
+    a.psi[0] = 1.0 + r, a.psi[1] = -r;
   } else if (y > hi && !c->fold) {
     const double r = (y - hi) / w;
-    *k = b - 1, psi[0] = -r, psi[1] = 1.0 + r;
+    a.k = a.b - 1, a.psi[0] = -r, a.psi[1] = 1.0 + r;
   }
-  return b;
+  return a;
 }
 
-/* Add a particle's values to the records of the bins of (folded) position y, each bin b its
-   share phi_b of: np plain values at plain_at; nn values times the weight psi_n of each node n
-   of U(y), at noded_at + (n - b + 1) nn; if pairs_at >= 0, m psi_n psi_n' (RQ_PP). */
-static void add_at(const struct euler_config *c, double y, const double *plain, int np,
-                   int plain_at, const double *noded, int nn, int noded_at, int pairs_at, double m,
-                   double *P, size_t stride, size_t offset) {
-  double phi[2], psi[2];
-  int k;
-  const int b = weights(c, y, phi, &k, psi);
+/* Add a particle's values to the records of the bins of its weights a, each bin b its share
+   phi_b of: np plain values at plain_at; nn values times the weight psi_n of each node n of
+   U(y), at noded_at + (n - b + 1) nn; if pairs_at >= 0, m psi_n psi_n' (RQ_PP). */
+static void add_at(const struct rs_at *a, const double *plain, int np, int plain_at,
+                   const double *noded, int nn, int noded_at, int pairs_at, double m, double *P,
+                   size_t stride, size_t offset) {
+  const int b = a->b, k = a->k;
+  const double *phi = a->phi, *psi = a->psi;
   for (int t = 0; t < 2 && (t == 0 || phi[1] > 0.0); t++) {
     double *R = P + (size_t)(b + t) * stride + offset;
     const int n0 = k - (b + t) + 1; /* node index (RS_NODE) of node k seen from bin b + t */
@@ -95,12 +100,12 @@ static void add_at(const struct euler_config *c, double y, const double *plain, 
   }
 }
 
-/* Add the quantities q (RQ_*) of mass m and velocity u at (folded) y, at record offset at. */
-static void add_state(const struct euler_config *c, double y, double m, const double u[3], int at,
-                      double *P, size_t stride, size_t offset) {
+/* Add the quantities q (RQ_*) of mass m and velocity u with weights a, at record offset at. */
+static void add_state(const struct rs_at *a, double m, const double u[3], int at, double *P,
+                      size_t stride, size_t offset) {
   const double q[RQ_MU] = {m, m * u[0] * u[0], m * u[1] * u[1], m * u[2] * u[2], m * u[0] * u[1]};
   const double mu[3] = {m * u[0], m * u[1], m * u[2]};
-  add_at(c, y, q, RQ_MU, at, mu, 3, at + RQ_MU, at + RQ_PP, m, P, stride, offset);
+  add_at(a, q, RQ_MU, at, mu, 3, at + RQ_MU, at + RQ_PP, m, P, stride, offset);
 }
 
 void euler_rs_add(const struct euler_config *c, const struct stats_snapshot *s, size_t a, double yf,
@@ -135,16 +140,17 @@ void euler_rs_add(const struct euler_config *c, const struct stats_snapshot *s, 
         S[RS_XY] = m * b[0] * f[1], S[RS_YX] = m * b[1] * f[0];
         mf[3 * k] = m * f[0], mf[3 * k + 1] = m * f[1], mf[3 * k + 2] = m * f[2];
       }
-      const double yb = mirror ? 2.0 * c->delta - yf : yf;
-      add_at(c, yb, sp, RS_NPART * RS_NPROD, RSP_S, mf, RS_NPART * 3, RSP_F, -1, 0.0, P, stride,
+      const struct rs_at at = weights(c, mirror ? 2.0 * c->delta - yf : yf);
+      add_at(&at, sp, RS_NPART * RS_NPROD, RSP_S, mf, RS_NPART * 3, RSP_F, -1, 0.0, P, stride,
              offset);
-      add_state(c, yb, m, um, RSP_OLD, P, stride, offset);
+      add_state(&at, m, um, RSP_OLD, P, stride, offset);
     }
     /* the new state by its own positions */
     const double wh = euler_side_weight(s->y[a], c->delta, side);
-    if (wh > 0.0)
-      add_state(c, mirror ? 2.0 * c->delta - s->y[a] : s->y[a], wh * ma, um, RSP_NEW, P, stride,
-                offset);
+    if (wh > 0.0) {
+      const struct rs_at at = weights(c, mirror ? 2.0 * c->delta - s->y[a] : s->y[a]);
+      add_state(&at, wh * ma, um, RSP_NEW, P, stride, offset);
+    }
   }
 }
 
@@ -293,14 +299,12 @@ static void node_values(const struct euler_config *c, double *const *pr, const i
     }
     /* the system: row b, U(y_mean_b) = U_b, or node b = its interpolated value */
     for (int b = 0; b < nb; b++) {
-      double phi[2], psi[2];
-      int k = -2;
-      if (ok[b]) weights(c, pr[EP_Y_MEAN][b], phi, &k, psi);
+      const struct rs_at a = ok[b] ? weights(c, pr[EP_Y_MEAN][b]) : (struct rs_at){.k = -2};
       lo[b] = up[b] = 0.0, di[b] = 1.0, f[b] = out[b][d];
-      if (k == b)
-        di[b] = psi[0], up[b] = psi[1], f[b] = pr[comp[d]][b];
-      else if (k == b - 1)
-        lo[b] = psi[0], di[b] = psi[1], f[b] = pr[comp[d]][b];
+      if (a.k == b)
+        di[b] = a.psi[0], up[b] = a.psi[1], f[b] = pr[comp[d]][b];
+      else if (a.k == b - 1)
+        lo[b] = a.psi[0], di[b] = a.psi[1], f[b] = pr[comp[d]][b];
     }
     int good = 1; /* Thomas algorithm */
     for (int b = 1; b < nb && good; b++) {
