@@ -78,6 +78,7 @@ static inline __attribute__((always_inline)) void pair_sums(const struct fctx *C
   const double *restrict c = V->f[REC_C], *restrict nur = V->f[REC_NUR];
   const int32_t *restrict nl = V->nl;
   const double eta2 = M->eta2, nu = M->nu, np2 = M->dim + 2.0, dgrav = diffusion_dgrav(M);
+  const double dlr = M->diff_lr, dlc = M->diff_lc;
   const double xa = P->x[a], ya = P->y[a], za = P->z[a], ua = P->u[a], va = P->v[a];
   const double wa = P->w[a], ra = P->rho[a], pa = P->pr2[a], ca = P->c[a], ira = 1.0 / ra;
   const double pm_a = corr ? pa * ra * ra : 0.0;
@@ -119,7 +120,8 @@ static inline __attribute__((always_inline)) void pair_sums(const struct fctx *C
       const struct v3 vm = viscous_violeau_moments(&g, vb, np2, eta2);
       m1x += vm.x, m2x += vm.x * g.dy, m1z += vm.y, m2z += vm.y * g.dy;
     }
-    if (fluid) diff += diffusion_pair(&g, vb, ca, c[b], ra - rb, dgrav); /* term_diffusion.h */
+    if (fluid)
+      diff += diffusion_pair(&g, vb, ca, c[b], ra - rb, dgrav, dlr, dlc); /* term_diffusion.h */
   }
   out->p = (struct pressure_sums){{gpx, gpy, gpz}, {axx, axy, axz, ayy, ayz, azz}, {gcx, gcy, gcz}};
   out->v = (struct viscous_sums){{vx, vy, vz}, {mo2, moyy, mo1}, m1x, m2x, m1z, m2z};

@@ -93,6 +93,9 @@ const struct part_field part_fields[] = {
      "kernel sum S of the continuity equation", 0, 0},
     {F(ddiff), "diffusion", NULL, PT_F64, 1, PF_PERMUTE | PF_MIGRATE, PN_CORE, 0, 0, NULL, NULL, 0,
      0},
+    {F(drate), "density_rate", "density_rate", PT_F64, 1,
+     PF_PERMUTE | PF_MIGRATE | PF_CKPT | PF_HEALTH, PN_DAMPER, 0, 1, "1/s",
+     "(1/rho) D rho/Dt of the last step, = -div u (the acoustic damper)", 0, 0},
     {F(c), "sound", NULL, PT_F64, 1, PF_PAIR, PN_CORE, 0, 0, NULL, NULL, REC_C,
      PR_DENSITY | PR_WALLS},
     {F(pr2), "p_over_rho2", NULL, PT_F64, 1, PF_PAIR, PN_CORE, 0, 0, NULL, NULL, REC_PR2,
@@ -167,6 +170,8 @@ int part_needed(enum part_need need, const struct scene *s) {
       return s->shifting != SHIFT_NONE;
     case PN_QCRIT:
       return s->q_criterion;
+    case PN_DAMPER:
+      return s->damper > 0.0;
   }
   return 0;
 }

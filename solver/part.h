@@ -38,6 +38,8 @@ struct particles {
   double *gam;       /*!< renormalisation gamma [-] (fluid) */
   double *ksum;      /*!< kernel sum S_a = sum_b m_b w_ab at the current positions [kg/m^dim] */
   double *ddiff;     /*!< volume-diffusion sum D_a of thesis Eq. 3.64 [kg/m^dim/s] */
+  double *drate;     /*!< (1/rho) D rho/Dt of the last step without the diffusion [1/s]; NULL
+                          without the acoustic damper (term_damper.h) */
   int64_t *id;       /*!< global particle id */
   uint8_t *kind;     /*!< enum part_kind */
   /* recomputed every step, not permuted */
@@ -140,7 +142,8 @@ enum part_need {
   PN_WALL_TAU,   /*!< wall stresses at the vertices: LES or a turbulent wall law */
   PN_EULERIAN,   /*!< Eulerian statistics (the momentum budget's parts) */
   PN_SHIFTING,   /*!< particle shifting */
-  PN_QCRIT       /*!< output.q_criterion */
+  PN_QCRIT,      /*!< output.q_criterion */
+  PN_DAMPER      /*!< sph.acoustic_damper > 0 */
 };
 
 /** The refreshes of the ghosts' copies within a step (dd_refresh): after the pass that sets a

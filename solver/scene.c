@@ -57,6 +57,7 @@ static const char *const names_drive_mode[] = {"force", "flux", NULL};
 static const char *const names_drive_controller[] = {"eq3.43", "eq3.38", NULL};
 static const char *const names_init_profile[] = {"rest", "laminar",   "reichardt",
                                                  "wave", "synthetic", NULL};
+static const char *const names_sph_diffusion[] = {"ferrand", "delta_sph", NULL};
 static const char *const names_stats_method[] = {"bins", "sph", NULL};
 static const char *const names_stats_target_profiles[] = {"both", "u_mean", "uv_peak", NULL};
 
@@ -84,6 +85,24 @@ static const struct key keys[] = {
      "Volume-diffusion constant xi of thesis Eq. 3.34; 0 selects the mixing-length value "
      "1000 dr / (2 delta) (thesis Sec. 3.2, 6.1.1).",
      OFF(xi)},
+    {"sph", "diffusion", T_CHOICE, "ferrand", 0, 0, 0, names_sph_diffusion, "-",
+     "Pair form of the volume diffusion of the continuity equation: ferrand (thesis Eq. 3.34, "
+     "strength 1/xi, the pair weight grows with the pair distance r_ab) or delta_sph (the "
+     "delta-SPH strength of Antuono et al. (2010): 2 delta h in place of r_ab / xi, with the "
+     "same hydrostatic density difference as Fourtakas et al. (2019); docs/theory.md, "
+     "\"Continuity\").",
+     OFF(diffusion)},
+    {"sph", "delta", T_DOUBLE, "0.1", 0, 1, 0, NULL, "-",
+     "delta of sph.diffusion = delta_sph (0.1 is the delta-SPH literature's value).",
+     OFF(diff_delta)},
+    {"sph", "acoustic_damper", T_DOUBLE, "0", 0, 2, 0, NULL, "-",
+     "Acoustic damper alpha (Sun, Pilloton, Antuono & Colagrossi 2023): a bulk viscosity "
+     "zeta = alpha rho0 c0 h, applied as the pressure p - zeta div u with div u = -(1/rho) "
+     "D rho/Dt from the density change of the last step (without the volume diffusion's part); "
+     "it damps the particle-scale acoustic (dilatational) motion and leaves solenoidal motion "
+     "alone; the viscous time-step limit takes nu + zeta / rho0. 0 = off (docs/theory.md, "
+     "\"The acoustic damper\").",
+     OFF(damper)},
     {"sph", "viscous", T_CHOICE, "morris", 0, 0, 0, names_sph_viscous, "-",
      "Viscous operator: Morris (thesis Eq. 2.147) or Violeau (Eq. 2.100), both with the wall "
      "shear term.",

@@ -28,6 +28,8 @@ enum init_profile {
 enum les_model { LES_NONE = 0, LES_SMAGORINSKY = 1 };
 enum les_strain { STRAIN_GRADIENT = 0, STRAIN_VIOLEAU_ISSA = 1 };
 enum pressure_gradient { PGRAD_STANDARD = 0, PGRAD_CORRECTED = 1 };
+/** Pair form of the volume diffusion (term_diffusion.h). */
+enum diffusion_form { DIFFUSION_FERRAND = 0, DIFFUSION_DELTA_SPH = 1 };
 enum shifting { SHIFT_NONE = 0, SHIFT_FICKIAN = 1 };
 enum shift_velocity { SHIFT_KEEP = 0, SHIFT_TAYLOR = 1, SHIFT_CONSERVATIVE = 2 };
 enum wall_collision { WALL_STOP = 0, WALL_REFLECT = 1 };
@@ -52,6 +54,9 @@ struct scene {
   double h_over_dr;   /*!< smoothing length over spacing [-] */
   int kernel;         /*!< enum kernel_shape (kernel.h) */
   double xi;          /*!< volume-diffusion constant [-]; 0 selects 1000 dr / (2 delta) */
+  int diffusion;      /*!< enum diffusion_form: the volume diffusion's pair form */
+  double diff_delta;  /*!< delta of the delta-SPH form [-] */
+  double damper;      /*!< acoustic damper alpha of zeta = alpha rho0 c0 h [-]; 0 = off */
   double wall_dmin;   /*!< delta r of Eq. 2.148 over dr [-] */
   double eta2;        /*!< regularisation of 1/r^2 in the viscous term, over h^2 [-] */
   int viscous;        /*!< enum viscous_form */

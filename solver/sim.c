@@ -226,7 +226,8 @@ static double time_step(struct sim *S, const struct force_info *fi) {
   const struct scene *sc = S->sc;
   const double h = S->M.h;
   S->dt_limits[0] = sc->cfl * h / sc->c0;
-  S->dt_limits[1] = viscous_dt_limit(sc->c_visc, h, S->nu_max); /* nu + nu_r */
+  /* nu + nu_r, and the acoustic damper's bulk viscosity (term_damper.h) */
+  S->dt_limits[1] = viscous_dt_limit(sc->c_visc, h, S->nu_max + S->M.damper_zeta / sc->rho0);
   S->dt_limits[2] = fi->amax > 0.0 ? sc->c_force * sqrt(h / fi->amax) : INFINITY;
   S->dt_limits[3] = sc->c_gamma > 0.0 && fi->gvmax > 0.0 ? sc->c_gamma / fi->gvmax : INFINITY;
   if (sc->dt_fixed > 0.0) {

@@ -14,6 +14,8 @@
 
 #include "pair_loop.h"
 #include "records.h"
+#include "term_damper.h"
+#include "term_diffusion.h"
 #include "timers.h"
 #include "wall.h"
 
@@ -28,6 +30,8 @@ void sph_model_init(struct model *M, const struct scene *s) {
   M->lx = s->lx, M->ly = 2.0 * s->delta, M->lz = s->dim == 3 ? s->lz : 1.0;
   M->nu = s->nu;
   M->inv_xi = 1.0 / scene_xi(s);
+  diffusion_init(M, s);
+  M->damper_zeta = damper_zeta_of(s->damper, s->rho0, s->c0, M->h);
   M->gy = s->gravity_y;
   M->wall_dmin = s->wall_dmin * s->dr;
   M->eta2 = s->eta2 * M->h * M->h;
@@ -141,14 +145,20 @@ void sph_density(const struct model *M, struct particles *P, const double *ksum_
   timer_push("density");
   const double *restrict y = P->y, *restrict m = P->m;
   const uint8_t *restrict kind = P->kind;
+  double *restrict drate = M->damper_zeta > 0.0 ? P->drate : NULL;
 #pragma omp parallel for schedule(static)
   for (size_t a = 0; a < P->n; a++) {
     if (kind[a] != KIND_FLUID) continue;
-    const double s = ksum_new[a], gam = channel_gamma(M, y[a]);
-    if (dt > 0.0) P->rho[a] = (P->gam[a] * P->rho[a] + s - P->ksum[a] + dt * P->ddiff[a]) / gam;
+    const double s = ksum_new[a], gam = channel_gamma(M, y[a]), r_old = P->rho[a];
+    if (dt > 0.0) P->rho[a] = (P->gam[a] * r_old + s - P->ksum[a] + dt * P->ddiff[a]) / gam;
     P->ksum[a] = s;
     P->gam[a] = gam;
-    const double r = P->rho[a], pa = eos_pressure(&M->e, r);
+    const double r = P->rho[a];
+    double pa = eos_pressure(&M->e, r);
+    if (drate) { /* term_damper.h; restored (dt = 0): the rate of the checkpoint */
+      if (dt > 0.0) drate[a] = damper_rate(r_old, r, dt, P->ddiff[a], gam);
+      pa = damper_pressure(pa, M->damper_zeta, drate[a]);
+    }
     P->p[a] = pa, P->c[a] = eos_sound(&M->e, r);
     P->pr2[a] = pa / (r * r), P->vol[a] = m[a] / r;
   }

@@ -26,17 +26,21 @@ struct model {
   double dr, h;      /*!< spacing and smoothing length [m] */
   double nu;         /*!< kinematic viscosity [m^2/s] */
   double inv_xi;     /*!< 1 / xi of the volume diffusion [-] */
-  double gy;         /*!< wall-normal body acceleration [m/s^2] */
-  double wall_dmin;  /*!< delta r of Eq. 2.148 [m] */
-  double eta2;       /*!< regularisation of r^2 in the viscous term [m^2] */
-  int lap_norm;      /*!< enum laplacian_norm */
-  int wall_weight;   /*!< enum wall_weight: weight of the wall shear term */
-  int wall_pressure; /*!< enum wall_pressure: weight of the pressure wall term */
-  int pgrad;         /*!< enum pressure_gradient */
-  int les;           /*!< eddy viscosity on (enum les_model) */
-  int strain;        /*!< enum les_strain */
-  int strain_lag;    /*!< 1: the force loop forms the strain sums; nu_r, k_r apply one step later */
-  int van_driest;    /*!< damping on */
+  /** the volume diffusion's pair length l_ab = diff_lr r_ab + diff_lc: (1, 0) for ferrand, (0,
+      2 delta h xi) for delta_sph (term_diffusion.h) */
+  double diff_lr, diff_lc;
+  double damper_zeta; /*!< bulk viscosity zeta = alpha rho0 c0 h of the acoustic damper [Pa s] */
+  double gy;          /*!< wall-normal body acceleration [m/s^2] */
+  double wall_dmin;   /*!< delta r of Eq. 2.148 [m] */
+  double eta2;        /*!< regularisation of r^2 in the viscous term [m^2] */
+  int lap_norm;       /*!< enum laplacian_norm */
+  int wall_weight;    /*!< enum wall_weight: weight of the wall shear term */
+  int wall_pressure;  /*!< enum wall_pressure: weight of the pressure wall term */
+  int pgrad;          /*!< enum pressure_gradient */
+  int les;            /*!< eddy viscosity on (enum les_model) */
+  int strain;         /*!< enum les_strain */
+  int strain_lag; /*!< 1: the force loop forms the strain sums; nu_r, k_r apply one step later */
+  int van_driest; /*!< damping on */
   double cs, delta_g, a_plus; /*!< C_S [-], Delta_G [m], A+ [-] */
   double cy;                  /*!< Yoshizawa C_Y [-]; 0 = off */
   struct wall_law_def law;    /*!< wall law of the wall shear term */

@@ -3,11 +3,14 @@
  * @brief The volume diffusion of the continuity equation (thesis Eq. 3.34, 3.64, with the
  *        hydrostatic density difference varrho_ab of Eq. 3.61): its pair term and its finish.
  *
- * D_a = (1/xi) sum_b V_b max(c_a, c_b) (rho_a - rho_b - rho0 g_y y_ab / c0^2) F_ab r_ab over the
- * fluid neighbours; sph_density() adds dt D_a to gamma_a rho_a (Eq. 3.64: no 1/gamma_a).
- * Hooks: diffusion_pair (summed by the force loop over the fluid part of the list),
- * diffusion_finish. It has no budget part (it changes no momentum) and no time-step limit of
- * its own.
+ * D_a = (1/xi) sum_b V_b max(c_a, c_b) (rho_a - rho_b - rho0 g_y y_ab / c0^2) F_ab l_ab over the
+ * fluid neighbours, with the pair length l_ab = r_ab (sph.diffusion = ferrand, the thesis) or
+ * l_ab = 2 delta h xi (delta_sph: the strength of the delta-SPH diffusion of Antuono et al.
+ * 2010, D_a = 2 delta h sum_b V_b c_ab varrho_ab F_ab; varrho_ab is the dynamic density
+ * difference of Fourtakas et al. 2019); sph_density() adds dt D_a to gamma_a rho_a (Eq. 3.64:
+ * no 1/gamma_a). Hooks: diffusion_init (the model's constants), diffusion_pair (summed by the
+ * force loop over the fluid part of the list), diffusion_finish. It has no budget part (it
+ * changes no momentum) and no time-step limit of its own.
  */
 #ifndef CHANSPH_TERM_DIFFUSION_H
 #define CHANSPH_TERM_DIFFUSION_H
@@ -15,13 +18,21 @@
 #include "pair.h"
 #include "sph.h"
 
+/** The pair length of the scene's form: l_ab = diff_lr r_ab + diff_lc. */
+static inline void diffusion_init(struct model *M, const struct scene *s) {
+  const int delta = s->diffusion == DIFFUSION_DELTA_SPH;
+  M->diff_lr = delta ? 0.0 : 1.0;
+  M->diff_lc = delta ? 2.0 * s->diff_delta * M->h / M->inv_xi : 0.0;
+}
+
 /** Volume diffusion of one fluid pair, to be divided by xi: V_b max(c_a, c_b) (drho - dgrav
-    y_ab) F_ab r, with drho = rho_a - rho_b formed by the caller in double and
-    dgrav = rho0 g_y / c0^2 (diffusion_dgrav). */
+    y_ab) F_ab l_ab, with drho = rho_a - rho_b formed by the caller in double,
+    dgrav = rho0 g_y / c0^2 (diffusion_dgrav) and l_ab = lr r_ab + lc (struct model diff_lr,
+    diff_lc): one form of loop for both pair forms. */
 static inline double diffusion_pair(const struct pair *g, double vb, double ca, double cb,
-                                    double drho, double dgrav) {
+                                    double drho, double dgrav, double lr, double lc) {
   const double cab = ca > cb ? ca : cb;
-  return vb * cab * (drho - dgrav * g->dy) * g->f * g->r;
+  return vb * cab * (drho - dgrav * g->dy) * g->f * (lr * g->r + lc);
 }
 
 /** rho0 g_y / c0^2 of Eq. 3.61: the hydrostatic density gradient. */

@@ -11,6 +11,8 @@
 #   shift      fast 2-D flow with particle shifting (sph.shifting = fickian; velocities kept,
 #              and carried by the conservative transport), 200 steps, ids
 #              checked after every step: 2 ranks equal 1 rank
+#   damper     fast 2-D flow with the acoustic damper and the delta-SPH diffusion, 200 steps,
+#              ids checked after every step: 2 ranks equal 1 rank
 #   too_many   more ranks than the slabs allow: a message naming domain.lx, exit 1
 #   resume_too_many  a 1-rank checkpoint resumed on more ranks than its slabs allow: the same
 #                    message, exit 1, the checkpoints untouched
@@ -173,6 +175,19 @@ case $case in
       echo "sph.shift_velocity = $carry:"
       compare r1 r2 200
     done
+    ;;
+  damper) # the acoustic damper (sph.acoustic_damper): migrating particles carry their density
+    # rate (term_damper.h), which the pressure of the next step reads
+    scene=$scenes/poiseuille2d.ini
+    args=(--set domain.lx=2.0 --set time.t_end=1000 --set time.max_steps=200 --set init.profile=laminar
+      --set drive.force=4 --set init.noise=0.5 --set run.check_ids=1 --set output.log_every=100
+      --set sph.acoustic_damper=0.1 --set sph.diffusion=delta_sph)
+    for np in 1 2; do
+      mpi "$np" run "$scene" --out r$np --overwrite "${args[@]}" > r$np.txt 2>&1 ||
+        { tail -20 r$np.txt; echo "FAIL: $np ranks exited with $?"; exit 1; }
+    done
+    grep -h "^decomposition: 2 ranks" r2.txt
+    compare r1 r2 200
     ;;
   too_many)
     if mpi 4 run "$scenes/les395_smoke.ini" --out r4 --overwrite > r4.txt 2>&1; then

@@ -103,3 +103,9 @@ target_link_libraries(test_budget_parts PRIVATE chansph_core m)
 add_test(NAME unit_budget_parts COMMAND test_budget_parts ${CMAKE_SOURCE_DIR}/jobs/scenes)
 set_tests_properties(unit_budget_parts PROPERTIES LABELS unit PASS_REGULAR_EXPRESSION "PASS"
   FAIL_REGULAR_EXPRESSION "FAIL")
+
+# the acoustic damper against the bulk-viscous damping rate of a sound wave (term_damper.h)
+add_executable(test_damper test_damper.c)
+target_link_libraries(test_damper PRIVATE chansph_core)
+add_test(NAME unit_damper COMMAND test_damper)
+set_tests_properties(unit_damper PROPERTIES LABELS unit)

@@ -13,6 +13,7 @@ TOOLS = {
     "windows": ("windows", "per-window turbulence indicators of a run"),
     "window_peaks": ("window_peaks", "Reynolds-stress peaks over time ranges against a DNS"),
     "ab_table": ("ab_table", "A/B table of turbulent runs"),
+    "ab_score": ("ab_score", "scored A/B table: redistribution, pressure noise, peaks, cost"),
     "error_vs_time": ("error_vs_time", "error against the DNS window group by window group"),
     "blocking": ("blocking", "blocking analysis: the standard errors against the batch length"),
     "resolution_extrapolate": ("resolution_extrapolate",

@@ -5,6 +5,9 @@ read_dns(FILE) reads one file of a set:
   Moser, Kim & Mansour 1999: chanNNN.means (+ companion chanNNN.reystress, found by name)
   Lee & Moser 2015:          LM_Channel_NNNN_mean_prof.dat (+ derived/LM_Channel_RetauNNN.txt)
                              or the derived table itself.
+  same-box mesh DNS (CaNS):  box_<Lx>x<2delta>x<Lz>[_coarse].txt of stats/dns/samebox/, the
+                             boxes of chansph's channel scenes (columns y, yp, U+, urms+, vrms+,
+                             wrms+, -uv+, each with its standard error).
 It returns a dict: yplus, y_delta, re_tau and the QUANTITIES (absent when the set lacks them).
 A file that cannot be used raises cli.InputError naming the file and line.
 """
@@ -98,6 +101,8 @@ def read_dns(path):
             out["-u'v'+"] = -r[:, 5]
             out["source"] += " + " + os.path.basename(rey)
         return out
+    if re.match(r"box_[0-9.]+x[0-9.]+x[0-9.]+(_coarse)?\.txt$", base):  # same-box CaNS DNS
+        return read_samebox(path, out)
     m = re.match(r"LM_Channel_(\d+)_mean_prof\.dat$", base)
     derived = None
     if m:  # Lee & Moser 2015, mean profile
@@ -143,7 +148,22 @@ def read_dns(path):
         raise InputError("%s: no such file" % path)
     raise InputError("%s: not a DNS file of a known set: the name must be chanNNN.means or "
                      "chanNNN.reystress (Moser, Kim & Mansour 1999), LM_Channel_NNNN_mean_prof.dat "
-                     "or LM_Channel_RetauNNN.txt (Lee & Moser 2015)" % path)
+                     "or LM_Channel_RetauNNN.txt (Lee & Moser 2015) or box_LXx2xLZ.txt (same-box CaNS, "
+                     "stats/dns/samebox)" % path)
+
+
+def read_samebox(path, out):
+    """A same-box CaNS table (stats/dns/samebox/README.md): 12 columns, y/delta, y+, then U+,
+    u_rms+, v_rms+, w_rms+, -u'v'+ each followed by its standard error."""
+    a, lines = numeric_rows(path, 12, "a same-box DNS table (y, yp, U+, U+_se, ... -uv+_se)")
+    increasing(path, a, 0, lines, "y/delta")
+    increasing(path, a, 1, lines, "y+")
+    out.update(yplus=a[:, 1], y_delta=a[:, 0], re_tau=a[-1, 1] / a[-1, 0],
+               source="same-box mesh DNS (CaNS), %s" % os.path.basename(path))
+    for k, q in enumerate(QUANTITIES):
+        out[q] = a[:, 2 + 2 * k]
+        out[q + "_se"] = a[:, 3 + 2 * k]
+    return out
 
 
 def through_bins(dns, lo, hi, at, n=400):

@@ -49,7 +49,7 @@ def window_values(mom, pln, delta, fold, ut, nu):
                     parts[key] = np.where(up, -parts[key], parts[key])
             rey = -uv  # -u'v' towards the centre (upper half mirrored above)
             total = rey + parts["pair"] + parts["visc"] + parts["model"] + parts["wall"]
-            for name, target in (("30", 30.0), ("half", 0.5 * delta * ut / nu)):
+            for name, target in (("12", 12.0), ("30", 30.0), ("half", 0.5 * delta * ut / nu)):
                 i = int(np.nanargmin(np.abs(yp - target) + np.where(ok, 0, np.inf)))
                 r["res_" + name] = rey[i] / total[i]
                 r["pair_" + name] = parts["pair"][i] / total[i]

@@ -1,0 +1,54 @@
+#!/usr/bin/env bash
+# The scheme A/B (docs/validation/scheme_ab.md): candidate numerical settings against the
+# reference in the wide box at dr+ = 6 with Wendland C4, h = 2 dr (jobs/scenes/mfu180w_dr6_c4_ab.ini,
+# 148 680 particles), each run from a developed state of the converged run for T turnovers
+# (default 1) with the momentum and Reynolds-stress budgets every 10 steps and windows of 0.1,
+# then the scored table (chansph-stats ab_score: redistributed fraction, pressure noise against
+# the viscous term, the vv viscous term, the numerical pair stress share, the rms peaks, cost;
+# each with its standard error). Two start states (two "seeds"), 7.5 turnovers apart:
+#   s16   jobs/states/mfu180w_dr6c4_t16.nc   (t = 16 of the converged C4 run)
+#   s8.5  jobs/states/mfu180w_dr6c4_t8.5.nc  (t = 8.5 of the same run)
+# Each run is a batch job through jobs/chain.sh (checkpoints; start the script again to go on),
+# about 15 minutes a turnover with 2 threads on an idle 2-core machine.
+# usage: jobs/ab39.sh OUTDIR START [T] [CANDIDATE...]   e.g. jobs/ab39.sh runs/ab39 s16 1 damper_0.1
+# The table alone, for runs already made: stats/python/chansph-stats ab_score OUTDIR/*_s16
+#   --csv OUTDIR/ab_score.csv --markdown
+set -uo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+[ $# -ge 2 ] || { sed -n 2,16p "$0" >&2; exit 1; }
+out=$1 start=$2 tend=${3:-1}
+shift $(($# >= 3 ? 3 : 2))
+scene=jobs/scenes/mfu180w_dr6_c4_ab.ini
+case $start in
+  s16) state=$root/jobs/states/mfu180w_dr6c4_t16.nc ;;
+  s8.5) state=$root/jobs/states/mfu180w_dr6c4_t8.5.nc ;;
+  *) echo "error: START must be s16 or s8.5 (got '$start')" >&2; exit 1 ;;
+esac
+declare -A sets=(
+  [reference]=""
+  [damper_0.05]="--set sph.acoustic_damper=0.05"
+  [damper_0.1]="--set sph.acoustic_damper=0.1"
+  [damper_0.15]="--set sph.acoustic_damper=0.15"
+  [damper_0.3]="--set sph.acoustic_damper=0.3"
+  [delta_0.1]="--set sph.diffusion=delta_sph --set sph.delta=0.1"
+  [delta_0.2]="--set sph.diffusion=delta_sph --set sph.delta=0.2"
+  [damper_0.1_delta_0.1]="--set sph.acoustic_damper=0.1 --set sph.diffusion=delta_sph --set sph.delta=0.1"
+  [morris]="--set sph.viscous=morris"
+)
+names=("$@")
+[ ${#names[@]} -gt 0 ] || names=(reference damper_0.1 delta_0.1)
+mkdir -p "$out"
+runs=()
+cd "$root" || exit 1
+. "$root/jobs/campaign_lib.sh"
+for name in "${names[@]}"; do
+  [ -n "${sets[$name]+x}" ] || { echo "error: unknown candidate '$name' (${!sets[*]})" >&2; exit 1; }
+  dir=$out/${name}_$start
+  runs+=("$dir")
+  # shellcheck disable=SC2086
+  OMP_NUM_THREADS=${OMP_NUM_THREADS:-2} campaign_run "$dir" "$scene" "$name ($start)" \
+    --set init.from="$state" --set time.t_end="$tend" ${sets[$name]}
+done
+mapfile -t done_runs < <(campaign_finished "${runs[@]}")
+[ ${#done_runs[@]} -gt 0 ] &&
+  "$root/stats/python/chansph-stats" ab_score "${done_runs[@]}" --csv "$out/ab_score_$start.csv" --markdown
