@@ -227,25 +227,32 @@ static inline __attribute__((always_inline)) void force_chunk(const struct fctx 
     slower for the two data paths; 2.3 times for the two shapes). */
 typedef void (*force_loop)(const struct fctx *C, size_t a0, size_t a1, double mx[2]);
 
-/** Defines forces_NAME_SHAPE_PATH: operator VISC, kernel KERNEL_SHAPE, gathered records (1,
-    AVX-512) or the particle arrays through the list (0). */
-#define FORCE_LOOP(NAME, VISC, SHAPE, PATH, GATHERED)                                          \
-  static CHANSPH_CLONES void forces_##NAME##_##SHAPE##_##PATH(const struct fctx *C, size_t a0, \
-                                                              size_t a1, double mx[2]) {       \
-    force_chunk(C, a0, a1, mx, VISC, KERNEL_##SHAPE, GATHERED);                                \
+/** Defines the force loop FN for the operator VISC, the kernel SHAPE (enum kernel_shape) and
+    gathered records (GATHERED = 1, AVX-512) or the particle arrays through the list (0). Each
+    loop's name is written out below (no token pasting), so a grep finds its definition. The
+    four loops of an operator: sph.viscous = morris or violeau; the LES operator with nu_r of
+    this step (les.strain_lag = 0, or its first step); the LES operator that forms the eddy
+    viscosity of the next step (les.strain_lag). */
+#define FORCE_LOOP(FN, VISC, SHAPE, GATHERED)                                               \
+  static CHANSPH_CLONES void FN(const struct fctx *C, size_t a0, size_t a1, double mx[2]) { \
+    force_chunk(C, a0, a1, mx, VISC, SHAPE, GATHERED);                                      \
   }
-/** The four loops of one operator (sph.viscous = morris or violeau; the LES operator with nu_r
-    of this step, les.strain_lag = 0 or its first step; the LES operator forming the eddy
-    viscosity of the next step, les.strain_lag). */
-#define FORCE_LOOPS(NAME, VISC)           \
-  FORCE_LOOP(NAME, VISC, C2, gathered, 1) \
-  FORCE_LOOP(NAME, VISC, C2, arrays, 0)   \
-  FORCE_LOOP(NAME, VISC, C4, gathered, 1) \
-  FORCE_LOOP(NAME, VISC, C4, arrays, 0)
-FORCE_LOOPS(morris, VK_MORRIS)
-FORCE_LOOPS(violeau, VK_VIOLEAU)
-FORCE_LOOPS(les, VK_LES)
-FORCE_LOOPS(les_lag, VK_LES_LAG)
+FORCE_LOOP(forces_morris_C2_gathered, VK_MORRIS, KERNEL_C2, 1)
+FORCE_LOOP(forces_morris_C2_arrays, VK_MORRIS, KERNEL_C2, 0)
+FORCE_LOOP(forces_morris_C4_gathered, VK_MORRIS, KERNEL_C4, 1)
+FORCE_LOOP(forces_morris_C4_arrays, VK_MORRIS, KERNEL_C4, 0)
+FORCE_LOOP(forces_violeau_C2_gathered, VK_VIOLEAU, KERNEL_C2, 1)
+FORCE_LOOP(forces_violeau_C2_arrays, VK_VIOLEAU, KERNEL_C2, 0)
+FORCE_LOOP(forces_violeau_C4_gathered, VK_VIOLEAU, KERNEL_C4, 1)
+FORCE_LOOP(forces_violeau_C4_arrays, VK_VIOLEAU, KERNEL_C4, 0)
+FORCE_LOOP(forces_les_C2_gathered, VK_LES, KERNEL_C2, 1)
+FORCE_LOOP(forces_les_C2_arrays, VK_LES, KERNEL_C2, 0)
+FORCE_LOOP(forces_les_C4_gathered, VK_LES, KERNEL_C4, 1)
+FORCE_LOOP(forces_les_C4_arrays, VK_LES, KERNEL_C4, 0)
+FORCE_LOOP(forces_les_lag_C2_gathered, VK_LES_LAG, KERNEL_C2, 1)
+FORCE_LOOP(forces_les_lag_C2_arrays, VK_LES_LAG, KERNEL_C2, 0)
+FORCE_LOOP(forces_les_lag_C4_gathered, VK_LES_LAG, KERNEL_C4, 1)
+FORCE_LOOP(forces_les_lag_C4_arrays, VK_LES_LAG, KERNEL_C4, 0)
 
 /** The force loops by [enum visc_kind][kernel shape][gathered]. */
 static const force_loop force_loops[4][2][2] = {
