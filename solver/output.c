@@ -290,11 +290,13 @@ static void log_progress(struct output *o, struct sim *S, const struct diag *d) 
   double frac;
   const double eta = progress_left(o, S, now, &frac);
   char el[32], et[32];
+  /* eddy turnovers t u_tau/delta, u_tau of the body force: sqrt(|f| delta) */
+  const double delta = S->sc->delta, turnovers = S->t * sqrt(fabs(S->fx) / delta);
   output_log(o,
              "step %8ld  t %.6e  dt %.3e  u_bulk %.6e  force %.6e  max|v| %.4e  rho [%.6g, %.6g]"
-             "  min_gamma %.4f  %.3e p-steps/s  elapsed %s  %5.1f%%  ETA %s\n",
+             "  min_gamma %.4f  %.3e p-steps/s  turnovers %.4g  elapsed %s  %5.1f%%  ETA %s\n",
              S->step, S->t, S->dt, d->u_bulk, S->fx, d->max_speed, d->rho_min, d->rho_max,
-             d->min_gamma, rate, hms(now - o->wall0, el, sizeof el), 100.0 * frac,
+             d->min_gamma, rate, turnovers, hms(now - o->wall0, el, sizeof el), 100.0 * frac,
              hms(eta, et, sizeof et));
   if (d->reflections > o->reflections) /* new ones since the last log line */
     output_log(o, "  wall reflections since this job began: %ld (sph.wall_collision = reflect)\n",

@@ -432,7 +432,7 @@ static const struct key keys[] = {
      "Ejections and sweeps dominate in wall turbulence, not in particle noise. Empty = off.",
      OFF(quad_y_plus)},
     {"pdfs", "y_plus", T_LIST, "", 0, BIG, 0, NULL, "-",
-     "Comma-separated y+ levels (up to 8) of the one-point PDFs of u', v', w' (issue 25; MKM "
+     "Comma-separated y+ levels (up to 8) of the one-point PDFs of u', v', w' (MKM "
      "1999 give them at y+ = 5, 10, 19, 30, 40, 59, 79, 98, 178): fluid particles in a slab at "
      "each level and its mirror (v -> -v), binned in units of the local rms about the mean of "
      "the averaged windows; stats.nc group pdfs (docs/stats-format.md). Empty = off.",

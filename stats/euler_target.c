@@ -85,9 +85,9 @@ void euler_log(const struct euler *e, char *buf, size_t len) {
   snprintf(buf, len,
            "stats: %d complete windows of %.4g s, %.0f snapshots; correlation time %.3g s "
            "(window/corr %.3g); max stderr(u_mean) %.3g m/s (%.3g%% of max u_mean); "
-           "u_tau wall %.6g force %.6g; stress balance error %.3g%s\n",
+           "u_tau wall %.6g force %.6g%s\n",
            r.n_batches, win, r.snapshots, r.corr_time, win / r.corr_time, se,
-           umax > 0 ? 100 * se / umax : NAN, r.u_tau_wall, r.u_tau_force, r.balance_error,
+           umax > 0 ? 100 * se / umax : NAN, r.u_tau_wall, r.u_tau_force,
            r.n_batches < 2           ? " (fewer than 2 windows: no error bars yet)"
            : win < 5.0 * r.corr_time ? " (windows shorter than 5 correlation times: error bars "
                                        "too small; increase stats.window)"
