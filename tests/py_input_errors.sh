@@ -55,6 +55,14 @@ expect windows_every_0 "argument --every: 0: must be at least 1" "$tool" windows
 expect windows_every_x "argument --every: 'x' is not an integer" "$tool" windows "$nowin" --every x
 expect windows_u_tau "argument --u-tau: -1: must be at least 0" "$tool" windows "$nowin" --u-tau -1
 expect ab_table_missing "missing/stats.nc: cannot open: No such file" "$tool" ab_table "$w/missing"
+expect summary_missing "missing.nc: cannot open statistics file: No such file" "$tool" summary "$missing" --dns "$dns"
+expect summary_not_netcdf "text.nc: cannot open as netCDF" "$tool" summary "$w/text.nc" --dns "$dns"
+expect summary_no_var "particles.nc: no variable 'y_mean'" "$tool" summary "$part" --dns "$dns"
+expect summary_no_window "stats.nc: no positive u_tau" "$tool" summary "$nowin" --dns "$dns"
+expect summary_long_missing "missing.nc: cannot open statistics file" "$tool" summary "$nowin" --dns "$dns" --long "$missing"
+expect figures_missing "missing.nc: cannot open statistics file: No such file" "$tool" figures "$missing"
+expect figures_no_var "particles.nc: no variable 'y_mean'" "$tool" figures "$part"
+expect figures_no_window "stats.nc: no positive u_tau" "$tool" figures "$nowin"
 expect ab_table_no_window "stats.nc: no averaging window" "$tool" ab_table "$run"
 expect ab_table_from "argument --from: 'x' is not a number" "$tool" ab_table "$run" --from x
 expect window_peaks_spec "nowin: expected LABEL=RUN_DIR" "$tool" window_peaks --dns "$dns" "$run"
