@@ -11,7 +11,9 @@ Also the last screen of jobs/quickstart.sh. It says, from the files alone:
   - a table of the five quantities (U+, u_rms+, v_rms+, w_rms+, -u'v'+): the peak with its
     standard error and the largest deviation from the DNS over 10 < y+ < 150 relative to the
     DNS peak (the measure of `chansph compare`), for the run and, with --long, for a second
-    (converged) run, each in wall units of its own u_tau (--u-tau, default the wall stress).
+    (converged) run, each in wall units of its own u_tau (--u-tau, default the wall stress);
+    a run averaged over fewer than 2 eddy turnovers is said to have standard errors far too
+    small to judge by (its windows hold too few bursts).
 The exit status is 0 whatever the verdict (a summary, not a test).
 """
 import math
@@ -25,6 +27,7 @@ from .ncfile import open_nc
 
 LO, HI = 10.0, 150.0
 MAX_LINES = 30
+SHORT = 2.0  # turnovers: a shorter average holds too few bursts for its standard errors
 
 
 def evidence(path, ours, dns):
@@ -122,11 +125,11 @@ def describe(path):
     with open_nc(path) as d:
         a = {k: d.getncattr(k) for k in d.ncattrs()}
     ut, nu, delta = float(a.get("u_tau_force", math.nan)), float(a["nu"]), float(a["delta"])
-    box = " x ".join("%.3g" % (float(a.get(k, math.nan)) / delta) for k in ("lx", "lz"))
-    return ("%s: Re_tau %.0f (driving force), %s, dr+ = %.2g, box %s x 2 delta (x, z, y), "
-            "%d particles" % (path, ut * delta / nu, "LES" if int(a.get("les", 0)) else
-                              "quasi-DNS (no turbulence model)", float(a["dr"]) * ut / nu, box,
-                              int(a.get("n_fluid", 0))))
+    box = "%.3g x 2 x %.3g" % (float(a.get("lx", math.nan)) / delta, float(a.get("lz", math.nan)) / delta)
+    return ("%s: Re_tau %.0f (driving force), %s, dr+ = %.2g, box %s delta, %d particles"
+            % (path, ut * delta / nu, "LES" if int(a.get("les", 0)) else
+               "quasi-DNS (no turbulence model)", float(a["dr"]) * ut / nu, box,
+               int(a.get("n_fluid", 0))))
 
 
 def summary_lines(args):
@@ -144,6 +147,10 @@ def summary_lines(args):
     lines.append("relative to the DNS peak; wall units of each run's own u_tau:")
     lines += ["  " + u for u in units]
     lines += table_lines(runs, dns)
+    for name, path in (("this run", args.stats), ("the long run", args.long)):
+        if path and turnovers(path) < SHORT:
+            lines.append("(%s spans %.2g turnovers, less than %g: its standard errors are far too "
+                         "small to judge by)" % (name, turnovers(path), SHORT))
     return lines
 
 
