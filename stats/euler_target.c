@@ -82,11 +82,13 @@ void euler_log(const struct euler *e, char *buf, size_t len) {
     if (isfinite(r.prof[EP_U][b])) umax = fmax(umax, fabs(r.prof[EP_U][b]));
   }
   const double win = e->cfg.window;
+  /* the windows in eddy turnovers delta/u_tau of the driving force */
+  const double ett = r.u_tau_force > 0.0 ? r.n_batches * win * r.u_tau_force / e->cfg.delta : NAN;
   snprintf(buf, len,
-           "stats: %d complete windows of %.4g s, %.0f snapshots; correlation time %.3g s "
-           "(window/corr %.3g); max stderr(u_mean) %.3g m/s (%.3g%% of max u_mean); "
+           "stats: %d complete windows of %.4g s (%.3g turnovers), %.0f snapshots; correlation "
+           "time %.3g s (window/corr %.3g); max stderr(u_mean) %.3g m/s (%.3g%% of max u_mean); "
            "u_tau wall %.6g force %.6g%s\n",
-           r.n_batches, win, r.snapshots, r.corr_time, win / r.corr_time, se,
+           r.n_batches, win, ett, r.snapshots, r.corr_time, win / r.corr_time, se,
            umax > 0 ? 100 * se / umax : NAN, r.u_tau_wall, r.u_tau_force,
            r.n_batches < 2           ? " (fewer than 2 windows: no error bars yet)"
            : win < 5.0 * r.corr_time ? " (windows shorter than 5 correlation times: error bars "
