@@ -23,6 +23,11 @@ profiles and over the run's averaging range for the budgets:
   v_rms+, w_rms+, -u'v'+ peaks
                  of the profile over the windows taken, and its deviation from the DNS peak of
                  --dns (default: the same-box mesh DNS stats/dns/samebox/box_2x2x1.4.txt);
+  p mean, p' wall
+                 from the run's particles.nc (its last state): the mean pressure and the standard
+                 deviation of the particle pressure within 0.1 delta of the walls, over rho0
+                 u_tau^2 (the turbulence's own pressure fluctuation is 2-3 there): the mean acts
+                 as a background pressure, the rest is mostly particle-scale acoustic noise;
   Mp-st/ETT, s/ETT
                  particle-steps and wall seconds per eddy turnover delta/u_tau (from log.txt;
                  the wall seconds depend on what else the machine ran).
@@ -103,6 +108,25 @@ def mkm_redistribution(mkm):
     return (s("vv") + s("ww")) / -s("uu")
 
 
+def pressure_scores(run, ut):
+    """Mean pressure and the wall layer's pressure deviation of the last state in particles.nc,
+    over rho0 u_tau^2 (rho0 and delta: attributes of the run's stats.nc); NaN without it."""
+    from .ncfile import open_nc
+    path = os.path.join(run, "particles.nc")
+    if not os.path.exists(path):
+        return {"p mean": (math.nan, math.nan), "p' wall": (math.nan, math.nan)}
+    with open_nc(os.path.join(run, "stats.nc")) as d:
+        rho0, delta = float(d.getncattr("rho0")), float(d.getncattr("delta"))
+    with open_nc(path) as d:
+        def last(k):
+            v = d[k]
+            return np.asarray(v[-1] if v.ndim == 2 else v[:], dtype=float)
+        p, y = last("p"), last("y")
+    scale = rho0 * ut ** 2
+    near = np.minimum(y, 2 * delta - y) < 0.1 * delta
+    return {"p mean": (p.mean() / scale, math.nan), "p' wall": (p[near].std() / scale, math.nan)}
+
+
 def window_scores(run, t0, t1, dns):
     """The profile and momentum-budget scores over the windows inside [t0, t1]."""
     r = read_windows(os.path.join(run, "stats.nc"))
@@ -126,6 +150,7 @@ def window_scores(run, t0, t1, dns):
         x = np.array([v.get(name, math.nan) for v in vals], dtype=float)
         out[name.replace("_", " ")] = (float(np.nanmean(x)),
                                        float(np.nanstd(x, ddof=1) / math.sqrt(len(x))))
+    out.update(pressure_scores(run, r["ut"]))
     steps, wall = cost(run, r["ut"], r["delta"])
     out["Mp-st/ETT"] = (steps / 1e6, math.nan)
     out["s/ETT"] = (wall, math.nan)
@@ -134,7 +159,7 @@ def window_scores(run, t0, t1, dns):
 
 COLUMNS = ("redist 20-40", "noise/visc 10-30", "noise/visc 28", "vv visc/MKM 10-30", "pair 12",
            "pair 30", "v_rms+ pk", "v_rms+ dev", "w_rms+ pk", "w_rms+ dev", "-u'v'+ pk",
-           "-u'v'+ dev", "Mp-st/ETT", "s/ETT")
+           "-u'v'+ dev", "p mean", "p' wall", "Mp-st/ETT", "s/ETT")
 
 
 def fmt(name, v):
@@ -145,6 +170,8 @@ def fmt(name, v):
         return f"{100 * value:+.0f}±{100 * se:.0f}%"
     if name.endswith("/ETT"):
         return f"{value:.0f}"
+    if name in ("p mean", "p' wall"):
+        return f"{value:.1f}"
     return f"{value:.3f}±{se:.3f}" if math.isfinite(se) else f"{value:.3f}"
 
 
