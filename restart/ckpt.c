@@ -627,6 +627,7 @@ static herr_t read_rows(hid_t ds, const struct state_field *f, hid_t fsp, void *
 
 static int read_field(hid_t file, struct state_field *f, const char *path, char *err,
                       size_t errlen) {
+  if (f->optional && !link_exists(file, f->name)) return 0;
   if (f->type == STATE_TEXT) {
     char *text = read_text(file, f->name, path, err, errlen);
     if (!text) return 1;
@@ -634,7 +635,6 @@ static int read_field(hid_t file, struct state_field *f, const char *path, char 
     *(char **)f->data = text;
     return 0;
   }
-  if (f->optional && !link_exists(file, f->name)) return 0;
   const hid_t ds = open_dataset(file, f->name, path, err, errlen);
   if (ds < 0) return 1;
   int rc = 1;

@@ -14,6 +14,7 @@
 #include "alloc.h"
 #include "ckpt.h"
 #include "error.h"
+#include "init.h"
 #include "restart.h"
 #include "rotate.h"
 #include "timers.h"
@@ -259,6 +260,9 @@ static int try_one(const char *dir, struct candidate *cd, int n_set, char *const
     return CHANSPH_ERR;
   }
   S->sc = sc;
+  /* the state the run started from: unknown unless the checkpoint says (since format 1.11) */
+  free(S->init_run_id);
+  init_origin(NULL, &S->init_run_id, &S->init_time);
   if (output_reopen(o, dir, sc)) {
     sim_free(S);
     *fatal = 1;

@@ -355,6 +355,30 @@ static void interpolate(const struct source *src, struct particles *P) {
   free(start), free(fill), free(order), free(cellof);
 }
 
+/** A malloc'd copy of text. */
+static char *text_copy(const char *text) {
+  char *c = mem_alloc(strlen(text) + 1, 1, "initial state");
+  return strcpy(c, text);
+}
+
+void init_origin(const char *path, char **run_id, double *time) {
+  int nc;
+  size_t len = 0;
+  *time = NAN;
+  char *id = NULL;
+  if (!path || !path[0] || nc_open(path, NC_NOWRITE, &nc) != NC_NOERR) {
+    *run_id = text_copy(path && !path[0] ? "none" : "unknown"); /* read_columns reports errors */
+    return;
+  }
+  if (nc_get_att_double(nc, NC_GLOBAL, "time", time) != NC_NOERR) *time = NAN;
+  if (!nc_inq_attlen(nc, NC_GLOBAL, "run_id", &len) && len > 0 && len < 256) {
+    id = mem_calloc(len + 1, 1, "initial state");
+    if (nc_get_att_text(nc, NC_GLOBAL, "run_id", id) != NC_NOERR) free(id), id = NULL;
+  }
+  CHECK_NC(nc_close(nc));
+  *run_id = id ? id : text_copy("unknown");
+}
+
 static int from_file(const struct scene *sc, struct particles *P) {
   struct source src;
   TRY(read_source(sc->init_from, sc, &src));

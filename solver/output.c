@@ -392,6 +392,8 @@ static int write_stats(struct output *o, const struct sim *S) {
       {"viscous", visc, 0, 0},
       {"u_bulk_target", NULL, sc->drive_mode == DRIVE_FLUX ? sc->u_bulk : NAN, 0},
       {"body_force", NULL, S->fx, 0},
+      {"init_from_run_id", S->init_run_id ? S->init_run_id : "unknown", 0, 0},
+      {"init_from_time", NULL, S->init_time, 0},
       {"t_average_start", NULL, sc->t_average_start, 0},
       {"t_end", NULL, sc->t_end, 0},
       {"t_reached", NULL, S->t, 0},

@@ -134,6 +134,7 @@ int sim_create(struct sim *S, const struct scene *sc) {
     return CHANSPH_ERR;
   }
   if (sc->stats_eulerian) S->wall_ax = part_alloc("wall_ax", sizeof(double));
+  init_origin(sc->init_from, &S->init_run_id, &S->init_time);
   S->qcrit_step = -1;
   S->wall_fx[0] = S->wall_fx[1] = NAN;
   drive_init(&S->drive, sc);
@@ -179,6 +180,7 @@ void sim_free(struct sim *S) {
   for (int k = 0; k < 5; k++) part_free(S->scratch[k]);
   part_free(S->ksum_new);
   if (S->wall_ax) part_free(S->wall_ax);
+  free(S->init_run_id), S->init_run_id = NULL;
   part_destroy(&S->P, &S->W);
 }
 

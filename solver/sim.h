@@ -43,6 +43,11 @@ struct sim {
   long reflections;         /*!< wall reflections on this rank since the process began
                                  (sph.wall_collision = reflect) */
   void *gather[SIM_GATHER]; /*!< this rank's id block of the state, for a checkpoint */
+  char *init_run_id;        /*!< the state the run started from (init_origin): run_id of the
+                                 init.from file, "none" (the scene's initial condition) or
+                                 "unknown" (a file without run_id, or a resume from a
+                                 checkpoint that did not record it) */
+  double init_time;         /*!< that file's time [s], or NaN */
 };
 
 /** Global diagnostics of the current state (all fluid particles). */
