@@ -3,6 +3,7 @@
 #include "alloc.h"
 
 #include <Random123/philox.h>
+#include <float.h>
 #include <math.h>
 #include <mpi.h>
 #include <stdio.h>
@@ -236,8 +237,26 @@ static double time_step(struct sim *S, const struct force_info *fi) {
     check_fixed_dt(S, sc->dt_fixed);
     return sc->dt_fixed;
   }
-  double dt = S->dt_limits[0];
-  for (int k = 1; k < 4; k++) dt = fmin(dt, S->dt_limits[k]);
+  int k = 0;
+  for (int j = 1; j < 4; j++)
+    if (S->dt_limits[j] < S->dt_limits[k]) k = j;
+  const double dt = S->dt_limits[k];
+  /* a zero or subnormal step, or one too small to advance t, never reaches t_end: a numerical
+     failure (the step is taken; the run stops after it, exit 3) */
+  if (!(dt >= DBL_MIN) || S->t + dt == S->t) {
+    static const char *const names[4] = {"acoustic cfl h / c0 (Eq. 2.160)",
+                                         "viscous (Eq. 2.161) with nu + nu_r %.6g m^2/s",
+                                         "force c_force sqrt(h / |a|) (Eq. 2.162) with |a| %.6g "
+                                         "m/s^2",
+                                         "wall (Eq. 2.163) with a wall rate %.6g 1/s"};
+    const double arg[4] = {0.0, S->nu_max, fi->amax, fi->gvmax};
+    char limit[160];
+    snprintf(limit, sizeof limit, names[k], arg[k]);
+    snprintf(S->violation, sizeof S->violation,
+             "time step %.3g s at step %ld (t = %.9g) is zero, subnormal or too small to advance "
+             "t: the %.150s limit (check drive.force, fluid.nu, c0)",
+             dt, S->step, S->t, limit);
+  }
   return dt;
 }
 

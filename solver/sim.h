@@ -37,7 +37,8 @@ struct sim {
   double *wall_ax;          /*!< per particle x-acceleration from the walls (statistics only) */
   double wall_fx[2];        /*!< x-force of the walls y = 0, 2 delta on the fluid, last sampled
                                  force pass (NaN if not sampled) [N, N/m in 2-D] */
-  char violation[320];      /*!< a fixed dt broke a stability limit: what, where (else empty) */
+  char violation[384];      /*!< a fixed dt broke a stability limit, or the step is zero: what,
+                                 where (else empty) */
   int distributed;          /*!< 1 after the particles were split over the ranks */
   long qcrit_step;          /*!< step whose Q criterion P.qcrit holds (-1: none yet) */
   long reflections;         /*!< wall reflections on this rank since the process began
