@@ -976,6 +976,17 @@ static int write_range(const struct extract_args *a, const struct stored *s, siz
    printed, nothing touched. */
 static int out_refused(const struct extract_args *a) {
   struct stat so, si;
+  char dir[4096];
+  snprintf(dir, sizeof dir, "%s", a->nc_out);
+  char *slash = strrchr(dir, '/');
+  if (slash) /* its directory must exist (netCDF reports a missing one as "Permission denied") */
+    *(slash == dir ? slash + 1 : slash) = '\0';
+  const int missing = slash && stat(dir, &si) != 0;
+  if (slash && (missing || !S_ISDIR(si.st_mode))) {
+    fprintf(stderr, "error: --nc %s: the directory %s %s: create it first, or write elsewhere\n",
+            a->nc_out, dir, missing ? "does not exist" : "is not a directory");
+    return 1;
+  }
   if (stat(a->nc_out, &so) != 0) return 0; /* a new file */
   for (int k = 0; k < a->npaths; k++)
     if (stat(a->paths[k], &si) == 0 && si.st_dev == so.st_dev && si.st_ino == so.st_ino) {
@@ -996,9 +1007,8 @@ static int out_refused(const struct extract_args *a) {
       why = "not a stats.nc (no group 'eulerian')";
     CHECK_NC(nc_close(ncid));
   }
-  char dir[4096];
   snprintf(dir, sizeof dir, "%s", a->nc_out);
-  char *slash = strrchr(dir, '/');
+  slash = strrchr(dir, '/');
   snprintf(slash ? slash + 1 : dir, sizeof dir - (size_t)(slash ? slash + 1 - dir : 0), "run_id");
   const char *base = strrchr(a->nc_out, '/');
   if (!why && !strcmp(base ? base + 1 : a->nc_out, "stats.nc") && stat(dir, &si) == 0)
