@@ -212,6 +212,10 @@ void output_state(struct output *o, struct state_list *L) {
   state_add(L, "output/window_length", STATE_F64, 0, NULL, &o->window_len, "s")->optional = 1;
   /* format 1.5; before it, a run that ended at its target resumed as one that had not */
   state_add(L, "output/converged", STATE_I32, 0, NULL, &o->converged, NULL)->optional = 1;
+  /* format 1.12: the statistics an earlier resume from an older checkpoint left incomplete */
+  if (!o->resumed_without) o->resumed_without = mem_calloc(1, 1, "output");
+  state_add(L, "output/resumed_without", STATE_TEXT, 0, NULL, &o->resumed_without, NULL)->optional =
+      1;
 }
 
 double output_stats_window(const struct output *o, const struct scene *sc) {
@@ -401,6 +405,8 @@ static int write_stats(struct output *o, const struct sim *S) {
       {"n_fluid", NULL, (double)S->P.n_fluid, 1},
       {"n_snapshots", NULL, (double)o->st.samples, 1},
       {"code_version", CHANSPH_VERSION, 0, 0},
+      {"resumed_without", o->resumed_without && o->resumed_without[0] ? o->resumed_without : NULL,
+       NAN, 0},
       PROVENANCE_ATTRS(o, S, date),
   };
   int rc = CHANSPH_OK;
@@ -670,6 +676,7 @@ void output_close(struct output *o) {
   if (o->log) fclose(o->log);
   free(o->scene_text);
   free(o->history);
+  free(o->resumed_without);
   free(o->col);
   stats_free(&o->st);
   series_free(&o->ts);
