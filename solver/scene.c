@@ -338,7 +338,11 @@ static const struct key keys[] = {
      "command line, to the working directory). Overrides profile; streaks, modes and noise are "
      "added on top. A source that is not a state of the box is refused (exit 1): variables "
      "not 1-D over 'particle', no particles, ids not 0..n-1 each once, a NaN or Inf, rho or "
-     "mass not positive, a position outside the box.",
+     "mass not positive, a position outside the box, a value equal to its _FillValue or "
+     "missing_value, a packed id. CF-packed variables (scale_factor, add_offset, as NCO's "
+     "ncpdq writes them) are unpacked, to the packing's precision (a note says so). The file's "
+     "run_id and time are recorded in stats.nc (init_from_run_id, init_from_time): `chansph "
+     "extract` joins a run only after the run whose final state it started from.",
      OFF(init_from)},
     {"output", "log_every", T_INT, "100", 1, 1e9, 0, NULL, "steps",
      "Steps between progress lines (stdout and DIR/log.txt).", OFF(log_every)},
