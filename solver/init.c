@@ -432,6 +432,18 @@ void init_origin(const char *path, char **run_id, double *time) {
   *run_id = id ? id : text_copy("unknown");
 }
 
+double init_source_bytes(const struct scene *sc, double *count) {
+  int nc, d;
+  size_t n = 0;
+  *count = 0.0;
+  if (!sc->init_from[0] || nc_open(sc->init_from, NC_NOWRITE, &nc) != NC_NOERR) return 0.0;
+  if (nc_inq_dimid(nc, "particle", &d) || nc_inq_dimlen(nc, d, &n)) n = 0;
+  CHECK_NC(nc_close(nc));
+  *count = (double)n;
+  /* x y z u v w rho mass and id (8 bytes each), the ids' check (1) */
+  return (double)n * (9.0 * 8.0 + 1.0);
+}
+
 static int from_file(const struct scene *sc, struct particles *P) {
   struct source src;
   TRY(read_source(sc->init_from, sc, &src));

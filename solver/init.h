@@ -33,6 +33,14 @@ int init_fields(const struct scene *sc, struct particles *P);
 void init_origin(const char *path, char **run_id, double *time);
 
 /**
+ * @brief Memory reading the init.from file needs (its columns, ids and checks), from the
+ *        length of its dimension 'particle', before anything is read (a lower bound; 0 without
+ *        init.from or if the file cannot be opened: reading it reports that).
+ * @param[out] count its particles
+ */
+double init_source_bytes(const struct scene *sc, double *count);
+
+/**
  * @brief The friction velocity of the Reichardt initial profile: (force delta)^(1/2) in force
  *        mode, or the u_tau whose Reichardt profile has the target bulk velocity (flux mode).
  */

@@ -18,6 +18,7 @@
 #include "error.h"
 #include "euler.h"
 #include "git_commit.h"
+#include "lagr.h"
 #include "ncout.h"
 #include "stats_nc.h"
 #include "timers.h"
@@ -151,11 +152,12 @@ static int open_common(struct output *o, const char *dir, const struct scene *sc
   return CHANSPH_OK;
 }
 
-void output_stats_bytes(const struct scene *sc, double *eulerian, double *corr) {
+void output_stats_bytes(const struct scene *sc, double *eulerian, double *corr, double *lagr) {
   struct stats_scene view;
   output_stats_scene(sc, &view);
   *eulerian = euler_engine.estimate(&view);
   *corr = corr_engine.estimate(&view);
+  *lagr = lagr_engine.estimate(&view);
 }
 
 /* The checks and the directory of output_open (rank 0). */
@@ -429,6 +431,10 @@ void output_begin(struct output *o, struct sim *S) {
              "%.3e s, viscous %.3e s; output in %s\n",
              CHANSPH_VERSION, S->P.n_fluid, S->P.n_vertex, S->M.h, S->sc->cfl * S->M.h / S->sc->c0,
              S->sc->c_visc * S->M.h * S->M.h / S->sc->nu, o->dir);
+  output_log(o,
+             "memory: the large allocations need at least %.4g GB per rank (checked before "
+             "the start against 80%% of the machine's memory)\n",
+             sim_memory_estimate(S->sc) / 1e9);
   if (S->dd.size > 1)
     output_log(o, "decomposition: %d MPI ranks, slabs of %d-%d of the %d cell columns along x\n",
                S->dd.size, S->dd.ncol / S->dd.size, (S->dd.ncol + S->dd.size - 1) / S->dd.size,

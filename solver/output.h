@@ -87,9 +87,11 @@ void output_set_window(struct output *o, double len);
  * @brief Memory the statistics engines of a scene need on a rank, before they exist (lower
  *        bounds, for the scene's memory check).
  * @param[out] eulerian bytes of the Eulerian per-column partials (output.n_bins, domain.lx)
+ *             and of its per-window records (with the Reynolds-stress budgets) for the run
  * @param[out] corr bytes of the correlation grids and spectra (correlations.*)
+ * @param[out] lagr bytes of the Lagrangian records (lagrangian.*)
  */
-void output_stats_bytes(const struct scene *sc, double *eulerian, double *corr);
+void output_stats_bytes(const struct scene *sc, double *eulerian, double *corr, double *lagr);
 
 /** @brief Log a line to stdout and log.txt (printf-style). */
 void output_log(struct output *o, const char *fmt, ...);

@@ -83,6 +83,10 @@ int sim_init(struct sim *S, const struct scene *sc);
  */
 int sim_create(struct sim *S, const struct scene *sc);
 
+/** @brief The memory check's estimate of a scene's large allocations on one rank (lower bounds:
+           particles, statistics engines, synthetic eddies, the init.from state) [bytes]. */
+double sim_memory_estimate(const struct scene *sc);
+
 /** @brief Free the simulation. */
 void sim_free(struct sim *S);
 
