@@ -8,7 +8,7 @@ written at once):
   bins: output.n_bins = 6000 (per-window records with the 252-field Reynolds-stress budgets);
   lagr: the Lagrangian engine with 2 levels x 2001 lags x 101 release slots.
 Each large case: 0.75 <= peak / (estimate + base) <= 1.3 (before, the estimate left the
-records out: bins 0.6 of its peak, lagr 0.1). And refusals before anything is allocated, exit 1:
+per-window records and the Lagrangian engine out). And refusals before anything is allocated, exit 1:
   2 ranks on this node whose sum (not each rank's share) is above 80% of the memory: the
   message names the node's ranks and what to do;
   an init.from file whose dimension 'particle' claims 2e9 particles (a few kB on disk): named
