@@ -380,7 +380,10 @@ static const struct key keys[] = {
      "steps. A budget sample splits the pair forces into their conservative parts, which "
      "costs about one more force pass (docs/performance.md, \"The budgets\"); 1 samples them "
      "with every snapshot (the budget identity of every step needs 1 with output.stats_every "
-     "= 1).",
+     "= 1). A short run through a transient needs 1 for its momentum budget to close: the "
+     "fluxes are averaged over the budget snapshots, the momentum change over their span, and "
+     "a few irregular snapshots miss it (the quick-start, t = 0-0.1 from a decelerating burst: "
+     "0.0087 u_tau^2 with 1, 0.058 with 5; jobs/scenes/quickstart.ini uses 1).",
      OFF(budget_every)},
     {"stats", "window", T_DOUBLE, "0", 0, BIG, 0, NULL, "s",
      "Length of an averaging window: stats.nc keeps the sums of every window (re-average a "
