@@ -627,6 +627,8 @@ static herr_t read_rows(hid_t ds, const struct state_field *f, hid_t fsp, void *
 
 static int read_field(hid_t file, struct state_field *f, const char *path, char *err,
                       size_t errlen) {
+  f->absent = f->optional && !link_exists(file, f->name);
+  if (f->absent) return 0;
   if (f->type == STATE_TEXT) {
     char *text = read_text(file, f->name, path, err, errlen);
     if (!text) return 1;
@@ -634,7 +636,6 @@ static int read_field(hid_t file, struct state_field *f, const char *path, char 
     *(char **)f->data = text;
     return 0;
   }
-  if (f->optional && !link_exists(file, f->name)) return 0;
   const hid_t ds = open_dataset(file, f->name, path, err, errlen);
   if (ds < 0) return 1;
   int rc = 1;
@@ -685,11 +686,30 @@ static int read_field(hid_t file, struct state_field *f, const char *path, char 
   return rc;
 }
 
+/* A shape this build does not read in a file of an older minor format (its records grew
+   since): say so, with the versions and the remedies, after the dataset's message in err. */
+static void older_format(hid_t file, char *err, size_t errlen) {
+  int major = 0, minor = 0;
+  if (get_attr_int(file, "format_version_major", H5T_NATIVE_INT32, &major) ||
+      get_attr_int(file, "format_version_minor", H5T_NATIVE_INT32, &minor) ||
+      (major == CKPT_VERSION_MAJOR && minor >= CKPT_VERSION_MINOR))
+    return;
+  char *cut = strstr(err, " (a checkpoint of another scene?)");
+  if (cut) *cut = '\0';
+  const size_t n = strlen(err);
+  snprintf(err + n, errlen - n,
+           ": written in checkpoint format %d.%d, whose records this build (format %d.%d) does "
+           "not read; finish the run with the chansph version that started it, or start a new "
+           "segment from its state with init.from (docs/checkpoint-format.md)",
+           major, minor, CKPT_VERSION_MAJOR, CKPT_VERSION_MINOR);
+}
+
 int ckpt_read(const char *path, struct state_list *L, char *err, size_t errlen) {
   const hid_t file = open_file(path, err, errlen);
   if (file < 0) return 1;
   int rc = 0;
   for (int i = 0; i < L->n && !rc; i++) rc = read_field(file, &L->f[i], path, err, errlen);
+  if (rc && strstr(err, " has shape ")) older_format(file, err, errlen);
   if (H5Fclose(file) < 0 && !rc) {
     fail(err, errlen, "%s: error closing the file", path);
     rc = 1;

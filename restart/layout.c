@@ -112,6 +112,9 @@ void sim_state(struct sim *S, struct state_list *L) {
   state_add(L, "drive/ub_prev", STATE_F64, 0, NULL, &S->drive.ub_prev, "m/s");
   state_add(L, "drive/dt_prev", STATE_F64, 0, NULL, &S->drive.dt_prev, "s");
   state_add(L, "drive/started", STATE_I32, 0, NULL, &S->drive.started, NULL);
+  /* the state the run started from (since 1.11; an older checkpoint leaves "": unknown) */
+  state_add(L, "sim/init_from_run_id", STATE_TEXT, 0, NULL, &S->init_run_id, NULL)->optional = 1;
+  state_add(L, "sim/init_from_time", STATE_F64, 0, NULL, &S->init_time, "s")->optional = 1;
   /* the particle datasets hold the ids 0 .. N-1 in order (the file does not depend on the
      number of ranks); each rank names its id block. A running simulation first sends its
      particles to the block owners; before sim_distribute the block is read into the slots

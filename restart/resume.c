@@ -14,6 +14,7 @@
 #include "alloc.h"
 #include "ckpt.h"
 #include "error.h"
+#include "init.h"
 #include "restart.h"
 #include "rotate.h"
 #include "timers.h"
@@ -214,6 +215,31 @@ static int check_identity(const char *dir, const struct candidate *cd, struct ck
   return bad_file;
 }
 
+/* The statistics datasets (stats/...) the checkpoint lacked, being of an earlier format: what
+   they accumulate starts at this resume (the Reynolds-stress budgets, before format 1.6, cover
+   only the windows after it). Said in the log and kept in o->resumed_without (the global
+   attribute resumed_without of stats.nc, and checkpointed, so that later resumes keep it). */
+static void note_absent(struct output *o, const struct state_list *L, const char *path, double t) {
+  char list[1024] = "";
+  size_t m = 0;
+  for (int i = 0; i < L->n && m < sizeof list; i++)
+    if (L->f[i].absent && !strncmp(L->f[i].name, "stats/", 6))
+      m += (size_t)snprintf(list + m, sizeof list - m, "%s%s", m ? ", " : "", L->f[i].name);
+  if (!list[0]) return;
+  output_log(o,
+             "resume: note: %s lacks %s (an earlier checkpoint format): what %s accumulates "
+             "starts at this resume, t = %.9g%s; stats.nc says so (attribute resumed_without)\n",
+             path, list, strchr(list, ',') ? "they" : "it", t,
+             strstr(list, "reynolds_budget") ? " (the Reynolds-stress budgets cover only the "
+                                               "windows after it)"
+                                             : "");
+  const char *old = o->resumed_without ? o->resumed_without : "";
+  const size_t n = strlen(old) + strlen(list) + 64;
+  char *note = mem_alloc(n, 1, "resume");
+  snprintf(note, n, "%s%s%s from t = %.9g", old, old[0] ? "; " : "", list, t);
+  free(o->resumed_without), o->resumed_without = note;
+}
+
 /* Read one candidate; on failure everything it set up is released. */
 static int try_one(const char *dir, struct candidate *cd, int n_set, char *const *set,
                    struct scene *sc, struct sim *S, struct output *o, struct skipped *sk,
@@ -259,6 +285,9 @@ static int try_one(const char *dir, struct candidate *cd, int n_set, char *const
     return CHANSPH_ERR;
   }
   S->sc = sc;
+  /* the state the run started from: unknown unless the checkpoint says (since format 1.11) */
+  free(S->init_run_id);
+  init_origin(NULL, &S->init_run_id, &S->init_time);
   if (output_reopen(o, dir, sc)) {
     sim_free(S);
     *fatal = 1;
@@ -273,6 +302,7 @@ static int try_one(const char *dir, struct candidate *cd, int n_set, char *const
      seen by any rank skips the file on all */
   const int rc = ckpt_agree(ckpt_read(path, &L, err, sizeof err), err, sizeof err);
   seconds[0] = timer_now() - t0;
+  if (!rc) note_absent(o, &L, path, info.time);
   state_free(&L);
   if (!rc && S->step != info.step)
     snprintf(err, sizeof err,

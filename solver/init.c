@@ -89,6 +89,7 @@ struct source {
   long long *id;
   double lx, ly, lz, h;
   int dim;
+  int packed; /* variables that were CF-packed (unpacked when read) */
 };
 
 /** The variables of particles.nc that init.from reads, in the order of source.col, then id. */
@@ -104,6 +105,40 @@ static void source_free(struct source *src) {
 static int source_var_ok(int nc, int vid, int dimid) {
   int nd = 0, d = -1;
   return !nc_inq_varndims(nc, vid, &nd) && nd == 1 && !nc_inq_vardimid(nc, vid, &d) && d == dimid;
+}
+
+/** Variable vid (name) of file path as values: CF packing (scale_factor, add_offset, as NCO's
+    ncpdq writes it) applied to the n raw values col; a value equal to its _FillValue or
+    missing_value is missing: an error. *packed is set if it was packed. */
+static int unpack_column(int nc, int vid, const char *path, const char *name, double *col, size_t n,
+                         int *packed) {
+  double scale = 1.0, offset = 0.0, fill[2];
+  const int has_scale = !nc_get_att_double(nc, vid, "scale_factor", &scale);
+  const int has_offset = !nc_get_att_double(nc, vid, "add_offset", &offset);
+  const int has_fill[2] = {!nc_get_att_double(nc, vid, "_FillValue", &fill[0]),
+                           !nc_get_att_double(nc, vid, "missing_value", &fill[1])};
+  if (!has_scale) scale = 1.0;
+  if (!has_offset) offset = 0.0;
+  *packed = has_scale || has_offset;
+  if (!isfinite(scale) || !isfinite(offset)) {
+    error_input(
+        "%s (init.from): variable '%s' has a packing scale_factor %g, add_offset %g that "
+        "is not finite",
+        path, name, scale, offset);
+    return CHANSPH_ERR;
+  }
+  for (size_t b = 0; b < n; b++) {
+    for (int k = 0; k < 2; k++)
+      if (has_fill[k] && col[b] == fill[k]) {
+        error_input(
+            "%s (init.from): variable '%s' is missing at index %zu (its %s): not a "
+            "usable initial state",
+            path, name, b, k ? "missing_value" : "_FillValue");
+        return CHANSPH_ERR;
+      }
+    col[b] = col[b] * scale + offset;
+  }
+  return CHANSPH_OK;
 }
 
 /** Read the 'scene' attribute and the columns of particles.nc into src (src->n particles). */
@@ -132,6 +167,24 @@ static int read_columns(const char *path, struct source *src, char **text) {
       src->col[c] = mem_alloc(1, (n ? n : 1) * sizeof(double), "initial state");
       ok = src->col[c] && !nc_inq_varid(nc, source_names[c], &vid) &&
            !nc_get_var_double(nc, vid, src->col[c]);
+      int packed = 0;
+      if (ok && unpack_column(nc, vid, path, source_names[c], src->col[c], n, &packed)) {
+        CHECK_NC(nc_close(nc));
+        free(*text), source_free(src);
+        *text = NULL;
+        return CHANSPH_ERR;
+      }
+      src->packed += packed;
+    } else if (!nc_inq_varid(nc, "id", &vid) && (!nc_inq_att(nc, vid, "scale_factor", NULL, NULL) ||
+                                                 !nc_inq_att(nc, vid, "add_offset", NULL, NULL))) {
+      error_input(
+          "%s (init.from): variable 'id' is packed (scale_factor, add_offset): the ids "
+          "must be stored exactly (unpack the file, e.g. ncpdq -U)",
+          path);
+      CHECK_NC(nc_close(nc));
+      free(*text), source_free(src);
+      *text = NULL;
+      return CHANSPH_ERR;
     } else {
       src->id = mem_alloc(1, (n ? n : 1) * sizeof(long long), "initial state");
       ok = src->id && !nc_inq_varid(nc, "id", &vid) && !nc_get_var_longlong(nc, vid, src->id);
@@ -355,9 +408,49 @@ static void interpolate(const struct source *src, struct particles *P) {
   free(start), free(fill), free(order), free(cellof);
 }
 
+/** A malloc'd copy of text. */
+static char *text_copy(const char *text) {
+  char *c = mem_alloc(strlen(text) + 1, 1, "initial state");
+  return strcpy(c, text);
+}
+
+void init_origin(const char *path, char **run_id, double *time) {
+  int nc;
+  size_t len = 0;
+  *time = NAN;
+  char *id = NULL;
+  if (!path || !path[0] || nc_open(path, NC_NOWRITE, &nc) != NC_NOERR) {
+    *run_id = text_copy(path && !path[0] ? "none" : "unknown"); /* read_columns reports errors */
+    return;
+  }
+  if (nc_get_att_double(nc, NC_GLOBAL, "time", time) != NC_NOERR) *time = NAN;
+  if (!nc_inq_attlen(nc, NC_GLOBAL, "run_id", &len) && len > 0 && len < 256) {
+    id = mem_calloc(len + 1, 1, "initial state");
+    if (nc_get_att_text(nc, NC_GLOBAL, "run_id", id) != NC_NOERR) free(id), id = NULL;
+  }
+  CHECK_NC(nc_close(nc));
+  *run_id = id ? id : text_copy("unknown");
+}
+
+double init_source_bytes(const struct scene *sc, double *count) {
+  int nc, d;
+  size_t n = 0;
+  *count = 0.0;
+  if (!sc->init_from[0] || nc_open(sc->init_from, NC_NOWRITE, &nc) != NC_NOERR) return 0.0;
+  if (nc_inq_dimid(nc, "particle", &d) || nc_inq_dimlen(nc, d, &n)) n = 0;
+  CHECK_NC(nc_close(nc));
+  *count = (double)n;
+  /* x y z u v w rho mass and id (8 bytes each), the ids' check (1) */
+  return (double)n * (9.0 * 8.0 + 1.0);
+}
+
 static int from_file(const struct scene *sc, struct particles *P) {
   struct source src;
   TRY(read_source(sc->init_from, sc, &src));
+  if (src.packed)
+    msg("init: %d variables of %s were CF-packed (scale_factor, add_offset): unpacked to the "
+        "packing's precision\n",
+        src.packed, sc->init_from);
   if (src.n == P->n_fluid) { /* same resolution: the state itself, by id */
     for (size_t b = 0; b < src.n; b++) {
       /* fresh lattice: fluid particle a has id a; the ids are a permutation (check_source) */

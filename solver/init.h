@@ -20,6 +20,27 @@
 int init_fields(const struct scene *sc, struct particles *P);
 
 /**
+ * @brief The state a run starts from, for the provenance of its statistics (chansph extract
+ *        joins a segment only after the state its previous segment ended in): the global
+ *        attributes run_id and time of the init.from file path.
+ * @param[in] path particles.nc of an earlier run, "" (the scene's initial condition) or NULL
+ *            (not known: a resume from a checkpoint that did not record it)
+ * @param[out] run_id malloc'd: the file's run_id, "unknown" where it has none or for NULL,
+ *             "none" for ""
+
+ * @param[out] time its attribute time [s], or NaN
+ */
+void init_origin(const char *path, char **run_id, double *time);
+
+/**
+ * @brief Memory reading the init.from file needs (its columns, ids and checks), from the
+ *        length of its dimension 'particle', before anything is read (a lower bound; 0 without
+ *        init.from or if the file cannot be opened: reading it reports that).
+ * @param[out] count its particles
+ */
+double init_source_bytes(const struct scene *sc, double *count);
+
+/**
  * @brief The friction velocity of the Reichardt initial profile: (force delta)^(1/2) in force
  *        mode, or the u_tau whose Reichardt profile has the target bulk velocity (flux mode).
  */

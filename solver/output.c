@@ -18,6 +18,7 @@
 #include "error.h"
 #include "euler.h"
 #include "git_commit.h"
+#include "lagr.h"
 #include "ncout.h"
 #include "stats_nc.h"
 #include "timers.h"
@@ -151,11 +152,12 @@ static int open_common(struct output *o, const char *dir, const struct scene *sc
   return CHANSPH_OK;
 }
 
-void output_stats_bytes(const struct scene *sc, double *eulerian, double *corr) {
+void output_stats_bytes(const struct scene *sc, double *eulerian, double *corr, double *lagr) {
   struct stats_scene view;
   output_stats_scene(sc, &view);
   *eulerian = euler_engine.estimate(&view);
   *corr = corr_engine.estimate(&view);
+  *lagr = lagr_engine.estimate(&view);
 }
 
 /* The checks and the directory of output_open (rank 0). */
@@ -212,6 +214,10 @@ void output_state(struct output *o, struct state_list *L) {
   state_add(L, "output/window_length", STATE_F64, 0, NULL, &o->window_len, "s")->optional = 1;
   /* format 1.5; before it, a run that ended at its target resumed as one that had not */
   state_add(L, "output/converged", STATE_I32, 0, NULL, &o->converged, NULL)->optional = 1;
+  /* format 1.12: the statistics an earlier resume from an older checkpoint left incomplete */
+  if (!o->resumed_without) o->resumed_without = mem_calloc(1, 1, "output");
+  state_add(L, "output/resumed_without", STATE_TEXT, 0, NULL, &o->resumed_without, NULL)->optional =
+      1;
 }
 
 double output_stats_window(const struct output *o, const struct scene *sc) {
@@ -392,6 +398,8 @@ static int write_stats(struct output *o, const struct sim *S) {
       {"viscous", visc, 0, 0},
       {"u_bulk_target", NULL, sc->drive_mode == DRIVE_FLUX ? sc->u_bulk : NAN, 0},
       {"body_force", NULL, S->fx, 0},
+      {"init_from_run_id", S->init_run_id ? S->init_run_id : "unknown", 0, 0},
+      {"init_from_time", NULL, S->init_time, 0},
       {"t_average_start", NULL, sc->t_average_start, 0},
       {"t_end", NULL, sc->t_end, 0},
       {"t_reached", NULL, S->t, 0},
@@ -399,6 +407,8 @@ static int write_stats(struct output *o, const struct sim *S) {
       {"n_fluid", NULL, (double)S->P.n_fluid, 1},
       {"n_snapshots", NULL, (double)o->st.samples, 1},
       {"code_version", CHANSPH_VERSION, 0, 0},
+      {"resumed_without", o->resumed_without && o->resumed_without[0] ? o->resumed_without : NULL,
+       NAN, 0},
       PROVENANCE_ATTRS(o, S, date),
   };
   int rc = CHANSPH_OK;
@@ -421,6 +431,10 @@ void output_begin(struct output *o, struct sim *S) {
              "%.3e s, viscous %.3e s; output in %s\n",
              CHANSPH_VERSION, S->P.n_fluid, S->P.n_vertex, S->M.h, S->sc->cfl * S->M.h / S->sc->c0,
              S->sc->c_visc * S->M.h * S->M.h / S->sc->nu, o->dir);
+  output_log(o,
+             "memory: the large allocations need at least %.4g GB per rank (checked before "
+             "the start against 80%% of the machine's memory)\n",
+             sim_memory_estimate(S->sc) / 1e9);
   if (S->dd.size > 1)
     output_log(o, "decomposition: %d MPI ranks, slabs of %d-%d of the %d cell columns along x\n",
                S->dd.size, S->dd.ncol / S->dd.size, (S->dd.ncol + S->dd.size - 1) / S->dd.size,
@@ -668,6 +682,7 @@ void output_close(struct output *o) {
   if (o->log) fclose(o->log);
   free(o->scene_text);
   free(o->history);
+  free(o->resumed_without);
   free(o->col);
   stats_free(&o->st);
   series_free(&o->ts);

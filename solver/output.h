@@ -16,29 +16,32 @@
 
 /** Output state of a run. */
 struct output {
-  char dir[2048];     /*!< run directory */
-  FILE *log;          /*!< DIR/log.txt */
-  char *scene_text;   /*!< resolved scene */
-  struct stats st;    /*!< the statistics engine */
-  struct series ts;   /*!< time series */
-  double next_write;  /*!< simulated time of the next stats.nc rewrite [s] */
-  double window_len;  /*!< length of the Eulerian averaging windows in use [s] (checkpointed:
-                           fixed once averaging has begun; NaN while a checkpoint is read) */
-  double wall0;       /*!< wall clock at the start of the loop [s] */
-  double t0;          /*!< simulated time at the start of the loop [s] */
-  double last_wall;   /*!< wall clock of the last log line [s] */
-  long last_step;     /*!< step of the last log line */
-  long reflections;   /*!< wall reflections the log has reported (sph.wall_collision) */
-  long step0;         /*!< step at the start of the loop (0, or where a resume started) */
-  long max_steps;     /*!< the command line's --max-steps: steps of this process (0: none) */
-  int *col;           /*!< global cell column of each owned particle (statistics snapshots) */
-  size_t col_cap;     /*!< entries col holds */
-  long rebalances;    /*!< re-partitions already reported in the log */
-  char run_id[64];    /*!< identity of the run (DIR/run_id), attribute of stats.nc, particles.nc */
-  char *history;      /*!< DIR/history: every run and resume command, newest first (rank 0) */
-  size_t target_nwin; /*!< complete windows when the convergence target was last checked */
-  int converged;      /*!< the convergence target (stats.target_stderr) is met: end the run
-                           (checkpointed: a resumed run that met it stays finished) */
+  char dir[2048];    /*!< run directory */
+  FILE *log;         /*!< DIR/log.txt */
+  char *scene_text;  /*!< resolved scene */
+  struct stats st;   /*!< the statistics engine */
+  struct series ts;  /*!< time series */
+  double next_write; /*!< simulated time of the next stats.nc rewrite [s] */
+  double window_len; /*!< length of the Eulerian averaging windows in use [s] (checkpointed:
+                          fixed once averaging has begun; NaN while a checkpoint is read) */
+  double wall0;      /*!< wall clock at the start of the loop [s] */
+  double t0;         /*!< simulated time at the start of the loop [s] */
+  double last_wall;  /*!< wall clock of the last log line [s] */
+  long last_step;    /*!< step of the last log line */
+  long reflections;  /*!< wall reflections the log has reported (sph.wall_collision) */
+  long step0;        /*!< step at the start of the loop (0, or where a resume started) */
+  long max_steps;    /*!< the command line's --max-steps: steps of this process (0: none) */
+  int *col;          /*!< global cell column of each owned particle (statistics snapshots) */
+  size_t col_cap;    /*!< entries col holds */
+  long rebalances;   /*!< re-partitions already reported in the log */
+  char run_id[64];   /*!< identity of the run (DIR/run_id), attribute of stats.nc, particles.nc */
+  char *history;     /*!< DIR/history: every run and resume command, newest first (rank 0) */
+  char *resumed_without; /*!< malloc'd: the statistics datasets a checkpoint the run resumed
+                              from lacked (an earlier format) and the time of that resume
+                              ("" if none): what they accumulate starts there; checkpointed */
+  size_t target_nwin;    /*!< complete windows when the convergence target was last checked */
+  int converged;         /*!< the convergence target (stats.target_stderr) is met: end the run
+                              (checkpointed: a resumed run that met it stays finished) */
 };
 
 /**
@@ -84,9 +87,11 @@ void output_set_window(struct output *o, double len);
  * @brief Memory the statistics engines of a scene need on a rank, before they exist (lower
  *        bounds, for the scene's memory check).
  * @param[out] eulerian bytes of the Eulerian per-column partials (output.n_bins, domain.lx)
+ *             and of its per-window records (with the Reynolds-stress budgets) for the run
  * @param[out] corr bytes of the correlation grids and spectra (correlations.*)
+ * @param[out] lagr bytes of the Lagrangian records (lagrangian.*)
  */
-void output_stats_bytes(const struct scene *sc, double *eulerian, double *corr);
+void output_stats_bytes(const struct scene *sc, double *eulerian, double *corr, double *lagr);
 
 /** @brief Log a line to stdout and log.txt (printf-style). */
 void output_log(struct output *o, const char *fmt, ...);

@@ -37,6 +37,12 @@ struct key {
 
 #define OFF(f) offsetof(struct scene, f)
 #define BIG 1e300
+/* The bounds of the physical keys where the physics is finite (SI units): a body acceleration,
+   a speed and a kinematic viscosity beyond these are no channel flow, and would take the time
+   step to zero (a run that never advances) */
+#define ACCEL_MAX 1e12
+#define SPEED_MAX 1e8
+#define NU_MAX 1e6
 
 /* The names of the choice keys, in the order of their enums (scene.h): the value stored is
    the index. */
@@ -220,12 +226,12 @@ static const struct key keys[] = {
      "von Karman constant of the wall laws (thesis Eq. 5.33).", OFF(kappa)},
     {"wall", "b", T_DOUBLE, "5.2", -BIG, BIG, 0, NULL, "-",
      "Intercept B of the log law (thesis Eq. 5.33).", OFF(log_b)},
-    {"fluid", "nu", T_DOUBLE, NULL, 0, BIG, REQUIRED, NULL, "m^2/s",
+    {"fluid", "nu", T_DOUBLE, NULL, 0, NU_MAX, REQUIRED, NULL, "m^2/s",
      "Kinematic viscosity (0: inviscid, e.g. the energy experiment of thesis Sec. 3.1.2).",
      OFF(nu)},
     {"fluid", "rho0", T_DOUBLE, "1000", 0, BIG, LO_OPEN, NULL, "kg/m^3", "Reference density.",
      OFF(rho0)},
-    {"fluid", "c0", T_DOUBLE, NULL, 0, BIG, REQUIRED | LO_OPEN, NULL, "m/s",
+    {"fluid", "c0", T_DOUBLE, NULL, 0, SPEED_MAX, REQUIRED | LO_OPEN, NULL, "m/s",
      "Numerical speed of sound (about 10 times the largest velocity).", OFF(c0)},
     {"fluid", "zeta", T_DOUBLE, "7", 1, 10, 0, NULL, "-",
      "Exponent of the Tait equation of state (thesis Eq. 2.11).", OFF(zeta)},
@@ -236,11 +242,11 @@ static const struct key keys[] = {
      "For turbulence use 0: its pair stress destroys resolved turbulence within 0.15 "
      "delta/u_tau (docs/validation/turbulent_channel.md).",
      OFF(p_background)},
-    {"fluid", "gravity_y", T_DOUBLE, "0", -BIG, BIG, 0, NULL, "m/s^2",
+    {"fluid", "gravity_y", T_DOUBLE, "0", -ACCEL_MAX, ACCEL_MAX, 0, NULL, "m/s^2",
      "Wall-normal body acceleration; enters the momentum equation, the wall pressure "
      "(thesis Eq. 2.143, 3.63) and the volume diffusion (Eq. 3.61).",
      OFF(gravity_y)},
-    {"fluid", "nu_start", T_DOUBLE, "0", 0, BIG, 0, NULL, "m^2/s",
+    {"fluid", "nu_start", T_DOUBLE, "0", 0, NU_MAX, 0, NULL, "m^2/s",
      "Viscosity schedule (Jimenez & Moin 1991, thesis Sec. 6.1.1): nu_start until "
      "nu_ramp_begin, then linear in time to nu at nu_ramp_end; 0 = constant nu.",
      OFF(nu_start)},
@@ -250,11 +256,11 @@ static const struct key keys[] = {
      "End of the viscosity ramp (at least nu_ramp_begin).", OFF(nu_ramp_end)},
     {"drive", "mode", T_CHOICE, "force", 0, 0, 0, names_drive_mode, "-",
      "Drive the flow by a constant body force or by a controlled volume flux.", OFF(drive_mode)},
-    {"drive", "force", T_DOUBLE, "0", -BIG, BIG, 0, NULL, "m/s^2",
+    {"drive", "force", T_DOUBLE, "0", -ACCEL_MAX, ACCEL_MAX, 0, NULL, "m/s^2",
      "Streamwise body acceleration in force mode (tau_w = rho delta force, thesis Eq. 5.14); "
      "initial value in flux mode.",
      OFF(force)},
-    {"drive", "u_bulk", T_DOUBLE, "0", -BIG, BIG, 0, NULL, "m/s",
+    {"drive", "u_bulk", T_DOUBLE, "0", -SPEED_MAX, SPEED_MAX, 0, NULL, "m/s",
      "Target bulk velocity in flux mode.", OFF(u_bulk)},
     {"drive", "controller", T_CHOICE, "eq3.43", 0, 0, 0, names_drive_controller, "-",
      "Flux controller: thesis Eq. 3.43 (new, generalised to variable dt by Eq. 3.42) or the "
@@ -289,7 +295,7 @@ static const struct key keys[] = {
      "this scene's nu (3-D only; not divergence-free; docs/theory.md, \"Synthetic-eddy "
      "start-up\").",
      OFF(init_profile)},
-    {"init", "wave", T_DOUBLE, "0", -BIG, BIG, 0, NULL, "m/s",
+    {"init", "wave", T_DOUBLE, "0", -SPEED_MAX, SPEED_MAX, 0, NULL, "m/s",
      "Amplitude of the wall-normal wave of profile = wave (the thesis uses c0/10).",
      OFF(init_wave)},
     {"init", "streaks", T_DOUBLE, "0", 0, BIG, 0, NULL, "m/s",
@@ -332,7 +338,11 @@ static const struct key keys[] = {
      "command line, to the working directory). Overrides profile; streaks, modes and noise are "
      "added on top. A source that is not a state of the box is refused (exit 1): variables "
      "not 1-D over 'particle', no particles, ids not 0..n-1 each once, a NaN or Inf, rho or "
-     "mass not positive, a position outside the box.",
+     "mass not positive, a position outside the box, a value equal to its _FillValue or "
+     "missing_value, a packed id. CF-packed variables (scale_factor, add_offset, as NCO's "
+     "ncpdq writes them) are unpacked, to the packing's precision (a note says so). The file's "
+     "run_id and time are recorded in stats.nc (init_from_run_id, init_from_time): `chansph "
+     "extract` joins a run only after the run whose final state it started from.",
      OFF(init_from)},
     {"output", "log_every", T_INT, "100", 1, 1e9, 0, NULL, "steps",
      "Steps between progress lines (stdout and DIR/log.txt).", OFF(log_every)},
@@ -370,7 +380,10 @@ static const struct key keys[] = {
      "steps. A budget sample splits the pair forces into their conservative parts, which "
      "costs about one more force pass (docs/performance.md, \"The budgets\"); 1 samples them "
      "with every snapshot (the budget identity of every step needs 1 with output.stats_every "
-     "= 1).",
+     "= 1). A short run through a transient needs 1 for its momentum budget to close: the "
+     "fluxes are averaged over the budget snapshots, the momentum change over their span, and "
+     "a few irregular snapshots miss it (the quick-start, t = 0-0.1 from a decelerating burst: "
+     "0.0087 u_tau^2 with 1, 0.058 with 5; jobs/scenes/quickstart.ini uses 1).",
      OFF(budget_every)},
     {"stats", "window", T_DOUBLE, "0", 0, BIG, 0, NULL, "s",
      "Length of an averaging window: stats.nc keeps the sums of every window (re-average a "
@@ -1136,9 +1149,16 @@ void scene_write_doc(FILE *f) {
           "after a section header (`[wall] law = x`: a key goes on a line of its own), keys "
           "set twice, values out of range and inconsistent geometry are errors that name the "
           "file, line and key; so is a domain of more than 2^30 particles along a direction, "
-          "or a scene whose particles, statistics grids (`output.n_bins`, `correlations.*`) and "
-          "synthetic eddies would need more than 80%% of the machine's memory (the estimate, a "
-          "lower bound, is checked before anything is allocated).\n"
+          "or a scene whose particles, statistics (`output.n_bins` with the per-window records of "
+          "the budgets, `correlations.*`, `lagrangian.*`), synthetic eddies and `init.from` "
+          "state (from its dimension `particle`, before it is read) would need more than 80%% "
+          "of the machine's memory, summed over the MPI ranks of the node (the estimate, a "
+          "lower bound, is checked before anything is allocated and printed in the log).\n"
+          "The physical keys have finite ranges (accelerations within 1e12 m/s^2, speeds within "
+          "1e8 m/s, viscosities up to 1e6 m^2/s): beyond them there is no channel flow, and the "
+          "time step would go to zero. A time step that is zero, subnormal or too small to "
+          "advance the time (from the state's forces) stops the run as a numerical failure "
+          "(exit 3, naming the limit), not a run that checkpoints without advancing.\n"
           "The fully resolved scene (defaults included) is written to `DIR/scene.used.ini` "
           "and into the `scene` attribute of `stats.nc`.\n");
   const char *section = "";

@@ -3,6 +3,7 @@
 #include "alloc.h"
 
 #include <Random123/philox.h>
+#include <float.h>
 #include <math.h>
 #include <mpi.h>
 #include <stdio.h>
@@ -81,44 +82,79 @@ static void update_state(struct sim *S, int restored, double dt) {
   if (records_fast()) records_pack(P, P->n + P->n_ghost); /* what the force pass gathers */
 }
 
-/** Before any allocation: refuse a scene whose large allocations (lower bounds) need more than
-    80% of the machine's memory (sysconf physical pages) on a rank, naming the keys of the
-    largest and the sizes; a clear refusal, not the OOM killer of a shared node. The rest is
-    for the system, MPI and what the bounds leave out: the peak resident memory measured was
-    1.0 (2-D, dr = 0.002) to 1.25 (3-D, dr = 0.00625) times the bound (docs/performance.md,
-    "Memory check of a scene"). */
+/** The MPI ranks of this node (they share its memory). */
+static int ranks_on_node(void) {
+  MPI_Comm node;
+  int n = 1;
+  CHECK_MPI(MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &node));
+  CHECK_MPI(MPI_Comm_size(node, &n));
+  CHECK_MPI(MPI_Comm_free(&node));
+  return n;
+}
+
+/** Before any allocation: refuse a scene whose large allocations (lower bounds) on the ranks of
+    this node need more than 80% of the machine's memory (sysconf physical pages), naming the
+    keys of the largest and the sizes; a clear refusal, not the OOM killer of a shared node.
+    Every rank builds the full initial lattice and its own statistics engines, so a node's need
+    is its ranks' sum. The rest is for the system, MPI and what the bounds leave out: the peak
+    resident memory measured was 1.0 (2-D, dr = 0.002) to 1.25 (3-D, dr = 0.00625) times the
+    bound (docs/performance.md, "Memory check of a scene"). */
 static int check_memory(const struct scene *sc) {
-  double n = 0.0, eul = 0.0, corr = 0.0;
-  const double parts = part_bytes(sc, &n), eddies = init_bytes(sc);
-  output_stats_bytes(sc, &eul, &corr);
-  char what[4][160];
-  snprintf(what[0], sizeof what[0], "%.4g particles", n);
-  snprintf(what[1], sizeof what[1], "the Eulerian statistics of %d bins x %d cell columns",
+  enum { M_PARTS, M_EULER, M_CORR, M_LAGR, M_EDDIES, M_SOURCE, M_N };
+  double n = 0.0, src = 0.0, bytes[M_N];
+  bytes[M_PARTS] = part_bytes(sc, &n), bytes[M_EDDIES] = init_bytes(sc);
+  output_stats_bytes(sc, &bytes[M_EULER], &bytes[M_CORR], &bytes[M_LAGR]);
+  bytes[M_SOURCE] = init_source_bytes(sc, &src);
+  char what[M_N][160];
+  snprintf(what[M_PARTS], sizeof what[0], "%.4g particles", n);
+  snprintf(what[M_EULER], sizeof what[0],
+           "the Eulerian statistics of %d bins (x %d cell columns, per window with the "
+           "Reynolds-stress budgets)",
            sc->n_bins > 0 ? sc->n_bins : scene_bins(sc), nbr_columns(sc));
-  snprintf(what[2], sizeof what[2], "the correlation grids");
-  snprintf(what[3], sizeof what[3], "%.4g synthetic eddies", init_sem_count(sc));
-  static const char *const keys[4] = {
+  snprintf(what[M_CORR], sizeof what[0], "the correlation grids");
+  snprintf(what[M_LAGR], sizeof what[0], "the Lagrangian records (levels x lags x release slots)");
+  snprintf(what[M_EDDIES], sizeof what[0], "%.4g synthetic eddies", init_sem_count(sc));
+  snprintf(what[M_SOURCE], sizeof what[0], "the %.4g particles of %.100s", src, sc->init_from);
+  static const char *const keys[M_N] = {
       "keys 'domain.lx', 'domain.delta', 'domain.lz', 'domain.dr'",
-      "keys 'output.n_bins', 'domain.lx'",
+      "keys 'output.n_bins', 'domain.lx', 'stats.window'",
       "keys 'correlations.nx', 'correlations.nz', 'correlations.y_plus'",
-      "keys 'init.eddies', 'init.eddy_size'"};
-  const double bytes[4] = {parts, eul, corr, eddies}, total = parts + eul + corr + eddies;
+      "keys 'lagrangian.y_plus', 'lagrangian.n_lags', 'lagrangian.horizon', "
+      "'lagrangian.release_every'",
+      "keys 'init.eddies', 'init.eddy_size'",
+      "key 'init.from'"};
+  static const char *const remedy[M_N] = {"use a smaller domain or a larger dr",
+                                          "use fewer bins or longer windows",
+                                          "use fewer grid points or levels",
+                                          "use fewer levels or lags, or release less often",
+                                          "use fewer or larger eddies",
+                                          "a state of the scene's size (its dimension 'particle')"};
+  double total = 0.0;
+  int k = 0;
+  for (int i = 0; i < M_N; i++) {
+    total += bytes[i];
+    if (bytes[i] > bytes[k]) k = i;
+  }
+  const int ranks = ranks_on_node();
   const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
   const double have = pages > 0 && page > 0 ? (double)pages * (double)page : INFINITY;
-  if (total <= 0.8 * have) return CHANSPH_OK;
-  int k = 0;
-  for (int i = 1; i < 4; i++)
-    if (bytes[i] > bytes[k]) k = i;
+  if (total * ranks <= 0.8 * have) return CHANSPH_OK;
   error_input(
-      "%s: %s: %s need at least %.3g GB per MPI rank (every rank builds the initial lattice; "
-      "%.3g GB in all), more than the %.3g GB (80%%) of the %.3g GB of memory of this "
-      "machine: %s",
+      "%s: %s: %s need at least %.3g GB per MPI rank (every rank builds the initial "
+      "lattice and its statistics; %.3g GB in all, %.3g GB for the %d rank%s on this "
+      "node), more than the %.3g GB (80%%) of the %.3g GB of memory of this machine: %s",
       sc->path[0] ? sc->path : "(scene)", keys[k], what[k], bytes[k] / 1e9, total / 1e9,
-      0.8 * have / 1e9, have / 1e9,
-      k == 0   ? "use a smaller domain or a larger dr"
-      : k == 3 ? "use fewer or larger eddies"
-               : "use fewer bins or grid points");
+      total * ranks / 1e9, ranks, ranks > 1 ? "s" : "", 0.8 * have / 1e9, have / 1e9,
+      ranks > 1 && total <= 0.8 * have ? "use fewer ranks per node (more threads each)"
+                                       : remedy[k]);
   return CHANSPH_ERR;
+}
+
+/** The memory estimate of a scene on this rank (what check_memory adds up) [bytes]. */
+double sim_memory_estimate(const struct scene *sc) {
+  double n, src, e, c, l;
+  output_stats_bytes(sc, &e, &c, &l);
+  return part_bytes(sc, &n) + init_bytes(sc) + init_source_bytes(sc, &src) + e + c + l;
 }
 
 int sim_create(struct sim *S, const struct scene *sc) {
@@ -134,6 +170,7 @@ int sim_create(struct sim *S, const struct scene *sc) {
     return CHANSPH_ERR;
   }
   if (sc->stats_eulerian) S->wall_ax = part_alloc("wall_ax", sizeof(double));
+  init_origin(sc->init_from, &S->init_run_id, &S->init_time);
   S->qcrit_step = -1;
   S->wall_fx[0] = S->wall_fx[1] = NAN;
   drive_init(&S->drive, sc);
@@ -179,6 +216,7 @@ void sim_free(struct sim *S) {
   for (int k = 0; k < 5; k++) part_free(S->scratch[k]);
   part_free(S->ksum_new);
   if (S->wall_ax) part_free(S->wall_ax);
+  free(S->init_run_id), S->init_run_id = NULL;
   part_destroy(&S->P, &S->W);
 }
 
@@ -234,8 +272,26 @@ static double time_step(struct sim *S, const struct force_info *fi) {
     check_fixed_dt(S, sc->dt_fixed);
     return sc->dt_fixed;
   }
-  double dt = S->dt_limits[0];
-  for (int k = 1; k < 4; k++) dt = fmin(dt, S->dt_limits[k]);
+  int k = 0;
+  for (int j = 1; j < 4; j++)
+    if (S->dt_limits[j] < S->dt_limits[k]) k = j;
+  const double dt = S->dt_limits[k];
+  /* a zero or subnormal step, or one too small to advance t, never reaches t_end: a numerical
+     failure (the step is taken; the run stops after it, exit 3) */
+  if (!(dt >= DBL_MIN) || S->t + dt == S->t) {
+    static const char *const names[4] = {"acoustic cfl h / c0 (Eq. 2.160)",
+                                         "viscous (Eq. 2.161) with nu + nu_r %.6g m^2/s",
+                                         "force c_force sqrt(h / |a|) (Eq. 2.162) with |a| %.6g "
+                                         "m/s^2",
+                                         "wall (Eq. 2.163) with a wall rate %.6g 1/s"};
+    const double arg[4] = {0.0, S->nu_max, fi->amax, fi->gvmax};
+    char limit[160];
+    snprintf(limit, sizeof limit, names[k], arg[k]);
+    snprintf(S->violation, sizeof S->violation,
+             "time step %.3g s at step %ld (t = %.9g) is zero, subnormal or too small to advance "
+             "t: the %.150s limit (check drive.force, fluid.nu, c0)",
+             dt, S->step, S->t, limit);
+  }
   return dt;
 }
 

@@ -37,12 +37,18 @@ struct sim {
   double *wall_ax;          /*!< per particle x-acceleration from the walls (statistics only) */
   double wall_fx[2];        /*!< x-force of the walls y = 0, 2 delta on the fluid, last sampled
                                  force pass (NaN if not sampled) [N, N/m in 2-D] */
-  char violation[320];      /*!< a fixed dt broke a stability limit: what, where (else empty) */
+  char violation[384];      /*!< a fixed dt broke a stability limit, or the step is zero: what,
+                                 where (else empty) */
   int distributed;          /*!< 1 after the particles were split over the ranks */
   long qcrit_step;          /*!< step whose Q criterion P.qcrit holds (-1: none yet) */
   long reflections;         /*!< wall reflections on this rank since the process began
                                  (sph.wall_collision = reflect) */
   void *gather[SIM_GATHER]; /*!< this rank's id block of the state, for a checkpoint */
+  char *init_run_id;        /*!< the state the run started from (init_origin): run_id of the
+                                 init.from file, "none" (the scene's initial condition) or
+                                 "unknown" (a file without run_id, or a resume from a
+                                 checkpoint that did not record it) */
+  double init_time;         /*!< that file's time [s], or NaN */
 };
 
 /** Global diagnostics of the current state (all fluid particles). */
@@ -76,6 +82,10 @@ int sim_init(struct sim *S, const struct scene *sc);
  *        checkpoint into it (sim_state) and continues with sim_restored().
  */
 int sim_create(struct sim *S, const struct scene *sc);
+
+/** @brief The memory check's estimate of a scene's large allocations on one rank (lower bounds:
+           particles, statistics engines, synthetic eddies, the init.from state) [bytes]. */
+double sim_memory_estimate(const struct scene *sc);
 
 /** @brief Free the simulation. */
 void sim_free(struct sim *S);

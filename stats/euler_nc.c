@@ -320,11 +320,17 @@ double euler_scene_window(const struct stats_scene *sc) {
   return cfg.window;
 }
 
+/* The per-column partials of a sample, and the per-window records of the whole run (the
+   first 8 rows at once, then doubled as windows close: at least the run's windows), twice: the
+   accumulators and the stats.nc image built in memory when it is written. */
 static double estimate(const struct stats_scene *sc) {
   if (!stats_scene_num(sc, "stats.eulerian")) return 0.0;
   struct euler_config cfg;
   config_of(sc, &cfg);
-  return (double)euler_sample_bytes(cfg.nb, sc->columns);
+  const double windows = ceil((sc->t_end - sc->t_average_start) / cfg.window - 1e-9) + 1.0;
+  const double rows = fmax(8.0, windows);
+  const double row = WIN_LEN + (double)cfg.nb * (MOM_LEN + SCAL_LEN + PL_LEN + KN_LEN + RW_LEN);
+  return (double)euler_sample_bytes(cfg.nb, sc->columns) + 2.0 * rows * row * sizeof(double);
 }
 
 static void init(void *self, const void *cfg) {

@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "corr.h"
@@ -56,6 +57,17 @@ static int find_prof(const char *name) {
   return -1;
 }
 
+/* A file's place in a run (global attributes): the runs it holds, the state its first segment
+   started from and the state its last one ended in, and the flow it simulated. */
+struct origin {
+  char from_id[128]; /* init_from_run_id: "" if absent (written before it was recorded) */
+  double from_t;     /* init_from_time [s], NaN if absent */
+  char *ids;         /* segment_run_ids, else run_id ("" if absent): "; " between runs */
+  double end_t;      /* the time its last segment ended (segment_end_time, else t_reached) */
+  char drive[16];    /* drive_mode */
+  double dim, lx, lz, dr, force; /* dimension, the box, body_force (force mode: constant) */
+};
+
 /* The stored windows of stats.nc and the configuration they were gathered with. */
 struct stored {
   struct euler_config cfg;
@@ -65,6 +77,7 @@ struct stored {
   double *rsb;                   /* NULL without the Reynolds-stress budget (before 1.6) */
   int *complete;
   double t_reached; /* the run's reached time (global attribute t_reached; NaN if absent) */
+  struct origin o;  /* what makes it one run's segment */
 };
 
 static int get_att(int ncid, const char *name, double *v, const char *path) {
@@ -97,6 +110,39 @@ static int read_records(int g, const char *var, const char *dim, size_t n, size_
   return 0;
 }
 
+/* Global text attribute name of ncid into buf (len bytes); "" if absent or too long. */
+static void get_text(int ncid, const char *name, char *buf, size_t len) {
+  size_t n = 0;
+  buf[0] = '\0';
+  if (nc_inq_attlen(ncid, NC_GLOBAL, name, &n) || n >= len ||
+      nc_get_att_text(ncid, NC_GLOBAL, name, buf))
+    n = 0;
+  buf[n] = '\0';
+}
+
+/* Global double attribute name of ncid, or NaN. */
+static double get_num(int ncid, const char *name) {
+  double v;
+  return nc_get_att_double(ncid, NC_GLOBAL, name, &v) == NC_NOERR ? v : NAN;
+}
+
+/* The origin of file ncid (t_reached read before). */
+static void read_origin(int ncid, struct stored *s) {
+  struct origin *o = &s->o;
+  get_text(ncid, "init_from_run_id", o->from_id, sizeof o->from_id);
+  get_text(ncid, "drive_mode", o->drive, sizeof o->drive);
+  o->from_t = get_num(ncid, "init_from_time"), o->end_t = get_num(ncid, "segment_end_time");
+  if (isnan(o->end_t)) o->end_t = s->t_reached;
+  o->dim = get_num(ncid, "dimension"), o->lx = get_num(ncid, "lx"), o->lz = get_num(ncid, "lz");
+  o->dr = get_num(ncid, "dr"), o->force = get_num(ncid, "body_force");
+  size_t n = 0;
+  const char *name =
+      nc_inq_attlen(ncid, NC_GLOBAL, "segment_run_ids", &n) ? "run_id" : "segment_run_ids";
+  if (nc_inq_attlen(ncid, NC_GLOBAL, name, &n)) n = 0;
+  o->ids = mem_calloc(n + 1, 1, "chansph extract");
+  if (n && nc_get_att_text(ncid, NC_GLOBAL, name, o->ids)) o->ids[0] = '\0';
+}
+
 static int read_stored(const char *path, struct stored *s) {
   memset(s, 0, sizeof *s);
   int ncid, g, rc = nc_open(path, NC_NOWRITE, &ncid);
@@ -116,6 +162,7 @@ static int read_stored(const char *path, struct stored *s) {
   s->cfg.les = les != 0.0;
   if (nc_get_att_double(ncid, NC_GLOBAL, "t_reached", &s->t_reached) != NC_NOERR)
     s->t_reached = NAN;
+  read_origin(ncid, s);
   int dy, dw, vw, vm, vs, vc;
   size_t nb = 0;
   if (!bad && (nc_inq_ncid(ncid, "eulerian", &g) || nc_inq_dimid(ncid, "y", &dy) ||
@@ -157,7 +204,7 @@ static int read_stored(const char *path, struct stored *s) {
 
 static void free_stored(struct stored *s) {
   free(s->win), free(s->mom), free(s->snp), free(s->pln), free(s->kin), free(s->rsb),
-      free(s->complete);
+      free(s->complete), free(s->o.ids);
 }
 
 /* Whether segment b (path pb) was gathered as segment a (pa) was; prints what differs. */
@@ -170,8 +217,7 @@ static int same_gathering(const struct stored *a, const struct stored *b, const 
              {"rho0", a->cfg.rho0, b->cfg.rho0},    {"bin_lower", a->cfg.y0, b->cfg.y0},
              {"bin_upper", a->cfg.y1, b->cfg.y1},   {"wall_area", a->cfg.area, b->cfg.area},
              {"fold", a->cfg.fold, b->cfg.fold},    {"window_length", a->cfg.window, b->cfg.window},
-             {"les", a->cfg.les, b->cfg.les},       {"bins (dimension y)", a->cfg.nb, b->cfg.nb},
-             {"budget records", !a->pln, !b->pln},  {"kinetic-flux records", !a->kin, !b->kin}};
+             {"les", a->cfg.les, b->cfg.les},       {"bins (dimension y)", a->cfg.nb, b->cfg.nb}};
   for (size_t k = 0; k < sizeof key / sizeof key[0]; k++)
     if (key[k].x != key[k].y) {
       fprintf(stderr,
@@ -180,6 +226,137 @@ static int same_gathering(const struct stored *a, const struct stored *b, const 
               pb, key[k].name, key[k].y, pa, key[k].x);
       return 0;
     }
+  const struct {
+    const char *name;
+    int x, y;
+  } rec[] = {{"the momentum-budget records (planes)", a->pln != NULL, b->pln != NULL},
+             {"the kinetic-flux records (planes_kinetic)", a->kin != NULL, b->kin != NULL}};
+  for (size_t k = 0; k < sizeof rec / sizeof rec[0]; k++)
+    if (rec[k].x != rec[k].y) {
+      fprintf(stderr,
+              "error: %s: %s %s, but %s %s them: segments of one format are joined (run "
+              "both with one version)\n",
+              pb, rec[k].y ? "holds" : "lacks", rec[k].name, pa, rec[k].x ? "holds" : "lacks");
+      return 0;
+    }
+  return 1;
+}
+
+/* Whether the flow of b (path pb) is that of a (pa): dimension, box, resolution, drive (in
+   force mode the body force); prints what differs. */
+static int same_flow(const struct stored *a, const struct stored *b, const char *pa,
+                     const char *pb) {
+  const struct origin *x = &a->o, *y = &b->o;
+  if (strcmp(x->drive, y->drive)) {
+    fprintf(stderr,
+            "error: %s: drive_mode '%s', but %s has '%s': not the same flow, not joined "
+            "(average each run on its own)\n",
+            pb, y->drive, pa, x->drive);
+    return 0;
+  }
+  const int force = !strcmp(x->drive, "force");
+  const struct {
+    const char *name;
+    double x, y;
+  } key[] = {{"dimension", x->dim, y->dim},
+             {"lx", x->lx, y->lx},
+             {"lz", x->lz, y->lz},
+             {"dr", x->dr, y->dr},
+             {"body_force", force ? x->force : 0.0, force ? y->force : 0.0}};
+  for (size_t k = 0; k < sizeof key / sizeof key[0]; k++) {
+    const double u = key[k].x, v = key[k].y;
+    if ((isnan(u) && isnan(v)) || fabs(u - v) <= 1e-12 * fmax(fabs(u), fabs(v))) continue;
+    fprintf(stderr,
+            "error: %s: %s %.9g, but %s has %.9g: not the same flow, not joined (average each "
+            "run on its own)\n",
+            pb, key[k].name, v, pa, u);
+    return 0;
+  }
+  return 1;
+}
+
+/* The last run of the list ids ("; " between runs). */
+static const char *last_id(const char *ids) {
+  const char *semi = strrchr(ids, ';');
+  return semi ? semi + 2 : ids;
+}
+
+/* Whether the list ids holds run id. */
+static int holds_id(const char *ids, const char *id, size_t n) {
+  for (const char *p = ids; *p;) {
+    const char *semi = strchr(p, ';');
+    const size_t len = semi ? (size_t)(semi - p) : strlen(p);
+    if (len == n && !strncmp(p, id, n)) return 1;
+    if (!semi) break;
+    p = semi + 2;
+  }
+  return 0;
+}
+
+/* Whether b (path pb) is the continuation of the chain a ends (path pa: its last file): it
+   holds no run a holds, and it started (init.from) from the state a's last run ended in.
+   force: a segment whose start was not recorded (a file of an earlier version, or a source
+   without run_id) is taken on the user's word. Prints why not. */
+static int continues(const struct stored *a, const struct stored *b, const char *pa, const char *pb,
+                     int force) {
+  const struct origin *x = &a->o, *y = &b->o;
+  for (const char *p = y->ids; *p;) { /* a run in both: the same segment twice */
+    const char *semi = strchr(p, ';');
+    const size_t n = semi ? (size_t)(semi - p) : strlen(p);
+    if (holds_id(x->ids, p, n)) {
+      fprintf(stderr,
+              "error: %s: holds the statistics of run %.*s, which the files before it hold "
+              "already (%s: the same file twice, a copy of it, or a segment a joined file "
+              "holds): give each segment once, in order\n",
+              pb, (int)n, p, pa);
+      return 0;
+    }
+    if (!semi) break;
+    p = semi + 2;
+  }
+  const char *end_id = last_id(x->ids);
+  if (!strcmp(y->from_id, "none")) {
+    fprintf(stderr,
+            "error: %s: started from the scene's initial condition, not from the final state of "
+            "%s: an independent run, not its continuation (continue a run with init.from = its "
+            "final particles.nc)\n",
+            pb, pa);
+    return 0;
+  }
+  if (!y->from_id[0] || !strcmp(y->from_id, "unknown") || isnan(y->from_t)) {
+    if (force) return 1;
+    fprintf(stderr,
+            "error: %s: does not record the state it started from (%s): extract cannot check "
+            "that it continues %s (run %s, t = %.9g); if it was started with init.from = that "
+            "run's final particles.nc, join them with --force\n",
+            pb, y->from_id[0] ? "its init.from file has no run_id" : "written before chansph did",
+            pa, end_id, x->end_t);
+    return 0;
+  }
+  if (strcmp(y->from_id, end_id) && holds_id(x->ids, y->from_id, strlen(y->from_id))) {
+    fprintf(stderr,
+            "error: %s: started from the state of run %s at t = %.9g, an earlier segment than "
+            "the last of %s (run %s): the segments overlap in time (two continuations of one "
+            "state are two runs; join one of them)\n",
+            pb, y->from_id, y->from_t, pa, end_id);
+    return 0;
+  }
+  if (strcmp(y->from_id, end_id)) {
+    fprintf(stderr,
+            "error: %s: started from the state of run %s at t = %.9g, but %s ends with run %s: "
+            "not its continuation (segments out of order, or of another run; give them in "
+            "the order they ran)\n",
+            pb, y->from_id, y->from_t, pa, end_id);
+    return 0;
+  }
+  if (!(fabs(y->from_t - x->end_t) <= 1e-9 * fmax(1.0, fabs(x->end_t)))) {
+    fprintf(stderr,
+            "error: %s: started from the state of run %s at t = %.9g, but the statistics of %s "
+            "end at t = %.9g: the segments %s in time (continue from the final state; two "
+            "continuations of one state are two runs)\n",
+            pb, end_id, y->from_t, pa, x->end_t, y->from_t < x->end_t ? "overlap" : "leave a gap");
+    return 0;
+  }
   return 1;
 }
 
@@ -210,7 +387,7 @@ static void shift_times(struct stored *s, size_t r0, size_t r1, double offset) {
    before (init.from), joined into seg[0] as the windows of one run: each segment's times
    shifted by the sum of the reached times of those before it (each starts at t = 0). The
    others are freed. Nonzero on an input error (printed, naming the file). */
-static int join_stored(struct stored *seg, int n, char *const *paths) {
+static int join_stored(struct stored *seg, int n, char *const *paths, int force) {
   struct stored *s = &seg[0];
   double offset = 0.0;
   int bad = 0;
@@ -222,7 +399,9 @@ static int join_stored(struct stored *seg, int n, char *const *paths) {
               paths[k - 1]);
       bad = 1;
     }
-    if (bad || !same_gathering(s, b, paths[0], paths[k])) {
+    if (bad || !same_flow(s, b, paths[0], paths[k]) ||
+        !continues(s, b, paths[k - 1], paths[k], force) ||
+        !same_gathering(s, b, paths[0], paths[k])) {
       bad = 1;
       break;
     }
@@ -256,6 +435,10 @@ static int join_stored(struct stored *seg, int n, char *const *paths) {
     s->complete = mem_realloc(s->complete, ra + rb, sizeof(int), "chansph extract");
     memcpy(s->complete + ra, b->complete, rb * sizeof(int));
     s->rows = ra + rb, s->t_reached = offset + b->t_reached;
+    const size_t la = strlen(s->o.ids), lb = strlen(b->o.ids);
+    s->o.ids = mem_realloc(s->o.ids, la + lb + 3, 1, "chansph extract");
+    memcpy(s->o.ids + la, "; ", 2), memcpy(s->o.ids + la + 2, b->o.ids, lb + 1);
+    s->o.end_t = b->o.end_t;
   }
   for (int k = 1; k < n; k++) free_stored(&seg[k]);
   return bad;
@@ -277,13 +460,19 @@ static int parse_time(const char *text, const char *stop, double dflt, double *t
 static void usage(FILE *f) {
   fprintf(f,
           "usage: chansph extract STATS.nc [LATER.nc ...] [--var a,b,...] [--units wall|outer] "
-          "[--format csv|tsv] [--window T0:T1] [--pdfs] [--nc OUT.nc]\n"
+          "[--format csv|tsv] [--window T0:T1] [--pdfs] [--nc OUT.nc] [--force]\n"
           "  LATER.nc ...: the stats.nc of later segments of the same run, each started from the "
           "final\n"
           "    state of the one before (init.from, e.g. on another machine): their windows are "
           "joined\n"
           "    on one time axis (each segment's times shifted by the reached times of those "
-          "before it)\n"
+          "before it);\n"
+          "    refused (exit 1): a segment twice, out of order, overlapping or leaving a gap, "
+          "from rest,\n"
+          "    another flow (dimension, box, dr, drive, body force) or gathered otherwise\n"
+          "  --force: join a segment that does not record the state it started from (a file "
+          "of an earlier\n"
+          "    version) on your word that it continued the one before; the other checks stay\n"
           "  variables: u_mean v_mean w_mean p_mean rho_mean uu vv ww uv uw vw u_rms v_rms "
           "w_rms\n"
           "  u_skewness ... w_flatness viscous_stress total_stress total_stress_expected "
@@ -311,6 +500,7 @@ struct extract_args {
   int npaths;
   double t0, t1;      /* --window */
   int pdfs;           /* --pdfs */
+  int force;          /* --force: join segments whose start was not recorded */
   const char *nc_out; /* --nc: write the range as a stats.nc instead of a table */
 };
 
@@ -319,13 +509,26 @@ static const char *later_segments(const struct extract_args *a) {
   return a->npaths > 1 ? " and its later segments" : "";
 }
 
+/* More than EXTRACT_MAX_SEGMENTS files (the first left over: path); 1. */
+static int too_many(const char *path) {
+  fprintf(stderr,
+          "error: %s: more than %d files: extract joins at most %d segments at once (join them "
+          "in groups with --nc, then join the joined files)\n",
+          path, EXTRACT_MAX_SEGMENTS, EXTRACT_MAX_SEGMENTS);
+  return 1;
+}
+
 /* Parse the command line (argv[0]: the command name); 1: input error, -1: --help printed. */
 static int extract_parse(int argc, char **argv, struct extract_args *a) {
-  static const struct option opts[] = {
-      {"help", no_argument, NULL, 'h'},         {"var", required_argument, NULL, 'v'},
-      {"units", required_argument, NULL, 'u'},  {"format", required_argument, NULL, 'f'},
-      {"window", required_argument, NULL, 'w'}, {"pdfs", no_argument, NULL, 'p'},
-      {"nc", required_argument, NULL, 'n'},     {NULL, 0, NULL, 0}};
+  static const struct option opts[] = {{"help", no_argument, NULL, 'h'},
+                                       {"var", required_argument, NULL, 'v'},
+                                       {"units", required_argument, NULL, 'u'},
+                                       {"format", required_argument, NULL, 'f'},
+                                       {"window", required_argument, NULL, 'w'},
+                                       {"pdfs", no_argument, NULL, 'p'},
+                                       {"nc", required_argument, NULL, 'n'},
+                                       {"force", no_argument, NULL, 'F'},
+                                       {NULL, 0, NULL, 0}};
   *a = (struct extract_args){.vars = "u_mean,u_rms,v_rms,w_rms,uv",
                              .units = "wall",
                              .fmt = "csv",
@@ -339,8 +542,8 @@ static int extract_parse(int argc, char **argv, struct extract_args *a) {
       usage(stdout);
       return -1;
     }
-    if (code == 'p') {
-      a->pdfs = 1;
+    if (code == 'p' || code == 'F') {
+      *(code == 'p' ? &a->pdfs : &a->force) = 1;
     } else if (code == 'n') {
       a->nc_out = optarg;
     } else if (code == 'v' || code == 'u' || code == 'f') {
@@ -357,6 +560,8 @@ static int extract_parse(int argc, char **argv, struct extract_args *a) {
       }
     } else if (code == 1 && a->npaths < EXTRACT_MAX_SEGMENTS) {
       a->paths[a->npaths++] = optarg;
+    } else if (code == 1) {
+      return too_many(optarg);
     } else {
       fprintf(stderr, "error: unexpected argument '%s'\n", code == 1 ? optarg : argv[at]);
       usage(stderr);
@@ -365,6 +570,7 @@ static int extract_parse(int argc, char **argv, struct extract_args *a) {
   }
   while (optind < argc && a->npaths < EXTRACT_MAX_SEGMENTS) /* after "--" */
     a->paths[a->npaths++] = argv[optind++];
+  if (optind < argc) return too_many(argv[optind]);
   a->path = a->npaths ? a->paths[0] : NULL;
   if (a->pdfs && a->npaths > 1) {
     fprintf(stderr, "error: --pdfs reads one stats.nc, not the %d given\n", a->npaths);
@@ -555,9 +761,10 @@ static int extract_pdfs(const struct extract_args *a) {
 /* The global attributes the Eulerian engine writes for its averaged range (euler_nc.c), which
    --nc must not copy from the whole run. */
 static const char *const range_attrs[] = {
-    "u_tau",       "u_tau_stderr",     "u_tau_wall",           "u_tau_force",
-    "re_tau",      "correlation_time", "stress_balance_error", "average_start",
-    "average_end", "n_windows",        "n_snapshots",          "t_reached"};
+    "u_tau",           "u_tau_stderr",     "u_tau_wall",           "u_tau_force",
+    "re_tau",          "correlation_time", "stress_balance_error", "average_start",
+    "average_end",     "n_windows",        "n_snapshots",          "t_reached",
+    "segment_run_ids", "segment_end_time"};
 
 /* Copy the global attributes of file in to out, less those of range_attrs. */
 static int copy_run_attrs(int in, int out) {
@@ -687,6 +894,16 @@ static int put_segments(const struct extract_args *a, int out) {
   return rc;
 }
 
+/* The runs a file of several holds, and, if its range runs to the end (r1 = rows), the time
+   its last one ended: what a later segment must continue (segment_run_ids, segment_end_time). */
+static int put_origin(const struct stored *s, size_t r1, int out) {
+  if (!strchr(s->o.ids, ';')) return NC_NOERR; /* one run: run_id and t_reached say it */
+  int rc = nc_put_att_text(out, NC_GLOBAL, "segment_run_ids", strlen(s->o.ids), s->o.ids);
+  if (rc == NC_NOERR && r1 == s->rows && isfinite(s->o.end_t))
+    rc = nc_put_att_double(out, NC_GLOBAL, "segment_end_time", NC_DOUBLE, 1, &s->o.end_t);
+  return rc;
+}
+
 /* The windows r0 .. r1-1 of s as the state of an engine that gathered only them (its last row
    open if that window is), written by the engine's own writer to a.nc_out (through a
    temporary file, renamed when complete). */
@@ -731,6 +948,7 @@ static int write_range(const struct extract_args *a, const struct stored *s, siz
     rc = nc_put_att_double(out, NC_GLOBAL, "t_reached", NC_DOUBLE, 1, &t_end);
   if (rc == NC_NOERR) rc = nc_put_att_longlong(out, NC_GLOBAL, "n_snapshots", NC_INT64, 1, &ns);
   if (rc == NC_NOERR && a->npaths > 1) rc = put_segments(a, out);
+  if (rc == NC_NOERR) rc = put_origin(s, r1, out);
   if (rc == NC_NOERR) rc = euler_engine.write(&e, t_end, out, err, sizeof err);
   if (rc == NC_NOERR) rc = corr_output(&k, in, out, err, sizeof err);
   if (k.have == 1) corr_free(&k.c);
@@ -752,11 +970,63 @@ static int write_range(const struct extract_args *a, const struct stored *s, siz
   return 1;
 }
 
+/* Whether --nc OUT may be written: it does not exist, or it is an earlier output of extract,
+   not one of the files read (by inode: a copy is another file, a link the same), nor a run's
+   file (particles.nc, a snapshot, a run's own stats.nc) or a foreign file. Nonzero: refused,
+   printed, nothing touched. */
+static int out_refused(const struct extract_args *a) {
+  struct stat so, si;
+  char dir[4096];
+  snprintf(dir, sizeof dir, "%s", a->nc_out);
+  char *slash = strrchr(dir, '/');
+  if (slash) /* its directory must exist (netCDF reports a missing one as "Permission denied") */
+    *(slash == dir ? slash + 1 : slash) = '\0';
+  const int missing = slash && stat(dir, &si) != 0;
+  if (slash && (missing || !S_ISDIR(si.st_mode))) {
+    fprintf(stderr, "error: --nc %s: the directory %s %s: create it first, or write elsewhere\n",
+            a->nc_out, dir, missing ? "does not exist" : "is not a directory");
+    return 1;
+  }
+  if (stat(a->nc_out, &so) != 0) return 0; /* a new file */
+  for (int k = 0; k < a->npaths; k++)
+    if (stat(a->paths[k], &si) == 0 && si.st_dev == so.st_dev && si.st_ino == so.st_ino) {
+      fprintf(stderr,
+              "error: --nc %s is the input %s (the same file): extract never replaces what it "
+              "reads; write to another name\n",
+              a->nc_out, a->paths[k]);
+      return 1;
+    }
+  int ncid, g, d;
+  const char *why = NULL;
+  if (nc_open(a->nc_out, NC_NOWRITE, &ncid) != NC_NOERR) {
+    why = "not a netCDF file";
+  } else {
+    if (nc_inq_dimid(ncid, "particle", &d) == NC_NOERR)
+      why = "a run's particle state (dimension 'particle': particles.nc or a snapshot)";
+    else if (nc_inq_ncid(ncid, "eulerian", &g) != NC_NOERR)
+      why = "not a stats.nc (no group 'eulerian')";
+    CHECK_NC(nc_close(ncid));
+  }
+  snprintf(dir, sizeof dir, "%s", a->nc_out);
+  slash = strrchr(dir, '/');
+  snprintf(slash ? slash + 1 : dir, sizeof dir - (size_t)(slash ? slash + 1 - dir : 0), "run_id");
+  const char *base = strrchr(a->nc_out, '/');
+  if (!why && !strcmp(base ? base + 1 : a->nc_out, "stats.nc") && stat(dir, &si) == 0)
+    why = "a run's own stats.nc (its directory holds run_id)";
+  if (why)
+    fprintf(stderr,
+            "error: --nc %s exists and is %s: extract replaces only a file it wrote; remove it "
+            "or write to another name\n",
+            a->nc_out, why);
+  return why != NULL;
+}
+
 int extract_main(int argc, char **argv) {
   struct extract_args a;
   const int prc = extract_parse(argc, argv, &a);
   if (prc) return prc < 0 ? 0 : 1;
   if (a.pdfs) return extract_pdfs(&a);
+  if (a.nc_out && out_refused(&a)) return 1;
   struct stored seg[EXTRACT_MAX_SEGMENTS], s;
   int bad = 0, n = 0;
   for (; n < a.npaths && !bad; n++) bad = read_stored(a.paths[n], &seg[n]);
@@ -764,7 +1034,7 @@ int extract_main(int argc, char **argv) {
     while (n--) free_stored(&seg[n]);
     return 1;
   }
-  bad = join_stored(seg, n, a.paths), s = seg[0];
+  bad = join_stored(seg, n, a.paths, a.force), s = seg[0];
   if (bad) {
     free_stored(&s);
     return 1;

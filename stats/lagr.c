@@ -647,7 +647,7 @@ done:
 }
 
 /* The engine's table of operations (engine.h). */
-static int engine_init_scene(void *self, const struct stats_scene *sc) {
+static int config_of(const struct stats_scene *sc, struct lagr_config *cp) {
   struct lagr_config c;
   memset(&c, 0, sizeof c);
   c.n_levels = stats_scene_levels(sc, "lagrangian.y_plus", c.y_plus, c.y, LAGR_MAX_LEVELS);
@@ -660,9 +660,27 @@ static int engine_init_scene(void *self, const struct stats_scene *sc) {
   c.release_every = every > 0.0 ? every : c.horizon;
   c.n_stations = stats_scene_list(sc, "lagrangian.pdf_x", c.station, LAGR_MAX_STATIONS);
   c.t_start = sc->t_average_start;
-  if (!(c.n_levels > 0)) return 0;
+  *cp = c;
+  return c.n_levels > 0;
+}
+
+static int engine_init_scene(void *self, const struct stats_scene *sc) {
+  struct lagr_config c;
+  if (!config_of(sc, &c)) return 0;
   lagr_init(self, &c);
   return 1;
+}
+
+/* The records lagr_init allocates (sums, the release slots' sums, the PDFs), before any, twice:
+   they and their copy in a checkpoint (built in memory, restart/ckpt.c). */
+static double engine_estimate(const struct stats_scene *sc) {
+  struct lagr_config c;
+  if (!config_of(sc, &c)) return 0.0;
+  const double nl = c.n_levels, nlag = c.n_lags + 1.0, nst = c.n_stations ? c.n_stations : 1;
+  const double slots = ceil(c.horizon / c.release_every - 1e-9) + 1.0;
+  return 2.0 * sizeof(double) *
+         (nl * nlag * LG_LEN * (1.0 + slots) + slots * SL_LEN + nl * 3 * SCAL_LEN +
+          nl * nst * (c.pdf_bins + 3.0));
 }
 
 STATS_ENGINE_ADAPTERS(lagr)
@@ -689,6 +707,7 @@ static int engine_warnings(const void *self, char *buf, size_t len) {
 const struct stats_engine lagr_engine = {.name = "Lagrangian statistics",
                                          .size = sizeof(struct lagr),
                                          .init_scene = engine_init_scene,
+                                         .estimate = engine_estimate,
                                          .init = engine_init,
                                          .free = engine_free,
                                          .sample = engine_sample,

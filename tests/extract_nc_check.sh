@@ -35,7 +35,7 @@ PY
 msg=$("$chansph" extract "$stats" --window "$range" --nc "$work/no/such/dir/x.nc" 2>&1)
 rc=$?
 echo "$msg"
-[ $rc -eq 1 ] && echo "$msg" | grep -q "cannot write $work/no/such/dir/x.nc" ||
-  { echo "FAIL: an unwritable --nc is not an input error naming it (exit $rc)"; exit 1; }
+[ $rc -eq 1 ] && echo "$msg" | grep -q "error: --nc $work/no/such/dir/x.nc: the directory $work/no/such/dir does not exist: create it first" ||
+  { echo "FAIL: a --nc in a missing directory is not an input error saying so (exit $rc)"; exit 1; }
 ls "$work/no/such/dir" 2>/dev/null && { echo "FAIL: something was left behind"; exit 1; }
 echo "PASS: the range as a stats.nc of its own"

@@ -39,7 +39,7 @@ import numpy as np
 path, minor = sorted(glob.glob(sys.argv[1] + "/checkpoints/ckpt_*.h5"))[-1], int(sys.argv[2])
 done = []
 with h5py.File(path, "a") as h:
-    assert h.attrs["format_version_minor"] == 11, h.attrs["format_version_minor"]
+    assert h.attrs["format_version_minor"] == 12, h.attrs["format_version_minor"]
     width = 47 if minor == 9 else 46 if minor >= 7 else 43  # sums per record
     for k in ("stats/lagrangian/sums", "stats/lagrangian/slot_sums"):
         a = h[k][()]

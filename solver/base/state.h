@@ -49,6 +49,7 @@ struct state_field {
       converts the layout of an earlier format into the live one in place (or NULL). */
   void (*after_read)(void *owner, int rank, const size_t *dims);
   int optional; /*!< 1: a checkpoint of an earlier format may lack it (reading leaves it) */
+  int absent;   /*!< set by the reader: an optional field the checkpoint lacked */
   /** Distributed fields (total > 0): this rank holds rows offset .. offset+dims[0]-1 of a
       dataset of total rows (the other dimensions whole); each rank reads and writes its own
       rows. total = 0: the whole field, the same on every rank. */

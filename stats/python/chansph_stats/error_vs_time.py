@@ -84,7 +84,7 @@ def main(argv, prog):
     ap.add_argument("--group", type=cli.number(float, 0, above=True), default=0.25,
                     help="window group length [delta/u_tau]")
     ap.add_argument("--out", default=".")
-    ap.add_argument("--cumulative", type=float, default=None, metavar="T0",
+    ap.add_argument("--cumulative", type=cli.number(float, 0), default=None, metavar="T0",
                     help="the error of the running average from T0 [delta/u_tau] to the end "
                          "of each group (within each run directory), instead of each group's own")
     a = ap.parse_args(argv)
@@ -98,6 +98,15 @@ def main(argv, prog):
         for run in dirs.split("+"):
             t, ps, wall = log_cost(run)
             groups = group_profiles(run, a.group, a.cumulative)
+            if not groups:
+                w = read_windows(os.path.join(run, "stats.nc"))["win"]
+                raise InputError(
+                    "%s: no complete window%s (its windows span t = %.6g .. %.6g): "
+                    "give a --cumulative T0 inside that span" % (
+                        os.path.join(run, "stats.nc"),
+                        "" if a.cumulative is None else " starts at or after --cumulative %g"
+                        % a.cumulative, w[0, 0] if len(w) else math.nan,
+                        w[-1, 1] if len(w) else math.nan))
             for t0, t1, prof in groups:
                 p1, w1 = np.interp(t1, t, ps), np.interp(t1, t, wall)
                 errs = [[rel_l2(prof, d, q) for q in QUANTITIES] for d in dns]

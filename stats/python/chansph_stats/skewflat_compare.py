@@ -129,6 +129,13 @@ def main(argv, prog):
     r = read_run(a.stats, a.u_tau)
     b = batches(r)
     yp, ok = r["y+"], np.isfinite(r["y+"]) & (r["n_samples"] > 0)
+    if ok.any():
+        lo, hi = float(yp[ok].min()), float(yp[ok].max())
+        out = [y for y in at if not 0 < y <= hi]
+        if out:
+            raise InputError("--at %s: y+ %s outside the channel of the run (0 < y+ <= %.4g, "
+                             "its bins' centres y+ %.3g .. %.3g in %s): give y+ within it"
+                             % (a.at, ", ".join("%g" % y for y in out), hi, lo, hi, a.stats))
     failed = False
     print("# %s: %d complete windows (batches of the standard errors); wall units of u_tau = "
           "%.5g m/s; run value +- standard error (MKM)" % (a.stats, b["u"][2], r["u_tau"]))
