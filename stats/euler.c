@@ -196,6 +196,31 @@ const struct euler_meta euler_prof_meta[EP_NPROF] = {
                        "standard error of advective_stress (batch means)"},
     [EP_SE_TAU + 6] = {"total_stress_stderr", "m^2/s^2",
                        "standard error of total_stress (batch means)"},
+    [EP_UU_BIN + 0] = {"uu_bin", "m^2/s^2",
+                       "<u'u'> about the bin mean: includes the spread of the mean velocity over "
+                       "the bin (compare --binned)"},
+    [EP_UU_BIN + 1] = {"vv_bin", "m^2/s^2", "<v'v'> about the bin mean (compare --binned)"},
+    [EP_UU_BIN + 2] = {"ww_bin", "m^2/s^2", "<w'w'> about the bin mean (compare --binned)"},
+    [EP_UU_BIN + 3] = {"uv_bin", "m^2/s^2",
+                       "<u'v'> about the bin mean: includes the covariance of the mean velocity "
+                       "with v over the bin (compare --binned)"},
+    [EP_UU_BIN + 4] = {"uw_bin", "m^2/s^2", "<u'w'> about the bin mean (compare --binned)"},
+    [EP_UU_BIN + 5] = {"vw_bin", "m^2/s^2", "<v'w'> about the bin mean (compare --binned)"},
+    [EP_LOCAL] = {"local_mean", "1",
+                  "flag: 1 where uu .. vw are fluctuations about the local mean U(y) = U_b + "
+                  "dU/dy (y - y_mean) (the bin's co-moments with y), 0 where about the bin mean "
+                  "(records of checkpoint format 1.11 or older in the range)"},
+    [EP_CORR_TIME] = {"correlation_time_bin", "s",
+                      "integrated correlation time of the bin's per-snapshot mean of u "
+                      "(statistical inefficiency of the batch means)"},
+    [EP_NEFF] = {"n_eff_windows", "1",
+                 "effective number of independent windows behind the batch-means standard "
+                 "errors at the bin's correlation time (exponential correlation; the complete "
+                 "windows when they are much longer than it)"},
+    [EP_SHORT] = {"short_windows", "1",
+                  "flag: 1 where the averaging windows are shorter than the bin's correlation "
+                  "time (its batch-means standard errors are too small; compare widens them by "
+                  "sqrt(n_windows / n_eff_windows))"},
     [EP_RSB] = RSB_ALL("", "Reynolds-stress "),
     [EP_RSB_SE] = RSB_ALL("_stderr", "standard error (batch means) of the Reynolds-stress "),
 };
@@ -628,6 +653,85 @@ void euler_sample(struct euler *e, const struct stats_snapshot *s) {
   win[WIN_SUM_TW1] += -s->wall_fx[1] / (c->rho0 * c->area) + s->fx * c->wall_layer;
 }
 
+double euler_n_eff(double n, double window, double tau) {
+  if (!(tau > 0.0) || !(window > 0.0) || !(n >= 1.0)) return NAN;
+  const double x = tau / window;
+  /* the variance of a mean over a span s of an exponentially correlated signal is
+     2 tau / s sigma^2 a(tau / s), a(x) = 1 - x (1 - e^(-1/x)) */
+  const double a1 = 1.0 + x * expm1(-1.0 / x), an = 1.0 + x / n * expm1(-n / x);
+  return an > 0.0 ? n * a1 / an : NAN;
+}
+
+/* The derivative of f at point i: 3-point central (euler_deriv) between two neighbours with ok
+   set; at an end, of the parabola through i and its next two neighbours (a linear one-sided
+   difference is first order: in the wall bin it would leave (dU/dy error)^2 var(y) in the
+   stresses about the local mean); euler_deriv's two points where only one neighbour exists. */
+static double local_slope(const double *x, const double *f, const int *ok, int n, int i) {
+  int l = i - 1, r = i + 1;
+  while (l >= 0 && !ok[l]) l--;
+  while (r < n && !ok[r]) r++;
+  if ((l >= 0) == (r < n)) return euler_deriv(x, f, ok, n, i);
+  const int step = l < 0 ? 1 : -1;
+  int j1 = l < 0 ? r : l, j2 = j1 + step;
+  while (j2 >= 0 && j2 < n && !ok[j2]) j2 += step;
+  if (j2 < 0 || j2 >= n) return euler_deriv(x, f, ok, n, i);
+  const double x0 = x[i], x1 = x[j1], x2 = x[j2];
+  return f[i] * (2.0 * x0 - x1 - x2) / ((x0 - x1) * (x0 - x2)) +
+         f[j1] * (x0 - x2) / ((x1 - x0) * (x1 - x2)) + f[j2] * (x0 - x1) / ((x2 - x0) * (x2 - x1));
+}
+
+/* The covariance c (MOM_UU .. MOM_VW) of a moment record m about the local mean
+   U_i(y) = U_i + g_i (y - <y>) of the bin: C_ij - g_i C_jy - g_j C_iy + g_i g_j C_yy over n
+   (the bin mean's covariance if the record has no co-moments with y: NaN there). */
+static double local_cov(const double *m, const double *g, int c) {
+  const int i = mom_pair[c][0], j = mom_pair[c][1];
+  const double n = m[MOM_N];
+  const double l =
+      m[MOM_C2 + c] - g[i] * m[MOM_CY + j] - g[j] * m[MOM_CY + i] + g[i] * g[j] * m[MOM_CYY];
+  return (isfinite(l) ? l : m[MOM_C2 + c]) / n;
+}
+
+/* The stresses of every bin about the local mean (EP_UU .. EP_VW, their standard errors from
+   the complete windows' own, about the same U(y)) where the range's records have the
+   co-moments with y, the bin-mean ones kept in EP_UU_BIN ..; the gradients of U, V, W at each
+   bin's mean position (local_slope; zero where a bin has no neighbour) in grad. */
+static void local_stresses(const struct euler_config *cfg, const double *mom, const int *complete,
+                           size_t r0, size_t r1, const double *tot, const int *ok, double *grad,
+                           struct euler_result *res) {
+  const int nb = cfg->nb;
+  double *const *pr = res->prof;
+  res->local_mean = 1;
+  for (int b = 0; b < nb; b++) {
+    double *g = grad + 3 * b;
+    for (int i = 0; i < 3; i++) {
+      g[i] = ok[b] ? local_slope(pr[EP_Y_MEAN], pr[EP_U + i], ok, nb, b) : 0.0;
+      if (!isfinite(g[i])) g[i] = 0.0;
+    }
+    for (int c = 0; c < MOM_NC; c++) pr[EP_UU_BIN + c][b] = pr[EP_UU + c][b];
+    const double *M = tot + (size_t)b * MOM_LEN;
+    const int local = ok[b] && isfinite(M[MOM_CYY]) && isfinite(M[MOM_CY]) &&
+                      isfinite(M[MOM_CY + 1]) && isfinite(M[MOM_CY + 2]);
+    pr[EP_LOCAL][b] = ok[b] ? local : NAN;
+    if (!local) {
+      if (ok[b]) res->local_mean = 0;
+      continue;
+    }
+    double batch[MOM_NC][SCAL_LEN] = {{0}};
+    for (size_t r = r0; r < r1; r++) {
+      const double *m = mom + (r * (size_t)nb + (size_t)b) * MOM_LEN;
+      if (!complete[r] || m[MOM_N] <= 0.0) continue;
+      for (int c = 0; c < MOM_NC; c++) scal_add(batch[c], local_cov(m, g, c));
+    }
+    for (int c = 0; c < MOM_NC; c++) {
+      pr[EP_UU + c][b] = local_cov(M, g, c);
+      pr[EP_SE_U + 5 + c][b] =
+          batch[c][SCAL_N] >= 2.0
+              ? sqrt(batch[c][SCAL_M2] / (batch[c][SCAL_N] - 1.0) / batch[c][SCAL_N])
+              : NAN;
+    }
+  }
+}
+
 /* Profiles of the momentum budget over rows [r0, r1) (pln: the plane sums; kin: the kinetic
    flux, NULL or short in files of earlier versions): the mean of each part, the Reynolds part
    -<u'v'>, the rest of the particles' kinetic flux as the advective part (NaN, and left out
@@ -636,7 +740,7 @@ void euler_sample(struct euler *e, const struct stats_snapshot *s) {
    snapshot of the range carried the forces (the profiles stay as they are). */
 static int budget_profiles(const struct euler_config *cfg, const double *mom, const double *pln,
                            const double *kin, const int *complete, size_t r0, size_t r1,
-                           struct euler_result *res) {
+                           const double *grad, struct euler_result *res) {
   const int nb = cfg->nb;
   int any = 0;
   for (int b = 0; b < nb; b++) {
@@ -659,8 +763,10 @@ static int budget_profiles(const struct euler_config *cfg, const double *mom, co
       const double *m = mom + (r * (size_t)nb + (size_t)b) * MOM_LEN;
       if (!complete[r] || p[PL_N] <= 0.0 || m[MOM_N] <= 0.0) continue;
       /* in the order of EP_TAU_*: Reynolds, viscous, model, pair, wall, advective; the total */
-      double w[7] = {-m[MOM_C2 + MOM_UV] / m[MOM_N], p[PL_VISCOUS] / p[PL_N], p[PL_MODEL] / p[PL_N],
-                     p[PL_PRESSURE] / p[PL_N], p[PL_WALL] / p[PL_N]};
+      const double uv = res->prof[EP_LOCAL][b] == 1.0 ? local_cov(m, grad + 3 * b, MOM_UV)
+                                                      : m[MOM_C2 + MOM_UV] / m[MOM_N];
+      double w[7] = {-uv, p[PL_VISCOUS] / p[PL_N], p[PL_MODEL] / p[PL_N], p[PL_PRESSURE] / p[PL_N],
+                     p[PL_WALL] / p[PL_N]};
       w[5] = K && K[KN_N] == p[PL_N] ? K[KN_SUM] / K[KN_N] - w[0] : 0.0;
       w[6] = w[0] + w[1] + w[2] + w[3] + w[4] + w[5];
       for (int k = 0; k < 7; k++) scal_add(batch[k], w[k]);
@@ -741,7 +847,8 @@ static int bin_profiles(const struct euler_config *cfg, int b, const double *m, 
    the forces) and its largest error over the interior bins. */
 static void stress_balance(const struct euler_config *cfg, const double *mom, const double *pln,
                            const double *kin, const int *complete, size_t r0, size_t r1,
-                           const int *ok, double tw_force, struct euler_result *res) {
+                           const int *ok, const double *grad, double tw_force,
+                           struct euler_result *res) {
   const int nb = cfg->nb;
   const double nan = NAN;
   /* shear-stress balance (Eq. 5.11-5.13): nu dU/dy - <u'v'> = tau_w/rho (1 - y/delta) */
@@ -755,7 +862,7 @@ static void stress_balance(const struct euler_config *cfg, const double *mom, co
     res->prof[EP_TOTAL][b] = nu_eff * dudy - res->prof[EP_UV][b];
     res->prof[EP_TOTAL_EXPECTED][b] = tw_force * (1.0 - yb / cfg->delta);
   }
-  res->budget = pln && budget_profiles(cfg, mom, pln, kin, complete, r0, r1, res);
+  res->budget = pln && budget_profiles(cfg, mom, pln, kin, complete, r0, r1, grad, res);
   if (!res->budget)
     for (int k = EP_TAU_REYNOLDS; k < EP_SE_TAU_END; k++)
       for (int b = 0; b < nb; b++) res->prof[k][b] = nan;
@@ -773,6 +880,27 @@ static void stress_balance(const struct euler_config *cfg, const double *mom, co
 static double wall_samples(const struct euler_config *cfg, const double *win, const double *pln,
                            size_t r) {
   return pln ? pln[r * (size_t)cfg->nb * PL_LEN + PL_N] : win[r * WIN_LEN + WIN_NSNAP];
+}
+
+/* The correlation time of each bin (EP_CORR_TIME) and their mean over the bins: the
+   statistical inefficiency s of the per-snapshot bin means (batch variance sn times the batch
+   size over the variance within the batches), correlation time = s dt_sample / 2. */
+static void corr_times(int nb, const double *sn, const double *within, double per_batch,
+                       double dt_s, struct euler_result *res) {
+  double tau_sum = 0.0;
+  int tau_n = 0;
+  for (int b = 0; b < nb; b++) {
+    const double *s = sn + (size_t)b * SCAL_LEN;
+    res->prof[EP_CORR_TIME][b] = NAN;
+    if (s[SCAL_N] >= 2.0 && within[2 * b + 1] > 0.0 && within[2 * b] > 0.0 && per_batch > 0.0) {
+      const double var_b = s[SCAL_M2] / (s[SCAL_N] - 1.0);
+      const double var_w = within[2 * b] / within[2 * b + 1];
+      const double ineff = fmax(1.0, per_batch * var_b / var_w);
+      res->prof[EP_CORR_TIME][b] = 0.5 * ineff * dt_s;
+      tau_sum += 0.5 * ineff * dt_s, tau_n++;
+    }
+  }
+  res->corr_time = tau_n ? tau_sum / tau_n : NAN;
 }
 
 void euler_finalise(const struct euler_config *cfg, const double *win, const double *mom,
@@ -820,24 +948,20 @@ void euler_finalise(const struct euler_config *cfg, const double *win, const dou
   res->snapshots = snaps;
   const double nan = NAN;
   int *ok = mem_alloc((size_t)nb, sizeof(int), "Eulerian statistics");
-  double tau_sum = 0.0;
-  int tau_n = 0;
-  for (int b = 0; b < nb; b++) {
+  double *grad = mem_alloc(3 * (size_t)nb, sizeof(double), "Eulerian statistics");
+  for (int b = 0; b < nb; b++)
     ok[b] =
         bin_profiles(cfg, b, tot + (size_t)b * MOM_LEN, bm + (size_t)b * BM_LEN * SCAL_LEN, res);
-    /* statistical inefficiency of the per-snapshot bin means: batch variance times batch
-       size over the variance within the batches; correlation time = s dt_sample / 2 */
-    const double *s = sn + (size_t)b * SCAL_LEN;
-    if (s[SCAL_N] >= 2.0 && within[2 * b + 1] > 0.0 && within[2 * b] > 0.0 && snaps > 0.0) {
-      const double var_b = s[SCAL_M2] / (s[SCAL_N] - 1.0);
-      const double var_w = within[2 * b] / within[2 * b + 1];
-      const double per_batch = snaps / (double)(r1 - r0);
-      const double dt_s = batch_len / (double)res->n_batches / per_batch;
-      const double ineff = fmax(1.0, per_batch * var_b / var_w);
-      tau_sum += 0.5 * ineff * dt_s, tau_n++;
-    }
+  local_stresses(cfg, mom, complete, r0, r1, tot, ok, grad, res);
+  const double per_batch = r1 > r0 ? snaps / (double)(r1 - r0) : 0.0;
+  const double len = res->n_batches ? batch_len / res->n_batches : nan;
+  corr_times(nb, sn, within, per_batch, len / per_batch, res);
+  res->n_eff = euler_n_eff(res->n_batches, len, res->corr_time);
+  for (int b = 0; b < nb; b++) {
+    const double tau = res->prof[EP_CORR_TIME][b];
+    res->prof[EP_NEFF][b] = euler_n_eff(res->n_batches, len, tau);
+    res->prof[EP_SHORT][b] = isfinite(tau) ? (double)(len < tau) : nan;
   }
-  res->corr_time = tau_n ? tau_sum / tau_n : nan;
   const double tw_force = snaps > 0.0 ? cfg->delta * sum_fx / snaps : nan;
   const double tw_wall = walls > 0.0 ? sum_tw / walls : nan;
   res->u_tau_force = tw_force >= 0.0 ? sqrt(tw_force) : nan;
@@ -849,10 +973,10 @@ void euler_finalise(const struct euler_config *cfg, const double *win, const dou
                                 (2.0 * res->u_tau_wall)
                           : nan;
   res->re_tau = res->u_tau * cfg->delta / cfg->nu;
-  stress_balance(cfg, mom, pln, kin, complete, r0, r1, ok, tw_force, res);
+  stress_balance(cfg, mom, pln, kin, complete, r0, r1, ok, grad, tw_force, res);
   res->rs_budget = euler_rs_profiles(cfg, rsb, complete, r0, r1, res);
   if (!(tw_force > 0.0)) res->balance_error = nan;
-  free(ok), free(tot), free(bm), free(sn), free(within);
+  free(ok), free(grad), free(tot), free(bm), free(sn), free(within);
 }
 
 void euler_result_free(struct euler_result *res) {
@@ -870,9 +994,24 @@ static void *reserve_win(void *owner, int rank, const size_t *dims) {
 }
 static void *reserve_mom(void *owner, int rank, const size_t *dims) {
   struct euler *e = owner;
-  if (rank != 3 || dims[1] != (size_t)e->cfg.nb || dims[2] != MOM_LEN) return NULL;
+  if (rank != 3 || dims[1] != (size_t)e->cfg.nb || (dims[2] != MOM_LEN && dims[2] != MOM_LEN_1_11))
+    return NULL;
   reserve_rows(e, dims[0]);
   return e->mom;
+}
+
+void euler_widen_moments(double *mom, size_t records, size_t width) {
+  if (width >= MOM_LEN) return;
+  for (size_t i = records; i-- > 0;) { /* from the end: the wide records end later */
+    double *dst = mom + i * MOM_LEN;
+    memmove(dst, mom + i * width, width * sizeof(double));
+    for (size_t k = width; k < MOM_LEN; k++) dst[k] = dst[MOM_N] > 0.0 ? NAN : 0.0;
+  }
+}
+
+static void widen_mom(void *owner, int rank, const size_t *dims) {
+  struct euler *e = owner;
+  if (rank == 3) euler_widen_moments(e->mom, dims[0] * dims[1], dims[2]);
 }
 static void *reserve_snp(void *owner, int rank, const size_t *dims) {
   struct euler *e = owner;
@@ -908,7 +1047,7 @@ void euler_state(struct euler *e, struct state_list *L) {
   struct state_field *f = state_add(L, "stats/eulerian/windows", STATE_F64, 2, dw, e->win, NULL);
   f->reserve = reserve_win, f->owner = e;
   f = state_add(L, "stats/eulerian/moments", STATE_F64, 3, dm, e->mom, NULL);
-  f->reserve = reserve_mom, f->owner = e;
+  f->reserve = reserve_mom, f->after_read = widen_mom, f->owner = e; /* 1.11: 21 fields */
   f = state_add(L, "stats/eulerian/snapshot_u", STATE_F64, 3, ds, e->snp, NULL);
   f->reserve = reserve_snp, f->owner = e;
   const size_t dp[3] = {rows, nb, PL_LEN};

@@ -164,7 +164,12 @@ enum {
   EP_RSB_SE_END = EP_RSB_SE + RS_NCOMP * RS_NTERM,
   EP_SE_SF = EP_RSB_SE_END, /* stderr of u, v, w skewness, then u, v, w flatness (batch means) */
   EP_SE_SF_END = EP_SE_SF + 6,
-  EP_NPROF = EP_SE_SF_END
+  EP_UU_BIN = EP_SE_SF_END, /* uu .. vw about the bin mean (with the mean's spread over the bin) */
+  EP_LOCAL = EP_UU_BIN + 6, /* 1: EP_UU .. EP_VW are about the local mean U(y); 0: the bin mean */
+  EP_CORR_TIME,             /* the bin's correlation time of its bin means of u [s] */
+  EP_NEFF,                  /* effective number of independent windows of its batch means */
+  EP_SHORT,                 /* 1: the windows are shorter than the bin's correlation time */
+  EP_NPROF
 };
 
 /** Name, units and long name of each finished profile. */
@@ -183,6 +188,8 @@ struct euler_result {
   double u_tau_stderr;    /*!< batch-means standard error of u_tau [m/s] */
   double re_tau;          /*!< u_tau delta / nu */
   double corr_time;       /*!< integrated correlation time of the bin means of u [s] */
+  double n_eff;           /*!< effective independent windows at corr_time (NaN: not measured) */
+  int local_mean;         /*!< 1: every bin's stresses are about the local mean U(y) */
   double balance_error;   /*!< max |total - expected| / u_tau_force^2 over interior bins */
   int budget;             /*!< 1: total_stress is the method-of-planes budget (snapshots with
                                the parts of the acceleration); 0: nu dU/dy - <u'v'> */
@@ -236,6 +243,22 @@ void euler_finalise(const struct euler_config *cfg, const double *win, const dou
 
 /** @brief Free a result. */
 void euler_result_free(struct euler_result *res);
+
+/** @brief Widen records moment records of width fields (MOM_LEN_1_11: checkpoint format
+           1.11 or older, stats.nc likewise) in place to MOM_LEN (the buffer holds records x
+           MOM_LEN); the co-moments with y they lack become NaN in records with samples. */
+void euler_widen_moments(double *mom, size_t records, size_t width);
+
+/** @brief Read the moment records of variable var of group g (a stats.nc's `moments`: records
+           of MOM_LEN or MOM_LEN_1_11 fields) into mom (records x MOM_LEN), widened
+           (euler_widen_moments); a netCDF status (NC_EINVAL: another shape). */
+int euler_nc_read_moments(int g, int var, size_t records, double *mom);
+
+/** @brief Effective number of independent windows of n batch means of windows of length
+           window, for an exponential correlation of integral time tau: n times the ratio of
+           the variance of one window mean to n times that of the n windows' mean (n when
+           window >> tau, 1 when n window << tau; NaN if tau is not known). */
+double euler_n_eff(double n, double window, double tau);
 
 /** @brief Rows holding data (closed windows plus the open one if it has samples). */
 size_t euler_rows(const struct euler *e);

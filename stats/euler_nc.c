@@ -55,9 +55,9 @@ static const char *const window_fields[WIN_LEN] = {
     [WIN_T0] = "t_start",     [WIN_T1] = "t_end",           [WIN_NSNAP] = "snapshots",
     [WIN_SUM_FX] = "sum_f_x", [WIN_SUM_TW0] = "sum_tau_w0", [WIN_SUM_TW1] = "sum_tau_w1"};
 static const char *const moment_names[MOM_LEN] = {
-    "count",     "mean_u",   "mean_v", "mean_w", "mean_p", "mean_rho", "mean_y",
-    "mean_nu_t", "mean_k_r", "C2_uu",  "C2_vv",  "C2_ww",  "C2_uv",    "C2_uw",
-    "C2_vw",     "M3_u",     "M3_v",   "M3_w",   "M4_u",   "M4_v",     "M4_w"};
+    "count", "mean_u", "mean_v", "mean_w", "mean_p", "mean_rho", "mean_y", "mean_nu_t", "mean_k_r",
+    "C2_uu", "C2_vv",  "C2_ww",  "C2_uv",  "C2_uw",  "C2_vw",    "M3_u",   "M3_v",      "M3_w",
+    "M4_u",  "M4_v",   "M4_w",   "C2_uy",  "C2_vy",  "C2_wy",    "C2_yy"};
 static const char *const scal_names[SCAL_LEN] = {"count", "mean", "M2"};
 static const char *const plane_names[PL_LEN] = {
     [PL_N] = "snapshots",           [PL_PRESSURE] = "sum_pair_stress",
@@ -70,6 +70,17 @@ static const char *const kinetic_names[KN_LEN] = {
     [KN_N] = "snapshots",         [KN_SUM] = "sum_kinetic",     [KN_FIRST] = "first_recorded",
     [KN_F] = "first_pair_stress", [KN_F + 1] = "first_viscous", [KN_F + 2] = "first_model",
     [KN_F + 3] = "first_wall",    [KN_F + 4] = "first_drive",   [KN_F_KINETIC] = "first_kinetic"};
+
+int euler_nc_read_moments(int g, int var, size_t records, double *mom) {
+  int nd, dims[NC_MAX_VAR_DIMS];
+  size_t width = 0;
+  if (nc_inq_varndims(g, var, &nd) || nd != 3 || nc_inq_vardimid(g, var, dims) ||
+      nc_inq_dimlen(g, dims[2], &width) || (width != MOM_LEN && width != MOM_LEN_1_11))
+    return NC_EINVAL;
+  const int rc = nc_get_var_double(g, var, mom);
+  if (rc == NC_NOERR) euler_widen_moments(mom, records, width);
+  return rc;
+}
 
 /* The root's profiles on dimension dy and the run's scalars as global attributes; t_reached:
    the time the run reached (NaN: not known), where an incomplete last window ends. */
@@ -92,27 +103,31 @@ static int write_profiles(const struct euler *e, const struct euler_result *rp, 
     const char *name;
     double v;
     int integer; /* a count or flag: int64 */
-  } scal[] = {{"u_tau", r.u_tau, 0},
-              {"u_tau_stderr", r.u_tau_stderr, 0},
-              {"u_tau_wall", r.u_tau_wall, 0},
-              {"u_tau_force", r.u_tau_force, 0},
-              {"re_tau", r.re_tau, 0},
-              {"correlation_time", r.corr_time, 0},
-              {"stress_balance_error", r.balance_error, 0},
-              {"average_start", r.t0, 0},
-              {"average_end", isnan(t_reached) ? r.t1 : fmin(r.t1, t_reached), 0},
-              {"n_windows", (double)r.n_batches, 1},
-              {"window_length", e->cfg.window, 0},
-              {"bin_lower", e->cfg.y0, 0},
-              {"bin_upper", e->cfg.y1, 0},
-              {"wall_area", e->cfg.area, 0},
-              {"fold", (double)e->cfg.fold, 1},
-              {"les", (double)e->cfg.les, 1}};
+  } scal[] = {
+      {"u_tau", r.u_tau, 0},
+      {"u_tau_stderr", r.u_tau_stderr, 0},
+      {"u_tau_wall", r.u_tau_wall, 0},
+      {"u_tau_force", r.u_tau_force, 0},
+      {"re_tau", r.re_tau, 0},
+      {"correlation_time", r.corr_time, 0},
+      {"n_eff_windows", r.n_eff, 0},
+      {"short_windows", isfinite(r.corr_time) ? (double)(e->cfg.window < r.corr_time) : NAN, 1},
+      {"local_mean", (double)r.local_mean, 1},
+      {"stress_balance_error", r.balance_error, 0},
+      {"average_start", r.t0, 0},
+      {"average_end", isnan(t_reached) ? r.t1 : fmin(r.t1, t_reached), 0},
+      {"n_windows", (double)r.n_batches, 1},
+      {"window_length", e->cfg.window, 0},
+      {"bin_lower", e->cfg.y0, 0},
+      {"bin_upper", e->cfg.y1, 0},
+      {"wall_area", e->cfg.area, 0},
+      {"fold", (double)e->cfg.fold, 1},
+      {"les", (double)e->cfg.les, 1}};
   for (size_t i = 0; i < sizeof scal / sizeof scal[0]; i++)
-    if (scal[i].integer) {
+    if (scal[i].integer && isfinite(scal[i].v)) {
       const long long v = (long long)scal[i].v;
       CK(nc_put_att_longlong(ncid, NC_GLOBAL, scal[i].name, NC_INT64, 1, &v));
-    } else if (isfinite(scal[i].v)) { /* not known (no windows, no force balance): absent */
+    } else if (!scal[i].integer && isfinite(scal[i].v)) { /* not known: absent */
       CK(put_att_d(ncid, NC_GLOBAL, scal[i].name, scal[i].v));
     }
   return NC_NOERR;
@@ -158,7 +173,8 @@ static int field_axes(int g, int fd[6], char *err, size_t errlen) {
       {"window_field", WIN_LEN, "fields of the window records", window_fields},
       {"moment", MOM_LEN,
        "fields of the moment records: count, means, co-moments C2 (sums of products of "
-       "deviations), third and fourth central moments M3, M4 (sums)",
+       "deviations), third and fourth central moments M3, M4 (sums), co-moments of u, v, w and "
+       "y with y (from checkpoint format 1.12 on)",
        moment_names},
       {"snapshot_moment", SCAL_LEN,
        "fields of the records of per-snapshot bin means of u: count, mean, M2", scal_names},

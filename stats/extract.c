@@ -180,8 +180,9 @@ static int read_stored(const char *path, struct stored *s) {
     s->mom = mem_alloc(1, r * nb * MOM_LEN * sizeof(double), "chansph extract");
     s->snp = mem_alloc(1, r * nb * SCAL_LEN * sizeof(double), "chansph extract");
     s->complete = mem_alloc(1, r * sizeof(int), "chansph extract");
-    if (s->rows && (nc_get_var_double(g, vw, s->win) || nc_get_var_double(g, vm, s->mom) ||
-                    nc_get_var_double(g, vs, s->snp) || nc_get_var_int(g, vc, s->complete))) {
+    if (s->rows &&
+        (nc_get_var_double(g, vw, s->win) || euler_nc_read_moments(g, vm, r * nb, s->mom) ||
+         nc_get_var_double(g, vs, s->snp) || nc_get_var_int(g, vc, s->complete))) {
       fprintf(stderr, "error: %s: cannot read the raw windows\n", path);
       bad = 1;
     }

@@ -17,14 +17,21 @@
 enum { MOM_U, MOM_V, MOM_W, MOM_P, MOM_RHO, MOM_Y, MOM_NUT, MOM_KR, MOM_NQ };
 /** Co-moment slots: uu vv ww uv uw vw. */
 enum { MOM_UU, MOM_VV, MOM_WW, MOM_UV, MOM_UW, MOM_VW, MOM_NC };
-/** Layout of a record: [count | means[8] | co-moments[6] | M3 of u,v,w | M4 of u,v,w]. */
+/** Layout of a record: [count | means[8] | co-moments[6] | M3 of u,v,w | M4 of u,v,w |
+    co-moments of u, v, w with the position y | C2 of y]. The last four (checkpoint format
+    1.12) let the stresses be taken about the local mean U(y) = U_b + dU/dy (y - y_b) instead
+    of the bin mean U_b (euler_finalise); records of earlier formats are MOM_LEN_1_11 long and
+    are widened with NaN there (no local mean for the bins and ranges that include them). */
 enum {
   MOM_N = 0,
   MOM_MEAN = 1,
   MOM_C2 = MOM_MEAN + MOM_NQ,
   MOM_M3 = MOM_C2 + MOM_NC,
   MOM_M4 = MOM_M3 + 3,
-  MOM_LEN = MOM_M4 + 3
+  MOM_CY = MOM_M4 + 3,
+  MOM_CYY = MOM_CY + 3,
+  MOM_LEN = MOM_CYY + 1,
+  MOM_LEN_1_11 = MOM_CY
 };
 
 /** Velocity indices of the six co-moments. */
@@ -59,6 +66,8 @@ static inline void mom_merge(double *restrict a, const double *restrict b) {
   }
   for (int c = 0; c < MOM_NC; c++)
     a[MOM_C2 + c] += b[MOM_C2 + c] + d[mom_pair[c][0]] * d[mom_pair[c][1]] * f;
+  for (int i = 0; i < 3; i++) a[MOM_CY + i] += b[MOM_CY + i] + d[i] * d[MOM_Y] * f;
+  a[MOM_CYY] += b[MOM_CYY] + d[MOM_Y] * d[MOM_Y] * f;
   for (int q = 0; q < MOM_NQ; q++) a[MOM_MEAN + q] += d[q] * nb / n;
   a[MOM_N] = n;
 }
@@ -80,6 +89,8 @@ static inline void mom_add(double *restrict a, const double *restrict s) {
     a[MOM_M3 + i] += di * di * di * f * (na - 1.0) / n - 3.0 * di * m2a / n;
   }
   for (int c = 0; c < MOM_NC; c++) a[MOM_C2 + c] += d[mom_pair[c][0]] * d[mom_pair[c][1]] * f;
+  for (int i = 0; i < 3; i++) a[MOM_CY + i] += d[i] * d[MOM_Y] * f;
+  a[MOM_CYY] += d[MOM_Y] * d[MOM_Y] * f;
   for (int q = 0; q < MOM_NQ; q++) a[MOM_MEAN + q] += d[q] / n;
   a[MOM_N] = n;
 }

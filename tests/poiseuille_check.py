@@ -10,6 +10,10 @@ Subcommands (each runs chansph, reads its netCDF output, prints the numbers, exi
   study SCENE2D SCENE3D --doc DIR   error against wall-clock time for four resolutions (PNG + table)
   stats SCENE --max-stress E   statistics engine on laminar flow: Reynolds stresses below
                                E u_bulk^2, shear-stress balance and u_tau within 1%
+  localmean SCENE --max-stress E  bins of two particle layers (output.n_bins = 2 delta/dr/2 - 1):
+                               the stresses about the bin mean hold the spread of U over the
+                               bin, (U(y2) - U(y1))^2/4 within 5%; those about the local mean
+                               U(y) (the default) fall below E u_bulk^2 (the lattice level)
   restart-finer SCENE --max-l2 E  start a run at dr/2 from the steady particles.nc of a run at
                                dr (init.from, Shepard interpolation): initial profile error
   smagorinsky SCENE --max-l2 E   steady laminar flow with the Smagorinsky model on, against the
@@ -250,6 +254,42 @@ def cmd_stats(args):
     return worst < args.max_stress and bal < 0.01 and dut < 0.01
 
 
+def cmd_localmean(args):
+    """Bins that each hold two particle layers (the middle one three): the spread of the mean
+    over a bin is known exactly, and the stresses about the local mean must not hold it."""
+    out0, _ = run(args, args.scene, "stats_" + os.path.basename(args.scene)[:-4], args.set)
+    a0 = attrs(os.path.join(out0, "stats.nc"))
+    layers = int(round(2 * a0["delta"] / a0["dr"])) - 1  # walls at 0, 2 delta; layers j dr
+    nb = (layers - 1) // 2
+    out, _ = run(args, args.scene, "localmean_" + os.path.basename(args.scene)[:-4],
+                 args.set + ["output.n_bins=%d" % nb])
+    with netCDF4.Dataset(os.path.join(out, "stats.nc")) as d:
+        a = {k: d.getncattr(k) for k in d.ncattrs()}
+        ub = float(d["u_bulk"][-1])
+        v = {n: np.ma.filled(d[n][:].astype(float), np.nan) for n in
+             ("uu", "uu_bin", "uv", "uv_bin", "local_mean", "y_bounds")}
+    yl = a["dr"] * np.arange(1, layers + 1)
+    ok = int(a["local_mean"]) == 1 and np.all(v["local_mean"] == 1)
+    print("%d bins over %d layers; local_mean = %d" % (nb, layers, a["local_mean"]))
+    for b in range(nb):
+        lo, hi = v["y_bounds"][b]
+        inside = yl[(yl > lo) & (yl < hi)]
+        if len(inside) != 2:
+            print("  bin %d: %d layers (not checked)" % (b, len(inside)))
+            continue
+        ua = laminar(a, inside)
+        spread = (ua[1] - ua[0]) ** 2 / 4
+        rel = v["uu_bin"][b] / spread - 1
+        good = abs(rel) < 0.05 and abs(v["uu"][b]) < args.max_stress * ub ** 2
+        print("  bin %d (layers %.3g, %.3g): uu about the bin mean %.4e u_bulk^2 (exact spread "
+              "%.4e, %+.1f%%), about U(y) %.3e u_bulk^2 (limit %.3g), uv %.2e (bin mean %.2e): %s"
+              % (b, inside[0], inside[1], v["uu_bin"][b] / ub ** 2, spread / ub ** 2, 100 * rel,
+                 v["uu"][b] / ub ** 2, args.max_stress, v["uv"][b] / ub ** 2,
+                 v["uv_bin"][b] / ub ** 2, "ok" if good else "FAIL"))
+        ok &= good
+    return bool(ok)
+
+
 def scene_attr(out, section, key):
     """A value of the resolved scene stored in stats.nc."""
     text = attrs(os.path.join(out, "stats.nc"))["scene"]
@@ -316,7 +356,7 @@ def main():
     p.add_argument("--chansph", default="build/chansph")
     p.add_argument("--runs", default="build/test-runs")
     p.add_argument("what", choices=["steady", "startup", "flux", "longrun", "convergence", "study",
-                                    "stats", "smagorinsky", "restart-finer"])
+                                    "stats", "localmean", "smagorinsky", "restart-finer"])
     p.add_argument("scene")
     p.add_argument("scene3d", nargs="?")
     p.add_argument("--max-l2", type=float, default=0.01)

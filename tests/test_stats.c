@@ -22,8 +22,14 @@
 enum { NB = 8, NP = 4000, NSNAP = 400 };
 static const double A = 0.3, B = -0.2, C = 0.25, SW = 0.15; /* u' = A g1, v' = B g1 + C g2 */
 
+/* The mean velocity U(y) = 1 + S y, linear: its spread over a bin of width 0.25 adds
+   S^2 0.25^2 / 12 to the variance of u about the bin mean, and nothing about U(y). */
+static const double S_U = 1.0;
+static double U_of_y(double y) {
+  return 1.0 + S_U * y;
+}
 static double U_of_bin(int b) {
-  return 1.0 + 0.1 * b;
+  return U_of_y(0.25 * (b + 0.5));
 }
 
 /* Snapshot s of the synthetic field: y uniform in (0, 2), bins of width 0.25. */
@@ -32,9 +38,8 @@ static void make_snapshot(long s, double *y, double *u, double *v, double *w, do
   for (size_t a = 0; a < NP; a++) {
     const uint64_t k = ((uint64_t)s * NP + a) * 8;
     y[a] = 2.0 * uniform(k);
-    const int b = (int)floor(y[a] / 0.25);
     const double g1 = gauss(k + 1), g2 = gauss(k + 2), g3 = gauss(k + 3);
-    u[a] = U_of_bin(b) + A * g1;
+    u[a] = U_of_y(y[a]) + A * g1;
     v[a] = B * g1 + C * g2;
     w[a] = SW * g3;
     p[a] = 100.0 + gauss(k + 4), rho[a] = 1000.0;
@@ -85,7 +90,9 @@ static void finalise(const struct euler *e, struct euler_result *r) {
   free(complete);
 }
 
-/* Acceptance 1: means and stresses of a field with known answers within 3 standard errors. */
+/* Acceptance 1: means and stresses of a field with known answers within 3 standard errors:
+   the stresses about the local mean U(y) (issue 43: the default) are those of the
+   fluctuations, those about the bin mean (uu_bin ...) hold the spread of U over the bin. */
 static void test_known_field(double *buf) {
   const struct euler_config cfg = config();
   struct euler e;
@@ -101,12 +108,22 @@ static void test_known_field(double *buf) {
     EXPECT(fabs(z_u) < 3 && fabs(z_v) < 3, "bin %d: u_mean %.6f (exact %.6f, se %.2e)", b,
            r.prof[EP_U][b], U_of_bin(b), r.prof[EP_SE_U][b]);
     worst = fmax(worst, fmax(fabs(z_u), fabs(z_v)));
+    EXPECT(r.prof[EP_LOCAL][b] == 1.0, "bin %d: stresses not about the local mean", b);
     for (int c = 0; c < 6; c++) {
-      const double z = (r.prof[EP_UU + c][b] - exact[c]) / r.prof[EP_SE_U + 5 + c][b];
-      worst = fmax(worst, fabs(z));
+      const double se = r.prof[EP_SE_U + 5 + c][b];
+      const double z = (r.prof[EP_UU + c][b] - exact[c]) / se;
+      /* the bin's spread of U: uniform y over the bin (the end bins reach no further) */
+      const double spread = c == 0 ? S_U * S_U * 0.25 * 0.25 / 12.0 : 0.0;
+      const double zb = (r.prof[EP_UU_BIN + c][b] - exact[c] - spread) / se;
+      worst = fmax(worst, fmax(fabs(z), fabs(zb)));
       EXPECT(fabs(z) < 3, "bin %d stress %d: %.6f exact %.6f se %.2e", b, c, r.prof[EP_UU + c][b],
-             exact[c], r.prof[EP_SE_U + 5 + c][b]);
+             exact[c], se);
+      EXPECT(fabs(zb) < 3, "bin %d stress %d about the bin mean: %.6f exact %.6f se %.2e", b, c,
+             r.prof[EP_UU_BIN + c][b], exact[c] + spread, se);
     }
+    EXPECT(S_U * S_U * 0.25 * 0.25 / 12.0 > 3.0 * r.prof[EP_SE_U + 5][b],
+           "bin %d: the spread of U is not resolved by the test (se %.2e)", b,
+           r.prof[EP_SE_U + 5][b]);
     for (int i = 0; i < 3; i++) {
       EXPECT(fabs(r.prof[EP_SKEW_U + i][b]) < 0.05, "bin %d skewness %d = %.4f", b, i,
              r.prof[EP_SKEW_U + i][b]);
@@ -169,9 +186,13 @@ static void test_merge(void) {
         scale = sqrt(ref[MOM_C2 + i] * ref[MOM_C2 + j]);
       }
       if (k >= MOM_M3 && k < MOM_M3 + 3) scale = pow(ref[MOM_C2 + k - MOM_M3], 1.5) / sqrt(N);
+      if (k >= MOM_CY && k < MOM_CYY) scale = sqrt(ref[MOM_C2 + k - MOM_CY] * ref[MOM_CYY]);
       const double e = scale > 0 ? fabs(ref[k] - m[k]) / scale : 0.0;
       worst = fmax(worst, e);
-      EXPECT(e < 1e-14, "split %d slot %d: %.17g vs %.17g", split, k, ref[k], m[k]);
+      /* the co-moments with y (issue 43) are new slots, not a loosened one: measured 1.01e-14
+         for C2_yy of a uniform y (the same formula as C2_uu, whose samples give less) */
+      EXPECT(e < (k >= MOM_CY ? 2e-14 : 1e-14), "split %d slot %d: %.17g vs %.17g", split, k,
+             ref[k], m[k]);
     }
   }
   printf(

@@ -16,10 +16,15 @@ average_end, number of windows); the summary names the largest error. A warning 
 with fewer than 2 windows (no standard errors: the plots then have no error bars) and when the
 run's Re_tau differs from the DNS's by more than 20%. The DNS profiles are
 interpolated (linearly in y+) to the run's bin positions; the upper half of an unfolded run
-is mirrored onto the lower one. With --binned the DNS is instead seen through the run's bins
-(dns.through_bins): bin averages, and u_rms+ broadened by the spread of the mean velocity
-over the bin, which a binned estimate of a sheared flow contains (+76% in the wall bin of
-dr+ = 6, +5% at y+ = 12, below 2% beyond y+ = 15): the like-for-like comparison near the wall. Prints the L2 (root mean square) and Linf (maximum)
+is mirrored onto the lower one. Files from checkpoint format 1.12 on hold the stresses about
+the local mean U(y) (the engine removes the mean's spread over each bin): the default
+comparison is then fair at the wall too. With --binned the DNS is instead seen through the
+run's bins (dns.through_bins): bin averages, and u_rms+ broadened by the spread of the mean
+velocity over the bin (+76% in the wall bin of dr+ = 6, +5% at y+ = 12, below 2% beyond
+y+ = 15), against our stresses about the bin mean (uu_bin ...; an older file has only those):
+the like-for-like comparison of binned estimates. Standard errors are widened by
+sqrt(n_windows / n_eff_windows) where the file has it, and bins whose windows are shorter than
+their correlation time are marked. Prints the L2 (root mean square) and Linf (maximum)
 differences of U+, u_rms+, v_rms+, w_rms+ and -u'v'+ per y+ range, with the RMS over the range
 of our own standard error (batch means over the averaging windows; "stderr"): a difference much
 larger than it is a model or resolution error, one of its size is sampling noise. Writes
@@ -67,18 +72,33 @@ def pick_u_tau(a, choice, path):
     return ut, "u_tau = %.6g m/s (given with --u-tau; run averaged over %s)" % (ut, span)
 
 
-def read_run(path, u_tau="wall"):
+def read_run(path, u_tau="wall", binned=False):
     """Our profiles in wall units of u_tau (pick_u_tau; lower half, upper half mirrored), with
-    standard errors."""
+    standard errors: the stresses about the local mean U(y) where the file has them (variable
+    local_mean), about the bin mean with binned (uu_bin ...; files without them have only
+    those); the standard errors widened by sqrt(n_windows / n_eff_windows) where the file has
+    the effective number of windows, and the bins of short windows (short_windows) marked."""
     with open_nc(path) as d:
         a = {k: d.getncattr(k) for k in d.ncattrs()}
 
         def v(name):
             return np.ma.filled(need(d, name, path, "a chansph stats.nc with profiles")[:]
                                 .astype(float), np.nan)
-        y, u, uu, vv, ww, uv = (v(n) for n in ("y_mean", "u_mean", "uu", "vv", "ww", "uv"))
+        has_local = "local_mean" in d.variables
+        names = ("uu", "vv", "ww", "uv")
+        if binned and has_local:
+            names = tuple(n + "_bin" for n in names)
+        y, u, uu, vv, ww, uv = (v(n) for n in ("y_mean", "u_mean") + names)
+        local = v("local_mean") if has_local else np.zeros_like(y)
         bounds = v("y_bounds") if "y_bounds" in d.variables else None
         se = {n: v(n + "_stderr") for n in ("u_mean", "uu", "vv", "ww", "uv")}
+        n_eff = v("n_eff_windows") if "n_eff_windows" in d.variables else None
+        short = v("short_windows") if "short_windows" in d.variables else np.zeros_like(y)
+        nwin = float(a.get("n_windows", 0))
+        if n_eff is not None and nwin >= 2:
+            widen = np.sqrt(np.where(np.isfinite(n_eff) & (n_eff > 0),
+                                     np.maximum(nwin / np.where(n_eff > 0, n_eff, 1), 1.0), 1.0))
+            se = {n: x * widen for n, x in se.items()}
         budget = {n: v(n) for n in BUDGET + ("total_stress", "total_stress_expected",
                                              "momentum_change")
                   if n in d.variables} if "pair_stress" in d.variables else {}
@@ -91,7 +111,9 @@ def read_run(path, u_tau="wall"):
     sign = np.where(upper, -1.0, 1.0)
     out = {"yplus": y * ut / nu, "y_delta": y / delta, "re_tau": ut * delta / nu, "label": "chansph",
            "source": "chansph %s (%s)" % (path, ut_label), "u_tau_label": ut_label,
-           "n_windows": int(a.get("n_windows", 0)), "run": path}
+           "n_windows": int(a.get("n_windows", 0)), "run": path,
+           "short": np.nan_to_num(short) > 0, "local": np.nan_to_num(local) > 0,
+           "has_local": has_local, "widened": n_eff is not None and nwin >= 2}
     if bounds is not None:  # the bins in y+, mirrored like y
         lo = np.where(upper, 2 * delta - bounds[:, 1], bounds[:, 0])
         hi = np.where(upper, 2 * delta - bounds[:, 0], bounds[:, 1])
@@ -167,6 +189,19 @@ def warnings_for(ours, dns):
     if ours.get("n_windows") is not None and ours["n_windows"] < 2:
         out.append("%d averaging windows: no standard errors (at least 2 needed); the "
                    "differences may be sampling noise" % ours["n_windows"])
+    if "has_local" in ours and not ours["has_local"]:
+        out.append("the stresses of this file are about the bin mean (written before checkpoint "
+                   "format 1.12): near the wall they hold the mean velocity's spread over the "
+                   "bin; --binned compares like for like")
+    elif "has_local" in ours and not ours["local"].all():
+        out.append("%d bins have their stresses about the bin mean (records of format 1.11 or "
+                   "older in the range)" % int((~ours["local"]).sum()))
+    if "short" in ours and ours["short"].any():
+        out.append("%d bins have windows shorter than their correlation time: their standard "
+                   "errors are widened by sqrt(n_windows / n_eff_windows)%s and marked with "
+                   "open symbols in the plots" % (int(ours["short"].sum()),
+                                                  "" if ours.get("widened") else " (not: no "
+                                                  "n_eff_windows)"))
     if abs(ours["re_tau"] / dns["re_tau"] - 1) > 0.2:
         out.append("the run's Re_tau = %.1f differs from the DNS's %.1f by more than 20%%: the "
                    "profiles in wall units are not expected to agree" %
@@ -186,7 +221,8 @@ def largest(rows):
 def main(argv, prog="chansph compare"):
     args = parse(argv, prog)
     dns = read_dns(args.dns)
-    ours = read_run(args.stats, args.u_tau) if args.stats.endswith(".nc") else read_dns(args.stats)
+    ours = (read_run(args.stats, args.u_tau, args.binned) if args.stats.endswith(".nc")
+            else read_dns(args.stats))
     ours.setdefault("u_tau_label", "the DNS file's own wall units")
     out_dir = args.out or os.path.join(os.path.dirname(os.path.abspath(args.stats)), "compare")
     try:
@@ -261,7 +297,8 @@ def references(ours, dns, binned, path):
         raise InputError("--binned: %s has no bin bounds (y_bounds): not a chansph stats.nc"
                          % path)
     print("the DNS as the run's bins see it (--binned): bin averages, u_rms+ broadened by the "
-          "mean shear over each bin")
+          "mean shear over each bin%s" % ("; ours: the stresses about the bin mean (uu_bin ...)"
+                                          if ours.get("has_local") else ""))
     return through_bins(dns, ours["yplus_lo"], ours["yplus_hi"], ours["yplus"])
 
 
@@ -313,6 +350,10 @@ def plots(ours, dns, out_dir, binned=None):
         ax.errorbar(ours["yplus"], ours[q], yerr=yerr, fmt="o", ms=3, capsize=2,
                     label=ours["label"] + (" (bars: 2 standard errors)" if yerr is not None
                                            else " (no standard errors: < 2 windows)"))
+        short = ours.get("short")
+        if short is not None and short.any():
+            ax.plot(ours["yplus"][short], ours[q][short], "o", ms=7, mfc="none", mec="r",
+                    label="windows shorter than the correlation time (bars widened)")
         if binned is not None and q in binned:
             ax.semilogx(ours["yplus"], binned[q], "kx", ms=4, label="DNS through the bins")
         if q == "U+":
