@@ -31,6 +31,21 @@ static double *slot_rec(const struct lagr *g, int slot, int level, size_t k) {
          rec(g, level, k);
 }
 
+static size_t n_st(const struct lagr_config *c) { /* station records (1 without stations) */
+  return (size_t)(c->n_stations ? c->n_stations : 1);
+}
+
+/* A slot's record of the dispersion PDF of its release: a flag (1: the release's crossings
+   are all there; 0 after a resume from a checkpoint without the record, format <= 1.11), then
+   [level][station][pdf_bins + 3] as g->pdf. */
+static size_t slot_pdf_len(const struct lagr *g) {
+  return 1 + (size_t)g->cfg.n_levels * n_st(&g->cfg) * (size_t)(g->cfg.pdf_bins + 3);
+}
+
+static double *slot_pdf(const struct lagr *g, int slot) {
+  return g->slot_pdf + (size_t)slot * slot_pdf_len(g);
+}
+
 void lagr_init(struct lagr *g, const struct lagr_config *cfg) {
   memset(g, 0, sizeof *g);
   g->cfg = *cfg;
@@ -43,6 +58,11 @@ void lagr_init(struct lagr *g, const struct lagr_config *cfg) {
       mem_calloc((size_t)g->n_slots * nl * g->nlag * LG_LEN, sizeof(double), "Lagrangian engine");
   g->slots = mem_calloc((size_t)g->n_slots * SL_LEN, sizeof(double), "Lagrangian engine");
   g->tl = mem_calloc(nl * 3 * SCAL_LEN, sizeof(double), "Lagrangian engine");
+  g->rb = mem_calloc(nl * LF_LEN * g->nlag * SCAL_LEN, sizeof(double), "Lagrangian engine");
+  g->slot_pdf =
+      mem_calloc((size_t)g->n_slots * slot_pdf_len(g), sizeof(double), "Lagrangian engine");
+  g->pdf_rb = mem_calloc(nl * n_st(cfg) * (size_t)(cfg->pdf_bins + 2) * SCAL_LEN, sizeof(double),
+                         "Lagrangian engine");
   g->pdf =
       mem_calloc(nl * (size_t)(cfg->n_stations ? cfg->n_stations : 1) * (size_t)(cfg->pdf_bins + 3),
                  sizeof(double), "Lagrangian engine");
@@ -51,6 +71,7 @@ void lagr_init(struct lagr *g, const struct lagr_config *cfg) {
 
 void lagr_free(struct lagr *g) {
   free(g->sums), free(g->slot_sums), free(g->slots), free(g->tl), free(g->pdf);
+  free(g->rb), free(g->slot_pdf), free(g->pdf_rb);
   free(g->tracks), free(g->index), free(g->mine), free(g->all);
   memset(g, 0, sizeof *g);
 }
@@ -121,9 +142,40 @@ double lagr_tl(const double *rho, size_t nlag, double dtau) {
   return sum;
 }
 
+static void functions_of(const struct lagr *g, const double *sums, double *out);
+
+/* One completed release's own values, each a batch: its lag functions (functions_of on its
+   sums) and, where its crossings are all recorded, its dispersion PDFs, mu_y and variance. */
+static void release_batches(struct lagr *g, int slot) {
+  const struct lagr_config *c = &g->cfg;
+  const size_t nlag = g->nlag, nb = (size_t)c->pdf_bins;
+  double *fn = mem_alloc(LF_LEN * nlag, sizeof(double), "Lagrangian engine");
+  for (int l = 0; l < c->n_levels; l++) {
+    functions_of(g, slot_rec(g, slot, l, 0), fn);
+    double *B = g->rb + (size_t)l * LF_LEN * nlag * SCAL_LEN;
+    for (size_t i = 0; i < LF_LEN * nlag; i++)
+      if (isfinite(fn[i])) scal_add(B + i * SCAL_LEN, fn[i]);
+  }
+  free(fn);
+  const double *sp = slot_pdf(g, slot);
+  if (sp[0] != 1.0) return;
+  const double width = 2.0 * c->delta / (double)nb;
+  for (size_t ls = 0; ls < (size_t)c->n_levels * (size_t)c->n_stations; ls++) {
+    const double *P = sp + 1 + ls * (nb + 3), n = P[nb];
+    if (!(n > 0.0)) continue;
+    double *B = g->pdf_rb + ls * (nb + 2) * SCAL_LEN;
+    for (size_t b = 0; b < nb; b++) scal_add(B + b * SCAL_LEN, P[b] / (n * width));
+    const double mu = P[nb + 1] / n;
+    scal_add(B + nb * SCAL_LEN, mu);
+    scal_add(B + (nb + 1) * SCAL_LEN, P[nb + 2] / n - mu * mu);
+  }
+}
+
 static void retire(struct lagr *g, int slot) {
   const int nl = g->cfg.n_levels;
   const double dtau = g->cfg.horizon / g->cfg.n_lags;
+  release_batches(g, slot);
+  memset(slot_pdf(g, slot), 0, slot_pdf_len(g) * sizeof(double));
   double *rho = mem_calloc(g->nlag, sizeof(double), "Lagrangian engine");
   for (int l = 0; l < nl; l++) {
     for (size_t k = 0; k < g->nlag; k++) {
@@ -238,6 +290,8 @@ static void release(struct lagr *g, int slot, const struct stats_snapshot *s) {
   const struct lagr_config *c = &g->cfg;
   double *sl = g->slots + (size_t)slot * SL_LEN;
   sl[SL_T0] = s->t, sl[SL_LAST_K] = 0.0, sl[SL_ACTIVE] = 1.0, sl[SL_N] = 0.0;
+  memset(slot_pdf(g, slot), 0, slot_pdf_len(g) * sizeof(double));
+  slot_pdf(g, slot)[0] = 1.0;
   for (size_t i = 0; i < g->nall; i++) {
     const double *p = g->all + i * LR_LEN;
     if (p[LR_CAND] == 0.0) continue;
@@ -289,6 +343,9 @@ void lagr_sample(struct lagr *g, const struct stats_snapshot *s) {
       int b = (int)floor(yc / ly * c->pdf_bins);
       b = b < 0 ? 0 : b >= c->pdf_bins ? c->pdf_bins - 1 : b;
       P[b] += 1.0, P[c->pdf_bins] += 1.0, P[c->pdf_bins + 1] += yc, P[c->pdf_bins + 2] += yc * yc;
+      double *Q = slot_pdf(g, (int)tr[TR_SLOT]) + 1 +
+                  ((size_t)l * (size_t)c->n_stations + (size_t)st) * nbin; /* its release's */
+      Q[b] += 1.0, Q[c->pdf_bins] += 1.0, Q[c->pdf_bins + 1] += yc, Q[c->pdf_bins + 2] += yc * yc;
       tr[TR_DONE] = (double)((unsigned)tr[TR_DONE] | bit);
     }
   }
@@ -386,14 +443,28 @@ void lagr_state(struct lagr *g, struct state_list *L) {
   state_add(L, "stats/lagrangian/pdf", STATE_F64, 3, dp, g->pdf, NULL);
   f = state_add(L, "stats/lagrangian/tracks", STATE_F64, 2, dtr, g->tracks, NULL);
   f->reserve = reserve_tr, f->owner = g;
+  /* format 1.12: the per-release batches; absent before (the standard errors then count the
+     releases completed after the resume; the running releases' PDFs are left out of them) */
+  const size_t drb[3] = {nl, LF_LEN * g->nlag, SCAL_LEN}, dsp[2] = {ns, slot_pdf_len(g)};
+  const size_t dpb[3] = {nl * st, (size_t)g->cfg.pdf_bins + 2, SCAL_LEN};
+  state_add(L, "stats/lagrangian/release_batches", STATE_F64, 3, drb, g->rb, NULL)->optional = 1;
+  state_add(L, "stats/lagrangian/slot_pdf", STATE_F64, 2, dsp, g->slot_pdf, NULL)->optional = 1;
+  state_add(L, "stats/lagrangian/pdf_batches", STATE_F64, 3, dpb, g->pdf_rb, NULL)->optional = 1;
   state_add(L, "stats/lagrangian/next_release", STATE_F64, 0, NULL, &g->next_release, "s");
   state_add(L, "stats/lagrangian/releases", STATE_F64, 0, NULL, &g->releases, NULL);
 }
 
 void lagr_functions(const struct lagr *g, int level, double *out, double *tl) {
+  functions_of(g, g->sums + rec(g, level, 0), out);
+  for (int i = 0; i < 3; i++)
+    tl[i] = lagr_tl(out + (LF_RHO_L + i) * g->nlag, g->nlag, g->cfg.horizon / g->cfg.n_lags);
+}
+
+/* The lag functions (rows LF_*) of the sums of one level (nlag records of LG_LEN). */
+static void functions_of(const struct lagr *g, const double *sums, double *out) {
   const size_t nlag = g->nlag;
   for (size_t k = 0; k < nlag; k++) {
-    const double *R = g->sums + rec(g, level, k);
+    const double *R = sums + k * LG_LEN;
     const double n = R[LG_N];
     for (int i = 0; i < 3; i++) {
       out[(LF_RHO_L + i) * nlag + k] = corr5(R + LG_VEL + 5 * i, n);
@@ -413,8 +484,6 @@ void lagr_functions(const struct lagr *g, int level, double *out, double *tl) {
     out[LF_N * nlag + k] = n;
     out[LF_TAU * nlag + k] = n > 0 ? R[LG_TAU] / n : NAN; /* NaN: resumed from format <= 1.8 */
   }
-  for (int i = 0; i < 3; i++)
-    tl[i] = lagr_tl(out + (LF_RHO_L + i) * nlag, nlag, g->cfg.horizon / g->cfg.n_lags);
 }
 
 int lagr_warnings(const struct lagr *g, char *buf, size_t len) {
@@ -466,6 +535,11 @@ int lagr_warnings(const struct lagr *g, char *buf, size_t len) {
 }
 
 #define CK(call) NC_TRY(call, done)
+
+/* The standard error of the mean of the batches of a Welford record (NaN below 2). */
+static double batch_se(const double *W) {
+  return W[SCAL_N] >= 2.0 ? sqrt(W[SCAL_M2] / (W[SCAL_N] - 1.0) / W[SCAL_N]) : NAN;
+}
 
 static int put_rows(int g, int v, int level, size_t n, const double *src) {
   double *tmp = mem_alloc(1, n * sizeof *tmp, "Lagrangian statistics");
@@ -540,6 +614,22 @@ static int write_pdfs(const struct lagr *g, int gr, int dl, double *tmp, char *e
                "variance of the height about mu_y (Eq. 5.68, printed there as sigma_y)", &vvar));
   CK(ncout_fill(gr, vvar));
   CK(ncout_def(gr, "pdf_count", NC_DOUBLE, 2, dls, "1", "tracks that crossed the station", &vn));
+  int vpe, vmue, vvare, vnb;
+  CK(ncout_def(gr, "pdf_y_stderr", NC_DOUBLE, 3, d3, "1/m",
+               "standard error of pdf_y over the completed releases (each release's own PDF a "
+               "batch)",
+               &vpe));
+  CK(ncout_fill(gr, vpe));
+  CK(ncout_def(gr, "pdf_mu_y_stderr", NC_DOUBLE, 2, dls, "m",
+               "standard error of pdf_mu_y over the completed releases", &vmue));
+  CK(ncout_fill(gr, vmue));
+  CK(ncout_def(gr, "pdf_var_y_stderr", NC_DOUBLE, 2, dls, "m^2",
+               "standard error of pdf_var_y over the completed releases", &vvare));
+  CK(ncout_fill(gr, vvare));
+  CK(ncout_def(gr, "pdf_release_batches", NC_DOUBLE, 2, dls, "1",
+               "completed releases with crossings of the station: the batches of the pdf "
+               "standard errors",
+               &vnb));
   const double width = 2.0 * c->delta / nb;
   for (int l = 0; l < nl; l++)
     for (int s = 0; s < ns; s++) {
@@ -553,6 +643,19 @@ static int write_pdfs(const struct lagr *g, int gr, int dl, double *tmp, char *e
       CK(nc_put_var1_double(gr, vmu, st2, &mu));
       CK(nc_put_var1_double(gr, vvar, st2, &var));
       CK(nc_put_var1_double(gr, vn, st2, &n));
+      const double *B = g->pdf_rb + ((size_t)l * ns + (size_t)s) * (size_t)(nb + 2) * SCAL_LEN;
+      for (int b = 0; b < nb; b++) {
+        const double se = batch_se(B + (size_t)b * SCAL_LEN);
+        tmp[b] = isfinite(se) ? se : NC_FILL_DOUBLE;
+      }
+      CK(nc_put_vara_double(gr, vpe, st3, ct3, tmp));
+      const double se_mu = batch_se(B + (size_t)nb * SCAL_LEN);
+      const double se_var = batch_se(B + (size_t)(nb + 1) * SCAL_LEN);
+      const double se_n = B[(size_t)nb * SCAL_LEN + SCAL_N];
+      CK(nc_put_var1_double(gr, vmue, st2, isfinite(se_mu) ? &se_mu : &(double){NC_FILL_DOUBLE}));
+      CK(nc_put_var1_double(gr, vvare, st2,
+                            isfinite(se_var) ? &se_var : &(double){NC_FILL_DOUBLE}));
+      CK(nc_put_var1_double(gr, vnb, st2, &se_n));
     }
 done:
   return rc;
@@ -584,6 +687,47 @@ static const struct {
      LAGR_POS},
 };
 
+/* The lag functions of lagr_rows and their standard errors over the releases, with the
+   batch counts (release_batches), on dimensions d2 = (level, lag); fn: lagr_functions of
+   every level, tmp: scratch of nlag. */
+static int write_functions(const struct lagr *g, int gr, const int d2[2], const double *fn,
+                           double *tmp, char *err, size_t errlen) {
+  const int nl = g->cfg.n_levels;
+  const size_t nlag = g->nlag;
+  int rc = NC_NOERR, v;
+  for (size_t j = 0; j < sizeof lagr_rows / sizeof lagr_rows[0]; j++)
+    for (int i = 0; i < 3; i++) {
+      char name[48], ln[256];
+      const int row = lagr_rows[j].row + i;
+      snprintf(name, sizeof name, lagr_rows[j].fmt, lagr_rows[j].letters[i]);
+      snprintf(ln, sizeof ln, lagr_rows[j].lfmt, lagr_rows[j].letters[i], lagr_rows[j].letters[i]);
+      CK(ncout_def(gr, name, NC_DOUBLE, 2, d2, lagr_rows[j].units, ln, &v));
+      CK(ncout_fill(gr, v));
+      for (int l = 0; l < nl; l++)
+        CK(put_rows(gr, v, l, nlag, fn + ((size_t)l * LF_LEN + (size_t)row) * nlag));
+      /* its standard error over the completed releases, each release's own value a batch */
+      const size_t used = strlen(ln);
+      snprintf(ln + used, sizeof ln - used, ": standard error over the releases");
+      strncat(name, "_stderr", sizeof name - strlen(name) - 1);
+      CK(ncout_def(gr, name, NC_DOUBLE, 2, d2, lagr_rows[j].units, ln, &v));
+      CK(ncout_fill(gr, v));
+      for (int l = 0; l < nl; l++) {
+        const double *B = g->rb + ((size_t)l * LF_LEN + (size_t)row) * nlag * SCAL_LEN;
+        for (size_t k = 0; k < nlag; k++) tmp[k] = batch_se(B + k * SCAL_LEN);
+        CK(put_rows(gr, v, l, nlag, tmp));
+      }
+    }
+  CK(ncout_def(gr, "release_batches", NC_DOUBLE, 2, d2, "1",
+               "completed releases with samples at the lag: the batches of the *_stderr", &v));
+  for (int l = 0; l < nl; l++) {
+    const double *B = g->rb + ((size_t)l * LF_LEN + LF_D) * nlag * SCAL_LEN;
+    for (size_t k = 0; k < nlag; k++) tmp[k] = B[k * SCAL_LEN + SCAL_N];
+    CK(put_rows(gr, v, l, nlag, tmp));
+  }
+done:
+  return rc;
+}
+
 int lagr_nc_write(const struct lagr *g, int ncid, char *err, size_t errlen) {
   const struct lagr_config *c = &g->cfg;
   const int nl = c->n_levels, ns = c->n_stations, nb = c->pdf_bins;
@@ -603,6 +747,9 @@ int lagr_nc_write(const struct lagr *g, int ncid, char *err, size_t errlen) {
   CK(nc_put_att_double(gr, NC_GLOBAL, "x0", NC_DOUBLE, 1, &c->x0));
   CK(nc_put_att_double(gr, NC_GLOBAL, "horizon", NC_DOUBLE, 1, &c->horizon));
   CK(nc_put_att_double(gr, NC_GLOBAL, "release_every", NC_DOUBLE, 1, &c->release_every));
+  /* releases closer than the horizon meet the same eddies: their batches are not independent */
+  const long long overlap = c->release_every < c->horizon * (1.0 - 1e-9);
+  CK(nc_put_att_longlong(gr, NC_GLOBAL, "releases_overlap", NC_INT64, 1, &overlap));
   CK(nc_def_dim(gr, "level", (size_t)nl, &dl));
   CK(nc_def_dim(gr, "lag", nlag, &dk));
   CK(nc_def_dim(gr, "component", 3, &dc));
@@ -616,17 +763,7 @@ int lagr_nc_write(const struct lagr *g, int ncid, char *err, size_t errlen) {
   static const char *const components[3] = {"u", "v", "w"};
   CK(ncout_labels(gr, "component", dc, "velocity component", components));
   const int d2[2] = {dl, dk};
-  for (size_t j = 0; j < sizeof lagr_rows / sizeof lagr_rows[0]; j++)
-    for (int i = 0; i < 3; i++) {
-      char name[32], ln[160];
-      snprintf(name, sizeof name, lagr_rows[j].fmt, lagr_rows[j].letters[i]);
-      snprintf(ln, sizeof ln, lagr_rows[j].lfmt, lagr_rows[j].letters[i], lagr_rows[j].letters[i]);
-      CK(ncout_def(gr, name, NC_DOUBLE, 2, d2, lagr_rows[j].units, ln, &v));
-      CK(ncout_fill(gr, v));
-      for (int l = 0; l < nl; l++)
-        CK(put_rows(gr, v, l, nlag,
-                    fn + ((size_t)l * LF_LEN + (size_t)(lagr_rows[j].row + i)) * nlag));
-    }
+  if ((rc = write_functions(g, gr, d2, fn, tmp, err, errlen)) != NC_NOERR) goto done;
   CK(ncout_def(gr, "n_tracks", NC_DOUBLE, 2, d2, "1", "particle samples at each lag", &v));
   for (int l = 0; l < nl; l++)
     CK(put_rows(gr, v, l, nlag, fn + ((size_t)l * LF_LEN + LF_N) * nlag));
@@ -691,6 +828,8 @@ static size_t engine_bytes(const void *self) {
   const size_t nl = (size_t)g->cfg.n_levels, ns = (size_t)g->n_slots;
   const size_t nst = (size_t)(g->cfg.n_stations ? g->cfg.n_stations : 1);
   return nl * g->nlag * LG_LEN * d * (1 + ns) + ns * SL_LEN * d + nl * 3 * SCAL_LEN * d +
+         nl * LF_LEN * g->nlag * SCAL_LEN * d + ns * slot_pdf_len(g) * d +
+         nl * nst * ((size_t)g->cfg.pdf_bins + 2) * SCAL_LEN * d +
          nl * nst * ((size_t)g->cfg.pdf_bins + 3) * d + g->cap * TR_LEN * d +
          g->index_len * sizeof(long) + (g->mine_cap + g->all_cap) * LAGR_REC * d;
 }

@@ -103,6 +103,12 @@ struct lagr {
   double *slot_sums;   /*!< [slot][level][lag][LG_LEN] active releases */
   double *slots;       /*!< [slot][SL_LEN] */
   double *tl;          /*!< [level][3][3] Welford of the per-release T_L over releases */
+  double *rb;          /*!< [level][LF_LEN][lag][3] Welford over the completed releases of each
+                            release's own lag functions (checkpoint format 1.12) */
+  double *slot_pdf;    /*!< [slot][level][station][pdf_bins + 3] the active releases'
+                            crossings, as pdf; [slot][0] of level 0, station 0 ... see lagr.c */
+  double *pdf_rb;      /*!< [level][station][pdf_bins + 2][3] Welford over the completed releases
+                            of each release's own P(y; x), mu_y and variance */
   double *pdf;         /*!< [level][station][pdf_bins + 3]: counts, then n, sum y, sum y^2 */
   double *tracks;      /*!< [ntracks][TR_LEN] */
   size_t ntracks, cap; /*!< tracked particles, capacity */

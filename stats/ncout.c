@@ -42,6 +42,48 @@ static int def_var(int ncid, const char *name, nc_type type, int ndim, const int
 /* The file is built in memory (nc_create_mem) and written here with plain POSIX calls, so that a
    full disk or a file-size limit is an error message, not a failure inside HDF5's close (which
    HDF5 1.10 does not survive). Write the image to tmp, make it durable, move it into place. */
+/* 1 if every dimension of variable a of group g is one of variable b's. */
+static int dims_within(int g, int a, int b) {
+  int na, nb, da[NC_MAX_VAR_DIMS], db[NC_MAX_VAR_DIMS];
+  if (nc_inq_var(g, a, NULL, NULL, &na, da, NULL) || nc_inq_var(g, b, NULL, NULL, &nb, db, NULL))
+    return 0;
+  for (int i = 0; i < na; i++) {
+    int found = 0;
+    for (int j = 0; j < nb && !found; j++) found = da[i] == db[j];
+    if (!found) return 0;
+  }
+  return 1;
+}
+
+int ncout_link_stderr(int ncid) {
+  static const char *const extra[] = {"n_eff_windows", "short_windows", "n_batches",
+                                      "release_batches", "pdf_release_batches"};
+  int nv, rc = nc_inq_nvars(ncid, &nv);
+  for (int v = 0; v < nv && rc == NC_NOERR; v++) {
+    char name[NC_MAX_NAME + 1], se[NC_MAX_NAME + 16], list[4 * NC_MAX_NAME];
+    int vs;
+    if ((rc = nc_inq_varname(ncid, v, name)) != NC_NOERR) break;
+    snprintf(se, sizeof se, "%s_stderr", name);
+    if (nc_inq_varid(ncid, se, &vs) != NC_NOERR) continue;
+    snprintf(list, sizeof list, "%s", se);
+    for (size_t k = 0; k < sizeof extra / sizeof extra[0]; k++) {
+      int ve;
+      if (nc_inq_varid(ncid, extra[k], &ve) == NC_NOERR && dims_within(ncid, ve, v))
+        snprintf(list + strlen(list), sizeof list - strlen(list), " %s", extra[k]);
+    }
+    rc = nc_put_att_text(ncid, v, "ancillary_variables", strlen(list), list);
+  }
+  int ng, *grps = NULL;
+  if (rc == NC_NOERR) rc = nc_inq_grps(ncid, &ng, NULL);
+  if (rc == NC_NOERR && ng > 0) {
+    grps = mem_alloc((size_t)ng, sizeof *grps, "netCDF output");
+    rc = nc_inq_grps(ncid, NULL, grps);
+    for (int i = 0; i < ng && rc == NC_NOERR; i++) rc = ncout_link_stderr(grps[i]);
+    free(grps);
+  }
+  return rc;
+}
+
 int ncout_commit(int ncid, const char *tmp, const char *path, char *err, size_t errlen) {
   NC_memio mem = {0, NULL, 0};
   const int rc = nc_close_memio(ncid, &mem);

@@ -42,6 +42,16 @@ struct nc_attr {
 int ncout_put_attrs(int ncid, const struct nc_attr *attrs, int nattrs);
 
 /**
+ * @brief CF links from each statistic to its uncertainty, in group ncid and every group below:
+ *        a variable NAME with a variable NAME_stderr beside it gets the attribute
+ *        ancillary_variables = "NAME_stderr", followed by those of n_eff_windows,
+ *        short_windows, n_batches, release_batches and pdf_release_batches that the group
+ *        holds on a subset of NAME's dimensions (the batches and the flags of that error).
+ * @return a netCDF status
+ */
+int ncout_link_stderr(int ncid);
+
+/**
  * @brief Close a file built in memory (nc_create_mem), write its image to tmp, make it durable
  *        and rename it to path; on failure tmp is removed and an earlier path is kept.
  * @param[out] err,errlen message on failure

@@ -6,10 +6,12 @@
 #include <math.h>
 #include <netcdf.h>
 #include <stddef.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "alloc.h"
+#include "moments.h"
 #include "ncout.h"
 #include "spar.h"
 #include "state.h"
@@ -20,10 +22,14 @@ void quad_init(struct quad *q, const struct quad_config *cfg) {
   if (cfg->n_levels <= 0) return;
   q->acc = mem_calloc((size_t)cfg->n_levels * QS_LEN, sizeof(double), "quadrant engine");
   q->samples = mem_calloc((size_t)cfg->n_levels, sizeof(double), "quadrant engine");
+  q->win = mem_calloc((size_t)cfg->n_levels * (QS_LEN + 1), sizeof(double), "quadrant engine");
+  q->batch =
+      mem_calloc((size_t)cfg->n_levels * QB_LEN * SCAL_LEN, sizeof(double), "quadrant engine");
+  q->win_end = cfg->window > 0.0 ? cfg->t_start + cfg->window : INFINITY;
 }
 
 void quad_free(struct quad *q) {
-  free(q->acc), free(q->samples), free(q->ent), free(q->all);
+  free(q->acc), free(q->samples), free(q->ent), free(q->all), free(q->win), free(q->batch);
   memset(q, 0, sizeof *q);
 }
 
@@ -72,8 +78,39 @@ static void plane_sums(struct quad *q, const struct stats_snapshot *s, struct sp
     for (size_t i = 0; i < rec; i++) out[i] += q->all[c * rec + i];
 }
 
+/* The results of one level's sums a (QS_LEN): uv, share, time of Q1..Q4 into r[QB_LEN]. */
+static void level_results(const double *a, double *r) {
+  const double n = a[QS_N] + a[QS_N + 1] + a[QS_N + 2] + a[QS_N + 3];
+  const double tot = a[QS_UV] + a[QS_UV + 1] + a[QS_UV + 2] + a[QS_UV + 3];
+  for (int k = 0; k < 4; k++) {
+    r[QB_UV + k] = n > 0 ? a[QS_UV + k] / n : NAN;
+    r[QB_SHARE + k] = n > 0 && tot != 0.0 ? a[QS_UV + k] / tot : NAN;
+    r[QB_TIME + k] = n > 0 ? a[QS_N + k] / n : NAN;
+  }
+}
+
+/* Close the open window when a snapshot at t lies past its end (the windows of the Eulerian
+   engine: t_start + k window): its values per level become one batch each; an empty window
+   is no batch. */
+static void close_window(struct quad *q, double t) {
+  const struct quad_config *c = &q->cfg;
+  if (t < q->win_end) return;
+  for (int l = 0; l < c->n_levels; l++) {
+    double *w = q->win + (size_t)l * (QS_LEN + 1), r[QB_LEN];
+    if (w[QS_LEN] > 0.0) {
+      level_results(w, r);
+      for (int k = 0; k < QB_LEN; k++)
+        if (isfinite(r[k])) scal_add(q->batch + ((size_t)l * QB_LEN + (size_t)k) * SCAL_LEN, r[k]);
+    }
+    memset(w, 0, (QS_LEN + 1) * sizeof(double));
+  }
+  q->win_end = c->t_start + c->window * (floor((t - c->t_start) / c->window) + 1.0);
+  if (q->win_end <= t) q->win_end += c->window; /* rounding */
+}
+
 void quad_sample(struct quad *q, const struct stats_snapshot *s) {
   if (q->cfg.n_levels <= 0 || s->t < q->cfg.t_start) return;
+  close_window(q, s->t);
   int lev[2 * QUAD_MAX_LEVELS] = {0}, mir[2 * QUAD_MAX_LEVELS] = {0};
   double yp[2 * QUAD_MAX_LEVELS] = {0}, mean[2 * 2 * QUAD_MAX_LEVELS] = {0};
   double s0[QS_LEN * 2 * QUAD_MAX_LEVELS], s1[QS_LEN * 2 * QUAD_MAX_LEVELS];
@@ -90,8 +127,9 @@ void quad_sample(struct quad *q, const struct stats_snapshot *s) {
   for (int pl = 0; pl < npl; pl++) {
     if (!(s0[QS_LEN * pl + 2] > 0)) continue;
     double *acc = q->acc + (size_t)lev[pl] * QS_LEN;
-    for (int k = 0; k < QS_LEN; k++) acc[k] += s1[QS_LEN * pl + k];
-    q->samples[lev[pl]] += 1.0;
+    double *w = q->win + (size_t)lev[pl] * (QS_LEN + 1);
+    for (int k = 0; k < QS_LEN; k++) acc[k] += s1[QS_LEN * pl + k], w[k] += s1[QS_LEN * pl + k];
+    q->samples[lev[pl]] += 1.0, w[QS_LEN] += 1.0;
   }
 }
 
@@ -100,28 +138,46 @@ void quad_state(struct quad *q, struct state_list *L) {
   const size_t d2[2] = {(size_t)q->cfg.n_levels, QS_LEN}, d1[1] = {d2[0]};
   state_add(L, "stats/quadrants/sums", STATE_F64, 2, d2, q->acc, NULL);
   state_add(L, "stats/quadrants/samples", STATE_F64, 1, d1, q->samples, NULL);
+  /* format 1.12: the window batches; a checkpoint without them resumes with none, and the
+     window open at the resume becomes a batch of its snapshots after the resume only */
+  const size_t dw[2] = {d2[0], QS_LEN + 1}, db[3] = {d2[0], QB_LEN, SCAL_LEN};
+  state_add(L, "stats/quadrants/window", STATE_F64, 2, dw, q->win, NULL)->optional = 1;
+  state_add(L, "stats/quadrants/window_end", STATE_F64, 0, NULL, &q->win_end, "s")->optional = 1;
+  state_add(L, "stats/quadrants/batches", STATE_F64, 3, db, q->batch, NULL)->optional = 1;
 }
 
 /* [level][4] from the sums: each quadrant's part of <u'v'> (sum over the quadrant / all
    samples), its share of the whole u'v', and its share of the samples. */
 static void quad_results(const struct quad *q, double *uv, double *share, double *time) {
   for (int l = 0; l < q->cfg.n_levels; l++) {
-    const double *a = q->acc + (size_t)l * QS_LEN;
-    const double n = a[QS_N] + a[QS_N + 1] + a[QS_N + 2] + a[QS_N + 3];
-    const double tot = a[QS_UV] + a[QS_UV + 1] + a[QS_UV + 2] + a[QS_UV + 3];
-    for (int k = 0; k < 4; k++) {
-      uv[4 * l + k] = n > 0 ? a[QS_UV + k] / n : NAN;
-      share[4 * l + k] = n > 0 && tot != 0.0 ? a[QS_UV + k] / tot : NAN;
-      time[4 * l + k] = n > 0 ? a[QS_N + k] / n : NAN;
+    double r[QB_LEN];
+    level_results(q->acc + (size_t)l * QS_LEN, r);
+    for (int k = 0; k < 4; k++)
+      uv[4 * l + k] = r[QB_UV + k], share[4 * l + k] = r[QB_SHARE + k],
+                 time[4 * l + k] = r[QB_TIME + k];
+  }
+}
+
+/* The batch-means standard errors of uv, uv_fraction and time_fraction (as quad_results) and
+   the complete windows of each level. */
+static void quad_stderr(const struct quad *q, double *se, double *nwin) {
+  const size_t nl = (size_t)q->cfg.n_levels;
+  for (size_t l = 0; l < nl; l++) {
+    nwin[l] = q->batch[l * QB_LEN * SCAL_LEN + SCAL_N];
+    for (int k = 0; k < QB_LEN; k++) {
+      const double *W = q->batch + (l * QB_LEN + (size_t)k) * SCAL_LEN;
+      se[(size_t)(k / 4) * 4 * nl + 4 * l + (size_t)(k % 4)] =
+          W[SCAL_N] >= 2.0 ? sqrt(W[SCAL_M2] / (W[SCAL_N] - 1.0) / W[SCAL_N]) : NAN;
     }
   }
 }
 
 int quad_nc_write(const struct quad *q, int ncid, char *err, size_t errlen) {
   const size_t nl = (size_t)q->cfg.n_levels;
-  double *r = mem_alloc(3 * 4 * nl, sizeof(double), "quadrants");
+  double *r = mem_alloc(6 * 4 * nl + nl, sizeof(double), "quadrants"), *se = r + 12 * nl;
   int rc = NC_NOERR, g, dl, dq, d2[2], d3[2], v;
   quad_results(q, r, r + 4 * nl, r + 8 * nl);
+  quad_stderr(q, se, se + 12 * nl);
   NC_TRY(nc_def_grp(ncid, "quadrants", &g), done);
   static const char desc[] =
       "quadrant analysis of u'v' (Wallace et al. 1972, Willmarth & Lu 1972): fluctuations about "
@@ -154,7 +210,21 @@ int quad_nc_write(const struct quad *q, int ncid, char *err, size_t errlen) {
     NC_TRY(ncout_def(g, name[k], NC_DOUBLE, 2, d2, units[k], lname[k], &v), done);
     NC_TRY(ncout_fill(g, v), done); /* a level without samples: _FillValue, never NaN */
     NC_TRY(ncout_put_filled(g, v, NULL, NULL, r + (size_t)k * 4 * nl, 4 * nl), done);
+    char sname[32], slname[160];
+    snprintf(sname, sizeof sname, "%s_stderr", name[k]);
+    snprintf(slname, sizeof slname,
+             "standard error of %s (batch means over the complete averaging windows)", name[k]);
+    NC_TRY(ncout_def(g, sname, NC_DOUBLE, 2, d2, units[k], slname, &v), done);
+    NC_TRY(ncout_fill(g, v), done);
+    NC_TRY(ncout_put_filled(g, v, NULL, NULL, se + (size_t)k * 4 * nl, 4 * nl), done);
   }
+  NC_TRY(ncout_def(g, "n_batches", NC_DOUBLE, 1, &dl, "1",
+                   "complete averaging windows with planes at the level: the batches of the "
+                   "*_stderr",
+                   &v),
+         done);
+  NC_TRY(nc_put_var_double(g, v, se + 12 * nl), done);
+  NC_TRY(nc_put_att_double(g, NC_GLOBAL, "window_length", NC_DOUBLE, 1, &q->cfg.window), done);
   d3[1] = 0; /* the raw sums, re-averageable: [level][u'v' Q1..Q4, count Q1..Q4] */
   {
     int ds;
@@ -181,6 +251,7 @@ static int engine_init_scene(void *self, const struct stats_scene *sc) {
   memset(&c, 0, sizeof c);
   c.n_levels = stats_scene_levels(sc, "quadrants.y_plus", c.y_plus, c.y, QUAD_MAX_LEVELS);
   c.half = 0.5 * sc->dr, c.delta = sc->delta, c.t_start = sc->t_average_start;
+  c.window = stats_scene_window(sc);
   if (!(c.n_levels > 0)) return 0;
   quad_init(self, &c);
   return 1;
@@ -190,7 +261,8 @@ STATS_ENGINE_ADAPTERS(quad)
 
 static size_t engine_bytes(const void *self) {
   const struct quad *q = self;
-  return ((size_t)q->cfg.n_levels * (QS_LEN + 1) + q->ent_cap + q->all_cap * q->rec) *
+  return ((size_t)q->cfg.n_levels * (2 * QS_LEN + 2 + QB_LEN * SCAL_LEN) + q->ent_cap +
+          q->all_cap * q->rec) *
          sizeof(double);
 }
 

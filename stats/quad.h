@@ -36,13 +36,21 @@ struct quad_config {
   double half;                    /*!< half thickness of the slabs [m] */
   double delta;                   /*!< channel half-width [m] (mirror levels) */
   double t_start;                 /*!< start of the averaging [s] */
+  double window;                  /*!< averaging window [s] (the Eulerian engine's; 0: none) */
 };
+
+/** Per-window batch values per level (checkpoint format 1.12): uv of Q1..Q4, their shares of
+    u'v', their shares of the samples. */
+enum { QB_UV = 0, QB_SHARE = 4, QB_TIME = 8, QB_LEN = 12 };
 
 /** The engine. */
 struct quad {
   struct quad_config cfg;
   double *acc;     /*!< [level][QS_LEN] sums over the planes */
   double *samples; /*!< [level] planes accumulated */
+  double *win;     /*!< [level][QS_LEN + 1] sums and planes of the open window */
+  double win_end;  /*!< end of the open window [s] */
+  double *batch;   /*!< [level][QB_LEN][3] Welford of the closed windows' values */
   double *ent;     /*!< scratch: this rank's per-(plane, column) partial sums */
   double *all;     /*!< scratch: the same gathered from all ranks */
   size_t ent_cap;  /*!< capacity of ent [doubles] */

@@ -65,5 +65,6 @@ int stats_nc_file(const char *path, const struct stats *st, const struct series 
   }
   free(col), free(vts);
   NCOUT_OR_DISCARD(rc);
+  NCOUT_OR_DISCARD(ncout_link_stderr(ncid)); /* CF: each statistic names its error */
   return ncout_commit(ncid, tmp, path, err, errlen);
 }
