@@ -109,3 +109,10 @@ add_executable(test_damper test_damper.c)
 target_link_libraries(test_damper PRIVATE chansph_core)
 add_test(NAME unit_damper COMMAND test_damper)
 set_tests_properties(unit_damper PROPERTIES LABELS unit)
+
+#   test_uncertainty: standard errors of the Lagrangian, quadrant and Eulerian engines against
+#                the exact ones of synthetic AR(1) and Gaussian signals, within 20% (issue 43)
+add_executable(test_uncertainty test_uncertainty.c)
+target_link_libraries(test_uncertainty PRIVATE chansph_core)
+add_test(NAME unit_stats_uncertainty COMMAND test_uncertainty)
+set_tests_properties(unit_stats_uncertainty PROPERTIES LABELS unit)
