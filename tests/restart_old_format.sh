@@ -2,7 +2,9 @@
 # Issue 25: a run cut at step N1 whose checkpoint is rewritten (h5py) as an older checkpoint
 # format writes it resumes to the end, and one group of stats.nc is compared with the
 # uninterrupted run's (restart_bitwise_all_stats, fixture ckpt_allstats). The rewrite removes
-# what the older format lacks: format <= 1.9 the sums of the interval-mean velocities
+# what the older format lacks: format <= 1.11 the co-moments with y of the Eulerian moment
+# records (stats/eulerian/moments: 25 -> 21 per record) and the per-release and per-window
+# batches of the Lagrangian and quadrant standard errors; <= 1.9 the sums of the interval-mean velocities
 # (stats/lagrangian/sums and slot_sums: 53 -> 47 per record), <= 1.8 also those of the actual
 # lags (-> 46), <= 1.7 the correlation engine's window records (stats/correlations/windows,
 # window_samples, window_spectra_1d), <= 1.6 the sums of the displacements (-> 43).
@@ -10,12 +12,18 @@
 #     cannot give: rate_var_* (and for 1.8 lag_time_mean, for 1.6 also disp_mean_*,
 #     disp_var_*), fill values where the stored sums had samples (at least one) and otherwise
 #     equal.
+#   stats111: the root group: stresses about the bin mean (local_mean 0; uu .. vw equal to
+#     uu_bin .. vw_bin, which equal the uninterrupted run's bit for bit), the means bit for
+#     bit; groups lagrangian and quadrants bit for bit except their standard errors and batch
+#     counts, which count only the releases and windows completed after the resume (fewer).
+#     (In every mode the Lagrangian standard errors and batch counts are left out of the
+#     bitwise comparison for the same reason.)
 #   corr17: group correlations bit for bit, except n_batches, which counts only the complete
 #     windows after the one of the resume (fewer than the uninterrupted run's), the
 #     *_stderr, which are fill values with fewer than 2 batches and finite otherwise, and the
 #     window records of stats.nc (dimension window), which start at the window of the resume
 #     (flagged partial, not complete) and then equal the uninterrupted run's rows bit for bit.
-# usage: restart_old_format.sh lagr16|lagr18|lagr19|corr17 CHANSPH SCENE RUNS N1 [--set k=v ...]
+# usage: restart_old_format.sh stats111|lagr16|lagr18|lagr19|corr17 CHANSPH SCENE RUNS N1 [--set k=v ...]
 set -u
 export CHANSPH_RUN_ID=compare-test
 mode=$1 chansph=$2 scene=$3 runs=$4 n1=$5
@@ -25,7 +33,8 @@ case $mode in
   lagr18) minor=8 part=$runs/lagr_format18_part ;;
   lagr19) minor=9 part=$runs/lagr_format19_part ;;
   corr17) minor=7 part=$runs/corr_format17_part ;;
-  *) echo "usage: $0 lagr16|lagr18|lagr19|corr17 CHANSPH SCENE RUNS N1 [--set k=v ...]"; exit 2 ;;
+  stats111) minor=11 part=$runs/stats_format111_part ;;
+  *) echo "usage: $0 stats111|lagr16|lagr18|lagr19|corr17 CHANSPH SCENE RUNS N1 [--set k=v ...]"; exit 2 ;;
 esac
 full=$runs/bitwise_allstats_full
 rm -rf "$part"
@@ -40,8 +49,17 @@ path, minor = sorted(glob.glob(sys.argv[1] + "/checkpoints/ckpt_*.h5"))[-1], int
 done = []
 with h5py.File(path, "a") as h:
     assert h.attrs["format_version_minor"] == 12, h.attrs["format_version_minor"]
-    width = 47 if minor == 9 else 46 if minor >= 7 else 43  # sums per record
-    for k in ("stats/lagrangian/sums", "stats/lagrangian/slot_sums"):
+    a = h["stats/eulerian/moments"][()]
+    assert a.shape[2] == 25, a.shape
+    del h["stats/eulerian/moments"]
+    h.create_dataset("stats/eulerian/moments", data=a[:, :, :21], chunks=a[:, :, :21].shape,
+                     fletcher32=True)
+    for k in ("lagrangian/release_batches", "lagrangian/slot_pdf", "lagrangian/pdf_batches",
+              "quadrants/window", "quadrants/window_end", "quadrants/batches"):
+        del h["stats/" + k]
+    done.append("Eulerian moments 21 per record, no batches of 1.12")
+    width = 53 if minor >= 10 else 47 if minor == 9 else 46 if minor >= 7 else 43
+    for k in ("stats/lagrangian/sums", "stats/lagrangian/slot_sums") if width < 53 else ():
         a = h[k][()]
         assert a.shape[2] == 53, (k, a.shape)
         del h[k]
@@ -63,11 +81,37 @@ import numpy as np
 mode = sys.argv[3]
 
 
+BATCHES = ("release_batches", "pdf_release_batches", "n_batches")
+
+
+def batched(k):
+    """A standard error or batch count of the per-release or per-window batches of format
+    1.12 (T_L's batches are older): after a resume from an older format they count only the
+    batches completed after it."""
+    return k in BATCHES or (k.endswith("_stderr") and k != "T_L_stderr")
+
+
+def fewer_batches(a, b, names):
+    """Every batch count of b at most a's, and fewer in all."""
+    tot = [0, 0]
+    for k in names:
+        x, y = np.ma.filled(a[k][:], 0), np.ma.filled(b[k][:], 0)
+        if np.any(y > x):
+            return False
+        tot[0], tot[1] = tot[0] + x.sum(), tot[1] + y.sum()
+    return tot[1] < tot[0]
+
+
 def lagr(a, b, unknown):
     """Group lagrangian: the variables starting with one of unknown may be fill values where
-    the uninterrupted run has a value (at least one of each such family), the rest bitwise."""
+    the uninterrupted run has a value (at least one of each such family), the rest bitwise
+    but the batches of format 1.12 (fewer in b)."""
     bad, nan = [], {u: 0 for u in unknown}
+    if not fewer_batches(a, b, ("release_batches", "pdf_release_batches")):
+        bad.append("release_batches (not fewer after the resume)")
     for k, v in a.variables.items():
+        if batched(k):
+            continue
         x, y = v[:], b.variables[k][:]
         if x.dtype.kind != "f":
             bad += [] if np.array_equal(x, y) else [k]
@@ -81,7 +125,7 @@ def lagr(a, b, unknown):
         else:
             same = np.array_equal(x, y, equal_nan=True)
         bad += [] if same else [k]
-    ok = not bad and all(n > 0 for n in nan.values())
+    ok = not bad and all(n > 0 for n in nan.values()) if unknown else not bad
     print("%s: group lagrangian of the run resumed from format 1.%s sums: %s; fill values "
           "(unknown) in %s, the others equal" %
           ("PASS" if ok else "FAIL", mode[-1],
@@ -135,8 +179,41 @@ def corr(a, b):
     return ok
 
 
+def stats111(a, b):
+    """The root group and groups quadrants and lagrangian after a resume from format 1.11."""
+    bad = []
+    for k, v in a.variables.items():
+        if "y" not in v.dimensions or v.dimensions != ("y",):
+            continue
+        x, y = np.ma.filled(v[:], np.nan), np.ma.filled(b[k][:], np.nan)
+        if k in ("uu", "vv", "ww", "uv", "uw", "vw"):
+            same = np.array_equal(y, np.ma.filled(b[k + "_bin"][:], np.nan), equal_nan=True)
+        elif k == "local_mean":
+            same = np.all((y == 0) | np.isnan(y)) and np.any(y == 0)
+        elif k.startswith(("rsb_", "reynolds_stress", "advective_stress", "total_stress")) or \
+                k.endswith("_stderr") or k in ("viscous_stress", "correlation_time_bin",
+                                               "n_eff_windows", "short_windows"):
+            continue  # functions of the stresses, or of the batches: about the bin mean now
+        else:
+            same = np.array_equal(x, y, equal_nan=True)
+        bad += [] if same else [k]
+    qa, qb = a.groups["quadrants"], b.groups["quadrants"]
+    for k in qa.variables:
+        if not batched(k) and not np.array_equal(qa[k][:], qb[k][:]):
+            bad.append("quadrants/" + k)
+    if not fewer_batches(qa, qb, ("n_batches",)):
+        bad.append("quadrants/n_batches (not fewer)")
+    print("%s: root group of the run resumed from format 1.11: stresses about the bin mean "
+          "(local_mean 0, uu .. vw = uu_bin .. vw_bin), the rest and group quadrants bitwise "
+          "but their batches: %s" % ("FAIL" if bad else "PASS",
+                                     "DIFFERENT: " + ", ".join(bad) if bad else "as expected"))
+    return not bad and lagr(a.groups["lagrangian"], b.groups["lagrangian"], [])
+
+
 fa, fb = netCDF4.Dataset(sys.argv[1]), netCDF4.Dataset(sys.argv[2])
-if mode == "corr17":
+if mode == "stats111":
+    ok = stats111(fa, fb)
+elif mode == "corr17":
     ok = corr(fa.groups["correlations"], fb.groups["correlations"])
 else:
     unknown = ["rate_var_"] + (["lag_time_mean"] if mode != "lagr19" else []) + \
