@@ -15,6 +15,8 @@ TOOLS = {
     "ab_table": ("ab_table", "A/B table of turbulent runs"),
     "ab_score": ("ab_score", "scored A/B table: redistribution, pressure noise, peaks, cost"),
     "error_vs_time": ("error_vs_time", "error against the DNS window group by window group"),
+    "convergence": ("convergence", "running averages and their standard errors against run time, "
+                    "with the projection to a target error"),
     "blocking": ("blocking", "blocking analysis: the standard errors against the batch length"),
     "resolution_extrapolate": ("resolution_extrapolate",
                                "the resolution a series extrapolates to"),
