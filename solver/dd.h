@@ -20,6 +20,7 @@
 #define CHANSPH_DD_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include "nbr.h"
 #include "part.h"
@@ -41,6 +42,10 @@ struct dd {
      the ghost slot of each received particle (left halo first) */
   size_t nsend[2], cap_send[2], *send[2];
   size_t nrecv[2], cap_ghost, *ghost;
+  /* particles per edge cell (row * halo + h): sent left (0), right (1), received from the left
+     (2), from the right (3); and per-row offsets into the lists (scratch) */
+  uint32_t *cnt[4];
+  size_t cap_cnt, *row;
   double *sbuf, *rbuf;
   size_t cap_sbuf, cap_rbuf;
   /* cost of the exchanges, for the log */
