@@ -39,40 +39,64 @@ static void reserve_buf(double **buf, size_t *cap, size_t n) {
   *buf = mem_realloc(*buf, *cap, sizeof(double), "domain decomposition");
 }
 
-static void pack(const struct particles *P, size_t a, double *r, int role) {
+/* The fields of one role as they travel, resolved once per exchange: each live field's array
+   (NULL: travels as zeros, not unpacked), width and type, in table order. */
+struct wire {
+  int n;
+  void *arr[F_LEN];
+  int width[F_LEN], type[F_LEN];
+};
+
+static void wire_fields(const struct particles *P, int role, struct wire *w) {
+  w->n = 0;
   for (int i = 0; i < part_n_fields; i++) {
     const struct part_field *f = &part_fields[i];
     if (!(f->roles & role)) continue;
-    const void *arr = part_field_live(P, f) ? part_field_ptr(P, f) : NULL;
-    if (f->type == PT_I64)
-      memcpy(r, (const int64_t *)arr + a, sizeof(double));
-    else if (f->type == PT_U8)
-      r[0] = ((const uint8_t *)arr)[a];
-    else
-      for (int k = 0; k < f->width; k++) r[k] = arr ? ((const double *)arr)[a * f->width + k] : 0.0;
-    r += f->width;
+    w->arr[w->n] = part_field_live(P, f) ? part_field_ptr(P, f) : NULL;
+    w->width[w->n] = f->width, w->type[w->n] = f->type, w->n++;
   }
 }
 
-static void unpack(struct particles *P, size_t a, const double *r, int role) {
-  for (int i = 0; i < part_n_fields; i++) {
-    const struct part_field *f = &part_fields[i];
-    if (!(f->roles & role)) continue;
-    void *arr = part_field_live(P, f) ? part_field_ptr(P, f) : NULL;
-    if (f->type == PT_I64)
+/* pack() and unpack() of slot a with the fields resolved (the same record). */
+static inline void wire_pack(const struct wire *w, size_t a, double *r) {
+  for (int i = 0; i < w->n; i++) {
+    const void *arr = w->arr[i];
+    if (w->type[i] == PT_I64)
+      memcpy(r, (const int64_t *)arr + a, sizeof(double));
+    else if (w->type[i] == PT_U8)
+      r[0] = ((const uint8_t *)arr)[a];
+    else
+      for (int k = 0; k < w->width[i]; k++)
+        r[k] = arr ? ((const double *)arr)[a * w->width[i] + k] : 0.0;
+    r += w->width[i];
+  }
+}
+
+static inline void wire_unpack(const struct wire *w, size_t a, const double *r) {
+  for (int i = 0; i < w->n; i++) {
+    void *arr = w->arr[i];
+    if (w->type[i] == PT_I64)
       memcpy((int64_t *)arr + a, r, sizeof(double));
-    else if (f->type == PT_U8)
+    else if (w->type[i] == PT_U8)
       ((uint8_t *)arr)[a] = (uint8_t)r[0];
     else if (arr)
-      for (int k = 0; k < f->width; k++) ((double *)arr)[a * f->width + k] = r[k];
-    r += f->width;
+      for (int k = 0; k < w->width[i]; k++) ((double *)arr)[a * w->width[i] + k] = r[k];
+    r += w->width[i];
   }
+}
+
+static void pack(const struct particles *P, size_t a, double *r, int role) {
+  struct wire w;
+  wire_fields(P, role, &w);
+  wire_pack(&w, a, r);
 }
 
 static void copy_slot(struct particles *P, size_t to, size_t from) {
   double r[F_LEN];
-  pack(P, from, r, PF_MIGRATE);
-  unpack(P, to, r, PF_MIGRATE);
+  struct wire w;
+  wire_fields(P, PF_MIGRATE, &w);
+  wire_pack(&w, from, r);
+  wire_unpack(&w, to, r);
 }
 
 static void partition_even(struct dd *d) {
@@ -216,7 +240,7 @@ void dd_migrate(struct dd *d, struct particles *P, const struct nbr *nb) {
   for (size_t i = 0; i < leaving; i++) {
     const size_t hole = leave[i];
     while (end > hole && dest[end - 1] >= 0) end--; /* leaving too: dropped, not moved */
-    if (end <= hole) break; /* no staying particle after this hole */
+    if (end <= hole) break;                         /* no staying particle after this hole */
     copy_slot(P, hole, --end);
   }
   P->n = n0 - leaving;
@@ -229,9 +253,10 @@ void dd_migrate(struct dd *d, struct particles *P, const struct nbr *nb) {
   timer_pop();
   const size_t arriving = (size_t)rdisp[np] / (size_t)rl;
   d->reserve(d->ctx, P->n + arriving);
+  struct wire w;
+  wire_fields(P, PF_MIGRATE, &w);
 #pragma omp parallel for schedule(static)
-  for (size_t i = 0; i < arriving; i++)
-    unpack(P, P->n + i, d->rbuf + i * (size_t)rl, PF_MIGRATE);
+  for (size_t i = 0; i < arriving; i++) wire_unpack(&w, P->n + i, d->rbuf + i * (size_t)rl);
   P->n += arriving;
   for (int r = 0; r < np; r++)
     if (scount[r]) d->messages++;
@@ -318,17 +343,20 @@ static void exchange(struct dd *d, int nf, void (*pack_fn)(const void *, size_t,
    refreshes (dd_refresh); nothing reads a ghost's kernel sum or acceleration, and its gamma
    only the budget's conservative split (PR_BUDGET). */
 static void pack_ghost(const void *arg, size_t a, double *r) {
-  pack(arg, a, r, PF_GHOST);
+  wire_pack(arg, a, r);
 }
 
 /* Exchange the particles per edge cell with both neighbours: what the left neighbour sends
    right (its right edge) is my left halo. */
 static void exchange_counts(struct dd *d, size_t n) {
   MPI_Request req[4];
-  CHECK_MPI(MPI_Irecv(d->cnt[2], (int)n, MPI_UINT32_T, d->left, TAG_RIGHT, MPI_COMM_WORLD, &req[0]));
-  CHECK_MPI(MPI_Irecv(d->cnt[3], (int)n, MPI_UINT32_T, d->right, TAG_LEFT, MPI_COMM_WORLD, &req[1]));
+  CHECK_MPI(
+      MPI_Irecv(d->cnt[2], (int)n, MPI_UINT32_T, d->left, TAG_RIGHT, MPI_COMM_WORLD, &req[0]));
+  CHECK_MPI(
+      MPI_Irecv(d->cnt[3], (int)n, MPI_UINT32_T, d->right, TAG_LEFT, MPI_COMM_WORLD, &req[1]));
   CHECK_MPI(MPI_Isend(d->cnt[0], (int)n, MPI_UINT32_T, d->left, TAG_LEFT, MPI_COMM_WORLD, &req[2]));
-  CHECK_MPI(MPI_Isend(d->cnt[1], (int)n, MPI_UINT32_T, d->right, TAG_RIGHT, MPI_COMM_WORLD, &req[3]));
+  CHECK_MPI(
+      MPI_Isend(d->cnt[1], (int)n, MPI_UINT32_T, d->right, TAG_RIGHT, MPI_COMM_WORLD, &req[3]));
   timer_push("halo:wait");
   CHECK_MPI(MPI_Waitall(4, req, MPI_STATUSES_IGNORE));
   timer_pop();
@@ -377,9 +405,11 @@ void dd_halo(struct dd *d, struct particles *P, struct nbr *nb) {
       }
     }
   const int hl = record_len(PF_GHOST);
-  exchange(d, hl, pack_ghost, P);
+  struct wire w;
+  wire_fields(P, PF_GHOST, &w);
+  exchange(d, hl, pack_ghost, &w);
 #pragma omp parallel for schedule(static)
-  for (size_t g = 0; g < ng; g++) unpack(P, d->ghost[g], d->rbuf + g * (size_t)hl, PF_GHOST);
+  for (size_t g = 0; g < ng; g++) wire_unpack(&w, d->ghost[g], d->rbuf + g * (size_t)hl);
   P->n_ghost = ng;
   d->seconds += MPI_Wtime() - t0;
   timer_pop();

@@ -47,22 +47,22 @@ struct nbr_block {
  */
 struct nbr {
   int dim;
-  int nx, ny, nz;    /*!< cells per direction (global) */
-  int ix0, nxo;      /*!< owned columns: ix0 .. ix0 + nxo - 1 */
-  int halo;          /*!< halo columns on each side (0: one rank, periodic wrap in the grid) */
-  size_t ncell_own;  /*!< owned cells */
-  double lx, ly, lz; /*!< domain lengths [m] (ly = 2 delta) */
-  double cx, cy, cz; /*!< inverse cell sizes [1/m] */
-  double support2;   /*!< (2h)^2 [m^2] */
-  size_t ncell;      /*!< owned + halo cells */
-  size_t *start;     /*!< particles of cell c are start[c] .. start[c+1]-1 */
-  uint32_t *tcount;  /*!< per thread: particles of each owned cell, then the thread's first
-                          slot in it (sort scratch, tcount_threads x tcount_cells) */
+  int nx, ny, nz;      /*!< cells per direction (global) */
+  int ix0, nxo;        /*!< owned columns: ix0 .. ix0 + nxo - 1 */
+  int halo;            /*!< halo columns on each side (0: one rank, periodic wrap in the grid) */
+  size_t ncell_own;    /*!< owned cells */
+  double lx, ly, lz;   /*!< domain lengths [m] (ly = 2 delta) */
+  double cx, cy, cz;   /*!< inverse cell sizes [1/m] */
+  double support2;     /*!< (2h)^2 [m^2] */
+  size_t ncell;        /*!< owned + halo cells */
+  size_t *start;       /*!< particles of cell c are start[c] .. start[c+1]-1 */
+  uint32_t *tcount;    /*!< per thread: particles of each owned cell, then the thread's first
+                            slot in it (sort scratch, tcount_threads x tcount_cells) */
   int tcount_threads;  /*!< threads tcount was made for */
   size_t tcount_cells; /*!< owned cells it was made for */
-  size_t *perm;      /*!< sort scratch */
-  int *cell;         /*!< cell of each particle (sort scratch) */
-  size_t cap;        /*!< particles the arrays hold */
+  size_t *perm;        /*!< sort scratch */
+  int *cell;           /*!< cell of each particle (sort scratch) */
+  size_t cap;          /*!< particles the arrays hold */
   /* neighbour list */
   int stride;       /*!< list slots per particle, a multiple of NBR_ALIGN */
   int *count;       /*!< neighbours of each particle (excluding itself) */
