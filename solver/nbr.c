@@ -75,8 +75,11 @@ void nbr_set_range(struct nbr *nb, int ix0, int nxo, int halo) {
   const size_t rows = (size_t)nb->ny * nb->nz;
   nb->ncell_own = (size_t)nxo * rows;
   nb->ncell = nb->ncell_own + 2 * (size_t)halo * rows;
-  part_free(nb->start);
+  part_free(nb->start), part_free(nb->tcount);
   nb->start = part_alloc("cell_start", (nb->ncell + 1) * sizeof(size_t));
+  nb->tcount_threads = omp_get_max_threads(), nb->tcount_cells = nb->ncell_own;
+  nb->tcount =
+      part_alloc("sort_counts", (size_t)nb->tcount_threads * nb->ncell_own * sizeof(uint32_t));
 }
 
 void nbr_reserve(struct nbr *nb, size_t n) {
@@ -110,8 +113,10 @@ static size_t sort_chunk(size_t n, int t, int nt) {
   return n * (size_t)t / (size_t)nt;
 }
 
-/* Per-thread cell counts of the counting sort (nt x ncell_own), made once per thread count and
-   grid; each thread touches only the cells between the first and last of its share. */
+/* Per-thread cell counts of the counting sort (nt x ncell_own), made with the grid (in the
+   place of the allocations of the serial sort's scratch, so the other arrays keep their cache
+   colours, part_alloc) and again if the threads grow; each thread touches only the cells
+   between the first and last of its share. */
 static void sort_counts(struct nbr *nb, int nt) {
   if (nb->tcount && nb->tcount_threads >= nt && nb->tcount_cells == nb->ncell_own) return;
   part_free(nb->tcount);

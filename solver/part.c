@@ -317,6 +317,14 @@ void part_permute(struct particles *P, size_t i0, size_t n, const size_t *perm) 
       if (!(f->roles & PF_PERMUTE) || f->type != PT_F64 || !part_field_live(P, f)) continue;
       double *restrict arr = part_field_ptr(P, f), *restrict col = P->tmp;
       const size_t w = (size_t)f->width;
+      if (w == 1) { /* contiguous: the loops vectorise */
+        const double *restrict src = arr + i0;
+#pragma omp for schedule(static)
+        for (size_t j = 0; j < n; j++) col[j] = src[perm[j]];
+#pragma omp for schedule(static) nowait
+        for (size_t j = 0; j < n; j++) arr[i0 + j] = col[j];
+        continue;
+      }
       for (size_t k = 0; k < w; k++) {
 #pragma omp for schedule(static)
         for (size_t j = 0; j < n; j++) col[j] = arr[(i0 + perm[j]) * w + k];
