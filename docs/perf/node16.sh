@@ -2,7 +2,15 @@
 # Issue 44: old (a5e68b9) and new chansph builds on one 16-core node, interleaved:
 # chansph bench mcf1.ini --steps 8 at 1, 2, 4, 8, 16 threads and 16x1, 8x2, 4x4, 2x8 ranks x
 # threads; passes over all cases until the deadline (medians of up to 3 per build).
-# usage: run16.sh BUNDLE_DIR OUT_DIR DEADLINE_S [quick]
+# usage: node16.sh BUNDLE_DIR OUT_DIR DEADLINE_S [quick]
+# BUNDLE_DIR holds bin/chansph_old (a5e68b9) and bin/chansph_new (generic Release builds), the
+# shared libraries they need (lib/; glibc in glibc/, used only where the system's is older),
+# Open MPI 4.1.4's orterun, orted, plugins (ompi/lib/openmpi3), help files and parameters
+# (ompi/share, ompi/etc), PMIx's plugins (pmix/) and mcf1.ini: the node had no MPI of its own.
+# Environment: CASES ("RANKS:THREADS ..."), REPS (passes), SANITY (builds of the 2-rank check).
+# Run 1 (docs/perf/node16_run1.log): node16.sh /tmp/b $OUT 450; run 2 (node16_run2.log, with the
+# width-1 permute loops and the sort's counts allocated with the grid):
+# SANITY= CASES="1:1 1:16 16:1 1:2" REPS=3 node16.sh /tmp/b $OUT 195.
 B=$1 OUT=$2 DEADLINE=${3:-470} MODE=${4:-full}
 T0=$(date +%s)
 elapsed() { echo $(( $(date +%s) - T0 )); }
