@@ -32,7 +32,12 @@ import math
 T_C_BENCH = 194.3e-3 / 99840  # s per particle-step per core, bench scene (1 x 1)
 T_C_LES = 107e-3 * 2 / 41250  # s per particle-step per core, les395_small LES (1 x 2 threads)
 GHOSTS_BENCH = 2 * 2 * (1.6 / 49) * 1.0 * 1.0 / 0.025 ** 3  # 2 sides x 2 cols x ly x lz x n
-T_G = 4.07e-3 / GHOSTS_BENCH  # s per ghost per step (mean over the 2 ranks)
+# s per ghost per step: the halo's own work (migration, ghosts, refreshes; not the MPI waits) of
+# a rank of mcf1 on 16 ranks x 1 thread of a 16-core node, 12.8 ms for 2 x 2 columns of ghosts
+# (issue 44, docs/perf/node16.csv; it was 4.07 ms for the bench scene's ghosts on 2 ranks
+# before the halo was threaded and lost its ghost sort, 0.49 us per ghost)
+GHOSTS_MCF1 = 2 * 2 * (3.140625 / 154) * 2.0 * 1.0 / 0.015625 ** 3
+T_G = 12.8e-3 / GHOSTS_MCF1
 B_GHOST = 1479.8e3 / GHOSTS_BENCH  # bytes per ghost per step (9 doubles built, 12 refreshed)
 MSG_SLAB = 8  # point-to-point messages per step and rank (bench, 2 ranks)
 # assumed cluster network

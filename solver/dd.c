@@ -3,6 +3,7 @@
 
 #include <math.h>
 #include <mpi.h>
+#include <omp.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -38,40 +39,64 @@ static void reserve_buf(double **buf, size_t *cap, size_t n) {
   *buf = mem_realloc(*buf, *cap, sizeof(double), "domain decomposition");
 }
 
-static void pack(const struct particles *P, size_t a, double *r, int role) {
+/* The fields of one role as they travel, resolved once per exchange: each live field's array
+   (NULL: travels as zeros, not unpacked), width and type, in table order. */
+struct wire {
+  int n;
+  void *arr[F_LEN];
+  int width[F_LEN], type[F_LEN];
+};
+
+static void wire_fields(const struct particles *P, int role, struct wire *w) {
+  w->n = 0;
   for (int i = 0; i < part_n_fields; i++) {
     const struct part_field *f = &part_fields[i];
     if (!(f->roles & role)) continue;
-    const void *arr = part_field_live(P, f) ? part_field_ptr(P, f) : NULL;
-    if (f->type == PT_I64)
-      memcpy(r, (const int64_t *)arr + a, sizeof(double));
-    else if (f->type == PT_U8)
-      r[0] = ((const uint8_t *)arr)[a];
-    else
-      for (int k = 0; k < f->width; k++) r[k] = arr ? ((const double *)arr)[a * f->width + k] : 0.0;
-    r += f->width;
+    w->arr[w->n] = part_field_live(P, f) ? part_field_ptr(P, f) : NULL;
+    w->width[w->n] = f->width, w->type[w->n] = f->type, w->n++;
   }
 }
 
-static void unpack(struct particles *P, size_t a, const double *r, int role) {
-  for (int i = 0; i < part_n_fields; i++) {
-    const struct part_field *f = &part_fields[i];
-    if (!(f->roles & role)) continue;
-    void *arr = part_field_live(P, f) ? part_field_ptr(P, f) : NULL;
-    if (f->type == PT_I64)
+/* pack() and unpack() of slot a with the fields resolved (the same record). */
+static inline void wire_pack(const struct wire *w, size_t a, double *r) {
+  for (int i = 0; i < w->n; i++) {
+    const void *arr = w->arr[i];
+    if (w->type[i] == PT_I64)
+      memcpy(r, (const int64_t *)arr + a, sizeof(double));
+    else if (w->type[i] == PT_U8)
+      r[0] = ((const uint8_t *)arr)[a];
+    else
+      for (int k = 0; k < w->width[i]; k++)
+        r[k] = arr ? ((const double *)arr)[a * w->width[i] + k] : 0.0;
+    r += w->width[i];
+  }
+}
+
+static inline void wire_unpack(const struct wire *w, size_t a, const double *r) {
+  for (int i = 0; i < w->n; i++) {
+    void *arr = w->arr[i];
+    if (w->type[i] == PT_I64)
       memcpy((int64_t *)arr + a, r, sizeof(double));
-    else if (f->type == PT_U8)
+    else if (w->type[i] == PT_U8)
       ((uint8_t *)arr)[a] = (uint8_t)r[0];
     else if (arr)
-      for (int k = 0; k < f->width; k++) ((double *)arr)[a * f->width + k] = r[k];
-    r += f->width;
+      for (int k = 0; k < w->width[i]; k++) ((double *)arr)[a * w->width[i] + k] = r[k];
+    r += w->width[i];
   }
+}
+
+static void pack(const struct particles *P, size_t a, double *r, int role) {
+  struct wire w;
+  wire_fields(P, role, &w);
+  wire_pack(&w, a, r);
 }
 
 static void copy_slot(struct particles *P, size_t to, size_t from) {
   double r[F_LEN];
-  pack(P, from, r, PF_MIGRATE);
-  unpack(P, to, r, PF_MIGRATE);
+  struct wire w;
+  wire_fields(P, PF_MIGRATE, &w);
+  wire_pack(&w, from, r);
+  wire_unpack(&w, to, r);
 }
 
 static void partition_even(struct dd *d) {
@@ -114,7 +139,8 @@ int dd_init(struct dd *d, const struct scene *sc, dd_reserve_fn reserve, void *c
 }
 
 void dd_free(struct dd *d) {
-  free(d->first), free(d->send[0]), free(d->send[1]), free(d->ghost);
+  free(d->first), free(d->send[0]), free(d->send[1]), free(d->ghost), free(d->row);
+  for (int s = 0; s < 4; s++) free(d->cnt[s]);
   free(d->sbuf), free(d->rbuf);
   memset(d, 0, sizeof *d);
 }
@@ -154,99 +180,160 @@ void dd_take_block(struct dd *d, struct particles *P, const struct nbr *nb, size
   d->seconds = d->bytes = 0.0, d->messages = d->migrated = 0; /* the run's counters start here */
 }
 
+/* The slots of the particles this rank keeps (dest[a] < 0) or sends (dest[a] >= 0), each list
+   in slot order: threads count their share, then fill their part of the lists. */
+static void split_slots(const int *dest, size_t n, size_t *leave, size_t *nleave) {
+  const int nt = omp_get_max_threads();
+  size_t *cnt = mem_calloc((size_t)nt + 1, sizeof(size_t), "domain decomposition");
+#pragma omp parallel num_threads(nt)
+  {
+    const int t = omp_get_thread_num(), th = omp_get_num_threads();
+    const size_t a0 = n * (size_t)t / (size_t)th, a1 = n * (size_t)(t + 1) / (size_t)th;
+    size_t k = 0;
+    for (size_t a = a0; a < a1; a++) k += dest[a] >= 0;
+    cnt[t + 1] = k;
+#pragma omp barrier
+#pragma omp single
+    for (int s = 0; s < th; s++) cnt[s + 1] += cnt[s];
+    k = cnt[t];
+    for (size_t a = a0; a < a1; a++)
+      if (dest[a] >= 0) leave[k++] = a;
+  }
+  *nleave = cnt[nt];
+  free(cnt);
+}
+
 void dd_migrate(struct dd *d, struct particles *P, const struct nbr *nb) {
   P->n_ghost = 0;
   if (d->size == 1) return;
-  timer_push("halo");
+  timer_push("halo:migrate");
   const double t0 = MPI_Wtime();
-  const int np = d->size;
+  const int np = d->size, rl = record_len(PF_MIGRATE);
   int *scount = mem_calloc((size_t)np, sizeof(int), "domain decomposition"),
       *rcount = mem_calloc((size_t)np, sizeof(int), "domain decomposition");
   int *sdisp = mem_calloc((size_t)np + 1, sizeof(int), "domain decomposition"),
       *rdisp = mem_calloc((size_t)np + 1, sizeof(int), "domain decomposition");
-  int *dest = mem_alloc(1, (P->n ? P->n : 1) * sizeof(int), "domain decomposition");
-  size_t leaving = 0;
-  for (size_t a = 0; a < P->n; a++) {
+  const size_t n0 = P->n;
+  int *dest = mem_alloc(1, (n0 ? n0 : 1) * sizeof(int), "domain decomposition");
+  size_t *leave = mem_alloc(1, (n0 ? n0 : 1) * sizeof(size_t), "domain decomposition");
+#pragma omp parallel for schedule(static)
+  for (size_t a = 0; a < n0; a++) {
     nbr_wrap_position(nb, &P->x[a], &P->z[a]);
     const int col = nbr_column(nb, P->x[a]);
     dest[a] = owned(d, col) ? -1 : dd_owner(d, col);
-    if (dest[a] >= 0) scount[dest[a]] += record_len(PF_MIGRATE), leaving++;
   }
+  size_t leaving;
+  split_slots(dest, n0, leave, &leaving);
+  for (size_t i = 0; i < leaving; i++) scount[dest[leave[i]]] += rl;
   for (int r = 0; r < np; r++) sdisp[r + 1] = sdisp[r] + scount[r];
   reserve_buf(&d->sbuf, &d->cap_sbuf, (size_t)sdisp[np]);
-  /* pack the leaving particles by destination and compact the staying ones in order */
+  /* pack the leaving particles by destination, each in slot order */
   int *fill = mem_calloc((size_t)np, sizeof(int), "domain decomposition");
-  size_t k = 0;
-  for (size_t a = 0; a < P->n; a++) {
-    if (dest[a] < 0) {
-      if (k != a) copy_slot(P, k, a);
-      k++;
-      continue;
-    }
-    pack(P, a, d->sbuf + sdisp[dest[a]] + fill[dest[a]], PF_MIGRATE);
-    fill[dest[a]] += record_len(PF_MIGRATE);
+  for (size_t i = 0; i < leaving; i++) {
+    const int r = dest[leave[i]];
+    pack(P, leave[i], d->sbuf + sdisp[r] + fill[r], PF_MIGRATE);
+    fill[r] += rl;
   }
-  P->n = k;
+  /* fill the holes they leave with the last staying particles (the order of the slots is
+     free: nbr_sort orders them by cell and id whatever order they come in) */
+  size_t end = n0;
+  for (size_t i = 0; i < leaving; i++) {
+    const size_t hole = leave[i];
+    while (end > hole && dest[end - 1] >= 0) end--; /* leaving too: dropped, not moved */
+    if (end <= hole) break;                         /* no staying particle after this hole */
+    copy_slot(P, hole, --end);
+  }
+  P->n = n0 - leaving;
   CHECK_MPI(MPI_Alltoall(scount, 1, MPI_INT, rcount, 1, MPI_INT, MPI_COMM_WORLD));
   for (int r = 0; r < np; r++) rdisp[r + 1] = rdisp[r] + rcount[r];
   reserve_buf(&d->rbuf, &d->cap_rbuf, (size_t)rdisp[np]);
+  timer_push("halo:wait");
   CHECK_MPI(MPI_Alltoallv(d->sbuf, scount, sdisp, MPI_DOUBLE, d->rbuf, rcount, rdisp, MPI_DOUBLE,
                           MPI_COMM_WORLD));
-  const size_t arriving = (size_t)rdisp[np] / (size_t)record_len(PF_MIGRATE);
+  timer_pop();
+  const size_t arriving = (size_t)rdisp[np] / (size_t)rl;
   d->reserve(d->ctx, P->n + arriving);
-  for (size_t i = 0; i < arriving; i++)
-    unpack(P, P->n + i, d->rbuf + i * (size_t)record_len(PF_MIGRATE), PF_MIGRATE);
+  struct wire w;
+  wire_fields(P, PF_MIGRATE, &w);
+#pragma omp parallel for schedule(static)
+  for (size_t i = 0; i < arriving; i++) wire_unpack(&w, P->n + i, d->rbuf + i * (size_t)rl);
   P->n += arriving;
   for (int r = 0; r < np; r++)
     if (scount[r]) d->messages++;
   d->bytes += (double)sdisp[np] * sizeof(double);
   d->migrated += (long)leaving;
-  free(scount), free(rcount), free(sdisp), free(rdisp), free(dest), free(fill);
+  free(scount), free(rcount), free(sdisp), free(rdisp), free(dest), free(fill), free(leave);
   d->seconds += MPI_Wtime() - t0;
   timer_pop();
 }
 
-/* Owned slots of the local columns [c0, c1) in cell order. */
-static size_t edge_slots(const struct nbr *nb, int c0, int c1, size_t **out, size_t *cap) {
-  size_t n = 0;
-  for (int pass = 0; pass < 2; pass++) {
-    if (pass == 1) {
-      if (n > *cap)
-        *cap = n + n / 2, *out = mem_realloc(*out, *cap, sizeof(size_t), "domain decomposition");
-      n = 0;
-    }
-    for (int iz = 0; iz < nb->nz; iz++)
-      for (int iy = 0; iy < nb->ny; iy++)
-        for (int lc = c0; lc < c1; lc++) {
-          const size_t c = nbr_owned_cell(nb, lc, iy, iz);
-          for (size_t a = nb->start[c]; a < nb->start[c + 1]; a++, n++)
-            if (pass == 1) (*out)[n] = a;
-        }
+/* The send list of one side: the owned slots of the local columns [c0, c0 + halo) in cell order
+   (rows iz * ny + iy, then columns; a cell's particles in id order), and the particles of each
+   of those cells (cnt[row * halo + h]), which tell the neighbour where each ghost goes. */
+static void edge_slots(struct dd *d, const struct nbr *nb, int side, int c0) {
+  const int R = d->halo;
+  const size_t rows = (size_t)nb->ny * nb->nz;
+  if (rows * (size_t)R > d->cap_cnt) {
+    d->cap_cnt = rows * (size_t)R;
+    for (int s = 0; s < 4; s++)
+      d->cnt[s] = mem_realloc(d->cnt[s], d->cap_cnt, sizeof(uint32_t), "domain decomposition");
+    d->row = mem_realloc(d->row, 2 * (rows + 1), sizeof(size_t), "domain decomposition");
   }
-  return n;
+  uint32_t *cnt = d->cnt[side];
+  size_t *row_off = d->row; /* first entry of each row in the list */
+  row_off[0] = 0;
+  for (size_t row = 0; row < rows; row++) {
+    size_t k = 0;
+    for (int h = 0; h < R; h++) {
+      const size_t c = row * (size_t)nb->nxo + (size_t)(c0 + h);
+      cnt[row * R + h] = (uint32_t)(nb->start[c + 1] - nb->start[c]);
+      k += cnt[row * R + h];
+    }
+    row_off[row + 1] = row_off[row] + k;
+  }
+  const size_t n = row_off[rows];
+  if (n > d->cap_send[side]) {
+    d->cap_send[side] = n + n / 2;
+    d->send[side] =
+        mem_realloc(d->send[side], d->cap_send[side], sizeof(size_t), "domain decomposition");
+  }
+  size_t *out = d->send[side];
+#pragma omp parallel for schedule(static)
+  for (size_t row = 0; row < rows; row++) {
+    size_t k = row_off[row];
+    for (int h = 0; h < R; h++) {
+      const size_t c = row * (size_t)nb->nxo + (size_t)(c0 + h);
+      for (size_t a = nb->start[c]; a < nb->start[c + 1]; a++) out[k++] = a;
+    }
+  }
+  d->nsend[side] = n;
 }
 
 /* Send nf values per entry of the send lists to both neighbours and receive theirs into
-   d->rbuf (left halo first). pack_fn fills a record for owned slot a. */
+   d->rbuf (left halo first). pack_fn fills a record for owned slot a; the threads pack. */
 static void exchange(struct dd *d, int nf, void (*pack_fn)(const void *, size_t, double *),
                      const void *arg) {
   const size_t ns = d->nsend[0] + d->nsend[1], nr = d->nrecv[0] + d->nrecv[1];
   reserve_buf(&d->sbuf, &d->cap_sbuf, ns * (size_t)nf);
   reserve_buf(&d->rbuf, &d->cap_rbuf, nr * (size_t)nf);
-  for (int s = 0, off = 0; s < 2; off += (int)d->nsend[s], s++)
-    for (size_t i = 0; i < d->nsend[s]; i++)
-      pack_fn(arg, d->send[s][i], d->sbuf + ((size_t)off + i) * nf);
   MPI_Request req[4];
   /* my left halo comes from the left neighbour's message to the right, and vice versa */
   CHECK_MPI(MPI_Irecv(d->rbuf, (int)(d->nrecv[0] * nf), MPI_DOUBLE, d->left, TAG_RIGHT,
                       MPI_COMM_WORLD, &req[0]));
   CHECK_MPI(MPI_Irecv(d->rbuf + d->nrecv[0] * nf, (int)(d->nrecv[1] * nf), MPI_DOUBLE, d->right,
                       TAG_LEFT, MPI_COMM_WORLD, &req[1]));
-  CHECK_MPI(MPI_Isend(d->sbuf, (int)(d->nsend[0] * nf), MPI_DOUBLE, d->left, TAG_LEFT,
-                      MPI_COMM_WORLD, &req[2]));
-  CHECK_MPI(MPI_Isend(d->sbuf + d->nsend[0] * nf, (int)(d->nsend[1] * nf), MPI_DOUBLE, d->right,
-                      TAG_RIGHT, MPI_COMM_WORLD, &req[3]));
+  for (int s = 0, off = 0; s < 2; off += (int)d->nsend[s], s++) {
+    const size_t *restrict slots = d->send[s];
+    double *restrict buf = d->sbuf + (size_t)off * nf;
+#pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < d->nsend[s]; i++) pack_fn(arg, slots[i], buf + i * nf);
+    /* the left message goes while the right one is packed */
+    CHECK_MPI(MPI_Isend(buf, (int)(d->nsend[s] * nf), MPI_DOUBLE, s == 0 ? d->left : d->right,
+                        s == 0 ? TAG_LEFT : TAG_RIGHT, MPI_COMM_WORLD, &req[2 + s]));
+  }
+  timer_push("halo:wait");
   CHECK_MPI(MPI_Waitall(4, req, MPI_STATUSES_IGNORE));
+  timer_pop();
   d->messages += 2;
   d->bytes += (double)ns * nf * sizeof(double);
 }
@@ -256,7 +343,25 @@ static void exchange(struct dd *d, int nf, void (*pack_fn)(const void *, size_t,
    refreshes (dd_refresh); nothing reads a ghost's kernel sum or acceleration, and its gamma
    only the budget's conservative split (PR_BUDGET). */
 static void pack_ghost(const void *arg, size_t a, double *r) {
-  pack(arg, a, r, PF_GHOST);
+  wire_pack(arg, a, r);
+}
+
+/* Exchange the particles per edge cell with both neighbours: what the left neighbour sends
+   right (its right edge) is my left halo. */
+static void exchange_counts(struct dd *d, size_t n) {
+  MPI_Request req[4];
+  CHECK_MPI(
+      MPI_Irecv(d->cnt[2], (int)n, MPI_UINT32_T, d->left, TAG_RIGHT, MPI_COMM_WORLD, &req[0]));
+  CHECK_MPI(
+      MPI_Irecv(d->cnt[3], (int)n, MPI_UINT32_T, d->right, TAG_LEFT, MPI_COMM_WORLD, &req[1]));
+  CHECK_MPI(MPI_Isend(d->cnt[0], (int)n, MPI_UINT32_T, d->left, TAG_LEFT, MPI_COMM_WORLD, &req[2]));
+  CHECK_MPI(
+      MPI_Isend(d->cnt[1], (int)n, MPI_UINT32_T, d->right, TAG_RIGHT, MPI_COMM_WORLD, &req[3]));
+  timer_push("halo:wait");
+  CHECK_MPI(MPI_Waitall(4, req, MPI_STATUSES_IGNORE));
+  timer_pop();
+  d->messages += 2;
+  d->bytes += 2.0 * (double)n * sizeof(uint32_t);
 }
 
 void dd_halo(struct dd *d, struct particles *P, struct nbr *nb) {
@@ -265,28 +370,47 @@ void dd_halo(struct dd *d, struct particles *P, struct nbr *nb) {
   timer_push("halo");
   const double t0 = MPI_Wtime();
   const int R = d->halo;
-  d->nsend[0] = edge_slots(nb, 0, R, &d->send[0], &d->cap_send[0]);
-  d->nsend[1] = edge_slots(nb, nb->nxo - R, nb->nxo, &d->send[1], &d->cap_send[1]);
-  /* counts: what my left neighbour sends right is my left halo */
-  unsigned long sc[2] = {d->nsend[0], d->nsend[1]}, rc[2];
-  MPI_Request req[4];
-  CHECK_MPI(MPI_Irecv(&rc[0], 1, MPI_UNSIGNED_LONG, d->left, TAG_RIGHT, MPI_COMM_WORLD, &req[0]));
-  CHECK_MPI(MPI_Irecv(&rc[1], 1, MPI_UNSIGNED_LONG, d->right, TAG_LEFT, MPI_COMM_WORLD, &req[1]));
-  CHECK_MPI(MPI_Isend(&sc[0], 1, MPI_UNSIGNED_LONG, d->left, TAG_LEFT, MPI_COMM_WORLD, &req[2]));
-  CHECK_MPI(MPI_Isend(&sc[1], 1, MPI_UNSIGNED_LONG, d->right, TAG_RIGHT, MPI_COMM_WORLD, &req[3]));
-  CHECK_MPI(MPI_Waitall(4, req, MPI_STATUSES_IGNORE));
-  d->nrecv[0] = rc[0], d->nrecv[1] = rc[1];
-  const int hl = record_len(PF_GHOST);
-  exchange(d, hl, pack_ghost, P);
+  const size_t rows = (size_t)nb->ny * nb->nz, nc = rows * (size_t)R;
+  edge_slots(d, nb, 0, 0);
+  edge_slots(d, nb, 1, nb->nxo - R);
+  exchange_counts(d, nc);
+  /* the ghosts go in halo cell order: the halo cells' ranges from the counts, then each
+     received ghost's slot (the messages hold their cells in the order of nbr_halo_cells) */
+  const uint32_t *const rc[2] = {d->cnt[2], d->cnt[3]};
+  d->nrecv[0] = d->nrecv[1] = 0;
+  for (size_t i = 0; i < nc; i++) d->nrecv[0] += rc[0][i], d->nrecv[1] += rc[1][i];
   const size_t ng = d->nrecv[0] + d->nrecv[1];
   d->reserve(d->ctx, P->n + ng);
-  for (size_t g = 0; g < ng; g++) unpack(P, P->n + g, d->rbuf + g * (size_t)hl, PF_GHOST);
+  nbr_halo_cells(nb, P->n, rc);
+  if (ng > d->cap_ghost) {
+    d->cap_ghost = ng + ng / 2;
+    d->ghost = mem_realloc(d->ghost, d->cap_ghost, sizeof(size_t), "domain decomposition");
+  }
+  for (int s = 0; s < 2; s++) {
+    size_t *row_off = d->row + (size_t)s * (rows + 1); /* first ghost of each row */
+    row_off[0] = s == 0 ? 0 : d->nrecv[0];
+    for (size_t row = 0; row < rows; row++) {
+      size_t k = 0;
+      for (int h = 0; h < R; h++) k += rc[s][row * R + h];
+      row_off[row + 1] = row_off[row] + k;
+    }
+  }
+#pragma omp parallel for schedule(static)
+  for (size_t row = 0; row < rows; row++)
+    for (int s = 0; s < 2; s++) {
+      size_t g = d->row[(size_t)s * (rows + 1) + row];
+      for (int h = 0; h < R; h++) {
+        const size_t c = nb->ncell_own + row * 2 * R + (size_t)(s * R + h);
+        for (size_t a = nb->start[c]; a < nb->start[c + 1]; a++) d->ghost[g++] = a;
+      }
+    }
+  const int hl = record_len(PF_GHOST);
+  struct wire w;
+  wire_fields(P, PF_GHOST, &w);
+  exchange(d, hl, pack_ghost, &w);
+#pragma omp parallel for schedule(static)
+  for (size_t g = 0; g < ng; g++) wire_unpack(&w, d->ghost[g], d->rbuf + g * (size_t)hl);
   P->n_ghost = ng;
-  nbr_sort_ghosts(nb, P, d->nrecv[0]);
-  if (ng > d->cap_ghost) d->cap_ghost = ng + ng / 2;
-  d->ghost = mem_realloc(d->ghost, (d->cap_ghost ? d->cap_ghost : 1), sizeof(size_t),
-                         "domain decomposition");
-  for (size_t i = 0; i < ng; i++) d->ghost[nb->perm[i]] = P->n + i;
   d->seconds += MPI_Wtime() - t0;
   timer_pop();
 }
@@ -324,10 +448,11 @@ void dd_refresh(struct dd *d, const struct particles *P, const struct walls *W, 
   stage_fields(P, W, stage, &F);
   const int nf = F.np + F.nw;
   if (nf == 0) return;
-  timer_push("halo");
+  timer_push("halo:refresh");
   const double t0 = MPI_Wtime();
   exchange(d, nf, pack_fields, &F);
   const size_t ng = d->nrecv[0] + d->nrecv[1];
+#pragma omp parallel for schedule(static)
   for (size_t g = 0; g < ng; g++) {
     const size_t a = d->ghost[g];
     const double *r = d->rbuf + g * (size_t)nf;

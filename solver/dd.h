@@ -4,14 +4,20 @@
  *
  * Rank r owns the cell columns first[r] .. first[r+1]-1 of the global grid (nbr.h) and the
  * particles in them. Each step:
- *  1. dd_migrate() sends the particles that left a rank's columns to their new owner;
+ *  1. dd_migrate() sends the particles that left a rank's columns to their new owner (the holes
+ *     they leave are filled from the end of the slots, the arrivals appended: nbr_sort orders
+ *     them whatever order they come in);
  *  2. nbr_sort() orders the owned particles by cell and id;
  *  3. dd_halo() copies the particles of the NBR_REACH columns at each edge of every slab to the
  *     neighbouring rank (ghosts, with their unshifted coordinates: the periodic shift is applied
- *     by the stencil, as on one rank), and nbr_sort_ghosts() orders them;
+ *     by the stencil, as on one rank), cell by cell in the sender's order, with the particles
+ *     of each edge cell: each ghost goes straight to its slot in the halo cells
+ *     (nbr_halo_cells), with no sort;
  *  4. after each pass that computes a per-particle value the next pass reads at neighbours,
  *     dd_refresh() refreshes the ghosts' copies of the fields the field table (part.h) marks
  *     for that stage, in one exchange.
+ * Packing and unpacking are threaded; the time in MPI waits is the timer phase "halo:wait",
+ * the rest "halo" (building the ghosts), "halo:refresh" and "halo:migrate" (docs/parallel.md).
  * Sums over all particles (dd_sum) are formed per global column in the cell order, then
  * added over the columns in a fixed order, so every result is bitwise the same on any number
  * of ranks and threads (docs/parallel.md).
@@ -20,6 +26,7 @@
 #define CHANSPH_DD_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include "nbr.h"
 #include "part.h"
@@ -41,6 +48,10 @@ struct dd {
      the ghost slot of each received particle (left halo first) */
   size_t nsend[2], cap_send[2], *send[2];
   size_t nrecv[2], cap_ghost, *ghost;
+  /* particles per edge cell (row * halo + h): sent left (0), right (1), received from the left
+     (2), from the right (3); and per-row offsets into the lists (scratch) */
+  uint32_t *cnt[4];
+  size_t cap_cnt, *row;
   double *sbuf, *rbuf;
   size_t cap_sbuf, cap_rbuf;
   /* cost of the exchanges, for the log */
@@ -84,8 +95,9 @@ void dd_take_block(struct dd *d, struct particles *P, const struct nbr *nb, size
 void dd_migrate(struct dd *d, struct particles *P, const struct nbr *nb);
 
 /**
- * @brief Build the ghosts: after nbr_sort(), send the particles of the edge columns to the
- *        neighbours, append what arrives and order it with nbr_sort_ghosts(). Collective.
+ * @brief Build the ghosts: after nbr_sort(), send the particles of the edge columns and their
+ *        count per edge cell to the neighbours, and put what arrives in halo cell order after
+ *        the owned particles (nbr_halo_cells). Collective.
  */
 void dd_halo(struct dd *d, struct particles *P, struct nbr *nb);
 

@@ -75,9 +75,11 @@ void nbr_set_range(struct nbr *nb, int ix0, int nxo, int halo) {
   const size_t rows = (size_t)nb->ny * nb->nz;
   nb->ncell_own = (size_t)nxo * rows;
   nb->ncell = nb->ncell_own + 2 * (size_t)halo * rows;
-  part_free(nb->start), part_free(nb->pos);
+  part_free(nb->start), part_free(nb->tcount);
   nb->start = part_alloc("cell_start", (nb->ncell + 1) * sizeof(size_t));
-  nb->pos = part_alloc("cell_fill", nb->ncell * sizeof(size_t));
+  nb->tcount_threads = omp_get_max_threads(), nb->tcount_cells = nb->ncell_own;
+  nb->tcount =
+      part_alloc("sort_counts", (size_t)nb->tcount_threads * nb->ncell_own * sizeof(uint32_t));
 }
 
 void nbr_reserve(struct nbr *nb, size_t n) {
@@ -94,7 +96,7 @@ void nbr_reserve(struct nbr *nb, size_t n) {
 }
 
 void nbr_free(struct nbr *nb) {
-  part_free(nb->start), part_free(nb->pos), part_free(nb->perm), part_free(nb->cell);
+  part_free(nb->start), part_free(nb->tcount), part_free(nb->perm), part_free(nb->cell);
   part_free(nb->count), part_free(nb->list), part_free(nb->nfluid);
   for (int t = 0; t < nb->scratch_threads; t++)
     part_free(nb->scratch[t]), part_free(nb->pairbuf[t]), part_free(nb->blocks[t]);
@@ -106,33 +108,98 @@ static inline int clampi(int i, int n) {
   return i < 0 ? 0 : i >= n ? n - 1 : i;
 }
 
-/* Counting sort of slots [i0, i0 + n) by nb->cell[i0 + i] over cells [c0, c1) (start[] of
-   those cells counted from i0), then by id within each cell; the permutation is left in
-   nb->perm[0 .. n-1] and applied. */
-static void sort_range(struct nbr *nb, struct particles *P, size_t i0, size_t n, size_t c0,
-                       size_t c1) {
-  const int *restrict cell = nb->cell + i0;
-  size_t *restrict start = nb->start;
-  for (size_t c = c0; c <= c1; c++) start[c] = 0;
-  for (size_t a = 0; a < n; a++) start[cell[a] + 1]++;
-  start[c0] = i0;
-  for (size_t c = c0; c < c1; c++) start[c + 1] += start[c];
-  /* stable scatter, then order each cell by id (insertion sort: cells are small and their
-     content changes little from one step to the next) */
-  size_t *restrict perm = nb->perm;
-  size_t *restrict pos = nb->pos;
-  for (size_t c = c0; c < c1; c++) pos[c] = start[c] - i0;
-  for (size_t a = 0; a < n; a++) perm[pos[cell[a]]++] = a;
-  const int64_t *id = P->id + i0;
-#pragma omp parallel for schedule(static)
-  for (size_t c = c0; c < c1; c++)
-    for (size_t i = start[c] - i0 + 1; i < start[c + 1] - i0; i++) {
-      const size_t key = perm[i];
-      size_t j = i;
-      while (j > start[c] - i0 && id[perm[j - 1]] > id[key]) perm[j] = perm[j - 1], j--;
-      perm[j] = key;
+/* Threads' shares of the owned particles for the counting sort: slots [n t / nt, n (t+1) / nt). */
+static size_t sort_chunk(size_t n, int t, int nt) {
+  return n * (size_t)t / (size_t)nt;
+}
+
+/* Per-thread cell counts of the counting sort (nt x ncell_own), made with the grid (in the
+   place of the allocations of the serial sort's scratch, so the other arrays keep their cache
+   colours, part_alloc) and again if the threads grow; each thread touches only the cells
+   between the first and last of its share. */
+static void sort_counts(struct nbr *nb, int nt) {
+  if (nb->tcount && nb->tcount_threads >= nt && nb->tcount_cells == nb->ncell_own) return;
+  part_free(nb->tcount);
+  nb->tcount = part_alloc("sort_counts", (size_t)nt * nb->ncell_own * sizeof(uint32_t));
+  nb->tcount_threads = nt, nb->tcount_cells = nb->ncell_own;
+}
+
+/* Counting sort of the owned slots [0, n) by nb->cell[], then by id within each cell; sets
+   start[] of the owned cells and leaves the permutation in nb->perm[0 .. n-1] (slot i of the
+   new order takes old slot perm[i]). Threaded and bitwise the order of a serial stable
+   counting sort: thread t counts its share of the slots (in the cells between the first and
+   the last of its share: the slots come mostly in cell order, from the previous step), the
+   threads' counts of a cell are laid out in thread order after the cells before it, and each
+   thread scatters its share in slot order. Every cell is then put in id order (insertion sort:
+   cells are small and their content changes little from one step to the next); ids are unique,
+   so the result does not depend on the order the slots came in either. */
+static void sort_cells(struct nbr *nb, const struct particles *P, size_t n) {
+  const int nt = omp_get_max_threads();
+  const size_t nc = nb->ncell_own;
+  sort_counts(nb, nt);
+  int *lo = mem_alloc((size_t)nt * 2, sizeof(int), "cell sort"), *hi = lo + nt; /* cell ranges */
+  size_t *part = mem_alloc((size_t)nt + 1, sizeof(size_t), "cell sort"); /* slots per share */
+  const int *restrict cell = nb->cell;
+  size_t *restrict start = nb->start, *restrict perm = nb->perm;
+  const int64_t *restrict id = P->id;
+#pragma omp parallel num_threads(nt)
+  {
+    const int t = omp_get_thread_num(), th = omp_get_num_threads();
+    /* 1. count my share of the slots */
+    const size_t a0 = sort_chunk(n, t, th), a1 = sort_chunk(n, t + 1, th);
+    int l = INT32_MAX, h = -1;
+    for (size_t a = a0; a < a1; a++) l = cell[a] < l ? cell[a] : l, h = cell[a] > h ? cell[a] : h;
+    uint32_t *restrict cnt = nb->tcount + (size_t)t * nc;
+    if (h >= l) memset(cnt + l, 0, (size_t)(h - l + 1) * sizeof *cnt);
+    for (size_t a = a0; a < a1; a++) cnt[cell[a]]++;
+    lo[t] = l, hi[t] = h;
+#pragma omp barrier
+    /* 2. slots per cell over the threads, summed over my share of the cells */
+    const size_t c0 = sort_chunk(nc, t, th), c1 = sort_chunk(nc, t + 1, th);
+    size_t sum = 0;
+    for (size_t c = c0; c < c1; c++) {
+      size_t k = 0;
+      for (int s = 0; s < th; s++)
+        if ((int)c >= lo[s] && (int)c <= hi[s]) k += nb->tcount[(size_t)s * nc + c];
+      start[c] = k, sum += k;
     }
-  part_permute(P, i0, n, perm);
+    part[t + 1] = sum;
+#pragma omp barrier
+#pragma omp single
+    {
+      part[0] = 0;
+      for (int s = 0; s < th; s++) part[s + 1] += part[s];
+      start[nc] = n;
+    }
+    /* 3. the cells' starts, and each thread's first slot in each cell */
+    size_t off = part[t];
+    for (size_t c = c0; c < c1; c++) {
+      start[c] = off;
+      for (int s = 0; s < th; s++)
+        if ((int)c >= lo[s] && (int)c <= hi[s]) {
+          uint32_t *q = &nb->tcount[(size_t)s * nc + c];
+          const uint32_t m = *q;
+          *q = (uint32_t)(off - start[c]), off += m;
+        }
+    }
+#pragma omp barrier
+    /* 4. scatter my share in slot order */
+    for (size_t a = a0; a < a1; a++) {
+      const int c = cell[a];
+      perm[start[c] + cnt[c]++] = a;
+    }
+#pragma omp barrier
+    /* 5. id order in each cell */
+#pragma omp for schedule(static)
+    for (size_t c = 0; c < nc; c++)
+      for (size_t i = start[c] + 1; i < start[c + 1]; i++) {
+        const size_t key = perm[i];
+        size_t j = i;
+        while (j > start[c] && id[perm[j - 1]] > id[key]) perm[j] = perm[j - 1], j--;
+        perm[j] = key;
+      }
+  }
+  free(lo), free(part);
 }
 
 void nbr_sort(struct nbr *nb, struct particles *P) {
@@ -153,29 +220,23 @@ void nbr_sort(struct nbr *nb, struct particles *P) {
     cell[a] = (int)nbr_owned_cell(nb, lc < 0 ? 0 : lc >= nb->nxo ? nb->nxo - 1 : lc, iy, iz);
   }
   if (stray) die("nbr_sort: a particle outside this rank's columns (migration missed it)");
-  sort_range(nb, P, 0, n, 0, nb->ncell_own);
+  sort_cells(nb, P, n);
+  timer_push("sort:permute");
+  part_permute(P, 0, n, nb->perm);
+  timer_pop();
   timer_pop();
 }
 
-void nbr_sort_ghosts(struct nbr *nb, struct particles *P, size_t n_left) {
-  timer_push("sort");
-  const size_t n0 = P->n, ng = P->n_ghost;
+void nbr_halo_cells(struct nbr *nb, size_t n_owned, const uint32_t *const cnt[2]) {
   const int R = nb->halo;
-  int *restrict cell = nb->cell + n0;
-#pragma omp parallel for schedule(static)
-  for (size_t g = 0; g < ng; g++) {
-    const size_t a = n0 + g;
-    const int ix = nbr_column(nb, P->x[a]); /* ghosts arrive wrapped */
-    const int h = g < n_left ? (ix - nb->ix0 + R + nb->nx) % nb->nx
-                             : R + (ix - (nb->ix0 + nb->nxo) + nb->nx) % nb->nx;
-    const int iy = clampi((int)fmin(fmax(P->y[a] * nb->cy, 0.0), nb->ny), nb->ny);
-    const int iz =
-        nb->dim == 3 ? clampi((int)fmin(fmax(P->z[a] * nb->cz, 0.0), nb->nz), nb->nz) : 0;
-    cell[g] = (int)(nb->ncell_own + ((size_t)iz * nb->ny + iy) * 2 * R + clampi(h, 2 * R));
-  }
-  /* sort_range indexes cell[] from slot i0 */
-  sort_range(nb, P, n0, ng, nb->ncell_own, nb->ncell);
-  timer_pop();
+  const size_t rows = (size_t)nb->ny * nb->nz;
+  size_t k = n_owned;
+  for (size_t row = 0; row < rows; row++)
+    for (int h = 0; h < 2 * R; h++) {
+      nb->start[nb->ncell_own + row * 2 * R + (size_t)h] = k;
+      k += h < R ? cnt[0][row * R + (size_t)h] : cnt[1][row * R + (size_t)(h - R)];
+    }
+  nb->start[nb->ncell] = k;
 }
 
 /* Append the particles of [b0, b1), shifted by (sx, 0, sz), that lie within the support of a

@@ -47,19 +47,22 @@ struct nbr_block {
  */
 struct nbr {
   int dim;
-  int nx, ny, nz;    /*!< cells per direction (global) */
-  int ix0, nxo;      /*!< owned columns: ix0 .. ix0 + nxo - 1 */
-  int halo;          /*!< halo columns on each side (0: one rank, periodic wrap in the grid) */
-  size_t ncell_own;  /*!< owned cells */
-  double lx, ly, lz; /*!< domain lengths [m] (ly = 2 delta) */
-  double cx, cy, cz; /*!< inverse cell sizes [1/m] */
-  double support2;   /*!< (2h)^2 [m^2] */
-  size_t ncell;      /*!< owned + halo cells */
-  size_t *start;     /*!< particles of cell c are start[c] .. start[c+1]-1 */
-  size_t *pos;       /*!< fill position of each cell (sort scratch) */
-  size_t *perm;      /*!< sort scratch */
-  int *cell;         /*!< cell of each particle (sort scratch) */
-  size_t cap;        /*!< particles the arrays hold */
+  int nx, ny, nz;      /*!< cells per direction (global) */
+  int ix0, nxo;        /*!< owned columns: ix0 .. ix0 + nxo - 1 */
+  int halo;            /*!< halo columns on each side (0: one rank, periodic wrap in the grid) */
+  size_t ncell_own;    /*!< owned cells */
+  double lx, ly, lz;   /*!< domain lengths [m] (ly = 2 delta) */
+  double cx, cy, cz;   /*!< inverse cell sizes [1/m] */
+  double support2;     /*!< (2h)^2 [m^2] */
+  size_t ncell;        /*!< owned + halo cells */
+  size_t *start;       /*!< particles of cell c are start[c] .. start[c+1]-1 */
+  uint32_t *tcount;    /*!< per thread: particles of each owned cell, then the thread's first
+                            slot in it (sort scratch, tcount_threads x tcount_cells) */
+  int tcount_threads;  /*!< threads tcount was made for */
+  size_t tcount_cells; /*!< owned cells it was made for */
+  size_t *perm;        /*!< sort scratch */
+  int *cell;           /*!< cell of each particle (sort scratch) */
+  size_t cap;          /*!< particles the arrays hold */
   /* neighbour list */
   int stride;       /*!< list slots per particle, a multiple of NBR_ALIGN */
   int *count;       /*!< neighbours of each particle (excluding itself) */
@@ -133,11 +136,13 @@ void nbr_free(struct nbr *nb);
 void nbr_sort(struct nbr *nb, struct particles *P);
 
 /**
- * @brief Order the ghosts (slots P->n .. P->n + P->n_ghost - 1) by halo cell and id. The first
- *        n_left ghosts belong to the left halo, the others to the right one. On return
- *        nb->perm[i] is the ghost (0-based, in the order before) that went to ghost slot i.
+ * @brief Set the ranges of the halo cells (start[]) for ghosts that take the slots from n_owned
+ *        on in halo cell order: cnt[0] holds the particles of the left halo's cells, row by row
+ *        (row = iz * ny + iy) and halo column by column (row * halo + h), cnt[1] the right
+ *        halo's. The neighbours send their edge cells in this order with their particles in id
+ *        order (dd_halo), so the ghosts need no sort.
  */
-void nbr_sort_ghosts(struct nbr *nb, struct particles *P, size_t n_left);
+void nbr_halo_cells(struct nbr *nb, size_t n_owned, const uint32_t *const cnt[2]);
 
 /** @brief Owned cells of local column lc (0 .. nxo-1): cell (iz * ny + iy) * nxo + lc. */
 static inline size_t nbr_owned_cell(const struct nbr *nb, int lc, int iy, int iz) {

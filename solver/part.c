@@ -304,33 +304,38 @@ void part_resize(struct particles *P, size_t cap) {
   P->cap = cap;
 }
 
-static void permute_d(double *arr, double *tmp, size_t i0, size_t n, const size_t *perm) {
-  const double *restrict src = arr + i0;
-  double *restrict dst = tmp;
-#pragma omp parallel for schedule(static)
-  for (size_t i = 0; i < n; i++) dst[i] = src[perm[i]];
-  memcpy(arr + i0, tmp, n * sizeof(double));
-}
-
 void part_permute(struct particles *P, size_t i0, size_t n, const size_t *perm) {
-  /* the doubles first (P->tmp is their scratch), then ids and kinds */
-  for (int i = 0; i < part_n_fields; i++) {
-    const struct part_field *f = &part_fields[i];
-    if (!(f->roles & PF_PERMUTE) || f->type != PT_F64 || !part_field_live(P, f)) continue;
-    double *arr = part_field_ptr(P, f);
-    if (f->width == 1) {
-      permute_d(arr, P->tmp, i0, n, perm);
-      continue;
-    }
-    for (int k = 0; k < f->width; k++) { /* one column at a time */
-      double *restrict col = P->tmp;
-      for (size_t j = 0; j < n; j++) col[j] = arr[(i0 + perm[j]) * f->width + k];
-      for (size_t j = 0; j < n; j++) arr[(i0 + j) * f->width + k] = col[j];
-    }
-  }
+  /* the doubles first (P->tmp is their scratch, a column at a time), then ids and kinds; every
+     thread gathers and writes back the same share of the slots (static schedule), so only the
+     gather of a column waits for all threads before its write-back */
   int64_t *restrict id = P->tmp_i;
   uint8_t *restrict kind = (uint8_t *)P->tmp; /* P->tmp is free after the doubles */
-  for (size_t i = 0; i < n; i++) id[i] = P->id[i0 + perm[i]], kind[i] = P->kind[i0 + perm[i]];
-  memcpy(P->id + i0, id, n * sizeof(int64_t));
-  memcpy(P->kind + i0, kind, n);
+#pragma omp parallel
+  {
+    for (int i = 0; i < part_n_fields; i++) {
+      const struct part_field *f = &part_fields[i];
+      if (!(f->roles & PF_PERMUTE) || f->type != PT_F64 || !part_field_live(P, f)) continue;
+      double *restrict arr = part_field_ptr(P, f), *restrict col = P->tmp;
+      const size_t w = (size_t)f->width;
+      if (w == 1) { /* contiguous: the loops vectorise */
+        const double *restrict src = arr + i0;
+#pragma omp for schedule(static)
+        for (size_t j = 0; j < n; j++) col[j] = src[perm[j]];
+#pragma omp for schedule(static) nowait
+        for (size_t j = 0; j < n; j++) arr[i0 + j] = col[j];
+        continue;
+      }
+      for (size_t k = 0; k < w; k++) {
+#pragma omp for schedule(static)
+        for (size_t j = 0; j < n; j++) col[j] = arr[(i0 + perm[j]) * w + k];
+#pragma omp for schedule(static) nowait
+        for (size_t j = 0; j < n; j++) arr[(i0 + j) * w + k] = col[j];
+      }
+    }
+#pragma omp barrier /* the kinds' bytes overlap other threads' shares of the last column */
+#pragma omp for schedule(static)
+    for (size_t j = 0; j < n; j++) id[j] = P->id[i0 + perm[j]], kind[j] = P->kind[i0 + perm[j]];
+#pragma omp for schedule(static) nowait
+    for (size_t j = 0; j < n; j++) P->id[i0 + j] = id[j], P->kind[i0 + j] = kind[j];
+  }
 }

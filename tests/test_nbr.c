@@ -12,7 +12,9 @@
  *    tiny negative x can give, is counted and printed), and every permuted array (x, y, z,
  *    u, v, w, rho, m, gam, ksum, ddiff, kind) moved with its particle's id;
  *  - a second nbr_sort is the identity; the list is the same (in order) with 1 thread, and
- *    after forcing the list to grow from a tiny stride.
+ *    after forcing the list to grow from a tiny stride;
+ *  - the threaded sort gives the order of 1 thread with 2, 3 and 7 threads, from shuffled slots
+ *    and from sorted slots with 1% swapped (check_threads).
  */
 #include <math.h>
 #include <mpi.h>
@@ -351,6 +353,84 @@ static int check_round(const char *name0, int round, const struct scene *sc, str
   return fails;
 }
 
+/* Sort the particles of P with nt threads and keep the order of ids and the owned cells' start. */
+static void sort_with(struct nbr *nb, struct particles *P, int nt, int64_t *id, size_t *start) {
+  omp_set_num_threads(nt);
+  nbr_sort(nb, P);
+  memcpy(id, P->id, P->n * sizeof *id);
+  memcpy(start, nb->start, (nb->ncell_own + 1) * sizeof *start);
+}
+
+/**
+ * The threaded counting sort keeps the serial order: from the same state (displaced, then the
+ * slots shuffled so that every thread's share spans the whole grid), sort with 1, 2, 3 and 7
+ * threads; then swap 1% of the slots of the sorted state (a few out-of-place slots in
+ * otherwise ordered shares) and sort again. The ids, start[] and the values moved with them
+ * (u, ddiff) must be the same as with 1 thread. Returns the number of failures.
+ */
+static int check_threads(const char *name, int n_set, char **set) {
+  struct scene s;
+  if (scene_load(&s, NULL, n_set, set) != 0) return 1;
+  const int threads[] = {1, 2, 3, 7}, saved = omp_get_max_threads();
+  int64_t *ref[2] = {NULL, NULL};
+  size_t *ref_start[2] = {NULL, NULL}, bad = 0, n = 0;
+  for (int k = 0; k < 4; k++) {
+    struct particles P;
+    struct walls W;
+    part_create(&P, &W, &s);
+    n = P.n;
+    lcg_state = 0x2545F4914F6CDD1DULL;
+    for (size_t a = 0; a < n; a++) {
+      P.u[a] = (double)a + 0.5, P.ddiff[a] = -(double)a;
+      if (P.kind[a] != KIND_FLUID) continue;
+      P.x[a] += 0.4 * s.dr * (2.0 * lcg_uniform() - 1.0);
+      P.y[a] += 0.4 * s.dr * (2.0 * lcg_uniform() - 1.0);
+      if (s.dim == 3) P.z[a] += 0.4 * s.dr * (2.0 * lcg_uniform() - 1.0);
+    }
+    size_t *perm = malloc(n * sizeof *perm);
+    for (size_t a = 0; a < n; a++) perm[a] = a;
+    for (size_t a = n - 1; a > 0; a--) { /* Fisher-Yates */
+      const size_t b = (size_t)(lcg_uniform() * (double)(a + 1)), t = perm[a];
+      perm[a] = perm[b], perm[b] = t;
+    }
+    part_permute(&P, 0, n, perm);
+    struct nbr nb;
+    nbr_init(&nb, &s, n, 0, nbr_columns(&s), 0);
+    for (int pass = 0; pass < 2; pass++) {
+      int64_t *id = malloc(n * sizeof *id);
+      size_t *start = malloc((nb.ncell_own + 1) * sizeof *start);
+      if (pass == 1) { /* swap 1% of the sorted slots */
+        for (size_t a = 0; a < n; a++) perm[a] = a;
+        for (size_t i = 0; i < n / 100 + 1; i++) {
+          const size_t a = (size_t)(lcg_uniform() * (double)n),
+                       b = (size_t)(lcg_uniform() * (double)n);
+          const size_t t = perm[a];
+          perm[a] = perm[b], perm[b] = t;
+        }
+        part_permute(&P, 0, n, perm);
+      }
+      sort_with(&nb, &P, threads[k], id, start);
+      for (size_t a = 0; a < n; a++)
+        bad += P.u[a] != (double)P.id[a] + 0.5 || P.ddiff[a] != -(double)P.id[a];
+      if (k == 0) {
+        ref[pass] = id, ref_start[pass] = start;
+        continue;
+      }
+      for (size_t a = 0; a < n; a++) bad += id[a] != ref[pass][a];
+      for (size_t c = 0; c <= nb.ncell_own; c++) bad += start[c] != ref_start[pass][c];
+      free(id), free(start);
+    }
+    free(perm);
+    nbr_free(&nb);
+    part_destroy(&P, &W);
+  }
+  omp_set_num_threads(saved);
+  for (int pass = 0; pass < 2; pass++) free(ref[pass]), free(ref_start[pass]);
+  printf("nbr %s: sort with 1, 2, 3, 7 threads (shuffled, then 1%% swapped): %zu differences, %s\n",
+         name, bad, bad ? "FAILED" : "ok");
+  return bad != 0;
+}
+
 int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
   int fails = 0;
@@ -367,6 +447,7 @@ int main(int argc, char **argv) {
                    "domain.dr=0.05",     "domain.delta=0.4", "sph.h_over_dr=1.6",
                    "fluid.nu=0.1",       "fluid.c0=10",      "time.t_end=1"};
   fails += run_case("3-D h=1.6dr", 9, wide3);
+  fails += check_threads("3-D h=1.6dr", 9, wide3);
   printf("%s\n", fails ? "test_nbr: FAILED" : "test_nbr: passed");
   MPI_Finalize();
   return fails != 0;
