@@ -34,7 +34,7 @@ T_C_LES = 107e-3 * 2 / 41250  # s per particle-step per core, les395_small LES (
 GHOSTS_BENCH = 2 * 2 * (1.6 / 49) * 1.0 * 1.0 / 0.025 ** 3  # 2 sides x 2 cols x ly x lz x n
 # s per ghost per step: the halo's own work (migration, ghosts, refreshes; not the MPI waits) of
 # a rank of mcf1 on 16 ranks x 1 thread of a 16-core node, 12.8 ms for 2 x 2 columns of ghosts
-# (issue 44, docs/perf/node16.csv; it was 4.07 ms for the bench scene's ghosts on 2 ranks
+# (docs/perf/node16.csv; it was 4.07 ms for the bench scene's ghosts on 2 ranks
 # before the halo was threaded and lost its ghost sort, 0.49 us per ghost)
 GHOSTS_MCF1 = 2 * 2 * (3.140625 / 154) * 2.0 * 1.0 / 0.015625 ** 3
 T_G = 12.8e-3 / GHOSTS_MCF1
