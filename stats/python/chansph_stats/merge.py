@@ -60,9 +60,50 @@ def window_values(mom, pln, delta, fold, ut, nu):
     return out
 
 
+CY = C2 + 6 + 6  # the co-moments of u, v, w with y, then of y with y (format 1.12 records)
+CYY = CY + 3
+
+
+def deriv(x, f, ok, i):
+    """euler_deriv (stats/euler_rs.c): 3-point central derivative of f at i between the nearest
+    bins with ok on each side, one-sided where only one exists."""
+    n = len(x)
+    lo = next((j for j in range(i - 1, -1, -1) if ok[j]), -1)
+    hi = next((j for j in range(i + 1, n) if ok[j]), n)
+    if lo < 0 and hi >= n:
+        return math.nan
+    if lo < 0:
+        return (f[hi] - f[i]) / (x[hi] - x[i])
+    if hi >= n:
+        return (f[i] - f[lo]) / (x[i] - x[lo])
+    h1, h2 = x[i] - x[lo], x[hi] - x[i]
+    return (-h2 / (h1 * (h1 + h2))) * f[lo] + ((h2 - h1) / (h1 * h2)) * f[i] + \
+        (h1 / (h2 * (h1 + h2))) * f[hi]
+
+
+def local_slope(x, f, ok, i):
+    """local_slope (stats/euler.c): deriv inside, the parabola through i and its next two
+    neighbours at an end."""
+    n = len(x)
+    lo = next((j for j in range(i - 1, -1, -1) if ok[j]), -1)
+    hi = next((j for j in range(i + 1, n) if ok[j]), n)
+    if (lo >= 0) == (hi < n):
+        return deriv(x, f, ok, i)
+    step = 1 if lo < 0 else -1
+    j1 = hi if lo < 0 else lo
+    j2 = next((j for j in range(j1 + step, n if step > 0 else -1, step) if ok[j]), None)
+    if j2 is None:
+        return deriv(x, f, ok, i)
+    x0, x1, x2 = x[i], x[j1], x[j2]
+    return f[i] * (2 * x0 - x1 - x2) / ((x0 - x1) * (x0 - x2)) + \
+        f[j1] * (x0 - x2) / ((x1 - x0) * (x1 - x2)) + f[j2] * (x0 - x1) / ((x2 - x0) * (x2 - x1))
+
+
 def merged_profile(r, sel):
     """Profiles of U+, u_rms+, v_rms+, w_rms+, -u'v'+ (force-balance wall units) over the windows
-    sel of a read_windows record: their counts, means and co-moments merged (Chan et al. 1979)."""
+    sel of a read_windows record: their counts, means and co-moments merged (Chan et al. 1979);
+    the stresses about the local mean U(y) = U + g (y - <y>) of each bin where the records hold
+    the co-moments with y (format 1.12, as chansph extract), else about the bin mean."""
     mom = r["mom"]
     n = mom[sel][:, :, MOM_N].sum(axis=0)
     ok = n > 0
@@ -70,10 +111,24 @@ def merged_profile(r, sel):
     mean = sum(mom[i][:, MEAN:MEAN + 8] * mom[i][:, [MOM_N]] for i in sel) / nn[:, None]
     pairs = ((0, 0), (1, 1), (2, 2), (0, 1))  # uu vv ww uv
     c2 = np.zeros((len(n), len(pairs)))
+    cy, cyy = np.zeros((len(n), 3)), np.zeros(len(n))
+    local = mom.shape[2] > CYY
     for i in sel:
-        d = mom[i][:, MEAN:MEAN + 3] - mean[:, :3]
+        d = mom[i][:, MEAN:MEAN + 6] - mean[:, :6]
         for c, (p, q) in enumerate(pairs):
             c2[:, c] += mom[i][:, C2 + c] + mom[i][:, MOM_N] * d[:, p] * d[:, q]
+        if local:
+            for k in range(3):
+                cy[:, k] += mom[i][:, CY + k] + mom[i][:, MOM_N] * d[:, k] * d[:, 5]
+            cyy += mom[i][:, CYY] + mom[i][:, MOM_N] * d[:, 5] ** 2
+    if local:
+        for b in np.nonzero(ok)[0]:
+            g = [local_slope(mean[:, 5], mean[:, k], ok, b) for k in range(3)]
+            g = [x if math.isfinite(x) else 0.0 for x in g]
+            if not (np.isfinite(cy[b]).all() and math.isfinite(cyy[b])):
+                continue
+            for c, (p, q) in enumerate(pairs):
+                c2[b, c] += -g[p] * cy[b, q] - g[q] * cy[b, p] + g[p] * g[q] * cyy[b]
     y = np.where(ok, mean[:, 5], np.nan)
     u = np.where(ok, mean[:, 0], np.nan)
     uu, vv, ww, uv = (np.where(ok, c2[:, c] / nn, np.nan) for c in range(4))
