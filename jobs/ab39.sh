@@ -34,6 +34,11 @@ declare -A sets=(
   [delta_0.2]="--set sph.diffusion=delta_sph --set sph.delta=0.2"
   [damper_0.1_delta_0.1]="--set sph.acoustic_damper=0.1 --set sph.diffusion=delta_sph --set sph.delta=0.1"
   [morris]="--set sph.viscous=morris"
+  [lapnorm_trace]="--set sph.laplacian_norm=trace"
+  [lapnorm_none]="--set sph.laplacian_norm=none"
+  [rho0]="--set init.density=rho0"
+  [delta_0.1_rho0]="--set sph.diffusion=delta_sph --set sph.delta=0.1 --set init.density=rho0"
+  [delta_0.2_rho0]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set init.density=rho0"
 )
 names=("$@")
 [ ${#names[@]} -gt 0 ] || names=(reference damper_0.1 delta_0.1)

@@ -444,6 +444,18 @@ double init_source_bytes(const struct scene *sc, double *count) {
   return (double)n * (9.0 * 8.0 + 1.0);
 }
 
+/** init.density = rho0: shift every fluid particle's density by one constant so that their
+    mean is rho0 (summed in id order: the same on every rank), removing the mean overpressure
+    of a developed state (docs/validation/scheme_ab.md). */
+static void shift_density(const struct scene *sc, struct particles *P) {
+  double sum = 0.0;
+  for (size_t a = 0; a < P->n_fluid; a++) sum += P->rho[a];
+  const double shift = sc->rho0 - sum / (double)P->n_fluid;
+  for (size_t a = 0; a < P->n_fluid; a++) P->rho[a] += shift;
+  msg("init: densities shifted by %.6g kg/m^3 to the mean rho0 = %.6g (init.density = rho0)\n",
+      shift, sc->rho0);
+}
+
 static int from_file(const struct scene *sc, struct particles *P) {
   struct source src;
   TRY(read_source(sc->init_from, sc, &src));
@@ -461,6 +473,7 @@ static int from_file(const struct scene *sc, struct particles *P) {
     }
     msg("init: positions, velocities and densities of %zu particles from %s\n", src.n,
         sc->init_from);
+    if (sc->init_density == INIT_DENSITY_RHO0) shift_density(sc, P);
   } else {
     interpolate(&src, P);
     msg("init: velocity interpolated from %zu particles of %s onto %zu particles\n", src.n,

@@ -63,6 +63,7 @@ static const char *const names_drive_mode[] = {"force", "flux", NULL};
 static const char *const names_drive_controller[] = {"eq3.43", "eq3.38", NULL};
 static const char *const names_init_profile[] = {"rest", "laminar",   "reichardt",
                                                  "wave", "synthetic", NULL};
+static const char *const names_init_density[] = {"keep", "rho0", NULL};
 static const char *const names_sph_diffusion[] = {"ferrand", "delta_sph", NULL};
 static const char *const names_stats_method[] = {"bins", "sph", NULL};
 static const char *const names_stats_target_profiles[] = {"both", "u_mean", "uv_peak", NULL};
@@ -344,6 +345,13 @@ static const struct key keys[] = {
      "run_id and time are recorded in stats.nc (init_from_run_id, init_from_time): `chansph "
      "extract` joins a run only after the run whose final state it started from.",
      OFF(init_from)},
+    {"init", "density", T_CHOICE, "keep", 0, 0, 0, names_init_density, "-",
+     "With init.from at the same particle count: keep the particles' densities, or (rho0) "
+     "shift them all by one constant so that their mean is fluid.rho0. A developed state may "
+     "carry a mean overpressure (the density's mean drifts slowly, over tens of turnovers), "
+     "which acts on the symmetric pressure gradient as a background pressure "
+     "(docs/validation/scheme_ab.md); rho0 starts without it.",
+     OFF(init_density)},
     {"output", "log_every", T_INT, "100", 1, 1e9, 0, NULL, "steps",
      "Steps between progress lines (stdout and DIR/log.txt).", OFF(log_every)},
     {"output", "series_every", T_INT, "10", 1, 1e9, 0, NULL, "steps",

@@ -25,6 +25,8 @@ enum init_profile {
   INIT_WAVE = 3,
   INIT_SYNTHETIC = 4
 };
+/** init.density: the densities of an init.from state kept, or shifted to the mean rho0. */
+enum init_density { INIT_DENSITY_KEEP = 0, INIT_DENSITY_RHO0 = 1 };
 enum les_model { LES_NONE = 0, LES_SMAGORINSKY = 1 };
 enum les_strain { STRAIN_GRADIENT = 0, STRAIN_VIOLEAU_ISSA = 1 };
 enum pressure_gradient { PGRAD_STANDARD = 0, PGRAD_CORRECTED = 1 };
@@ -116,6 +118,7 @@ struct scene {
   long init_eddies;      /*!< synthetic eddies (0 = box volume / sigma^3) [-] */
   double init_eddy_size; /*!< synthetic-eddy half-width sigma [delta] */
   char init_from[512];   /*!< particles.nc of an earlier run to start from, or empty */
+  int init_density;      /*!< enum init_density: init.from's densities kept or shifted */
   /* [output] */
   int log_every;          /*!< steps between log lines */
   int series_every;       /*!< steps between time-series records */
