@@ -424,6 +424,7 @@ static int write_stats(struct output *o, const struct sim *S) {
 void output_begin(struct output *o, struct sim *S) {
   struct diag d;
   record(o, S, &d);
+  timer_reset(); /* the phase report covers the steps, as after a resume (not the set-up) */
   o->wall0 = o->last_wall = timer_now();
   o->t0 = S->t, o->last_step = o->step0 = S->step;
   output_log(o,
