@@ -36,6 +36,7 @@ case $start in
     from=(--set init.from=$state --set domain.dr=0.05 --set stats.window=0.25) ;;
   *) echo "error: START must be a, b, w9a or w9b (got '$start')" >&2; exit 1 ;;
 esac
+# shellcheck disable=SC2034  # read by name in campaign_candidates
 declare -A sets=(
   [reference]=""
   [shift_taylor]="--set sph.shifting=fickian --set sph.shift_velocity=taylor"
@@ -52,18 +53,10 @@ declare -A sets=(
 )
 names=("$@")
 [ ${#names[@]} -gt 0 ] || names=(reference xi_x0.5 morris h_1.8 wall_analytic corrected)
-mkdir -p "$out"
-runs=()
 cd "$root" || exit 1
 . "$root/jobs/campaign_lib.sh"
-for name in "${names[@]}"; do
-  [ -n "${sets[$name]+x}" ] || { echo "error: unknown candidate '$name' (${!sets[*]})" >&2; exit 1; }
-  dir=$out/${name}_$start
-  runs+=("$dir")
-  # shellcheck disable=SC2086
-  campaign_run "$dir" "$scene" "$name ($start)" "${from[@]}" \
-    --set time.t_end="$tend" --set output.t_average_start=1 ${sets[$name]}
-done
-mapfile -t done_runs < <(campaign_finished "${runs[@]}")
+campaign_candidates sets "$out" "$start" "$scene" "${names[@]}" -- "${from[@]}" \
+  --set time.t_end="$tend" --set output.t_average_start=1 || exit 1
+mapfile -t done_runs < <(campaign_finished "${campaign_runs[@]}")
 [ ${#done_runs[@]} -gt 0 ] &&
   "$root/stats/python/chansph-stats" ab_table "${done_runs[@]}" --from 1 --markdown

@@ -24,6 +24,7 @@ case $start in
   s8.5) state=$root/jobs/states/mfu180w_dr6c4_t8.5.nc ;;
   *) echo "error: START must be s16 or s8.5 (got '$start')" >&2; exit 1 ;;
 esac
+# shellcheck disable=SC2034  # read by name in campaign_candidates
 declare -A sets=(
   [reference]=""
   [damper_0.05]="--set sph.acoustic_damper=0.05"
@@ -42,18 +43,10 @@ declare -A sets=(
 )
 names=("$@")
 [ ${#names[@]} -gt 0 ] || names=(reference damper_0.1 delta_0.1)
-mkdir -p "$out"
-runs=()
 cd "$root" || exit 1
 . "$root/jobs/campaign_lib.sh"
-for name in "${names[@]}"; do
-  [ -n "${sets[$name]+x}" ] || { echo "error: unknown candidate '$name' (${!sets[*]})" >&2; exit 1; }
-  dir=$out/${name}_$start
-  runs+=("$dir")
-  # shellcheck disable=SC2086
-  OMP_NUM_THREADS=${OMP_NUM_THREADS:-2} campaign_run "$dir" "$scene" "$name ($start)" \
-    --set init.from="$state" --set time.t_end="$tend" ${sets[$name]}
-done
-mapfile -t done_runs < <(campaign_finished "${runs[@]}")
+export OMP_NUM_THREADS=${OMP_NUM_THREADS:-2}
+campaign_candidates sets "$out" "$start" "$scene" "${names[@]}" -- --set init.from="$state" --set time.t_end="$tend" || exit 1
+mapfile -t done_runs < <(campaign_finished "${campaign_runs[@]}")
 [ ${#done_runs[@]} -gt 0 ] &&
   "$root/stats/python/chansph-stats" ab_score "${done_runs[@]}" --csv "$out/ab_score_$start.csv" --markdown

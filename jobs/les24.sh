@@ -22,6 +22,7 @@ case $ny in
   '' | *[!0-9]*) echo "error: NY must be a positive integer (got '$ny')" >&2; exit 1 ;;
 esac
 dr=$(python3 -c "print(repr(2.0 / $ny))")
+# shellcheck disable=SC2034  # read by name in campaign_candidates
 declare -A sets=(
   [qdns]=""
   [les]="--set les.model=smagorinsky"
@@ -29,21 +30,12 @@ declare -A sets=(
 )
 names=("$@")
 [ ${#names[@]} -gt 0 ] || names=(qdns les les_wall)
-mkdir -p "$out"
-runs=()
 cd "$root" || exit 1
 . "$root/jobs/campaign_lib.sh"
-for name in "${names[@]}"; do
-  [ -n "${sets[$name]+x}" ] || { echo "error: unknown candidate '$name' (${!sets[*]})" >&2; exit 1; }
-  dir=$out/${name}_ny$ny
-  runs+=("$dir")
-  # shellcheck disable=SC2086
-  campaign_run "$dir" jobs/scenes/mfu180w_dr6.ini "$name (NY $ny)" --set domain.dr="$dr" \
-    --set init.from=jobs/states/mfu180w_dr6_t12.nc --set time.t_end="$tend" \
-    --set output.t_average_start=1 --set stats.window=0.25 --set sph.wall_collision=reflect \
-    ${sets[$name]}
-done
-mapfile -t done_runs < <(campaign_finished "${runs[@]}")
+campaign_candidates sets "$out" "ny$ny" jobs/scenes/mfu180w_dr6.ini "${names[@]}" -- \
+  --set domain.dr="$dr" --set init.from=jobs/states/mfu180w_dr6_t12.nc --set time.t_end="$tend" \
+  --set output.t_average_start=1 --set stats.window=0.25 --set sph.wall_collision=reflect || exit 1
+mapfile -t done_runs < <(campaign_finished "${campaign_runs[@]}")
 [ ${#done_runs[@]} -gt 0 ] || exit 0
 specs=()
 for r in "${done_runs[@]}"; do specs+=("$(basename "$r")=$r@1:$tend"); done
