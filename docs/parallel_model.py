@@ -6,8 +6,9 @@ Time per step on P ranks (one core each; with threads, read "rank" as "core"):
     T(P) = t_c N / P                      computation (gather loops over the rank's particles)
          + G(P) (t_g + b / B)              ghosts: pack, unpack, sort, and the bytes on the wire
          + m(P) alpha                      point-to-point messages (latency)
-         + (2 log2 P + P) alpha            two allreduces (dt, nu_max) and the alltoall of counts
-                                           in the migration (O(P) as implemented)
+         + (3 log2 P + 4) alpha            three allreduces (dt, nu_max, and whether every
+                                           migrating particle goes to a neighbour) and the
+                                           migration's four neighbour messages (counts, records)
 
 G(P) ghosts per rank: slabs of whole cell columns along x (implemented):
     G = 2 sides * w * ly * lz * n,   w = NBR_REACH cells of size ~h = 2 h,  n = 1 / dr^3,
@@ -69,7 +70,7 @@ def step_time(p, lx, ly, lz, dr, hr, t_c, blocks=False):
         pz = max(1, p // px)
         g = (2 * w * lz / pz + 2 * w * lx / px + 4 * w * w) * ly * n
         m = 4 * MSG_SLAB  # 8 neighbours instead of 2
-    comm = g * (T_G + B_GHOST / BW) + m * ALPHA + (2 * math.log2(p) + p) * ALPHA
+    comm = g * (T_G + B_GHOST / BW) + m * ALPHA + (3 * math.log2(p) + 4) * ALPHA
     return t_c * N / p + comm, comm
 
 

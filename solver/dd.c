@@ -203,6 +203,37 @@ static void split_slots(const int *dest, size_t n, size_t *leave, size_t *nleave
   free(cnt);
 }
 
+/* The exchange of dd_migrate when every leaving particle goes to the left or right neighbour
+   (packed by destination rank at sdisp, scount values each): the counts, then the records,
+   with the two neighbours only: four messages whatever the number of ranks, where the
+   all-to-all costs O(ranks). With 2 ranks the one neighbour is on both sides: all goes in the
+   right message. The arrivals land left first in d->rbuf; their order is free (nbr_sort
+   orders the particles by cell and id). Returns the values received. */
+static size_t migrate_near(struct dd *d, const int *scount, const int *sdisp) {
+  const int two = d->left != d->right;
+  const int sc[2] = {two ? scount[d->left] : 0, scount[d->right]};
+  const int off[2] = {sdisp[d->left], sdisp[d->right]};
+  int rc[2] = {0, 0};
+  MPI_Request req[4];
+  timer_push("halo:wait");
+  CHECK_MPI(MPI_Irecv(&rc[0], 1, MPI_INT, d->left, TAG_RIGHT, MPI_COMM_WORLD, &req[0]));
+  CHECK_MPI(MPI_Irecv(&rc[1], 1, MPI_INT, d->right, TAG_LEFT, MPI_COMM_WORLD, &req[1]));
+  CHECK_MPI(MPI_Isend(&sc[0], 1, MPI_INT, d->left, TAG_LEFT, MPI_COMM_WORLD, &req[2]));
+  CHECK_MPI(MPI_Isend(&sc[1], 1, MPI_INT, d->right, TAG_RIGHT, MPI_COMM_WORLD, &req[3]));
+  CHECK_MPI(MPI_Waitall(4, req, MPI_STATUSES_IGNORE));
+  reserve_buf(&d->rbuf, &d->cap_rbuf, (size_t)rc[0] + (size_t)rc[1]);
+  CHECK_MPI(MPI_Irecv(d->rbuf, rc[0], MPI_DOUBLE, d->left, TAG_RIGHT, MPI_COMM_WORLD, &req[0]));
+  CHECK_MPI(
+      MPI_Irecv(d->rbuf + rc[0], rc[1], MPI_DOUBLE, d->right, TAG_LEFT, MPI_COMM_WORLD, &req[1]));
+  CHECK_MPI(
+      MPI_Isend(d->sbuf + off[0], sc[0], MPI_DOUBLE, d->left, TAG_LEFT, MPI_COMM_WORLD, &req[2]));
+  CHECK_MPI(
+      MPI_Isend(d->sbuf + off[1], sc[1], MPI_DOUBLE, d->right, TAG_RIGHT, MPI_COMM_WORLD, &req[3]));
+  CHECK_MPI(MPI_Waitall(4, req, MPI_STATUSES_IGNORE));
+  timer_pop();
+  return (size_t)rc[0] + (size_t)rc[1];
+}
+
 void dd_migrate(struct dd *d, struct particles *P, const struct nbr *nb) {
   P->n_ghost = 0;
   if (d->size == 1) return;
@@ -244,14 +275,25 @@ void dd_migrate(struct dd *d, struct particles *P, const struct nbr *nb) {
     copy_slot(P, hole, --end);
   }
   P->n = n0 - leaving;
-  CHECK_MPI(MPI_Alltoall(scount, 1, MPI_INT, rcount, 1, MPI_INT, MPI_COMM_WORLD));
-  for (int r = 0; r < np; r++) rdisp[r + 1] = rdisp[r] + rcount[r];
-  reserve_buf(&d->rbuf, &d->cap_rbuf, (size_t)rdisp[np]);
-  timer_push("halo:wait");
-  CHECK_MPI(MPI_Alltoallv(d->sbuf, scount, sdisp, MPI_DOUBLE, d->rbuf, rcount, rdisp, MPI_DOUBLE,
-                          MPI_COMM_WORLD));
-  timer_pop();
-  const size_t arriving = (size_t)rdisp[np] / (size_t)rl;
+  /* the usual step: every particle that leaves goes to a neighbouring slab */
+  int near = 1;
+  for (size_t i = 0; i < leaving && near; i++)
+    near = dest[leave[i]] == d->left || dest[leave[i]] == d->right;
+  CHECK_MPI(MPI_Allreduce(MPI_IN_PLACE, &near, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD));
+  size_t arrived;
+  if (near) {
+    arrived = migrate_near(d, scount, sdisp);
+  } else { /* after a re-partition or the start: anywhere */
+    CHECK_MPI(MPI_Alltoall(scount, 1, MPI_INT, rcount, 1, MPI_INT, MPI_COMM_WORLD));
+    for (int r = 0; r < np; r++) rdisp[r + 1] = rdisp[r] + rcount[r];
+    reserve_buf(&d->rbuf, &d->cap_rbuf, (size_t)rdisp[np]);
+    timer_push("halo:wait");
+    CHECK_MPI(MPI_Alltoallv(d->sbuf, scount, sdisp, MPI_DOUBLE, d->rbuf, rcount, rdisp, MPI_DOUBLE,
+                            MPI_COMM_WORLD));
+    timer_pop();
+    arrived = (size_t)rdisp[np];
+  }
+  const size_t arriving = arrived / (size_t)rl;
   d->reserve(d->ctx, P->n + arriving);
   struct wire w;
   wire_fields(P, PF_MIGRATE, &w);
