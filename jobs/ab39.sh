@@ -33,6 +33,8 @@ declare -A sets=(
   [damper_0.3]="--set sph.acoustic_damper=0.3"
   [delta_0.1]="--set sph.diffusion=delta_sph --set sph.delta=0.1"
   [delta_0.2]="--set sph.diffusion=delta_sph --set sph.delta=0.2"
+  [delta_0.3]="--set sph.diffusion=delta_sph --set sph.delta=0.3"
+  [delta_0.4]="--set sph.diffusion=delta_sph --set sph.delta=0.4"
   [damper_0.1_delta_0.1]="--set sph.acoustic_damper=0.1 --set sph.diffusion=delta_sph --set sph.delta=0.1"
   [morris]="--set sph.viscous=morris"
   [lapnorm_trace]="--set sph.laplacian_norm=trace"
