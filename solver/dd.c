@@ -152,12 +152,16 @@ static int choose_blocks(struct dd *d, const struct scene *sc) {
     if (g >= 0.0 && (best < 0.0 || g < best - 1e-9)) best = g, d->px = px, d->pz = pz;
   }
   if (best < 0.0) {
-    error_input("%s: keys 'domain.lx', 'domain.lz': %d columns and %d planes of cells of size h "
-                "give blocks of at least %d x %d cells for at most %d x %d = %d ranks; this run "
-                "has %d (set run.ranks = Px,Pz, or run on fewer ranks)",
-                path, d->ncol, d->nplane, 2 * R, 2 * R, d->ncol / (2 * R),
-                sc->dim == 3 ? d->nplane / (2 * R) : 1,
-                d->ncol / (2 * R) * (sc->dim == 3 ? d->nplane / (2 * R) : 1), d->size);
+    const int mx = d->ncol / (2 * R), mz = sc->dim == 3 ? d->nplane / (2 * R) : 1;
+    if (sc->dim == 3)
+      error_input("%s: keys 'domain.lx', 'domain.lz': %d cell columns and %d planes of size h; "
+                  "a block needs at least %d columns along x and %d planes along z where "
+                  "they are cut, so at most %d x %d = %d ranks; this run has %d",
+                  path, d->ncol, d->nplane, 2 * R, 2 * R, mx, mz, mx * mz, d->size);
+    else
+      error_input("%s: key 'domain.lx': %d cell columns of size h; a slab needs at least %d, "
+                  "so at most %d ranks; this run has %d",
+                  path, d->ncol, 2 * R, mx, d->size);
     return CHANSPH_ERR;
   }
   return CHANSPH_OK;

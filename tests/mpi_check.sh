@@ -13,7 +13,7 @@
 #              checked after every step: 2 ranks equal 1 rank
 #   damper     fast 2-D flow with the acoustic damper and the delta-SPH diffusion, 200 steps,
 #              ids checked after every step: 2 ranks equal 1 rank
-#   too_many   more ranks than the slabs allow: a message naming domain.lx, exit 1
+#   too_many   more ranks than the blocks allow: a message naming domain.lx and domain.lz, exit 1
 #   resume_too_many  a 1-rank checkpoint resumed on more ranks than its slabs allow: the same
 #                    message, exit 1, the checkpoints untouched
 #   ckpt_resume      3-D LES: 100 steps on 2 ranks (parallel HDF5 checkpoint), resumed on 3 ranks
@@ -191,10 +191,10 @@ case $case in
     ;;
   too_many)
     if mpi 4 run "$scenes/les395_smoke.ini" --out r4 --overwrite > r4.txt 2>&1; then
-      echo "FAIL: 4 ranks on 9 columns were accepted"
+      echo "FAIL: 4 ranks on 9 columns and 6 planes were accepted"
       exit 1
     fi
-    grep -q "key 'domain.lx': lx = 1.2 gives 9 cell columns .* 4 MPI ranks need at least 16 .* at most 2 ranks" r4.txt ||
+    grep -q "keys 'domain.lx', 'domain.lz': 9 cell columns and 6 planes .* at most 2 x 1 = 2 ranks; this run has 4" r4.txt ||
       { cat r4.txt; echo "FAIL: message"; exit 1; }
     [ ! -e r4/stats.nc ] || { echo "FAIL: output written"; exit 1; }
     echo "ok: $(grep -h "domain.lx" r4.txt | head -1)"
@@ -206,7 +206,7 @@ case $case in
     mpi 4 resume r1 > r4.txt 2>&1
     rc=$?
     [ $rc -eq 1 ] || { cat r4.txt; echo "FAIL: resume on 4 ranks: exit $rc, expected 1"; exit 1; }
-    grep -q "key 'domain.lx': lx = 1 gives 15 cell columns .* 4 MPI ranks need at least 16 .* at most 3 ranks" r4.txt ||
+    grep -q "key 'domain.lx': 15 cell columns .* a slab needs at least 4, so at most 3 ranks; this run has 4" r4.txt ||
       { cat r4.txt; echo "FAIL: message"; exit 1; }
     [ "$before" = "$(ls r1/checkpoints)" ] || { echo "FAIL: the checkpoints changed"; exit 1; }
     echo "ok: $(grep -h "domain.lx" r4.txt | head -1)"
