@@ -122,9 +122,11 @@ static int choose_blocks(struct dd *d, const struct scene *sc) {
     const int px = sc->ranks.n == 2 ? (int)sc->ranks.v[0] : 0,
               pz = sc->ranks.n == 2 ? (int)sc->ranks.v[1] : 0;
     if (px < 1 || pz < 1 || (double)px * pz != (double)d->size) {
-      error_input("%s: key 'run.ranks': Px,Pz with Px x Pz = the %d MPI ranks of this run "
-                  "(got %d entries)",
-                  path, d->size, sc->ranks.n);
+      error_input("%s: key 'run.ranks': %s; this run has %d MPI ranks, so Px x Pz = %d "
+                  "(or leave it empty for the factorisation with the fewest ghosts; on resume: "
+                  "--set run.ranks=Px,Pz or --set run.ranks=)",
+                  path, sc->ranks.n == 2 ? "Px x Pz differs from the ranks" : "two entries Px,Pz",
+                  d->size, d->size);
       return CHANSPH_ERR;
     }
     if (sc->dim == 2 && pz > 1) {
