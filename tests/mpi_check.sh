@@ -224,7 +224,7 @@ case $case in
     if [ "$case" = blocks ]; then # 18 x 12 pencils
       lz=1.6 layouts="1,2 1,3 2,2"
     else # 18 x 16 pencils: 6, 8, 9, 12 and 16 ranks
-      lz=2.2 layouts="3,2 2,3 6,1 1,6 4,2 2,4 3,3 4,3 3,4 4,4"
+      lz=2.2 layouts="3,2 2,3 4,2 2,4 3,3 4,3 3,4 4,4"
     fi
     args=(--set domain.lx=2.4 --set domain.lz=$lz --set time.max_steps=60 --set output.stats_every=5
       "${all_engines[@]}")
