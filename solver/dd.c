@@ -30,8 +30,9 @@ static int record_len(int role) {
   return len[k] = n;
 }
 
-/* tags: a message going to the left neighbour, one going to the right */
-enum { TAG_LEFT = 11, TAG_RIGHT = 12 };
+/* tags: a message going below (to the lower neighbour) and above, along x and along z; the
+   migration's counts and records */
+enum { TAG_LEFT = 11, TAG_RIGHT = 12, TAG_ZLO = 13, TAG_ZHI = 14, TAG_MCNT = 15, TAG_MREC = 16 };
 
 static void reserve_buf(double **buf, size_t *cap, size_t n) {
   if (n <= *cap) return;
@@ -99,57 +100,154 @@ static void copy_slot(struct particles *P, size_t to, size_t from) {
   wire_unpack(&w, to, r);
 }
 
-static void partition_even(struct dd *d) {
-  for (int r = 0; r <= d->size; r++) d->first[r] = (int)((long)r * d->ncol / d->size);
+/* Even cuts of n cells over p parts. */
+static void cut_even(int *first, int p, int n) {
+  for (int r = 0; r <= p; r++) first[r] = (int)((long)r * n / p);
+}
+
+/* Ghost cells per rank of Px x Pz blocks (the halo's volume, in pencils), or -1 if a block
+   would be thinner than 2 NBR_REACH in a cut direction. */
+static double ghost_pencils(int px, int pz, int ncol, int nplane) {
+  const int R = NBR_REACH, hx = px > 1 ? R : 0, hz = pz > 1 ? R : 0;
+  if ((px > 1 && ncol < 2 * R * px) || (pz > 1 && nplane < 2 * R * pz)) return -1.0;
+  const double nxo = (double)ncol / px, nzo = (double)nplane / pz;
+  return 2.0 * hx * nzo + 2.0 * hz * (nxo + 2.0 * hx);
+}
+
+/* Px x Pz: run.ranks, or the factorisation with the fewest ghosts (ties: more slabs along x). */
+static int choose_blocks(struct dd *d, const struct scene *sc) {
+  const char *path = sc->path[0] ? sc->path : "(scene)";
+  const int R = NBR_REACH;
+  if (sc->ranks.n > 0) {
+    const int px = sc->ranks.n == 2 ? (int)sc->ranks.v[0] : 0,
+              pz = sc->ranks.n == 2 ? (int)sc->ranks.v[1] : 0;
+    if (px < 1 || pz < 1 || (double)px * pz != (double)d->size) {
+      error_input("%s: key 'run.ranks': %s; this run has %d MPI ranks, so Px x Pz = %d "
+                  "(or leave it empty for the factorisation with the fewest ghosts; on resume: "
+                  "--set run.ranks=Px,Pz or --set run.ranks=)",
+                  path, sc->ranks.n == 2 ? "Px x Pz differs from the ranks" : "two entries Px,Pz",
+                  d->size, d->size);
+      return CHANSPH_ERR;
+    }
+    if (sc->dim == 2 && pz > 1) {
+      error_input("%s: key 'run.ranks': a 2-D scene is cut along x only (Pz = 1, got %d)", path,
+                  pz);
+      return CHANSPH_ERR;
+    }
+    if (ghost_pencils(px, pz, d->ncol, d->nplane) < 0.0) {
+      error_input("%s: key 'run.ranks': %d x %d blocks of %d columns (domain.lx) and %d planes "
+                  "(domain.lz) of size h: each block needs at least %d columns and %d planes "
+                  "along a cut direction, so at most %d x %d ranks",
+                  path, px, pz, d->ncol, d->nplane, 2 * R, 2 * R, d->ncol / (2 * R),
+                  sc->dim == 3 ? d->nplane / (2 * R) : 1);
+      return CHANSPH_ERR;
+    }
+    d->px = px, d->pz = pz;
+    return CHANSPH_OK;
+  }
+  double best = -1.0;
+  for (int px = d->size; px >= 1; px--) {
+    if (d->size % px) continue;
+    const int pz = d->size / px;
+    if (sc->dim == 2 && pz > 1) continue;
+    const double g = ghost_pencils(px, pz, d->ncol, d->nplane);
+    if (g >= 0.0 && (best < 0.0 || g < best - 1e-9)) best = g, d->px = px, d->pz = pz;
+  }
+  if (best < 0.0) {
+    const int mx = d->ncol / (2 * R), mz = sc->dim == 3 ? d->nplane / (2 * R) : 1;
+    if (sc->dim == 3)
+      error_input("%s: keys 'domain.lx', 'domain.lz': %d cell columns and %d planes of size h; "
+                  "a block needs at least %d columns along x and %d planes along z where "
+                  "they are cut, so at most %d x %d = %d ranks; this run has %d",
+                  path, d->ncol, d->nplane, 2 * R, 2 * R, mx, mz, mx * mz, d->size);
+    else
+      error_input("%s: key 'domain.lx': %d cell columns of size h; a slab needs at least %d, "
+                  "so at most %d ranks; this run has %d",
+                  path, d->ncol, 2 * R, mx, d->size);
+    return CHANSPH_ERR;
+  }
+  return CHANSPH_OK;
+}
+
+/* The neighbours of the block: along x and z for the halo, and the distinct ranks of the 3 x 3
+   blocks around it (not itself) for the migration. */
+static void set_neighbours(struct dd *d) {
+  const int px = d->px, pz = d->pz;
+  d->dir[0].width = px > 1 ? NBR_REACH : 0, d->dir[1].width = pz > 1 ? NBR_REACH : 0;
+  d->dir[0].lo = d->bz * px + (d->bx + px - 1) % px, d->dir[0].hi = d->bz * px + (d->bx + 1) % px;
+  d->dir[1].lo = ((d->bz + pz - 1) % pz) * px + d->bx, d->dir[1].hi = ((d->bz + 1) % pz) * px + d->bx;
+  d->nnb = 0;
+  for (int dz = -1; dz <= 1; dz++)
+    for (int dx = -1; dx <= 1; dx++) {
+      const int r = ((d->bz + dz + pz) % pz) * px + (d->bx + dx + px) % px;
+      int seen = r == d->rank;
+      for (int k = 0; k < d->nnb; k++) seen |= d->nb_rank[k] == r;
+      if (!seen) d->nb_rank[d->nnb++] = r;
+    }
 }
 
 int dd_init(struct dd *d, const struct scene *sc, dd_reserve_fn reserve, void *ctx) {
   memset(d, 0, sizeof *d);
   MPI_Comm_rank(MPI_COMM_WORLD, &d->rank);
   MPI_Comm_size(MPI_COMM_WORLD, &d->size);
-  d->ncol = nbr_columns(sc);
-  d->halo = d->size > 1 ? NBR_REACH : 0;
+  const struct nbr_range whole = nbr_whole(sc);
+  d->ncol = whole.nxo, d->nplane = whole.nzo;
   d->reserve = reserve, d->ctx = ctx;
-  d->left = (d->rank + d->size - 1) % d->size, d->right = (d->rank + 1) % d->size;
-  d->first = mem_alloc((size_t)(d->size + 1), sizeof(int), "domain decomposition");
-  if (d->size > 1 && d->ncol < 2 * d->halo * d->size) {
-    error_input(
-        "%s: key 'domain.lx': lx = %g gives %d cell columns of size h along x; %d MPI "
-        "ranks need at least %d (each rank owns %d or more whole columns), so run on at "
-        "most %d ranks",
-        sc->path[0] ? sc->path : "(scene)", sc->lx, d->ncol, d->size, 2 * d->halo * d->size,
-        2 * d->halo, d->ncol / (2 * d->halo));
-    return CHANSPH_ERR;
+  d->px = d->pz = 1;
+  if (d->size > 1 && choose_blocks(d, sc)) return CHANSPH_ERR;
+  d->bx = d->rank % d->px, d->bz = d->rank / d->px;
+  d->fx = mem_alloc((size_t)(d->px + d->pz + 2), sizeof(int), "domain decomposition");
+  d->fz = d->fx + d->px + 1;
+  cut_even(d->fx, d->px, d->ncol), cut_even(d->fz, d->pz, d->nplane);
+  set_neighbours(d);
+  d->comm_x = d->comm_z = MPI_COMM_NULL;
+  if (d->pz > 1) {
+    CHECK_MPI(MPI_Comm_split(MPI_COMM_WORLD, d->bx, d->bz, &d->comm_z));
+    if (d->px > 1) CHECK_MPI(MPI_Comm_split(MPI_COMM_WORLD, d->bz, d->bx, &d->comm_x));
   }
-  partition_even(d);
   const struct scene_list *L = &sc->partition;
-  if (L->n > 0) { /* columns per rank from the scene */
-    int sum = 0, ok = L->n == d->size;
-    for (int r = 0; r < L->n; r++) sum += (int)L->v[r], ok = ok && (int)L->v[r] >= 2 * d->halo;
+  if (L->n > 0) { /* columns per rank from the scene: slabs */
+    const int minw = 2 * NBR_REACH;
+    int sum = 0, ok = L->n == d->size && d->pz == 1;
+    for (int r = 0; r < L->n; r++) sum += (int)L->v[r], ok = ok && (int)L->v[r] >= minw;
     if (!ok || sum != d->ncol) {
       error_input(
           "%s: key 'run.partition': %d entries summing to %d; this run needs %d entries "
-          "(one per rank), each at least %d, summing to the %d cell columns",
-          sc->path[0] ? sc->path : "(scene)", L->n, sum, d->size, 2 * d->halo, d->ncol);
+          "(one per rank, with slabs: run.ranks = %d,1), each at least %d, summing to the %d "
+          "cell columns",
+          sc->path[0] ? sc->path : "(scene)", L->n, sum, d->size, d->size, minw, d->ncol);
       return CHANSPH_ERR;
     }
-    for (int r = 0; r < d->size; r++) d->first[r + 1] = d->first[r] + (int)L->v[r];
+    for (int r = 0; r < d->size; r++) d->fx[r + 1] = d->fx[r] + (int)L->v[r];
   }
   return CHANSPH_OK;
 }
 
+struct nbr_range dd_range(const struct dd *d) {
+  return (struct nbr_range){d->fx[d->bx], d->fx[d->bx + 1] - d->fx[d->bx], d->dir[0].width,
+                            d->fz[d->bz], d->fz[d->bz + 1] - d->fz[d->bz], d->dir[1].width};
+}
+
 void dd_free(struct dd *d) {
-  free(d->first), free(d->send[0]), free(d->send[1]), free(d->ghost), free(d->row);
-  for (int s = 0; s < 4; s++) free(d->cnt[s]);
+  int fin = 0;
+  MPI_Finalized(&fin);
+  if (!fin && d->comm_x != MPI_COMM_NULL) MPI_Comm_free(&d->comm_x);
+  if (!fin && d->comm_z != MPI_COMM_NULL) MPI_Comm_free(&d->comm_z);
+  free(d->fx), free(d->ghost), free(d->row);
+  for (int k = 0; k < 2; k++) {
+    free(d->dir[k].send[0]), free(d->dir[k].send[1]);
+    for (int s = 0; s < 4; s++) free(d->dir[k].cnt[s]);
+  }
   free(d->sbuf), free(d->rbuf);
   memset(d, 0, sizeof *d);
 }
 
-int dd_owner(const struct dd *d, int col) {
-  int lo = 0, hi = d->size - 1; /* the rank r with first[r] <= col < first[r+1] */
+/* The part p with first[p] <= i < first[p+1] (n parts). */
+static int part_of(const int *first, int n, int i) {
+  int lo = 0, hi = n - 1;
   while (lo < hi) {
     const int mid = (lo + hi + 1) / 2;
-    if (d->first[mid] <= col)
+    if (first[mid] <= i)
       lo = mid;
     else
       hi = mid - 1;
@@ -157,15 +255,20 @@ int dd_owner(const struct dd *d, int col) {
   return lo;
 }
 
-static int owned(const struct dd *d, int col) {
-  return col >= d->first[d->rank] && col < d->first[d->rank + 1];
+int dd_owner(const struct dd *d, int col, int plane) {
+  return part_of(d->fz, d->pz, plane) * d->px + part_of(d->fx, d->px, col);
+}
+
+static int owned(const struct dd *d, int col, int plane) {
+  return col >= d->fx[d->bx] && col < d->fx[d->bx + 1] && plane >= d->fz[d->bz] &&
+         plane < d->fz[d->bz + 1];
 }
 
 void dd_keep_owned(struct dd *d, struct particles *P, const struct nbr *nb) {
   size_t k = 0;
   for (size_t a = 0; a < P->n; a++) {
     nbr_wrap_position(nb, &P->x[a], &P->z[a]);
-    if (!owned(d, nbr_column(nb, P->x[a]))) continue;
+    if (!owned(d, nbr_column(nb, P->x[a]), nbr_plane(nb, P->z[a]))) continue;
     if (k != a) copy_slot(P, k, a);
     k++;
   }
@@ -203,35 +306,35 @@ static void split_slots(const int *dest, size_t n, size_t *leave, size_t *nleave
   free(cnt);
 }
 
-/* The exchange of dd_migrate when every leaving particle goes to the left or right neighbour
-   (packed by destination rank at sdisp, scount values each): the counts, then the records,
-   with the two neighbours only: four messages whatever the number of ranks, where the
-   all-to-all costs O(ranks). With 2 ranks the one neighbour is on both sides: all goes in the
-   right message. The arrivals land left first in d->rbuf; their order is free (nbr_sort
-   orders the particles by cell and id). Returns the values received. */
+/* The exchange of dd_migrate when every leaving particle goes to a neighbouring block (packed
+   by destination rank at sdisp, scount values each): the counts, then the records, with the
+   distinct neighbours only (at most 8 messages each way whatever the number of ranks, where
+   the all-to-all costs O(ranks)). The arrivals land in neighbour order in d->rbuf; their
+   order is free (nbr_sort orders the particles by cell and id). Returns the values received. */
 static size_t migrate_near(struct dd *d, const int *scount, const int *sdisp) {
-  const int two = d->left != d->right;
-  const int sc[2] = {two ? scount[d->left] : 0, scount[d->right]};
-  const int off[2] = {sdisp[d->left], sdisp[d->right]};
-  int rc[2] = {0, 0};
-  MPI_Request req[4];
+  const int n = d->nnb;
+  int rc[8] = {0};
+  MPI_Request req[16];
   timer_push("halo:wait");
-  CHECK_MPI(MPI_Irecv(&rc[0], 1, MPI_INT, d->left, TAG_RIGHT, MPI_COMM_WORLD, &req[0]));
-  CHECK_MPI(MPI_Irecv(&rc[1], 1, MPI_INT, d->right, TAG_LEFT, MPI_COMM_WORLD, &req[1]));
-  CHECK_MPI(MPI_Isend(&sc[0], 1, MPI_INT, d->left, TAG_LEFT, MPI_COMM_WORLD, &req[2]));
-  CHECK_MPI(MPI_Isend(&sc[1], 1, MPI_INT, d->right, TAG_RIGHT, MPI_COMM_WORLD, &req[3]));
-  CHECK_MPI(MPI_Waitall(4, req, MPI_STATUSES_IGNORE));
-  reserve_buf(&d->rbuf, &d->cap_rbuf, (size_t)rc[0] + (size_t)rc[1]);
-  CHECK_MPI(MPI_Irecv(d->rbuf, rc[0], MPI_DOUBLE, d->left, TAG_RIGHT, MPI_COMM_WORLD, &req[0]));
-  CHECK_MPI(
-      MPI_Irecv(d->rbuf + rc[0], rc[1], MPI_DOUBLE, d->right, TAG_LEFT, MPI_COMM_WORLD, &req[1]));
-  CHECK_MPI(
-      MPI_Isend(d->sbuf + off[0], sc[0], MPI_DOUBLE, d->left, TAG_LEFT, MPI_COMM_WORLD, &req[2]));
-  CHECK_MPI(
-      MPI_Isend(d->sbuf + off[1], sc[1], MPI_DOUBLE, d->right, TAG_RIGHT, MPI_COMM_WORLD, &req[3]));
-  CHECK_MPI(MPI_Waitall(4, req, MPI_STATUSES_IGNORE));
+  for (int k = 0; k < n; k++) {
+    CHECK_MPI(MPI_Irecv(&rc[k], 1, MPI_INT, d->nb_rank[k], TAG_MCNT, MPI_COMM_WORLD, &req[k]));
+    CHECK_MPI(MPI_Isend(&scount[d->nb_rank[k]], 1, MPI_INT, d->nb_rank[k], TAG_MCNT,
+                        MPI_COMM_WORLD, &req[n + k]));
+  }
+  CHECK_MPI(MPI_Waitall(2 * n, req, MPI_STATUSES_IGNORE));
+  size_t total = 0, off[8];
+  for (int k = 0; k < n; k++) off[k] = total, total += (size_t)rc[k];
+  reserve_buf(&d->rbuf, &d->cap_rbuf, total);
+  for (int k = 0; k < n; k++) {
+    const int r = d->nb_rank[k];
+    CHECK_MPI(
+        MPI_Irecv(d->rbuf + off[k], rc[k], MPI_DOUBLE, r, TAG_MREC, MPI_COMM_WORLD, &req[k]));
+    CHECK_MPI(MPI_Isend(d->sbuf + sdisp[r], scount[r], MPI_DOUBLE, r, TAG_MREC, MPI_COMM_WORLD,
+                        &req[n + k]));
+  }
+  CHECK_MPI(MPI_Waitall(2 * n, req, MPI_STATUSES_IGNORE));
   timer_pop();
-  return (size_t)rc[0] + (size_t)rc[1];
+  return total;
 }
 
 void dd_migrate(struct dd *d, struct particles *P, const struct nbr *nb) {
@@ -250,8 +353,8 @@ void dd_migrate(struct dd *d, struct particles *P, const struct nbr *nb) {
 #pragma omp parallel for schedule(static)
   for (size_t a = 0; a < n0; a++) {
     nbr_wrap_position(nb, &P->x[a], &P->z[a]);
-    const int col = nbr_column(nb, P->x[a]);
-    dest[a] = owned(d, col) ? -1 : dd_owner(d, col);
+    const int col = nbr_column(nb, P->x[a]), plane = nbr_plane(nb, P->z[a]);
+    dest[a] = owned(d, col, plane) ? -1 : dd_owner(d, col, plane);
   }
   size_t leaving;
   split_slots(dest, n0, leave, &leaving);
@@ -275,10 +378,14 @@ void dd_migrate(struct dd *d, struct particles *P, const struct nbr *nb) {
     copy_slot(P, hole, --end);
   }
   P->n = n0 - leaving;
-  /* the usual step: every particle that leaves goes to a neighbouring slab */
+  /* the usual step: every particle that leaves goes to a neighbouring block */
   int near = 1;
-  for (size_t i = 0; i < leaving && near; i++)
-    near = dest[leave[i]] == d->left || dest[leave[i]] == d->right;
+  for (int r = 0; r < np && near; r++) {
+    if (!scount[r]) continue;
+    int k = 0;
+    while (k < d->nnb && d->nb_rank[k] != r) k++;
+    near = k < d->nnb;
+  }
   CHECK_MPI(MPI_Allreduce(MPI_IN_PLACE, &near, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD));
   size_t arrived;
   if (near) {
@@ -309,69 +416,97 @@ void dd_migrate(struct dd *d, struct particles *P, const struct nbr *nb) {
   timer_pop();
 }
 
-/* The send list of one side: the owned slots of the local columns [c0, c0 + halo) in cell order
-   (rows iz * ny + iy, then columns; a cell's particles in id order), and the particles of each
-   of those cells (cnt[row * halo + h]), which tell the neighbour where each ghost goes. */
-static void edge_slots(struct dd *d, const struct nbr *nb, int side, int c0) {
-  const int R = d->halo;
-  const size_t rows = (size_t)nb->ny * nb->nz;
-  if (rows * (size_t)R > d->cap_cnt) {
-    d->cap_cnt = rows * (size_t)R;
-    for (int s = 0; s < 4; s++)
-      d->cnt[s] = mem_realloc(d->cnt[s], d->cap_cnt, sizeof(uint32_t), "domain decomposition");
-    d->row = mem_realloc(d->row, 2 * (rows + 1), sizeof(size_t), "domain decomposition");
+/* The edge cells of direction k on side s (0: the lowest columns or planes of the block, sent
+   to the lower neighbour; 1: the highest), in the receiver's halo cell order (nbr.h): x, per
+   row (izl, iy) the width columns; z, per plane k and row iy the extended columns (the x halo
+   included: the corners). Calls fn(c, i, arg) for edge cell i, local cell c. */
+static size_t edge_cell(const struct nbr *nb, int k, int side, size_t i) {
+  const size_t ny = (size_t)nb->ny;
+  if (k == 0) {
+    const int R = nb->hx;
+    const size_t row = i / (size_t)R;
+    const int h = (int)(i % (size_t)R);
+    const int izl = (int)(row / ny), iy = (int)(row % ny);
+    return nbr_owned_cell(nb, side ? nb->nxo - R + h : h, iy, izl);
   }
-  uint32_t *cnt = d->cnt[side];
-  size_t *row_off = d->row; /* first entry of each row in the list */
-  row_off[0] = 0;
-  for (size_t row = 0; row < rows; row++) {
-    size_t k = 0;
-    for (int h = 0; h < R; h++) {
-      const size_t c = row * (size_t)nb->nxo + (size_t)(c0 + h);
-      cnt[row * R + h] = (uint32_t)(nb->start[c + 1] - nb->start[c]);
-      k += cnt[row * R + h];
-    }
-    row_off[row + 1] = row_off[row] + k;
-  }
-  const size_t n = row_off[rows];
-  if (n > d->cap_send[side]) {
-    d->cap_send[side] = n + n / 2;
-    d->send[side] =
-        mem_realloc(d->send[side], d->cap_send[side], sizeof(size_t), "domain decomposition");
-  }
-  size_t *out = d->send[side];
-#pragma omp parallel for schedule(static)
-  for (size_t row = 0; row < rows; row++) {
-    size_t k = row_off[row];
-    for (int h = 0; h < R; h++) {
-      const size_t c = row * (size_t)nb->nxo + (size_t)(c0 + h);
-      for (size_t a = nb->start[c]; a < nb->start[c + 1]; a++) out[k++] = a;
-    }
-  }
-  d->nsend[side] = n;
+  const size_t nxe = (size_t)nb->nxo + 2 * (size_t)nb->hx;
+  const int ixe = (int)(i % nxe), iy = (int)(i / nxe % ny), p = (int)(i / (nxe * ny));
+  return nbr_local_cell(nb, ixe - nb->hx, iy, side ? nb->nzo - nb->hz + p : p);
 }
 
-/* Send nf values per entry of the send lists to both neighbours and receive theirs into
-   d->rbuf (left halo first). pack_fn fills a record for owned slot a; the threads pack. */
-static void exchange(struct dd *d, int nf, void (*pack_fn)(const void *, size_t, double *),
+/* Edge cells per side of direction k. */
+static size_t edge_cells(const struct nbr *nb, int k) {
+  return k == 0 ? (size_t)nb->nzo * nb->ny * nb->hx
+                : (size_t)nb->hz * nb->ny * ((size_t)nb->nxo + 2 * (size_t)nb->hx);
+}
+
+static void reserve_row(struct dd *d, size_t n) {
+  if (n <= d->cap_row) return;
+  d->cap_row = n + n / 2;
+  d->row = mem_realloc(d->row, d->cap_row, sizeof(size_t), "domain decomposition");
+}
+
+/* The send list of one side of direction k: the slots of the edge cells in their order (a
+   cell's particles in id order), and the particles of each of those cells (cnt[side]), which
+   tell the neighbour where each ghost goes. */
+static void edge_slots(struct dd *d, const struct nbr *nb, int k, int side) {
+  struct dd_dir *D = &d->dir[k];
+  const size_t ne = edge_cells(nb, k);
+  if (ne > D->cap_cnt) {
+    D->cap_cnt = ne;
+    for (int s = 0; s < 4; s++)
+      D->cnt[s] = mem_realloc(D->cnt[s], ne ? ne : 1, sizeof(uint32_t), "domain decomposition");
+  }
+  D->ncnt = ne;
+  reserve_row(d, ne + 1);
+  uint32_t *cnt = D->cnt[side];
+  size_t *off = d->row; /* first entry of each edge cell in the list */
+  off[0] = 0;
+  for (size_t i = 0; i < ne; i++) {
+    const size_t c = edge_cell(nb, k, side, i);
+    cnt[i] = (uint32_t)(nb->start[c + 1] - nb->start[c]);
+    off[i + 1] = off[i] + cnt[i];
+  }
+  const size_t n = off[ne];
+  if (n > D->cap_send[side]) {
+    D->cap_send[side] = n + n / 2;
+    D->send[side] =
+        mem_realloc(D->send[side], D->cap_send[side], sizeof(size_t), "domain decomposition");
+  }
+  size_t *out = D->send[side];
+#pragma omp parallel for schedule(static)
+  for (size_t i = 0; i < ne; i++) {
+    const size_t c = edge_cell(nb, k, side, i);
+    size_t j = off[i];
+    for (size_t a = nb->start[c]; a < nb->start[c + 1]; a++) out[j++] = a;
+  }
+  D->nsend[side] = n;
+}
+
+/* Send nf values per entry of direction k's send lists to both its neighbours and receive
+   theirs into d->rbuf (the lower side's first). pack_fn fills a record for slot a; the threads
+   pack. */
+static void exchange(struct dd *d, int k, int nf, void (*pack_fn)(const void *, size_t, double *),
                      const void *arg) {
-  const size_t ns = d->nsend[0] + d->nsend[1], nr = d->nrecv[0] + d->nrecv[1];
+  struct dd_dir *D = &d->dir[k];
+  const int tlo = k ? TAG_ZLO : TAG_LEFT, thi = k ? TAG_ZHI : TAG_RIGHT;
+  const size_t ns = D->nsend[0] + D->nsend[1], nr = D->nrecv[0] + D->nrecv[1];
   reserve_buf(&d->sbuf, &d->cap_sbuf, ns * (size_t)nf);
   reserve_buf(&d->rbuf, &d->cap_rbuf, nr * (size_t)nf);
   MPI_Request req[4];
-  /* my left halo comes from the left neighbour's message to the right, and vice versa */
-  CHECK_MPI(MPI_Irecv(d->rbuf, (int)(d->nrecv[0] * nf), MPI_DOUBLE, d->left, TAG_RIGHT,
-                      MPI_COMM_WORLD, &req[0]));
-  CHECK_MPI(MPI_Irecv(d->rbuf + d->nrecv[0] * nf, (int)(d->nrecv[1] * nf), MPI_DOUBLE, d->right,
-                      TAG_LEFT, MPI_COMM_WORLD, &req[1]));
-  for (int s = 0, off = 0; s < 2; off += (int)d->nsend[s], s++) {
-    const size_t *restrict slots = d->send[s];
+  /* my lower halo comes from the lower neighbour's message upwards, and vice versa */
+  CHECK_MPI(MPI_Irecv(d->rbuf, (int)(D->nrecv[0] * nf), MPI_DOUBLE, D->lo, thi, MPI_COMM_WORLD,
+                      &req[0]));
+  CHECK_MPI(MPI_Irecv(d->rbuf + D->nrecv[0] * nf, (int)(D->nrecv[1] * nf), MPI_DOUBLE, D->hi, tlo,
+                      MPI_COMM_WORLD, &req[1]));
+  for (int s = 0, off = 0; s < 2; off += (int)D->nsend[s], s++) {
+    const size_t *restrict slots = D->send[s];
     double *restrict buf = d->sbuf + (size_t)off * nf;
 #pragma omp parallel for schedule(static)
-    for (size_t i = 0; i < d->nsend[s]; i++) pack_fn(arg, slots[i], buf + i * nf);
-    /* the left message goes while the right one is packed */
-    CHECK_MPI(MPI_Isend(buf, (int)(d->nsend[s] * nf), MPI_DOUBLE, s == 0 ? d->left : d->right,
-                        s == 0 ? TAG_LEFT : TAG_RIGHT, MPI_COMM_WORLD, &req[2 + s]));
+    for (size_t i = 0; i < D->nsend[s]; i++) pack_fn(arg, slots[i], buf + i * nf);
+    /* the lower message goes while the upper one is packed */
+    CHECK_MPI(MPI_Isend(buf, (int)(D->nsend[s] * nf), MPI_DOUBLE, s == 0 ? D->lo : D->hi,
+                        s == 0 ? tlo : thi, MPI_COMM_WORLD, &req[2 + s]));
   }
   timer_push("halo:wait");
   CHECK_MPI(MPI_Waitall(4, req, MPI_STATUSES_IGNORE));
@@ -388,17 +523,16 @@ static void pack_ghost(const void *arg, size_t a, double *r) {
   wire_pack(arg, a, r);
 }
 
-/* Exchange the particles per edge cell with both neighbours: what the left neighbour sends
-   right (its right edge) is my left halo. */
-static void exchange_counts(struct dd *d, size_t n) {
+/* Exchange the particles per edge cell of direction k with both neighbours: what the lower
+   neighbour sends upwards (its upper edge) is my lower halo. */
+static void exchange_counts(struct dd *d, int k) {
+  struct dd_dir *D = &d->dir[k];
+  const int tlo = k ? TAG_ZLO : TAG_LEFT, thi = k ? TAG_ZHI : TAG_RIGHT, n = (int)D->ncnt;
   MPI_Request req[4];
-  CHECK_MPI(
-      MPI_Irecv(d->cnt[2], (int)n, MPI_UINT32_T, d->left, TAG_RIGHT, MPI_COMM_WORLD, &req[0]));
-  CHECK_MPI(
-      MPI_Irecv(d->cnt[3], (int)n, MPI_UINT32_T, d->right, TAG_LEFT, MPI_COMM_WORLD, &req[1]));
-  CHECK_MPI(MPI_Isend(d->cnt[0], (int)n, MPI_UINT32_T, d->left, TAG_LEFT, MPI_COMM_WORLD, &req[2]));
-  CHECK_MPI(
-      MPI_Isend(d->cnt[1], (int)n, MPI_UINT32_T, d->right, TAG_RIGHT, MPI_COMM_WORLD, &req[3]));
+  CHECK_MPI(MPI_Irecv(D->cnt[2], n, MPI_UINT32_T, D->lo, thi, MPI_COMM_WORLD, &req[0]));
+  CHECK_MPI(MPI_Irecv(D->cnt[3], n, MPI_UINT32_T, D->hi, tlo, MPI_COMM_WORLD, &req[1]));
+  CHECK_MPI(MPI_Isend(D->cnt[0], n, MPI_UINT32_T, D->lo, tlo, MPI_COMM_WORLD, &req[2]));
+  CHECK_MPI(MPI_Isend(D->cnt[1], n, MPI_UINT32_T, D->hi, thi, MPI_COMM_WORLD, &req[3]));
   timer_push("halo:wait");
   CHECK_MPI(MPI_Waitall(4, req, MPI_STATUSES_IGNORE));
   timer_pop();
@@ -406,53 +540,72 @@ static void exchange_counts(struct dd *d, size_t n) {
   d->bytes += 2.0 * (double)n * sizeof(uint32_t);
 }
 
+/* The halo of direction k: the edge cells' counts, the halo cells' ranges from the slot
+   `first` on, each received ghost's slot (the messages hold their cells in the order of
+   nbr_halo_cells, so the ghosts of a message fill consecutive slots from its first cell's
+   start), then the ghosts. Returns the slot after the last ghost. */
+static size_t halo_dir(struct dd *d, struct particles *P, struct nbr *nb, int k, size_t first) {
+  struct dd_dir *D = &d->dir[k];
+  edge_slots(d, nb, k, 0);
+  edge_slots(d, nb, k, 1);
+  exchange_counts(d, k);
+  const uint32_t *const rc[2] = {D->cnt[2], D->cnt[3]};
+  D->nrecv[0] = D->nrecv[1] = 0;
+  for (size_t i = 0; i < D->ncnt; i++) D->nrecv[0] += rc[0][i], D->nrecv[1] += rc[1][i];
+  const size_t ng = D->nrecv[0] + D->nrecv[1];
+  d->reserve(d->ctx, first + ng);
+  const size_t end = nbr_halo_cells(nb, k, first, rc);
+  D->first = first;
+  const size_t done = first - P->n; /* ghosts of the directions before */
+  if (done + ng > d->cap_ghost) {
+    d->cap_ghost = done + ng + (done + ng) / 2;
+    d->ghost = mem_realloc(d->ghost, d->cap_ghost, sizeof(size_t), "domain decomposition");
+  }
+  size_t *ghost = d->ghost + done;
+  if (k == 0) { /* x: the halo cells interleave the two sides row by row */
+    const int R = nb->hx;
+    const size_t rows = (size_t)nb->nzo * nb->ny;
+    reserve_row(d, 2 * (rows + 1));
+    for (int s = 0; s < 2; s++) {
+      size_t *row_off = d->row + (size_t)s * (rows + 1); /* first ghost of each row */
+      row_off[0] = s == 0 ? 0 : D->nrecv[0];
+      for (size_t row = 0; row < rows; row++) {
+        size_t j = 0;
+        for (int h = 0; h < R; h++) j += rc[s][row * R + h];
+        row_off[row + 1] = row_off[row] + j;
+      }
+    }
+#pragma omp parallel for schedule(static)
+    for (size_t row = 0; row < rows; row++)
+      for (int s = 0; s < 2; s++) {
+        size_t g = d->row[(size_t)s * (rows + 1) + row];
+        for (int h = 0; h < R; h++) {
+          const size_t c = nb->ncell_own + row * 2 * R + (size_t)(s * R + h);
+          for (size_t a = nb->start[c]; a < nb->start[c + 1]; a++) ghost[g++] = a;
+        }
+      }
+  } else { /* z: the lower side's cells, then the upper side's: the slots in message order */
+#pragma omp parallel for schedule(static)
+    for (size_t g = 0; g < ng; g++) ghost[g] = first + g;
+  }
+  const int hl = record_len(PF_GHOST);
+  struct wire w;
+  wire_fields(P, PF_GHOST, &w);
+  exchange(d, k, hl, pack_ghost, &w);
+#pragma omp parallel for schedule(static)
+  for (size_t g = 0; g < ng; g++) wire_unpack(&w, ghost[g], d->rbuf + g * (size_t)hl);
+  P->n_ghost = end - P->n;
+  return end;
+}
+
 void dd_halo(struct dd *d, struct particles *P, struct nbr *nb) {
   P->n_ghost = 0;
   if (d->size == 1) return;
   timer_push("halo");
   const double t0 = MPI_Wtime();
-  const int R = d->halo;
-  const size_t rows = (size_t)nb->ny * nb->nz, nc = rows * (size_t)R;
-  edge_slots(d, nb, 0, 0);
-  edge_slots(d, nb, 1, nb->nxo - R);
-  exchange_counts(d, nc);
-  /* the ghosts go in halo cell order: the halo cells' ranges from the counts, then each
-     received ghost's slot (the messages hold their cells in the order of nbr_halo_cells) */
-  const uint32_t *const rc[2] = {d->cnt[2], d->cnt[3]};
-  d->nrecv[0] = d->nrecv[1] = 0;
-  for (size_t i = 0; i < nc; i++) d->nrecv[0] += rc[0][i], d->nrecv[1] += rc[1][i];
-  const size_t ng = d->nrecv[0] + d->nrecv[1];
-  d->reserve(d->ctx, P->n + ng);
-  nbr_halo_cells(nb, P->n, rc);
-  if (ng > d->cap_ghost) {
-    d->cap_ghost = ng + ng / 2;
-    d->ghost = mem_realloc(d->ghost, d->cap_ghost, sizeof(size_t), "domain decomposition");
-  }
-  for (int s = 0; s < 2; s++) {
-    size_t *row_off = d->row + (size_t)s * (rows + 1); /* first ghost of each row */
-    row_off[0] = s == 0 ? 0 : d->nrecv[0];
-    for (size_t row = 0; row < rows; row++) {
-      size_t k = 0;
-      for (int h = 0; h < R; h++) k += rc[s][row * R + h];
-      row_off[row + 1] = row_off[row] + k;
-    }
-  }
-#pragma omp parallel for schedule(static)
-  for (size_t row = 0; row < rows; row++)
-    for (int s = 0; s < 2; s++) {
-      size_t g = d->row[(size_t)s * (rows + 1) + row];
-      for (int h = 0; h < R; h++) {
-        const size_t c = nb->ncell_own + row * 2 * R + (size_t)(s * R + h);
-        for (size_t a = nb->start[c]; a < nb->start[c + 1]; a++) d->ghost[g++] = a;
-      }
-    }
-  const int hl = record_len(PF_GHOST);
-  struct wire w;
-  wire_fields(P, PF_GHOST, &w);
-  exchange(d, hl, pack_ghost, &w);
-#pragma omp parallel for schedule(static)
-  for (size_t g = 0; g < ng; g++) wire_unpack(&w, d->ghost[g], d->rbuf + g * (size_t)hl);
-  P->n_ghost = ng;
+  size_t next = P->n;
+  for (int k = 0; k < 2; k++)
+    if (d->dir[k].width) next = halo_dir(d, P, nb, k, next);
   d->seconds += MPI_Wtime() - t0;
   timer_pop();
 }
@@ -492,107 +645,159 @@ void dd_refresh(struct dd *d, const struct particles *P, const struct walls *W, 
   if (nf == 0) return;
   timer_push("halo:refresh");
   const double t0 = MPI_Wtime();
-  exchange(d, nf, pack_fields, &F);
-  const size_t ng = d->nrecv[0] + d->nrecv[1];
+  for (int k = 0; k < 2; k++) { /* x, then z: the z edges carry the x ghosts just refreshed */
+    const struct dd_dir *D = &d->dir[k];
+    if (!D->width) continue;
+    exchange(d, k, nf, pack_fields, &F);
+    const size_t ng = D->nrecv[0] + D->nrecv[1], *ghost = d->ghost + (D->first - P->n);
 #pragma omp parallel for schedule(static)
-  for (size_t g = 0; g < ng; g++) {
-    const size_t a = d->ghost[g];
-    const double *r = d->rbuf + g * (size_t)nf;
-    for (int k = 0; k < F.np; k++) F.f[k][a] = r[k];
-    if (F.nw == 0 || P->kind[a] != KIND_VERTEX) continue;
-    const size_t slot = part_vertex_slot(P, P->id[a]);
-    for (int k = F.np; k < nf; k++) F.f[k][slot] = r[k];
+    for (size_t g = 0; g < ng; g++) {
+      const size_t a = ghost[g];
+      const double *r = d->rbuf + g * (size_t)nf;
+      for (int j = 0; j < F.np; j++) F.f[j][a] = r[j];
+      if (F.nw == 0 || P->kind[a] != KIND_VERTEX) continue;
+      const size_t slot = part_vertex_slot(P, P->id[a]);
+      for (int j = F.np; j < nf; j++) F.f[j][slot] = r[j];
+    }
   }
   d->seconds += MPI_Wtime() - t0;
   timer_pop();
 }
 
+/* Gather per-pencil records of len doubles (this rank's block, (izl nxo + lc) len each) from
+   every rank into all[(ix nplane + iz) len]: the global pencils, x-major. */
+static void gather_pencils(const struct dd *d, const double *mine, size_t len, double *all) {
+  const size_t npen = (size_t)d->ncol * d->nplane;
+  const int nxo = d->fx[d->bx + 1] - d->fx[d->bx], nzo = d->fz[d->bz + 1] - d->fz[d->bz];
+  if (d->size == 1) {
+    for (int izl = 0; izl < nzo; izl++)
+      for (int lc = 0; lc < nxo; lc++)
+        memcpy(all + ((size_t)lc * d->nplane + izl) * len,
+               mine + ((size_t)izl * nxo + lc) * len, len * sizeof(double));
+    return;
+  }
+  int *cnt = mem_alloc(2 * (size_t)d->size, sizeof(int), "domain decomposition"),
+      *dsp = cnt + d->size;
+  for (int r = 0, off = 0; r < d->size; r++) {
+    const int bx = r % d->px, bz = r / d->px;
+    cnt[r] = (d->fx[bx + 1] - d->fx[bx]) * (d->fz[bz + 1] - d->fz[bz]) * (int)len;
+    dsp[r] = off, off += cnt[r];
+  }
+  double *buf = mem_alloc(npen * len, sizeof(double), "domain decomposition");
+  CHECK_MPI(MPI_Allgatherv(mine, cnt[d->rank], MPI_DOUBLE, buf, cnt, dsp, MPI_DOUBLE,
+                           MPI_COMM_WORLD));
+  for (int r = 0; r < d->size; r++) {
+    const int bx = r % d->px, bz = r / d->px;
+    const int x0 = d->fx[bx], nx = d->fx[bx + 1] - x0, z0 = d->fz[bz], nz = d->fz[bz + 1] - z0;
+    for (int izl = 0; izl < nz; izl++)
+      for (int lc = 0; lc < nx; lc++)
+        memcpy(all + ((size_t)(x0 + lc) * d->nplane + (size_t)(z0 + izl)) * len,
+               buf + dsp[r] + ((size_t)izl * nx + lc) * len, len * sizeof(double));
+  }
+  free(buf), free(cnt);
+}
+
 void dd_sum(const struct dd *d, const struct nbr *nb, int nv, const double *const *x, double *out) {
   if (nv > 8) die("dd_sum: at most 8 arrays (got %d)", nv);
-  const int nxo = nb->nxo, ncol = d->ncol;
-  double *all = mem_alloc((size_t)ncol * nv, sizeof(double), "domain decomposition");
-  double *mine = all + (size_t)nb->ix0 * nv; /* this rank's columns, [column][v] */
+  const size_t npen = (size_t)d->ncol * d->nplane, nmine = (size_t)nb->nxo * nb->nzo;
+  double *mine = mem_alloc(nmine * nv, sizeof(double), "domain decomposition");
 #pragma omp parallel for schedule(static)
-  for (int lc = 0; lc < nxo; lc++) {
+  for (size_t p = 0; p < nmine; p++) {
+    const int lc = (int)(p % (size_t)nb->nxo), izl = (int)(p / (size_t)nb->nxo);
     double s[8] = {0};
-    for (int iz = 0; iz < nb->nz; iz++)
-      for (int iy = 0; iy < nb->ny; iy++) {
-        const size_t c = nbr_owned_cell(nb, lc, iy, iz);
-        for (size_t a = nb->start[c]; a < nb->start[c + 1]; a++)
-          for (int v = 0; v < nv; v++) s[v] += x[v][a];
-      }
-    for (int v = 0; v < nv; v++) mine[(size_t)lc * nv + v] = s[v];
+    for (int iy = 0; iy < nb->ny; iy++) {
+      const size_t c = nbr_owned_cell(nb, lc, iy, izl);
+      for (size_t a = nb->start[c]; a < nb->start[c + 1]; a++)
+        for (int v = 0; v < nv; v++) s[v] += x[v][a];
+    }
+    for (int v = 0; v < nv; v++) mine[p * nv + v] = s[v];
   }
-  if (d->size > 1) {
-    int *cnt = mem_alloc((size_t)d->size, sizeof(int), "domain decomposition");
-    int *dsp = mem_alloc((size_t)d->size, sizeof(int), "domain decomposition");
-    for (int r = 0; r < d->size; r++)
-      cnt[r] = (d->first[r + 1] - d->first[r]) * nv, dsp[r] = d->first[r] * nv;
-    CHECK_MPI(MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_DATATYPE_NULL, all, cnt, dsp, MPI_DOUBLE,
-                             MPI_COMM_WORLD));
-    free(cnt), free(dsp);
-  }
-  double *col = mem_alloc((size_t)ncol, sizeof(double), "domain decomposition");
+  double *all = mem_alloc(npen * nv, sizeof(double), "domain decomposition");
+  gather_pencils(d, mine, (size_t)nv, all);
+  double *col = mem_alloc(npen, sizeof(double), "domain decomposition");
   for (int v = 0; v < nv; v++) {
-    for (int c = 0; c < ncol; c++) col[c] = all[(size_t)c * nv + v];
-    out[v] = reduce_pairwise(col, (size_t)ncol);
+    for (size_t p = 0; p < npen; p++) col[p] = all[p * nv + v];
+    out[v] = reduce_pairwise(col, npen);
   }
-  free(col), free(all);
+  free(col), free(all), free(mine);
+}
+
+/* New cuts of n cells with counts cnt over p parts, each at least minw cells wide: cut where
+   the running count passes r times the mean. */
+static void cut_balanced(const double *cnt, int n, int p, int minw, int *nf) {
+  double total = 0.0;
+  for (int c = 0; c < n; c++) total += cnt[c];
+  const double mean = total / p;
+  nf[0] = 0, nf[p] = n;
+  double run = 0.0;
+  int c = 0;
+  for (int r = 1; r < p; r++) {
+    const double target = r * mean;
+    const int cut = nf[r - 1] + minw;
+    while (c < cut) run += cnt[c++];
+    while (c < n - (p - r) * minw && run + 0.5 * cnt[c] < target) run += cnt[c++];
+    nf[r] = c;
+  }
+}
+
+/* The largest block's particles for cuts fx, fz of the pencil counts pc (x-major). */
+static double most_loaded(const struct dd *d, const double *pc, const int *fx, const int *fz) {
+  double most = 0.0;
+  for (int bz = 0; bz < d->pz; bz++)
+    for (int bx = 0; bx < d->px; bx++) {
+      double n = 0.0;
+      for (int ix = fx[bx]; ix < fx[bx + 1]; ix++)
+        for (int iz = fz[bz]; iz < fz[bz + 1]; iz++) n += pc[(size_t)ix * d->nplane + iz];
+      most = fmax(most, n);
+    }
+  return most;
 }
 
 int dd_balance(struct dd *d, struct nbr *nb, double threshold) {
   if (d->size == 1) return 0;
-  /* particles per column, gathered in column order */
-  const int ncol = d->ncol;
-  double *cnt = mem_alloc((size_t)ncol, sizeof(double), "domain decomposition");
-  memset(cnt, 0, (size_t)ncol * sizeof(double));
-  for (int lc = 0; lc < nb->nxo; lc++)
-    for (int iz = 0; iz < nb->nz; iz++)
-      for (int iy = 0; iy < nb->ny; iy++) {
-        const size_t c = nbr_owned_cell(nb, lc, iy, iz);
-        cnt[nb->ix0 + lc] += (double)(nb->start[c + 1] - nb->start[c]);
-      }
-  CHECK_MPI(
-      MPI_Allreduce(MPI_IN_PLACE, cnt, ncol, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD)); /* integers */
-  double total = 0.0, most = 0.0;
-  for (int c = 0; c < ncol; c++) total += cnt[c];
-  for (int r = 0; r < d->size; r++) {
-    double n = 0.0;
-    for (int c = d->first[r]; c < d->first[r + 1]; c++) n += cnt[c];
-    most = fmax(most, n);
+  /* particles per pencil, gathered (integers: exact in any order) */
+  const size_t npen = (size_t)d->ncol * d->nplane, nmine = (size_t)nb->nxo * nb->nzo;
+  double *mine = mem_alloc(nmine, sizeof(double), "domain decomposition");
+  for (size_t p = 0; p < nmine; p++) {
+    const int lc = (int)(p % (size_t)nb->nxo), izl = (int)(p / (size_t)nb->nxo);
+    size_t n = 0;
+    for (int iy = 0; iy < nb->ny; iy++) {
+      const size_t c = nbr_owned_cell(nb, lc, iy, izl);
+      n += nb->start[c + 1] - nb->start[c];
+    }
+    mine[p] = (double)n;
   }
-  const double mean = total / d->size;
+  double *pc = mem_alloc(npen, sizeof(double), "domain decomposition");
+  gather_pencils(d, mine, 1, pc);
+  double total = 0.0;
+  for (size_t p = 0; p < npen; p++) total += pc[p];
+  const double mean = total / d->size, most = most_loaded(d, pc, d->fx, d->fz);
   d->imbalance = mean > 0.0 ? most / mean : 1.0;
-  if (d->imbalance <= 1.0 + threshold) {
-    free(cnt);
-    return 0;
+  int changed = 0;
+  if (d->imbalance > 1.0 + threshold) {
+    /* the columns' and the planes' counts, each cut direction balanced on its own */
+    double *cx = mem_calloc((size_t)d->ncol + d->nplane, sizeof(double), "domain decomposition");
+    double *cz = cx + d->ncol;
+    for (int ix = 0; ix < d->ncol; ix++)
+      for (int iz = 0; iz < d->nplane; iz++)
+        cx[ix] += pc[(size_t)ix * d->nplane + iz], cz[iz] += pc[(size_t)ix * d->nplane + iz];
+    int *nf = mem_alloc((size_t)(d->px + d->pz + 2), sizeof(int), "domain decomposition");
+    int *nz = nf + d->px + 1;
+    memcpy(nf, d->fx, (size_t)(d->px + d->pz + 2) * sizeof(int));
+    if (d->px > 1) cut_balanced(cx, d->ncol, d->px, 2 * NBR_REACH, nf);
+    if (d->pz > 1) cut_balanced(cz, d->nplane, d->pz, 2 * NBR_REACH, nz);
+    /* keep the cuts unless the new ones lower the largest load by at least half the excess
+       over the mean: no flipping between equivalent cuts */
+    const double new_most = most_loaded(d, pc, nf, nz);
+    changed = new_most < mean + 0.5 * (most - mean) &&
+              memcmp(nf, d->fx, (size_t)(d->px + d->pz + 2) * sizeof(int)) != 0;
+    if (changed) memcpy(d->fx, nf, (size_t)(d->px + d->pz + 2) * sizeof(int));
+    free(nf), free(cx);
   }
-  /* cut where the running count passes r * mean, keeping 2 halo columns per rank */
-  const int minw = 2 * d->halo;
-  int *nf = mem_alloc((size_t)(d->size + 1), sizeof(int), "domain decomposition");
-  nf[0] = 0, nf[d->size] = ncol;
-  double run = 0.0;
-  int c = 0;
-  for (int r = 1; r < d->size; r++) {
-    const double target = r * mean;
-    int cut = nf[r - 1] + minw;
-    while (c < cut) run += cnt[c++];
-    while (c < ncol - (d->size - r) * minw && run + 0.5 * cnt[c] < target) run += cnt[c++];
-    nf[r] = c;
-  }
-  double new_most = 0.0; /* keep the cuts unless the new ones lower the largest load */
-  for (int r = 0; r < d->size; r++) {
-    double n = 0.0;
-    for (int k = nf[r]; k < nf[r + 1]; k++) n += cnt[k];
-    new_most = fmax(new_most, n);
-  }
-  /* ... by at least half the excess over the mean: no flipping between equivalent cuts */
-  const int changed = new_most < mean + 0.5 * (most - mean) &&
-                      memcmp(nf, d->first, (size_t)(d->size + 1) * sizeof(int)) != 0;
-  if (changed) memcpy(d->first, nf, (size_t)(d->size + 1) * sizeof(int));
-  free(nf), free(cnt);
+  free(pc), free(mine);
   if (!changed) return 0;
-  nbr_set_range(nb, d->first[d->rank], d->first[d->rank + 1] - d->first[d->rank], d->halo);
+  const struct nbr_range r = dd_range(d);
+  nbr_set_range(nb, &r);
   d->rebalances++;
   return 1;
 }

@@ -1,30 +1,34 @@
 /**
  * @file dd.h
- * @brief Domain decomposition across MPI ranks: slabs of whole cell columns along x.
+ * @brief Domain decomposition across MPI ranks: Px x Pz blocks of whole cell pencils (a
+ *        column along x and a plane along z, every row along y: the walls and the statistics'
+ *        y bins are never cut).
  *
- * Rank r owns the cell columns first[r] .. first[r+1]-1 of the global grid (nbr.h) and the
- * particles in them. Each step:
- *  1. dd_migrate() sends the particles that left a rank's columns to their new owner (the holes
- *     they leave are filled from the end of the slots, the arrivals appended: nbr_sort orders
- *     them whatever order they come in);
+ * Rank r = bz Px + bx owns the columns fx[bx] .. fx[bx+1]-1 and the planes fz[bz] .. fz[bz+1]-1
+ * of the global grid (nbr.h) and the particles in them; Pz = 1 are the slabs along x. Each step:
+ *  1. dd_migrate() sends the particles that left a rank's block to their new owner, one of the
+ *     (up to 8) neighbouring blocks (the holes they leave are filled from the end of the
+ *     slots, the arrivals appended: nbr_sort orders them whatever order they come in);
  *  2. nbr_sort() orders the owned particles by cell and id;
- *  3. dd_halo() copies the particles of the NBR_REACH columns at each edge of every slab to the
- *     neighbouring rank (ghosts, with their unshifted coordinates: the periodic shift is applied
- *     by the stencil, as on one rank), cell by cell in the sender's order, with the particles
- *     of each edge cell: each ghost goes straight to its slot in the halo cells
- *     (nbr_halo_cells), with no sort;
+ *  3. dd_halo() copies the particles of the NBR_REACH columns at each x edge of every block to
+ *     the neighbouring block along x (ghosts, with their unshifted coordinates: the periodic
+ *     shift is applied by the stencil, as on one rank), then the NBR_REACH planes at each z
+ *     edge, with the x ghosts next to them (the corners), to the neighbours along z; cell by
+ *     cell in the sender's order, with the particles of each edge cell: each ghost goes
+ *     straight to its slot in the halo cells (nbr_halo_cells), with no sort;
  *  4. after each pass that computes a per-particle value the next pass reads at neighbours,
  *     dd_refresh() refreshes the ghosts' copies of the fields the field table (part.h) marks
- *     for that stage, in one exchange.
+ *     for that stage, in one exchange per cut direction.
  * Packing and unpacking are threaded; the time in MPI waits is the timer phase "halo:wait",
  * the rest "halo" (building the ghosts), "halo:refresh" and "halo:migrate" (docs/parallel.md).
- * Sums over all particles (dd_sum) are formed per global column in the cell order, then
- * added over the columns in a fixed order, so every result is bitwise the same on any number
- * of ranks and threads (docs/parallel.md).
+ * Sums over all particles (dd_sum) are formed per global pencil in the cell order, then added
+ * over the pencils in a fixed order, so every result is bitwise the same on any number of
+ * ranks, any Px x Pz and any number of threads (docs/parallel.md).
  */
 #ifndef CHANSPH_DD_H
 #define CHANSPH_DD_H
 
+#include <mpi.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -35,23 +39,39 @@
 /** Grows every per-particle array of the simulation to hold n slots. */
 typedef void (*dd_reserve_fn)(void *ctx, size_t n);
 
+/** The halo exchange along one cut direction (x or z) in the current step. */
+struct dd_dir {
+  int width;           /*!< halo columns (planes) per side; 0: the direction is not cut */
+  int lo, hi;          /*!< the neighbouring ranks below and above (periodic) */
+  size_t nsend[2];     /*!< slots sent below (0) and above (1) */
+  size_t cap_send[2];  /*!< their capacity */
+  size_t *send[2];     /*!< the slots (owned, or x ghosts in the z direction), in cell order */
+  size_t nrecv[2];     /*!< ghosts received from below (0) and above (1) */
+  size_t first;        /*!< the slot of this direction's first ghost */
+  uint32_t *cnt[4];    /*!< particles per edge cell: sent below, above; received from below,
+                            above (nbr_halo_cells' order) */
+  size_t ncnt;         /*!< edge cells per side */
+  size_t cap_cnt;      /*!< their capacity */
+};
+
 /** The decomposition and the halo bookkeeping of the current step. */
 struct dd {
   int rank, size;        /*!< this rank, ranks */
-  int ncol;              /*!< global cell columns along x */
-  int halo;              /*!< halo columns per side (0 on one rank) */
-  int *first;            /*!< first column of each rank; first[size] = ncol */
-  int left, right;       /*!< neighbouring ranks (periodic) */
+  int px, pz;            /*!< blocks along x and z (size = px pz) */
+  int bx, bz;            /*!< this rank's block: rank = bz px + bx */
+  int ncol, nplane;      /*!< global cell columns along x, planes along z */
+  int *fx, *fz;          /*!< first column of each block column (fx[px] = ncol), first plane of
+                              each block row (fz[pz] = nplane) */
+  struct dd_dir dir[2];  /*!< the x and z halo exchanges */
+  int nnb, nb_rank[8];   /*!< the distinct neighbouring ranks (3 x 3 blocks around, not self) */
+  MPI_Comm comm_x;       /*!< the block row (the ranks of this bz, by bx); MPI_COMM_NULL if
+                              px = 1 or pz = 1 (the statistics' contract.h) */
+  MPI_Comm comm_z;       /*!< the block column (the ranks of this bx, by bz); MPI_COMM_NULL
+                              if pz = 1 */
   dd_reserve_fn reserve; /*!< grows the simulation's per-particle arrays */
   void *ctx;             /*!< its argument */
-  /* halo of the current step: owned slots sent to the left (0) and right (1) neighbour, and
-     the ghost slot of each received particle (left halo first) */
-  size_t nsend[2], cap_send[2], *send[2];
-  size_t nrecv[2], cap_ghost, *ghost;
-  /* particles per edge cell (row * halo + h): sent left (0), right (1), received from the left
-     (2), from the right (3); and per-row offsets into the lists (scratch) */
-  uint32_t *cnt[4];
-  size_t cap_cnt, *row;
+  size_t cap_ghost, *ghost; /*!< the ghost slot of each received record (x, then z) */
+  size_t *row, cap_row;     /*!< per-row offsets (scratch) */
   double *sbuf, *rbuf;
   size_t cap_sbuf, cap_rbuf;
   /* cost of the exchanges, for the log */
@@ -64,54 +84,61 @@ struct dd {
 };
 
 /**
- * @brief Partition the columns of the scene's grid evenly over the ranks of MPI_COMM_WORLD.
- * @return CHANSPH_OK, or CHANSPH_ERR after a message when the slabs would be too thin (every
- *         rank needs 2 NBR_REACH columns: the halo must come from the neighbouring rank only)
+ * @brief Choose Px x Pz (the scene's run.ranks, or the factorisation of the ranks of
+ *        MPI_COMM_WORLD with the fewest ghosts) and partition the columns and planes evenly
+ *        (or as run.partition says, for slabs).
+ * @return CHANSPH_OK, or CHANSPH_ERR after a message naming the key when the blocks would be
+ *         too thin (every cut direction needs 2 NBR_REACH columns or planes per block: the
+ *         halo must come from the neighbouring block only) or run.ranks does not fit
  */
 int dd_init(struct dd *d, const struct scene *sc, dd_reserve_fn reserve, void *ctx);
+
+/** @brief This rank's block as a cell range of the grid (nbr_set_range). */
+struct nbr_range dd_range(const struct dd *d);
 
 /** @brief Free the bookkeeping. */
 void dd_free(struct dd *d);
 
-/** @brief Owner rank of a global column. */
-int dd_owner(const struct dd *d, int col);
+/** @brief Owner rank of a global column and plane. */
+int dd_owner(const struct dd *d, int col, int plane);
 
 /**
- * @brief Keep only the particles of this rank's columns (after every rank built the same full
+ * @brief Keep only the particles of this rank's block (after every rank built the same full
  *        initial state); their order is kept.
  */
 void dd_keep_owned(struct dd *d, struct particles *P, const struct nbr *nb);
 
 /**
  * @brief Keep the slots lo .. lo+n-1 (a checkpoint's id block read on this rank) as this rank's
- *        particles and send each to the owner of its column (dd_migrate). Collective.
+ *        particles and send each to the owner of its pencil (dd_migrate). Collective.
  */
 void dd_take_block(struct dd *d, struct particles *P, const struct nbr *nb, size_t lo, size_t n);
 
 /**
- * @brief Drop the ghosts and send every owned particle that is not in this rank's columns to
+ * @brief Drop the ghosts and send every owned particle that is not in this rank's block to
  *        its owner (positions are wrapped first). Collective.
  */
 void dd_migrate(struct dd *d, struct particles *P, const struct nbr *nb);
 
 /**
- * @brief Build the ghosts: after nbr_sort(), send the particles of the edge columns and their
- *        count per edge cell to the neighbours, and put what arrives in halo cell order after
- *        the owned particles (nbr_halo_cells). Collective.
+ * @brief Build the ghosts: after nbr_sort(), send the particles of the edge cells and their
+ *        count per edge cell to the neighbours, x then z, and put what arrives in halo cell
+ *        order after the owned particles (nbr_halo_cells). Collective.
  */
 void dd_halo(struct dd *d, struct particles *P, struct nbr *nb);
 
 /**
  * @brief Refresh the ghosts' copies of every allocated per-particle and wall array whose
  *        table entry (part_fields, wall_fields) names this stage (enum part_refresh): one
- *        exchange for them all (wall arrays at the ghost vertices, by vertex slot). Collective.
+ *        exchange per cut direction for them all (wall arrays at the ghost vertices, by
+ *        vertex slot). Collective.
  */
 void dd_refresh(struct dd *d, const struct particles *P, const struct walls *W, int stage);
 
 /**
  * @brief Deterministic global sums of nv per-particle arrays over the owned particles: per
- *        global column in the cell order, then added pairwise over the columns; bitwise the
- *        same on any number of ranks and threads. Collective.
+ *        global pencil in the cell order, then added pairwise over the pencils in global
+ *        order (x-major); bitwise the same on any number of ranks and threads. Collective.
  * @param[in] nv arrays (at most 8)
  */
 void dd_sum(const struct dd *d, const struct nbr *nb, int nv, const double *const *x, double *out);
@@ -132,8 +159,8 @@ void dd_gather_fluid(const struct dd *d, const struct particles *P, int nf, cons
 size_t dd_check_ids(const struct dd *d, const struct particles *P, size_t n_total, long step);
 
 /**
- * @brief Re-partition the columns by particle count when the largest rank holds more than
- *        (1 + threshold) times the mean, then migrate. Collective.
+ * @brief Re-partition the columns (and planes) by particle count when the largest rank holds
+ *        more than (1 + threshold) times the mean; the caller migrates. Collective.
  * @return 1 if the partition changed
  */
 int dd_balance(struct dd *d, struct nbr *nb, double threshold);

@@ -50,14 +50,20 @@ int nbr_stride(const struct scene *s) {
   return nbr_round_stride((int)(1.5 * per) + 8);
 }
 
-void nbr_init(struct nbr *nb, const struct scene *s, size_t n, int ix0, int nxo, int halo) {
+struct nbr_range nbr_whole(const struct scene *s) {
+  const double cell = 2.0 * scene_h(s) / NBR_REACH;
+  const int nz = s->dim == 3 ? (int)floor(s->lz / cell * (1.0 + 1e-12)) : 1;
+  return (struct nbr_range){0, nbr_columns(s), 0, 0, nz, 0};
+}
+
+void nbr_init(struct nbr *nb, const struct scene *s, size_t n, const struct nbr_range *r) {
   memset(nb, 0, sizeof *nb);
   const double two_h = 2.0 * scene_h(s), cell = two_h / NBR_REACH;
   nb->dim = s->dim;
   nb->lx = s->lx, nb->ly = 2.0 * s->delta, nb->lz = s->dim == 3 ? s->lz : 1.0;
   nb->nx = nbr_columns(s);
   nb->ny = (int)floor(nb->ly / cell * (1.0 + 1e-12));
-  nb->nz = s->dim == 3 ? (int)floor(nb->lz / cell * (1.0 + 1e-12)) : 1;
+  nb->nz = nbr_whole(s).nzo;
   if (nb->ny < 1) nb->ny = 1;
   if (nb->nx < 2 * NBR_REACH + 1 || (s->dim == 3 && nb->nz < 2 * NBR_REACH + 1))
     die("periodic directions need at least %d cells of size 2h/%d (validated in scene.c)",
@@ -65,16 +71,18 @@ void nbr_init(struct nbr *nb, const struct scene *s, size_t n, int ix0, int nxo,
   nb->cx = nb->nx / nb->lx, nb->cy = nb->ny / nb->ly, nb->cz = nb->nz / nb->lz;
   nb->support2 = two_h * two_h;
   nb->avx512 = nbr_cpu_avx512();
-  nbr_set_range(nb, ix0, nxo, halo);
+  nbr_set_range(nb, r);
   nb->stride = nbr_stride(s);
   nbr_reserve(nb, n);
 }
 
-void nbr_set_range(struct nbr *nb, int ix0, int nxo, int halo) {
-  nb->ix0 = ix0, nb->nxo = nxo, nb->halo = halo;
-  const size_t rows = (size_t)nb->ny * nb->nz;
-  nb->ncell_own = (size_t)nxo * rows;
-  nb->ncell = nb->ncell_own + 2 * (size_t)halo * rows;
+void nbr_set_range(struct nbr *nb, const struct nbr_range *r) {
+  nb->ix0 = r->ix0, nb->nxo = r->nxo, nb->hx = r->hx;
+  nb->iz0 = r->iz0, nb->nzo = r->nzo, nb->hz = r->hz;
+  const size_t ny = (size_t)nb->ny, nxe = (size_t)nb->nxo + 2 * (size_t)nb->hx;
+  nb->ncell_own = (size_t)nb->nxo * ny * (size_t)nb->nzo;
+  nb->ncell_x = nb->ncell_own + 2 * (size_t)nb->hx * ny * (size_t)nb->nzo;
+  nb->ncell = nb->ncell_x + 2 * (size_t)nb->hz * ny * nxe;
   part_free(nb->start), part_free(nb->tcount);
   nb->start = part_alloc("cell_start", (nb->ncell + 1) * sizeof(size_t));
   nb->tcount_threads = omp_get_max_threads(), nb->tcount_cells = nb->ncell_own;
@@ -212,14 +220,12 @@ void nbr_sort(struct nbr *nb, struct particles *P) {
     nbr_wrap_position(nb, &P->x[a], &P->z[a]);
     /* clamped in floating point first: a NaN or huge coordinate (a failing run, reported by
        the health check after this step) must not overflow the integer conversion */
-    const int lc = nbr_column(nb, P->x[a]) - nb->ix0;
+    const int lc = nbr_column(nb, P->x[a]) - nb->ix0, lz = nbr_plane(nb, P->z[a]) - nb->iz0;
     const int iy = clampi((int)fmin(fmax(P->y[a] * nb->cy, 0.0), nb->ny), nb->ny);
-    const int iz =
-        nb->dim == 3 ? clampi((int)fmin(fmax(P->z[a] * nb->cz, 0.0), nb->nz), nb->nz) : 0;
-    if (lc < 0 || lc >= nb->nxo) stray = 1;
-    cell[a] = (int)nbr_owned_cell(nb, lc < 0 ? 0 : lc >= nb->nxo ? nb->nxo - 1 : lc, iy, iz);
+    if (lc < 0 || lc >= nb->nxo || lz < 0 || lz >= nb->nzo) stray = 1;
+    cell[a] = (int)nbr_owned_cell(nb, clampi(lc, nb->nxo), iy, clampi(lz, nb->nzo));
   }
-  if (stray) die("nbr_sort: a particle outside this rank's columns (migration missed it)");
+  if (stray) die("nbr_sort: a particle outside this rank's block (migration missed it)");
   sort_cells(nb, P, n);
   timer_push("sort:permute");
   part_permute(P, 0, n, nb->perm);
@@ -227,16 +233,28 @@ void nbr_sort(struct nbr *nb, struct particles *P) {
   timer_pop();
 }
 
-void nbr_halo_cells(struct nbr *nb, size_t n_owned, const uint32_t *const cnt[2]) {
-  const int R = nb->halo;
-  const size_t rows = (size_t)nb->ny * nb->nz;
-  size_t k = n_owned;
-  for (size_t row = 0; row < rows; row++)
-    for (int h = 0; h < 2 * R; h++) {
-      nb->start[nb->ncell_own + row * 2 * R + (size_t)h] = k;
-      k += h < R ? cnt[0][row * R + (size_t)h] : cnt[1][row * R + (size_t)(h - R)];
+size_t nbr_halo_cells(struct nbr *nb, int dir, size_t first, const uint32_t *const cnt[2]) {
+  const size_t ny = (size_t)nb->ny;
+  size_t k = first;
+  if (dir == 0) { /* x: per row of the block, the hx columns below, then the hx above */
+    const size_t R = (size_t)nb->hx;
+    for (size_t row = 0; row < (size_t)nb->nzo * ny; row++)
+      for (size_t h = 0; h < 2 * R; h++) {
+        nb->start[nb->ncell_own + row * 2 * R + h] = k;
+        k += h < R ? cnt[0][row * R + h] : cnt[1][row * R + h - R];
+      }
+    nb->start[nb->ncell_x] = k; /* the end of the last x halo cell (= ncell without a z halo) */
+    return k;
+  }
+  /* z: the planes below, then the planes above, each over the extended columns */
+  const size_t per = (size_t)nb->hz * ny * ((size_t)nb->nxo + 2 * (size_t)nb->hx);
+  for (size_t s = 0; s < 2; s++)
+    for (size_t i = 0; i < per; i++) {
+      nb->start[nb->ncell_x + s * per + i] = k;
+      k += cnt[s][i];
     }
   nb->start[nb->ncell] = k;
+  return k;
 }
 
 /* Append the particles of [b0, b1), shifted by (sx, 0, sz), that lie within the support of a
@@ -337,21 +355,10 @@ static int fluid_first(const uint8_t *restrict kind, const int32_t *restrict lb,
   return nf;
 }
 
-/* Column slot of the stencil column lc + dx of an owned column lc, and the periodic shift of
-   its particles: the same global column and shift on any decomposition. Returns the local
-   column (owned: 0 .. nxo-1) or -1 - h for halo column h. */
-static inline int stencil_column(const struct nbr *nb, int lc, int dx, double *sx) {
-  int jl = lc + dx;
-  const int gx = nb->ix0 + jl;
-  *sx = gx < 0 ? -nb->lx : gx >= nb->nx ? nb->lx : 0.0;
-  if (!nb->halo) { /* one rank: the whole grid, periodic wrap inside it */
-    if (jl < 0) jl += nb->nx;
-    if (jl >= nb->nx) jl -= nb->nx;
-    return jl;
-  }
-  if (jl < 0) return -1 - (jl + nb->halo);
-  if (jl >= nb->nxo) return -1 - (nb->halo + jl - nb->nxo);
-  return jl;
+/* Periodic shift of the cells of global index g (outside [0, n): the image across the
+   boundary) in a direction of length l. */
+static inline double stencil_shift(int g, int n, double l) {
+  return g < 0 ? -l : g >= n ? l : 0.0;
 }
 
 /* Gap between a coordinate and the cell interval [j, j + 1) / c: a lower bound of the distance
@@ -378,32 +385,27 @@ static int stencil_ranges(const struct nbr *nb, size_t c, struct cand_range *r) 
   const int dz_lo = nb->dim == 3 ? -R : 0, dz_hi = nb->dim == 3 ? R : 0;
   const int lc = (int)(c % (size_t)nb->nxo);
   const int iy = (int)(c / (size_t)nb->nxo % (size_t)nb->ny);
-  const int iz = (int)(c / ((size_t)nb->nxo * nb->ny));
+  const int izl = (int)(c / ((size_t)nb->nxo * nb->ny));
   const int gx = nb->ix0 + lc;
-  /* the x cells of the stencil are contiguous and unshifted away from the ends of the rank */
+  /* the x cells of the stencil are one unshifted run of local cells (owned, or of one row of
+     the z halo) away from the ends of the block along x and of the grid */
   const int inner = lc >= R && lc < nb->nxo - R && gx >= R && gx < nb->nx - R;
   int n = 0;
   for (int dz = dz_lo; dz <= dz_hi; dz++) {
-    int jz = iz + dz;
-    double sz = 0.0;
-    if (jz < 0)
-      jz += nb->nz, sz = -nb->lz;
-    else if (jz >= nb->nz)
-      jz -= nb->nz, sz = nb->lz;
+    const int gz = nb->iz0 + izl + dz;
+    const double sz = stencil_shift(gz, nb->nz, nb->lz);
+    const int jz = gz < 0 ? gz + nb->nz : gz >= nb->nz ? gz - nb->nz : gz; /* global plane */
     for (int dy = -R; dy <= R; dy++) {
       const int jy = iy + dy;
       if (jy < 0 || jy >= nb->ny) continue;
-      const size_t row = (size_t)jz * nb->ny + jy;
       if (inner) {
-        const size_t c0 = row * nb->nxo + lc;
-        r[n++] = (struct cand_range){nb->start[c0 - R], nb->start[c0 + R + 1], 0.0, sz, jy, jz};
+        const size_t c0 = nbr_local_cell(nb, lc - R, jy, izl + dz);
+        r[n++] = (struct cand_range){nb->start[c0], nb->start[c0 + 2 * R + 1], 0.0, sz, jy, jz};
         continue;
       }
       for (int dx = -R; dx <= R; dx++) {
-        double sx;
-        const int col = stencil_column(nb, lc, dx, &sx);
-        const size_t cc =
-            col >= 0 ? row * nb->nxo + col : nb->ncell_own + row * 2 * nb->halo + (-1 - col);
+        const size_t cc = nbr_local_cell(nb, lc + dx, jy, izl + dz);
+        const double sx = stencil_shift(gx + dx, nb->nx, nb->lx);
         r[n++] = (struct cand_range){nb->start[cc], nb->start[cc + 1], sx, sz, jy, jz};
       }
     }

@@ -37,20 +37,40 @@ struct nbr_block {
 };
 
 /**
+ * The part of the global cell grid a rank owns: the columns ix0 .. ix0+nxo-1 along x and the
+ * planes iz0 .. iz0+nzo-1 along z (every row along y), with hx halo columns on each side along
+ * x and hz halo planes on each side along z (0: the rank owns the whole direction, and the
+ * periodic wrap is inside its grid).
+ */
+struct nbr_range {
+  int ix0, nxo, hx;
+  int iz0, nzo, hz;
+};
+
+/**
  * Cell grid and neighbour list. The grid is global (cells of the whole channel, column ix
- * along x, row iy, plane iz); a rank owns the columns ix0 .. ix0+nxo-1 and, with several ranks,
- * keeps `halo` columns of ghosts on each side. Local cell numbers: the owned cells first,
- * (iz * ny + iy) * nxo + (ix - ix0), then the halo cells, ncell_own + (iz * ny + iy) * 2 halo + h
- * with h < halo for the left halo and h >= halo for the right one. The stencil of a particle
- * visits the same global cells in the same order on any decomposition, and the particles of a
- * cell are ordered by id, so neighbour sums are bitwise independent of the number of ranks.
+ * along x, row iy, plane iz); a rank owns a block of it (struct nbr_range). Local cell numbers:
+ *  - the owned cells first, (izl * ny + iy) * nxo + lc, lc = ix - ix0, izl = iz - iz0;
+ *  - then the x halo: ncell_own + (izl * ny + iy) * 2 hx + h, h < hx for the columns below the
+ *    block (column ix0 - hx + h), h >= hx for those above it (ix0 + nxo + h - hx);
+ *  - then the z halo, the planes below the block (s = 0, plane iz0 - hz + k) and above it (s =
+ *    1, plane iz0 + nzo + k), each over the block's columns and its x halo:
+ *    ncell_own + nzo ny 2 hx + ((s hz + k) ny + iy) nxe + ixe, ixe = ix - ix0 + hx < nxe =
+ *    nxo + 2 hx.
+ * The halo cells are filled in this order (dd_halo: the x halo, then the z halo with its
+ * corners taken from the neighbours' x halo). The stencil of a particle visits the same global
+ * cells in the same order on any decomposition, and the particles of a cell are ordered by id,
+ * so neighbour sums are bitwise independent of the number of ranks.
  */
 struct nbr {
   int dim;
   int nx, ny, nz;      /*!< cells per direction (global) */
   int ix0, nxo;        /*!< owned columns: ix0 .. ix0 + nxo - 1 */
-  int halo;            /*!< halo columns on each side (0: one rank, periodic wrap in the grid) */
+  int hx;              /*!< halo columns on each side (0: x not cut, periodic wrap in the grid) */
+  int iz0, nzo;        /*!< owned planes: iz0 .. iz0 + nzo - 1 */
+  int hz;              /*!< halo planes on each side (0: z not cut) */
   size_t ncell_own;    /*!< owned cells */
+  size_t ncell_x;      /*!< owned + x halo cells (the first z halo cell) */
   double lx, ly, lz;   /*!< domain lengths [m] (ly = 2 delta) */
   double cx, cy, cz;   /*!< inverse cell sizes [1/m] */
   double support2;     /*!< (2h)^2 [m^2] */
@@ -90,18 +110,20 @@ int nbr_columns(const struct scene *s);
     neighbours within 2h, plus 8, rounded up to the alignment). */
 int nbr_stride(const struct scene *s);
 
+/** @brief The whole grid of a scene on one rank (no halo). */
+struct nbr_range nbr_whole(const struct scene *s);
+
 /**
  * @brief Set up the cell grid for a domain.
  * @param[out] nb neighbour structure
  * @param[in] s scene
  * @param[in] n particle slots (grown later by nbr_reserve)
- * @param[in] ix0,nxo owned columns (0 and nbr_columns(s) on one rank)
- * @param[in] halo halo columns on each side (0 on one rank, else NBR_REACH)
+ * @param[in] r this rank's block (nbr_whole(s) on one rank)
  */
-void nbr_init(struct nbr *nb, const struct scene *s, size_t n, int ix0, int nxo, int halo);
+void nbr_init(struct nbr *nb, const struct scene *s, size_t n, const struct nbr_range *r);
 
-/** @brief Change the owned columns (after a re-partition); the particles must be sorted again. */
-void nbr_set_range(struct nbr *nb, int ix0, int nxo, int halo);
+/** @brief Change the owned block (after a re-partition); the particles must be sorted again. */
+void nbr_set_range(struct nbr *nb, const struct nbr_range *r);
 
 /** @brief Make the per-particle arrays hold at least n slots. */
 void nbr_reserve(struct nbr *nb, size_t n);
@@ -110,6 +132,19 @@ void nbr_reserve(struct nbr *nb, size_t n);
 static inline int nbr_column(const struct nbr *nb, double x) {
   const int ix = (int)fmin(fmax(x * nb->cx, 0.0), nb->nx);
   return ix < 0 ? 0 : ix >= nb->nx ? nb->nx - 1 : ix;
+}
+
+/** @brief Global plane of the position z (already wrapped into [0, lz); 0 in 2-D). */
+static inline int nbr_plane(const struct nbr *nb, double z) {
+  if (nb->dim != 3) return 0;
+  const int iz = (int)fmin(fmax(z * nb->cz, 0.0), nb->nz);
+  return iz < 0 ? 0 : iz >= nb->nz ? nb->nz - 1 : iz;
+}
+
+/** @brief Global pencil (column and plane: every cell along y) of a position, x-major:
+    ix nz + iz. */
+static inline int nbr_pencil(const struct nbr *nb, double x, double z) {
+  return nbr_column(nb, x) * nb->nz + nbr_plane(nb, z);
 }
 
 /** @brief Wrap x (and z in 3-D) of particle a into the periodic box. */
@@ -136,17 +171,37 @@ void nbr_free(struct nbr *nb);
 void nbr_sort(struct nbr *nb, struct particles *P);
 
 /**
- * @brief Set the ranges of the halo cells (start[]) for ghosts that take the slots from n_owned
- *        on in halo cell order: cnt[0] holds the particles of the left halo's cells, row by row
- *        (row = iz * ny + iy) and halo column by column (row * halo + h), cnt[1] the right
- *        halo's. The neighbours send their edge cells in this order with their particles in id
- *        order (dd_halo), so the ghosts need no sort.
+ * @brief Set the ranges of the halo cells of one direction (dir 0: x, 1: z; the x halo first)
+ *        for ghosts that take the slots from `first` on in halo cell order: cnt[0] holds the
+ *        particles of each cell of the halo below the block, cnt[1] of the one above it, in
+ *        the order of the local cell numbers (nbr above: x, (izl * ny + iy) * hx + h; z,
+ *        (k * ny + iy) * nxe + ixe). The neighbours send their edge cells in this order with
+ *        their particles in id order (dd_halo), so the ghosts need no sort.
+ * @return the slot after the last ghost of this direction
  */
-void nbr_halo_cells(struct nbr *nb, size_t n_owned, const uint32_t *const cnt[2]);
+size_t nbr_halo_cells(struct nbr *nb, int dir, size_t first, const uint32_t *const cnt[2]);
 
-/** @brief Owned cells of local column lc (0 .. nxo-1): cell (iz * ny + iy) * nxo + lc. */
-static inline size_t nbr_owned_cell(const struct nbr *nb, int lc, int iy, int iz) {
-  return ((size_t)iz * nb->ny + iy) * nb->nxo + lc;
+/**
+ * @brief Local cell of the cell (lc, iy, izl) of the block's extended grid: lc in
+ *        [-hx, nxo + hx), izl in [-hz, nzo + hz) (with hx or hz = 0 the direction wraps
+ *        inside the grid: any lc, izl); owned, x halo or z halo.
+ */
+static inline size_t nbr_local_cell(const struct nbr *nb, int lc, int iy, int izl) {
+  if (!nb->hx) lc = (lc % nb->nx + nb->nx) % nb->nx;
+  if (!nb->hz) izl = (izl % nb->nz + nb->nz) % nb->nz;
+  if (izl >= 0 && izl < nb->nzo) {
+    if (lc >= 0 && lc < nb->nxo) return ((size_t)izl * nb->ny + iy) * nb->nxo + lc;
+    const int h = lc < 0 ? lc + nb->hx : nb->hx + lc - nb->nxo;
+    return nb->ncell_own + ((size_t)izl * nb->ny + iy) * 2 * nb->hx + h;
+  }
+  const int sk = izl < 0 ? izl + nb->hz : nb->hz + izl - nb->nzo; /* s hz + k */
+  return nb->ncell_x + ((size_t)sk * nb->ny + iy) * (nb->nxo + 2 * nb->hx) + (lc + nb->hx);
+}
+
+/** @brief Owned cell of local column lc (0 .. nxo-1) and local plane izl (0 .. nzo-1):
+    (izl * ny + iy) * nxo + lc. */
+static inline size_t nbr_owned_cell(const struct nbr *nb, int lc, int iy, int izl) {
+  return ((size_t)izl * nb->ny + iy) * nb->nxo + lc;
 }
 
 /**

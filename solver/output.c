@@ -421,6 +421,22 @@ static int write_stats(struct output *o, const struct sim *S) {
   return agree(rc);
 }
 
+/* The decomposition at the start: Px x Pz blocks, their sizes and the ghosts per rank against
+   the owned particles' cells (the halo's volume: what the exchange moves). */
+static void log_blocks(struct output *o, const struct sim *S) {
+  const struct dd *d = &S->dd;
+  const int R = NBR_REACH, hx = d->px > 1 ? R : 0, hz = d->pz > 1 ? R : 0;
+  const double nxo = (double)d->ncol / d->px, nzo = (double)d->nplane / d->pz;
+  const double ghosts = 2.0 * hx * nzo + 2.0 * hz * (nxo + 2.0 * hx);
+  output_log(o,
+             "decomposition: %d MPI ranks as %d x %d blocks (x by z) of %d-%d columns and %d-%d "
+             "planes of the %d x %d cell pencils; halo %.0f pencils a rank, ghosts / owned "
+             "%.2f (run.ranks)\n",
+             d->size, d->px, d->pz, d->ncol / d->px, (d->ncol + d->px - 1) / d->px,
+             d->nplane / d->pz, (d->nplane + d->pz - 1) / d->pz, d->ncol, d->nplane, ghosts,
+             ghosts / (nxo * nzo));
+}
+
 void output_begin(struct output *o, struct sim *S) {
   struct diag d;
   record(o, S, &d);
@@ -436,10 +452,7 @@ void output_begin(struct output *o, struct sim *S) {
              "memory: the large allocations need at least %.4g GB per rank (checked before "
              "the start against 80%% of the machine's memory)\n",
              sim_memory_estimate(S->sc) / 1e9);
-  if (S->dd.size > 1)
-    output_log(o, "decomposition: %d MPI ranks, slabs of %d-%d of the %d cell columns along x\n",
-               S->dd.size, S->dd.ncol / S->dd.size, (S->dd.ncol + S->dd.size - 1) / S->dd.size,
-               S->dd.ncol);
+  if (S->dd.size > 1) log_blocks(o, S);
   warn_settings(o, S);
   log_progress(o, S, &d);
 }
@@ -475,7 +488,7 @@ void output_sample(struct output *o, struct sim *S) {
     o->col = mem_alloc(1, o->col_cap * sizeof *o->col, "output");
     if (!o->col) die("out of memory for the statistics snapshot");
   }
-  for (size_t a = 0; a < P->n; a++) o->col[a] = nbr_column(&S->nb, P->x[a]);
+  for (size_t a = 0; a < P->n; a++) o->col[a] = nbr_pencil(&S->nb, P->x[a], P->z[a]);
   const struct stats_snapshot snap = {
       .n = P->n,
       .x = P->x,
@@ -504,9 +517,14 @@ void output_sample(struct output *o, struct sim *S) {
       .wall_fx = {P->sx_live ? S->wall_fx[0] : NAN, P->sx_live ? S->wall_fx[1] : NAN},
       .col = o->col,
       .ncol = S->dd.ncol,
-      .col0 = S->dd.first[S->dd.rank],
-      .col1 = S->dd.first[S->dd.rank + 1],
-      .comm = MPI_COMM_WORLD};
+      .nplane = S->dd.nplane,
+      .col0 = S->nb.ix0,
+      .col1 = S->nb.ix0 + S->nb.nxo,
+      .plane0 = S->nb.iz0,
+      .plane1 = S->nb.iz0 + S->nb.nzo,
+      .comm = MPI_COMM_WORLD,
+      .comm_x = S->dd.comm_x,
+      .comm_z = S->dd.comm_z};
   stats_sample(&o->st, &snap);
   timer_pop();
   struct euler_target tg;
@@ -533,14 +551,16 @@ void output_sample(struct output *o, struct sim *S) {
 static void log_rebalance(struct output *o, const struct sim *S) {
   if (S->dd.rebalances == o->rebalances) return;
   const struct dd *dd = &S->dd;
-  char cols[256] = "";
-  for (int r = 0, k = 0; r < dd->size && k < (int)sizeof cols - 16; r++)
-    k += snprintf(cols + k, sizeof cols - (size_t)k, "%s%d", r ? " " : "",
-                  dd->first[r + 1] - dd->first[r]);
+  char cols[256] = "", planes[256] = "";
+  for (int r = 0, k = 0; r < dd->px && k < (int)sizeof cols - 16; r++)
+    k += snprintf(cols + k, sizeof cols - (size_t)k, "%s%d", r ? " " : "", dd->fx[r + 1] - dd->fx[r]);
+  for (int r = 0, k = 0; r < dd->pz && k < (int)sizeof planes - 16; r++)
+    k += snprintf(planes + k, sizeof planes - (size_t)k, "%s%d", r ? " " : "",
+                  dd->fz[r + 1] - dd->fz[r]);
   output_log(o,
              "load balance: step %ld, imbalance %.3f (max / mean particles per rank): "
-             "columns per rank now %s\n",
-             S->step, dd->imbalance, cols);
+             "columns per block column now %s, planes per block row %s\n",
+             S->step, dd->imbalance, cols, planes);
   o->rebalances = dd->rebalances;
 }
 
@@ -621,10 +641,10 @@ static void log_decomposition(struct output *o, struct sim *S, double wall) {
   CHECK_MPI(MPI_Allreduce(x, mx, 3, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD));
   CHECK_MPI(MPI_Allreduce(x, sum, 3, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD));
   output_log(o,
-             "decomposition: %d ranks, %d cell columns; halo exchange and migration %.3f s "
+             "decomposition: %d ranks (%d x %d blocks), %d x %d cell pencils; halo exchange and migration %.3f s "
              "(max over ranks, %.1f%% of the wall time); %.2f MB sent in all; %.0f particles "
              "migrated; %ld re-partitions (last imbalance %.3f)\n",
-             d->size, d->ncol, mx[0], wall > 0 ? 100.0 * mx[0] / wall : 0.0, sum[1] / 1048576.0,
+             d->size, d->px, d->pz, d->ncol, d->nplane, mx[0], wall > 0 ? 100.0 * mx[0] / wall : 0.0, sum[1] / 1048576.0,
              sum[2], d->rebalances, d->imbalance);
 }
 

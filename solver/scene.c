@@ -507,10 +507,16 @@ static const struct key keys[] = {
      "With several MPI ranks: steps between checks of the particles per rank (0 = never "
      "re-partition). Results do not depend on the partition (docs/parallel.md).",
      OFF(balance_every)},
+    {"run", "ranks", T_LIST, "", 1, 1e6, 0, NULL, "-",
+     "Px,Pz: the MPI ranks as Px x Pz blocks of whole cell pencils (Px along x, Pz along z; "
+     "Px Pz = the ranks; each block at least 4 cells of size h along a cut direction); empty = "
+     "the factorisation with the fewest ghosts per rank (logged). Results do not depend on it "
+     "(docs/parallel.md).",
+     OFF(ranks)},
     {"run", "partition", T_LIST, "", 1, 1e9, 0, NULL, "columns",
-     "Cell columns per rank at the start (up to 8 ranks, summing to the columns of the grid, "
-     "each at least 4); empty = an even split. The load balance may move the cuts later; the "
-     "results do not depend on them.",
+     "Slabs only (Pz = 1): cell columns per rank at the start (up to 8 ranks, summing to the "
+     "columns of the grid, each at least 4); empty = an even split. The load balance may move "
+     "the cuts later; the results do not depend on them.",
      OFF(partition)},
     {"run", "check_ids", T_INT, "0", 0, 1, 0, NULL, "-",
      "Debug mode: after every step gather all particle ids on rank 0 and check that each id "

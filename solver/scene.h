@@ -165,6 +165,7 @@ struct scene {
   int balance_every;           /*!< steps between load-balance checks (MPI) */
   int check_ids;               /*!< debug: check every step that each id is on exactly one rank */
   struct scene_list partition; /*!< cell columns per rank at the start (empty: even split) */
+  struct scene_list ranks;     /*!< Px, Pz blocks (empty: the factorisation with fewest ghosts) */
   double balance_threshold;    /*!< re-partition above (1 + this) x mean particles per rank */
   /* [checkpoint] */
   long ckpt_every_steps;     /*!< steps between checkpoints; 0 = not by steps */

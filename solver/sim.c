@@ -178,13 +178,13 @@ int sim_create(struct sim *S, const struct scene *sc) {
   return CHANSPH_OK;
 }
 
-/* Partition the columns over the ranks, keep this rank's particles, set up the grid. From a
+/* Partition the grid's pencils over the ranks (blocks), keep this rank's particles, set up the grid. From a
    checkpoint read on several ranks (block = 1), this rank holds the slots of its id block
    (sim_state), which migrate to their owners. */
 static int sim_distribute(struct sim *S, int block) {
   if (dd_init(&S->dd, S->sc, sim_reserve, S)) return CHANSPH_ERR;
-  const int ix0 = S->dd.first[S->dd.rank], nxo = S->dd.first[S->dd.rank + 1] - ix0;
-  nbr_init(&S->nb, S->sc, 0, ix0, nxo, S->dd.halo); /* sized below, for this rank's part */
+  const struct nbr_range r = dd_range(&S->dd);
+  nbr_init(&S->nb, S->sc, 0, &r); /* sized below, for this rank's part */
   if (block && S->dd.size > 1) {
     size_t lo, hi;
     sim_id_block(S->dd.rank, S->dd.size, S->P.n_fluid + S->P.n_vertex, &lo, &hi);

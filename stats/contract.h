@@ -38,10 +38,12 @@ enum { STATS_ACC = 3 * STATS_PARTS };
  * One snapshot of the particles, as plain arrays (the engine never sees solver structs).
  *
  * Across MPI ranks (docs/stats-format.md, "Statistics across ranks"): the arrays hold this
- * rank's owned particles; particle a lies in global cell column col[a] in [col0, col1); the
- * ranks of comm own contiguous column ranges in rank order covering 0 .. ncol - 1; within a
- * column the particles appear in the same order on any decomposition; the scalars are the
- * same on all ranks. The engine state then comes out bitwise identical on every rank and for
+ * rank's owned particles, a block of the grid's pencils: columns [col0, col1) by planes
+ * [plane0, plane1); particle a lies in the global pencil col[a]; the ranks of a block row
+ * (comm_x, or comm without plane cuts) own contiguous column ranges in rank order covering
+ * 0 .. ncol - 1, those of a block column (comm_z) contiguous plane ranges in rank order; within
+ * a column the particles appear plane by plane in the same order on any decomposition; the
+ * scalars are the same on all ranks. The engine state then comes out bitwise identical on every rank and for
  * any number of ranks. col = NULL puts every particle in column col0; with ncol = 0 as well
  * (the layout left unset by an initialiser) the layout is one rank owning column 0.
  * comm = MPI_COMM_NULL (or left zero by an initialiser, or MPI not initialised) is serial and
@@ -72,10 +74,18 @@ struct stats_snapshot {
   long step;              /*!< step number */
   double wall_fx[2];      /*!< x-force of the walls y = 0, 2 delta on the fluid [N];
                                NaN if unknown */
-  const int *col;         /*!< global cell column of each particle, or NULL (all in col0) */
+  const int *col;         /*!< global cell pencil of each particle, ix nplane + iz (the cell
+                               column ix when nplane <= 1), or NULL (all in col0) */
   int ncol;               /*!< global cell columns along x (0 with col = NULL: serial) */
   int col0, col1;         /*!< this rank's columns [col0, col1) */
+  int nplane;             /*!< global cell planes along z (0 or 1: the columns are not cut) */
+  int plane0, plane1;     /*!< this rank's planes [plane0, plane1) (with nplane > 1) */
   MPI_Comm comm;          /*!< ranks sharing the snapshot; MPI_COMM_NULL: serial */
+  MPI_Comm comm_x;        /*!< with nplane > 1 and the planes cut: the ranks of this rank's
+                               block row (the same planes), ordered by column; else
+                               MPI_COMM_NULL (then comm is the row) */
+  MPI_Comm comm_z;        /*!< the ranks of this rank's block column (the same columns),
+                               ordered by plane; MPI_COMM_NULL: the planes are not cut */
 };
 
 /**

@@ -50,12 +50,20 @@ void corr_free(struct corr *c) {
   memset(c, 0, sizeof *c);
 }
 
-/* One particle of a slab: sort key (plane, local column, grid point), memory position, values. */
+/* One particle of a slab: sort key (plane, local pencil, grid point), memory position, values. */
 struct hit {
   uint64_t key;
   size_t a;
   double u, v, w;
 };
+
+/* Gathered entries in the order (pencil, plane and grid point): for each grid point the
+   pencils' partials in global pencil order, on any decomposition. */
+static int ent_cmp(const void *pa, const void *pb) {
+  const double *x = pa, *y = pb;
+  if (x[5] != y[5]) return x[5] < y[5] ? -1 : 1;
+  return x[0] < y[0] ? -1 : x[0] > y[0];
+}
 
 static int hit_cmp(const void *pa, const void *pb) {
   const struct hit *x = pa, *y = pb;
@@ -63,8 +71,8 @@ static int hit_cmp(const void *pa, const void *pb) {
   return x->a < y->a ? -1 : x->a > y->a;
 }
 
-/* Bin the gathered partials of plane pl onto the grid in the order they were gathered (column
-   order for each grid point), remove the plane means, transform, and add the spectra to level
+/* Bin the gathered partials of plane pl onto the grid in their order (pencil order for each
+   grid point), remove the plane means, transform, and add the spectra to level
    l. Returns 0 if the slab holds no particle. */
 static int add_plane(struct corr *c, int l, size_t pl, const double *E, size_t ne) {
   const int nx = c->cfg.nx, nz = c->cfg.nz;
@@ -130,6 +138,8 @@ void corr_sample(struct corr *c, const struct stats_snapshot *s) {
   struct spar par;
   spar_open(&par, s);
   const uint64_t ncl = (uint64_t)(par.col1 - par.col0);
+  const uint64_t nzl = s->nplane > 1 ? (uint64_t)(s->plane1 - s->plane0) : 1; /* local planes */
+  const int plane0 = s->nplane > 1 ? s->plane0 : 0;
   size_t nh = 0;
   for (size_t a = 0; a < s->n; a++) {
     if (s->skip && s->skip[a]) continue;
@@ -143,14 +153,16 @@ void corr_sample(struct corr *c, const struct stats_snapshot *s) {
         c->hits = mem_realloc(c->hits, c->hits_cap, sizeof(struct hit), "statistics engine");
       }
       struct hit *h = (struct hit *)c->hits + nh++;
-      h->key = ((uint64_t)pl * ncl + (uint64_t)spar_lcol(&par, s, a)) * np + q;
+      const uint64_t lpen = (uint64_t)spar_lcol(&par, s, a) * nzl +
+                            (uint64_t)(spar_plane(&par, s, a) - plane0); /* local pencil */
+      h->key = ((uint64_t)pl * ncl * nzl + lpen) * np + q;
       h->a = a, h->u = s->u[a], h->v = mir[pl] ? -s->v[a] : s->v[a], h->w = s->w[a];
     }
   }
   struct hit *H = c->hits;
   if (nh) qsort(H, nh, sizeof *H, hit_cmp);
-  /* 2. per-(plane, column, grid point) partial sums in that order: [plane np + q, sums of u v
-     w, count] */
+  /* 2. per-(plane, pencil, grid point) partial sums in that order: [plane np + q, sums of u v
+     w, count, global pencil] */
   size_t ne = 0;
   for (size_t i = 0; i < nh;) {
     if (ne == c->ent_cap) {
@@ -158,14 +170,18 @@ void corr_sample(struct corr *c, const struct stats_snapshot *s) {
       c->ent = mem_realloc(c->ent, c->ent_cap * CORR_ENT, sizeof(double), "statistics engine");
     }
     double *e = c->ent + ne++ * CORR_ENT;
-    const uint64_t key = H[i].key, pl = key / (ncl * np), q = key % np;
+    const uint64_t key = H[i].key, pl = key / (ncl * nzl * np), q = key % np;
+    const uint64_t lpen = key / np % (ncl * nzl);
     e[0] = (double)(pl * np + q), e[1] = e[2] = e[3] = e[4] = 0.0;
+    e[5] = (double)((uint64_t)(par.col0 + (int)(lpen / nzl)) * (uint64_t)par.nplane +
+                    (uint64_t)plane0 + lpen % nzl);
     for (; i < nh && H[i].key == key; i++)
       e[1] += H[i].u, e[2] += H[i].v, e[3] += H[i].w, e[4] += 1.0;
   }
-  /* 3. every rank's partials on every rank, in rank (= column) order */
+  /* 3. every rank's partials on every rank, in pencil order */
   c->nall = spar_gather_var(&par, c->ent, ne, CORR_ENT, &c->all, &c->all_cap);
   spar_close(&par);
+  if (c->nall) qsort(c->all, c->nall, CORR_ENT * sizeof(double), ent_cmp);
   /* 4. the planes, identical on every rank */
   for (size_t pl = 0; pl < npl; pl++) add_plane(c, lev[pl], pl, c->all, c->nall);
 }

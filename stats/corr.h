@@ -80,7 +80,7 @@ static inline size_t corr_rows(const struct corr *c) {
 }
 
 /** A per-(plane, column, grid point) partial sum: plane np + grid point, sums of u v w, count. */
-enum { CORR_ENT = 5 };
+enum { CORR_ENT = 6 };
 
 /** @brief Set up (allocates only if n_levels > 0). */
 void corr_init(struct corr *c, const struct corr_config *cfg);

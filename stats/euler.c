@@ -591,10 +591,11 @@ static double *merge_columns(struct euler *e, struct spar *par) {
   }
   for (size_t i = 0; i < nmine; i++)
     node_record(k, nb, k->node[2 * i], k->node[2 * i + 1], NULL, 0, 0, k->mine + i * len);
-  /* 3. all subtrees on every rank (rank order is column order), merged up to the root */
-  const size_t nall = spar_gather_var(par, k->mine, nmine, len, &k->all, &k->all_cap);
+  /* 3. all subtrees on every rank of the block row (rank order is column order), merged up to
+     the root */
+  const size_t nall = spar_gather_row(par, k->mine, nmine, len, &k->all, &k->all_cap);
   size_t nn = 0;
-  for (int r = 0; r < par->size; r++)
+  for (int r = 0; r < par->xsize; r++)
     subtrees(k, &nn, 0, par->ncol, par->range[2 * r], par->range[2 * r + 1]);
   if (nn != nall) die("statistics: %zu column subtrees gathered, %zu expected", nall, nn);
   node_record(k, nb, 0, (int)ncol, k->all, nn, 0, k->mine);
@@ -625,9 +626,12 @@ void euler_sample(struct euler *e, const struct stats_snapshot *s) {
     k->part_cap = ncol;
   }
   double *mine = k->part + (size_t)par.col0 * len;
-  memset(mine, 0, (size_t)(par.col1 - par.col0) * len * sizeof(double));
+  const size_t nmine = (size_t)(par.col1 - par.col0) * len;
+  memset(mine, 0, nmine * sizeof(double));
+  spar_chain_begin(&par, mine, nmine); /* planes cut: the columns' partials from below */
   for (size_t a = 0; a < s->n; a++)
     if (!s->skip || !s->skip[a]) add_particle(e, s, a, mine + (size_t)spar_lcol(&par, s, a) * len);
+  spar_chain_end(&par, mine, nmine);
   const double *snap = merge_columns(e, &par); /* 2, 3: every bin of the snapshot */
   spar_close(&par);
   for (size_t b = 0; b < nb; b++) {

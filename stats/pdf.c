@@ -116,6 +116,7 @@ static void pdf_snapshot(struct pdf *p, const struct stats_snapshot *s, double *
   spar_open(&par, s);
   const size_t ncl = (size_t)(par.col1 - par.col0);
   pdf_scratch(p, ncl, npl);
+  spar_chain_begin(&par, p->ent, ncl * p->rec); /* planes cut: the columns' sums from below */
   for (size_t a = 0; a < s->n; a++) {
     if (s->skip && s->skip[a]) continue;
     double *e = p->ent + (size_t)spar_lcol(&par, s, a) * p->rec;
@@ -126,7 +127,8 @@ static void pdf_snapshot(struct pdf *p, const struct stats_snapshot *s, double *
         pdf_add_particle(p, s, a, 2 * (size_t)l + 1, 1, e);
     }
   }
-  const size_t ncol = spar_gather_var(&par, p->ent, ncl, p->rec, &p->all, &p->all_cap);
+  spar_chain_end(&par, p->ent, ncl * p->rec);
+  const size_t ncol = spar_gather_row(&par, p->ent, ncl, p->rec, &p->all, &p->all_cap);
   memset(sums, 0, p->rec * sizeof(double));
   for (size_t k = 0; k < ncol; k++)
     for (size_t i = 0; i < p->rec; i++) sums[i] += p->all[k * p->rec + i];

@@ -57,6 +57,7 @@ static void plane_sums(struct quad *q, const struct stats_snapshot *s, struct sp
     q->ent = mem_realloc(q->ent, q->ent_cap, sizeof(double), "quadrant engine");
   }
   memset(q->ent, 0, ncl * rec * sizeof(double));
+  spar_chain_begin(par, q->ent, ncl * rec); /* planes cut: the columns' sums from below */
   for (size_t a = 0; a < s->n; a++) {
     if (s->skip && s->skip[a]) continue;
     for (int pl = 0; pl < npl; pl++) {
@@ -72,7 +73,8 @@ static void plane_sums(struct quad *q, const struct stats_snapshot *s, struct sp
       e[QS_UV + k] += du * dv, e[QS_N + k] += 1.0;
     }
   }
-  const size_t ncol = spar_gather_var(par, q->ent, ncl, rec, &q->all, &q->all_cap);
+  spar_chain_end(par, q->ent, ncl * rec);
+  const size_t ncol = spar_gather_row(par, q->ent, ncl, rec, &q->all, &q->all_cap);
   memset(out, 0, rec * sizeof(double));
   for (size_t c = 0; c < ncol; c++)
     for (size_t i = 0; i < rec; i++) out[i] += q->all[c * rec + i];

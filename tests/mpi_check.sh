@@ -13,9 +13,17 @@
 #              checked after every step: 2 ranks equal 1 rank
 #   damper     fast 2-D flow with the acoustic damper and the delta-SPH diffusion, 200 steps,
 #              ids checked after every step: 2 ranks equal 1 rank
-#   too_many   more ranks than the slabs allow: a message naming domain.lx, exit 1
+#   too_many   more ranks than the blocks allow: a message naming domain.lx and domain.lz, exit 1
 #   resume_too_many  a 1-rank checkpoint resumed on more ranks than its slabs allow: the same
 #                    message, exit 1, the checkpoints untouched
+#   blocks     x-z blocks (run.ranks = Px,Pz) of 2-4 ranks, and 2 x 2 with 2 threads: equal 1 rank
+#   blocks_many      the same on 6, 8, 9, 12 and 16 ranks (every factorisation that fits), 4 x 4
+#                    with 2 threads
+#   blocks_resume    a checkpoint of 2 x 2 resumed on 1, 3 x 1, 1 x 3 and 2 x 2: each equals the
+#                    uninterrupted 1-rank run; on 3 ranks with its run.ranks: exit 1, nothing written
+#   blocks_resume_many  the same from 4 x 2 to 1, 3 x 1, 2 x 3
+#   blocks_kill      3 x 2 blocks, SIGKILL of one rank at random moments (checkpoints every 4
+#                    steps), resumed each time: equals the uninterrupted 1-rank run
 #   ckpt_resume      3-D LES: 100 steps on 2 ranks (parallel HDF5 checkpoint), resumed on 3 ranks
 #                    and on 1 rank to step 200; both equal the uninterrupted 1-rank run
 #   ckpt_write_fail  2 ranks under a file-size limit: exit 74, a message, previous checkpoint
@@ -191,10 +199,10 @@ case $case in
     ;;
   too_many)
     if mpi 4 run "$scenes/les395_smoke.ini" --out r4 --overwrite > r4.txt 2>&1; then
-      echo "FAIL: 4 ranks on 9 columns were accepted"
+      echo "FAIL: 4 ranks on 9 columns and 6 planes were accepted"
       exit 1
     fi
-    grep -q "key 'domain.lx': lx = 1.2 gives 9 cell columns .* 4 MPI ranks need at least 16 .* at most 2 ranks" r4.txt ||
+    grep -q "keys 'domain.lx', 'domain.lz': 9 cell columns and 6 planes .* at most 2 x 1 = 2 ranks; this run has 4" r4.txt ||
       { cat r4.txt; echo "FAIL: message"; exit 1; }
     [ ! -e r4/stats.nc ] || { echo "FAIL: output written"; exit 1; }
     echo "ok: $(grep -h "domain.lx" r4.txt | head -1)"
@@ -206,10 +214,99 @@ case $case in
     mpi 4 resume r1 > r4.txt 2>&1
     rc=$?
     [ $rc -eq 1 ] || { cat r4.txt; echo "FAIL: resume on 4 ranks: exit $rc, expected 1"; exit 1; }
-    grep -q "key 'domain.lx': lx = 1 gives 15 cell columns .* 4 MPI ranks need at least 16 .* at most 3 ranks" r4.txt ||
+    grep -q "key 'domain.lx': 15 cell columns .* a slab needs at least 4, so at most 3 ranks; this run has 4" r4.txt ||
       { cat r4.txt; echo "FAIL: message"; exit 1; }
     [ "$before" = "$(ls r1/checkpoints)" ] || { echo "FAIL: the checkpoints changed"; exit 1; }
     echo "ok: $(grep -h "domain.lx" r4.txt | head -1)"
+    ;;
+  blocks | blocks_many) # x-z blocks: every Px x Pz equals 1 rank, bitwise (stats.nc, particles.nc, checkpoint)
+    scene=$scenes/les395_smoke.ini
+    if [ "$case" = blocks ]; then # 18 x 12 pencils
+      lz=1.6 layouts="1,2 1,3 2,2"
+    else # 18 x 16 pencils: 6, 8, 9, 12 and 16 ranks
+      lz=2.2 layouts="3,2 2,3 4,2 2,4 3,3 4,3 3,4 4,4"
+    fi
+    args=(--set domain.lx=2.4 --set domain.lz=$lz --set time.max_steps=60 --set output.stats_every=5
+      "${all_engines[@]}")
+    mpi 1 run "$scene" --out r1 --overwrite "${args[@]}" > r1.txt 2>&1 || { tail r1.txt; echo "FAIL: 1 rank"; exit 1; }
+    for l in $layouts; do
+      np=$((${l%,*} * ${l#*,}))
+      mpi "$np" run "$scene" --out "r$l" --overwrite "${args[@]}" --set run.ranks=$l > "r$l.txt" 2>&1 ||
+        { tail "r$l.txt"; echo "FAIL: $l"; exit 1; }
+      grep -h "^decomposition: $np MPI ranks" "r$l/log.txt"
+      compare r1 "r$l" 60 noscene
+    done
+    l=2,2 # hybrid: blocks with 2 threads each
+    [ "$case" = blocks_many ] && l=4,4
+    np=$((${l%,*} * ${l#*,}))
+    OMP_NUM_THREADS=2 mpi "$np" run "$scene" --out "r${l}t2" --overwrite "${args[@]}" --set run.ranks=$l \
+      > "r${l}t2.txt" 2>&1 || { tail "r${l}t2.txt"; echo "FAIL: $l x 2 threads"; exit 1; }
+    compare r1 "r${l}t2" 60 noscene
+    ;;
+  blocks_resume | blocks_resume_many) # a checkpoint of one decomposition resumed on others
+    scene=$scenes/les395_smoke.ini
+    args=(--set domain.lx=2.4 --set domain.lz=1.6 --set time.max_steps=80 --set output.stats_every=5
+      "${all_engines[@]}")
+    if [ "$case" = blocks_resume ]; then
+      first=2,2 others="1 3,1 1,3"
+    else
+      first=4,2 others="1 3,1 2,3"
+      args+=(--set domain.lz=2.2)
+    fi
+    mpi 1 run "$scene" --out r1 --overwrite "${args[@]}" > r1.txt 2>&1 || { echo "FAIL: 1 rank"; exit 1; }
+    np=$((${first%,*} * ${first#*,}))
+    mpi "$np" run "$scene" --out rf --overwrite "${args[@]}" --set run.ranks=$first --max-steps 40 > rf.txt 2>&1
+    rc=$?
+    [ $rc -eq 75 ] || { tail rf.txt; echo "FAIL: the $first job exited with $rc, not 75"; exit 1; }
+    for l in $others; do
+      cp -a rf "rf_$l"
+      if [ "$l" = 1 ]; then
+        mpi 1 resume "rf_$l" --set run.ranks= > "rf_$l.txt" 2>&1
+      else
+        mpi $((${l%,*} * ${l#*,})) resume "rf_$l" --set run.ranks=$l > "rf_$l.txt" 2>&1
+      fi || { tail "rf_$l.txt"; echo "FAIL: resume of $first on $l"; exit 1; }
+      grep -h "resume: from" "rf_$l/log.txt" | tail -1
+      compare r1 "rf_$l" 80 noscene
+    done
+    # on the first layout again, without --set: the checkpoint's run.ranks
+    cp -a rf rf_same
+    mpi "$np" resume rf_same > rf_same.txt 2>&1 || { tail rf_same.txt; echo "FAIL: resume on $first"; exit 1; }
+    compare r1 rf_same 80 noscene
+    # a resume on a rank count that its run.ranks does not fit: exit 1, a message, nothing written
+    cp -a rf rf_bad
+    before=$(ls -l rf_bad/checkpoints)
+    mpi 3 resume rf_bad > rf_bad.txt 2>&1
+    rc=$?
+    [ $rc -eq 1 ] || { cat rf_bad.txt; echo "FAIL: resume of $first on 3 ranks: exit $rc, expected 1"; exit 1; }
+    grep -q "key 'run.ranks': Px x Pz differs from the ranks; this run has 3 MPI ranks" rf_bad.txt ||
+      { cat rf_bad.txt; echo "FAIL: message"; exit 1; }
+    [ "$before" = "$(ls -l rf_bad/checkpoints)" ] || { echo "FAIL: the checkpoints changed"; exit 1; }
+    echo "ok: $(grep -h "run.ranks" rf_bad.txt | head -1)"
+    ;;
+  blocks_kill) # SIGKILL of a rank at random moments (checkpoints every 4 steps), resumed each time
+    scene=$scenes/les395_smoke.ini
+    args=(--set domain.lx=2.4 --set domain.lz=1.6 --set time.max_steps=120 --set output.stats_every=5
+      --set checkpoint.every_steps=4 --set run.ranks=3,2 "${all_engines[@]}")
+    mpi 1 run "$scene" --out r1 --overwrite "${args[@]}" --set run.ranks= > r1.txt 2>&1 ||
+      { echo "FAIL: 1 rank"; exit 1; }
+    RANDOM=7
+    cmd=(run "$scene" --out rk --overwrite "${args[@]}")
+    kills=0 in_write=0
+    for k in 1 2 3 4 5 6; do
+      mpi 6 "${cmd[@]}" > "rk$k.txt" 2>&1 &
+      job=$!
+      sleep "$(printf '%d.%02d' $((2 + RANDOM % 3)) $((RANDOM % 100)))"
+      victim=$(pgrep -x chansph | shuf -n 1 --random-source=<(yes))
+      if [ -n "$victim" ] && kill -KILL "$victim" 2> /dev/null; then
+        kills=$((kills + 1))
+        ls rk/checkpoints/*.tmp > /dev/null 2>&1 && in_write=$((in_write + 1))
+      fi
+      wait $job
+      cmd=(resume rk)
+    done
+    mpi 6 resume rk > rk_end.txt 2>&1 || { tail rk_end.txt; echo "FAIL: the last resume"; exit 1; }
+    echo "killed $kills times ($in_write with a checkpoint file being written)"
+    compare r1 rk 120 noscene
     ;;
   ckpt_resume)
     scene=$scenes/les395_smoke.ini

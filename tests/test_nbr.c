@@ -89,7 +89,10 @@ static int run_case(const char *name, int n_set, char **set) {
     P.ddiff[a] = -2.0 * id - 0.25;
   }
   struct nbr nb;
-  nbr_init(&nb, &s, n, 0, nbr_columns(&s), 0);
+  {
+    const struct nbr_range whole = nbr_whole(&s);
+    nbr_init(&nb, &s, n, &whole);
+  }
   for (int round = 0; round < 2; round++) {
     fails += check_round(name, round, &s, &P, &nb);
     if (fails) break;
@@ -395,7 +398,10 @@ static int check_threads(const char *name, int n_set, char **set) {
     }
     part_permute(&P, 0, n, perm);
     struct nbr nb;
-    nbr_init(&nb, &s, n, 0, nbr_columns(&s), 0);
+    {
+    const struct nbr_range whole = nbr_whole(&s);
+    nbr_init(&nb, &s, n, &whole);
+  }
     for (int pass = 0; pass < 2; pass++) {
       int64_t *id = malloc(n * sizeof *id);
       size_t *start = malloc((nb.ncell_own + 1) * sizeof *start);

@@ -1,6 +1,6 @@
 /*
  * test_reduce.c: unit test of the deterministic sums: reduce_pairwise (solver/reduce.h) and the
- * per-column global sums dd_sum (solver/dd.h) over the particles of a 3-D channel lattice.
+ * per-pencil global sums dd_sum (solver/dd.h) over the particles of a 3-D channel lattice.
  *
  * Checks:
  *  - reduce_pairwise of 1e6 values spanning 16 decades, both signs (fixed-seed LCG), is within
@@ -90,7 +90,8 @@ int main(int argc, char **argv) {
   struct dd d;
   if (dd_init(&d, &sc, noop_reserve, NULL)) return 1;
   struct nbr nb;
-  nbr_init(&nb, &sc, P.n, 0, d.ncol, 0);
+  const struct nbr_range range = dd_range(&d);
+  nbr_init(&nb, &sc, P.n, &range);
   /* three fields of wide values, then a shuffle of positions (by id) and a re-sort */
   double *f[3];
   for (int k = 0; k < 3; k++) {
