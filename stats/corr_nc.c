@@ -478,50 +478,45 @@ int corr_nc_read(struct corr *c, int ncid, char *err, size_t errlen) {
 
 /* The engine's scene keys, section [correlations] (docs/scenes.md is generated from them). */
 static const struct scene_key_def key_y_plus = {
-    "correlations",
-    "y_plus",
-    SCENE_LIST,
-    "",
-    0,
-    SCENE_NO_BOUND,
-    SCENE_Y_PLUS,
-    NULL,
-    "-",
-    "Comma-separated y+ levels (up to 8) of the two-point correlations and 1-D spectra "
-    "(thesis Eq. 5.57-5.59); each level and its mirror 2 delta - y are sampled. Empty = off."};
+    .section = "correlations",
+    .name = "y_plus",
+    .type = SCENE_LIST,
+    .def = "",
+    .lo = 0,
+    .hi = SCENE_NO_BOUND,
+    .flags = SCENE_Y_PLUS,
+    .unit = "-",
+    .help =
+        "Comma-separated y+ levels (up to 8) of the two-point correlations and 1-D spectra "
+        "(thesis Eq. 5.57-5.59); each level and its mirror 2 delta - y are sampled. Empty = off."};
 static const struct scene_key_def key_nx = {
-    "correlations",
-    "nx",
-    SCENE_INT,
-    "0",
-    0,
-    1e6,
-    0,
-    NULL,
-    "-",
-    "Points of the plane grid along x (bin averages, Eq. 5.54-5.55); 0 = lx / dr."};
+    .section = "correlations",
+    .name = "nx",
+    .type = SCENE_INT,
+    .def = "0",
+    .lo = 0,
+    .hi = 1e6,
+    .unit = "-",
+    .help = "Points of the plane grid along x (bin averages, Eq. 5.54-5.55); 0 = lx / dr."};
 static const struct scene_key_def key_nz = {
-    "correlations",
-    "nz",
-    SCENE_INT,
-    "0",
-    0,
-    1e6,
-    0,
-    NULL,
-    "-",
-    "Points of the plane grid along z; 0 = lz / dr (1 in 2-D)."};
+    .section = "correlations",
+    .name = "nz",
+    .type = SCENE_INT,
+    .def = "0",
+    .lo = 0,
+    .hi = 1e6,
+    .unit = "-",
+    .help = "Points of the plane grid along z; 0 = lz / dr (1 in 2-D)."};
 static const struct scene_key_def key_thickness = {
-    "correlations",
-    "thickness",
-    SCENE_DOUBLE,
-    "1",
-    0,
-    100,
-    SCENE_LO_OPEN,
-    NULL,
-    "dr",
-    "Thickness of the slab of particles binned onto each plane, in units of dr."};
+    .section = "correlations",
+    .name = "thickness",
+    .type = SCENE_DOUBLE,
+    .def = "1",
+    .lo = 0,
+    .hi = 100,
+    .flags = SCENE_LO_OPEN,
+    .unit = "dr",
+    .help = "Thickness of the slab of particles binned onto each plane, in units of dr."};
 static const struct scene_key_def *const keys[] = {&key_y_plus, &key_nx, &key_nz, &key_thickness};
 
 /* The configuration from the scene; returns its number of levels (0: the engine does not run). */

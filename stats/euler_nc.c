@@ -298,146 +298,139 @@ fail:
 static const char *const names_stats_method[] = {"bins", "sph", NULL};
 static const char *const names_stats_target_profiles[] = {"both", "u_mean", "uv_peak", NULL};
 
-/* The engine's scene keys, section [stats] (docs/scenes.md is generated from them; the solver reads
- * some of them too, euler.h). */
+/* The engine's scene keys, section [stats] (docs/scenes.md is generated from them); exported
+   by euler.h, since the solver reads the switch, the budget interval, the window, u_tau_ref and
+   the convergence target too. */
 const struct scene_key_def euler_key_eulerian = {
-    "stats",
-    "eulerian",
-    SCENE_INT,
-    "1",
-    0,
-    1,
-    0,
-    NULL,
-    "-",
-    "Eulerian statistics: wall-normal profiles of means, Reynolds stresses, skewness, "
-    "flatness with standard errors, friction velocity and shear-stress balance "
-    "(docs/stats-format.md); sampled every output.stats_every steps from "
-    "output.t_average_start in output.n_bins bins."};
+    .section = "stats",
+    .name = "eulerian",
+    .type = SCENE_INT,
+    .def = "1",
+    .lo = 0,
+    .hi = 1,
+    .unit = "-",
+    .help =
+        "Eulerian statistics: wall-normal profiles of means, Reynolds stresses, skewness, "
+        "flatness with standard errors, friction velocity and shear-stress balance "
+        "(docs/stats-format.md); sampled every output.stats_every steps from "
+        "output.t_average_start in output.n_bins bins."};
 const struct scene_key_def euler_key_budget_every = {
-    "stats",
-    "budget_every",
-    SCENE_INT,
-    "5",
-    1,
-    1e9,
-    0,
-    NULL,
-    "samples",
-    "Every how many Eulerian samples also carries the momentum and Reynolds-stress budgets "
-    "and the wall shear stress (u_tau_wall): every stats.budget_every x output.stats_every "
-    "steps. A budget sample splits the pair forces into their conservative parts, which "
-    "costs about one more force pass (docs/performance.md, \"The budgets\"); 1 samples them "
-    "with every snapshot (the budget identity of every step needs 1 with output.stats_every "
-    "= 1). A short run through a transient needs 1 for its momentum budget to close: the "
-    "fluxes are averaged over the budget snapshots, the momentum change over their span, and "
-    "a few irregular snapshots miss it (the quick-start, t = 0-0.1 from a decelerating burst: "
-    "0.0087 u_tau^2 with 1, 0.058 with 5; jobs/scenes/quickstart.ini uses 1)."};
+    .section = "stats",
+    .name = "budget_every",
+    .type = SCENE_INT,
+    .def = "5",
+    .lo = 1,
+    .hi = 1e9,
+    .unit = "samples",
+    .help =
+        "Every how many Eulerian samples also carries the momentum and Reynolds-stress budgets "
+        "and the wall shear stress (u_tau_wall): every stats.budget_every x output.stats_every "
+        "steps. A budget sample splits the pair forces into their conservative parts, which "
+        "costs about one more force pass (docs/performance.md, \"The budgets\"); 1 samples them "
+        "with every snapshot (the budget identity of every step needs 1 with output.stats_every "
+        "= 1). A short run through a transient needs 1 for its momentum budget to close: the "
+        "fluxes are averaged over the budget snapshots, the momentum change over their span, and "
+        "a few irregular snapshots miss it (the quick-start, t = 0-0.1 from a decelerating burst: "
+        "0.0087 u_tau^2 with 1, 0.058 with 5; jobs/scenes/quickstart.ini uses 1)."};
 const struct scene_key_def euler_key_window = {
-    "stats",
-    "window",
-    SCENE_DOUBLE,
-    "0",
-    0,
-    SCENE_NO_BOUND,
-    0,
-    NULL,
-    "s",
-    "Length of an averaging window: stats.nc keeps the sums of every window (re-average a "
-    "range with `chansph extract --window`), and the window means are the batch means of "
-    "the standard errors, so a window should span several correlation times (the log "
-    "reports the estimate). 0 = a tenth of t_end - t_average_start. Fixed once averaging "
-    "has begun: a resume keeps the length (also with a new t_end) and refuses a new value."};
+    .section = "stats",
+    .name = "window",
+    .type = SCENE_DOUBLE,
+    .def = "0",
+    .lo = 0,
+    .hi = SCENE_NO_BOUND,
+    .unit = "s",
+    .help =
+        "Length of an averaging window: stats.nc keeps the sums of every window (re-average a "
+        "range with `chansph extract --window`), and the window means are the batch means of "
+        "the standard errors, so a window should span several correlation times (the log "
+        "reports the estimate). 0 = a tenth of t_end - t_average_start. Fixed once averaging "
+        "has begun: a resume keeps the length (also with a new t_end) and refuses a new value."};
 const struct scene_key_def euler_key_fold = {
-    "stats",
-    "fold",
-    SCENE_INT,
-    "0",
-    0,
-    1,
-    0,
-    NULL,
-    "-",
-    "Fold the upper half onto the lower one (y -> 2 delta - y, v -> -v) before binning; the "
-    "bins then cover 0 .. delta."};
+    .section = "stats",
+    .name = "fold",
+    .type = SCENE_INT,
+    .def = "0",
+    .lo = 0,
+    .hi = 1,
+    .unit = "-",
+    .help =
+        "Fold the upper half onto the lower one (y -> 2 delta - y, v -> -v) before binning; the "
+        "bins then cover 0 .. delta."};
 const struct scene_key_def euler_key_method = {
-    "stats",
-    "method",
-    SCENE_CHOICE,
-    "bins",
-    0,
-    0,
-    0,
-    names_stats_method,
-    "-",
-    "How particles make the profiles: bin sampling (thesis Eq. 5.54-5.55), or SPH "
-    "interpolation (Eq. 5.56) at the bin centres averaged over the plane, each particle "
-    "weighted by V_a times the plane integral of the kernel; the means are Eq. 5.56, the "
-    "stresses then also hold the mean-shear variation across the kernel (use bins for them)."};
+    .section = "stats",
+    .name = "method",
+    .type = SCENE_CHOICE,
+    .def = "bins",
+    .lo = 0,
+    .hi = 0,
+    .choices = names_stats_method,
+    .unit = "-",
+    .help =
+        "How particles make the profiles: bin sampling (thesis Eq. 5.54-5.55), or SPH "
+        "interpolation (Eq. 5.56) at the bin centres averaged over the plane, each particle "
+        "weighted by V_a times the plane integral of the kernel; the means are Eq. 5.56, the "
+        "stresses then also hold the mean-shear variation across the kernel (use bins for them)."};
 const struct scene_key_def euler_key_u_tau_ref = {
-    "stats",
-    "u_tau_ref",
-    SCENE_DOUBLE,
-    "0",
-    0,
-    SCENE_NO_BOUND,
-    0,
-    NULL,
-    "m/s",
-    "Friction velocity that places the y+ levels of the correlations and Lagrangian releases "
-    "(y = y+ nu / u_tau_ref); 0 = sqrt(delta drive.force), the force-balance value."};
+    .section = "stats",
+    .name = "u_tau_ref",
+    .type = SCENE_DOUBLE,
+    .def = "0",
+    .lo = 0,
+    .hi = SCENE_NO_BOUND,
+    .unit = "m/s",
+    .help =
+        "Friction velocity that places the y+ levels of the correlations and Lagrangian releases "
+        "(y = y+ nu / u_tau_ref); 0 = sqrt(delta drive.force), the force-balance value."};
 const struct scene_key_def euler_key_target_stderr = {
-    "stats",
-    "target_stderr",
-    SCENE_DOUBLE,
-    "0",
-    0,
-    1,
-    0,
-    NULL,
-    "-",
-    "Convergence target: once the standard errors relative to their profile (max "
-    "stderr(u_mean) / max |u_mean|, and stderr of -u'v' at its peak / the peak) are below "
-    "this, with at least target_windows complete windows of at least target_corr_ratio "
-    "correlation times, the run ends itself (checkpoint, stats.nc, exit 0). Checked when a "
-    "window closes; every convergence line of the log gives the projected simulated and wall "
-    "time to reach it. Needs stats.eulerian = 1. A resumed run that met it stays finished "
-    "unless a target key changes. 0 = off."};
+    .section = "stats",
+    .name = "target_stderr",
+    .type = SCENE_DOUBLE,
+    .def = "0",
+    .lo = 0,
+    .hi = 1,
+    .unit = "-",
+    .help =
+        "Convergence target: once the standard errors relative to their profile (max "
+        "stderr(u_mean) / max |u_mean|, and stderr of -u'v' at its peak / the peak) are below "
+        "this, with at least target_windows complete windows of at least target_corr_ratio "
+        "correlation times, the run ends itself (checkpoint, stats.nc, exit 0). Checked when a "
+        "window closes; every convergence line of the log gives the projected simulated and wall "
+        "time to reach it. Needs stats.eulerian = 1. A resumed run that met it stays finished "
+        "unless a target key changes. 0 = off."};
 const struct scene_key_def euler_key_target_profiles = {
-    "stats",
-    "target_profiles",
-    SCENE_CHOICE,
-    "both",
-    0,
-    0,
-    0,
-    names_stats_target_profiles,
-    "-",
-    "Profiles of the convergence target: u_mean and the -u'v' peak, or one of them (a laminar "
-    "flow has no -u'v' to converge)."};
+    .section = "stats",
+    .name = "target_profiles",
+    .type = SCENE_CHOICE,
+    .def = "both",
+    .lo = 0,
+    .hi = 0,
+    .choices = names_stats_target_profiles,
+    .unit = "-",
+    .help =
+        "Profiles of the convergence target: u_mean and the -u'v' peak, or one of them (a laminar "
+        "flow has no -u'v' to converge)."};
 const struct scene_key_def euler_key_target_corr_ratio = {
-    "stats",
-    "target_corr_ratio",
-    SCENE_DOUBLE,
-    "5",
-    0,
-    SCENE_NO_BOUND,
-    0,
-    NULL,
-    "-",
-    "Convergence target: smallest window length / correlation time for the standard errors "
-    "to count (shorter windows make them too small); 0 = no requirement."};
+    .section = "stats",
+    .name = "target_corr_ratio",
+    .type = SCENE_DOUBLE,
+    .def = "5",
+    .lo = 0,
+    .hi = SCENE_NO_BOUND,
+    .unit = "-",
+    .help =
+        "Convergence target: smallest window length / correlation time for the standard errors "
+        "to count (shorter windows make them too small); 0 = no requirement."};
 const struct scene_key_def euler_key_target_windows = {
-    "stats",
-    "target_windows",
-    SCENE_INT,
-    "4",
-    2,
-    1e9,
-    0,
-    NULL,
-    "-",
-    "Convergence target: fewest complete windows (batches) for the standard errors to count."};
+    .section = "stats",
+    .name = "target_windows",
+    .type = SCENE_INT,
+    .def = "4",
+    .lo = 2,
+    .hi = 1e9,
+    .unit = "-",
+    .help =
+        "Convergence target: fewest complete windows (batches) for the standard errors to count."};
 static const struct scene_key_def *const keys[] = {
     &euler_key_eulerian,      &euler_key_budget_every,    &euler_key_window,
     &euler_key_fold,          &euler_key_method,          &euler_key_u_tau_ref,

@@ -785,79 +785,79 @@ done:
 
 /* The engine's scene keys, section [lagrangian] (docs/scenes.md is generated from them). */
 static const struct scene_key_def key_y_plus = {
-    "lagrangian",
-    "y_plus",
-    SCENE_LIST,
-    "",
-    0,
-    SCENE_NO_BOUND,
-    SCENE_Y_PLUS,
-    NULL,
-    "-",
-    "Comma-separated y+ release levels (up to 8) of the Lagrangian statistics (thesis Sec. "
-    "5.2.3.2, 6.1.3): fluid particles within dr/2 of each level (and of its mirror) and "
-    "within dr/2 of x0 are tracked. Empty = off."};
+    .section = "lagrangian",
+    .name = "y_plus",
+    .type = SCENE_LIST,
+    .def = "",
+    .lo = 0,
+    .hi = SCENE_NO_BOUND,
+    .flags = SCENE_Y_PLUS,
+    .unit = "-",
+    .help =
+        "Comma-separated y+ release levels (up to 8) of the Lagrangian statistics (thesis Sec. "
+        "5.2.3.2, 6.1.3): fluid particles within dr/2 of each level (and of its mirror) and "
+        "within dr/2 of x0 are tracked. Empty = off."};
 static const struct scene_key_def key_x0 = {
-    "lagrangian",
-    "x0",
-    SCENE_DOUBLE,
-    "0",
-    0,
-    SCENE_NO_BOUND,
-    0,
-    NULL,
-    "m",
-    "Release plane: particles with |x - x0| < dr/2 are released."};
+    .section = "lagrangian",
+    .name = "x0",
+    .type = SCENE_DOUBLE,
+    .def = "0",
+    .lo = 0,
+    .hi = SCENE_NO_BOUND,
+    .unit = "m",
+    .help = "Release plane: particles with |x - x0| < dr/2 are released."};
 static const struct scene_key_def key_horizon = {
-    "lagrangian",
-    "horizon",
-    SCENE_DOUBLE,
-    "1",
-    0,
-    SCENE_NO_BOUND,
-    SCENE_LO_OPEN,
-    NULL,
-    "s",
-    "How long each release is followed (the largest lag tau)."};
+    .section = "lagrangian",
+    .name = "horizon",
+    .type = SCENE_DOUBLE,
+    .def = "1",
+    .lo = 0,
+    .hi = SCENE_NO_BOUND,
+    .flags = SCENE_LO_OPEN,
+    .unit = "s",
+    .help = "How long each release is followed (the largest lag tau)."};
 static const struct scene_key_def key_release_every = {
-    "lagrangian",
-    "release_every",
-    SCENE_DOUBLE,
-    "0",
-    0,
-    SCENE_NO_BOUND,
-    0,
-    NULL,
-    "s",
-    "Time between release iterations; releases overlap when shorter than the horizon. 0 = "
-    "the horizon (consecutive, independent releases, thesis Sec. 6.1.3)."};
+    .section = "lagrangian",
+    .name = "release_every",
+    .type = SCENE_DOUBLE,
+    .def = "0",
+    .lo = 0,
+    .hi = SCENE_NO_BOUND,
+    .unit = "s",
+    .help =
+        "Time between release iterations; releases overlap when shorter than the horizon. 0 = "
+        "the horizon (consecutive, independent releases, thesis Sec. 6.1.3)."};
 static const struct scene_key_def key_n_lags = {
-    "lagrangian",
-    "n_lags",
-    SCENE_INT,
-    "50",
-    2,
-    1e5,
-    0,
-    NULL,
-    "-",
-    "Lag samples over the horizon (a particle is sampled at the first statistics sample "
-    "in each lag interval)."};
+    .section = "lagrangian",
+    .name = "n_lags",
+    .type = SCENE_INT,
+    .def = "50",
+    .lo = 2,
+    .hi = 1e5,
+    .unit = "-",
+    .help =
+        "Lag samples over the horizon (a particle is sampled at the first statistics sample "
+        "in each lag interval)."};
 static const struct scene_key_def key_pdf_x = {
-    "lagrangian",
-    "pdf_x",
-    SCENE_LIST,
-    "",
-    0,
-    SCENE_NO_BOUND,
-    0,
-    NULL,
-    "m",
-    "Comma-separated downstream distances x - x0 (up to 8) of the stations of the PDFs P(y; "
-    "x) (Eq. 5.67-5.68); empty = no PDFs."};
+    .section = "lagrangian",
+    .name = "pdf_x",
+    .type = SCENE_LIST,
+    .def = "",
+    .lo = 0,
+    .hi = SCENE_NO_BOUND,
+    .unit = "m",
+    .help =
+        "Comma-separated downstream distances x - x0 (up to 8) of the stations of the PDFs P(y; "
+        "x) (Eq. 5.67-5.68); empty = no PDFs."};
 static const struct scene_key_def key_pdf_bins = {
-    "lagrangian", "pdf_bins", SCENE_INT, "50", 2,
-    1e5,          0,          NULL,      "-",  "Bins of the PDFs P(y; x) across the channel."};
+    .section = "lagrangian",
+    .name = "pdf_bins",
+    .type = SCENE_INT,
+    .def = "50",
+    .lo = 2,
+    .hi = 1e5,
+    .unit = "-",
+    .help = "Bins of the PDFs P(y; x) across the channel."};
 static const struct scene_key_def *const keys[] = {
     &key_y_plus, &key_x0, &key_horizon, &key_release_every, &key_n_lags, &key_pdf_x, &key_pdf_bins};
 

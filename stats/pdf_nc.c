@@ -240,59 +240,63 @@ int pdf_nc_read(struct pdf *p, int ncid, char *err, size_t errlen) {
 
 /* The engine's scene keys, section [pdfs] (docs/scenes.md is generated from them). */
 static const struct scene_key_def key_y_plus = {
-    "pdfs",
-    "y_plus",
-    SCENE_LIST,
-    "",
-    0,
-    SCENE_NO_BOUND,
-    SCENE_Y_PLUS,
-    NULL,
-    "-",
-    "Comma-separated y+ levels (up to 8) of the one-point PDFs of u', v', w' (MKM "
-    "1999 give them at y+ = 5, 10, 19, 30, 40, 59, 79, 98, 178): fluid particles in a slab at "
-    "each level and its mirror (v -> -v), binned in units of the local rms about the mean of "
-    "the averaged windows; stats.nc group pdfs (docs/stats-format.md). Empty = off."};
+    .section = "pdfs",
+    .name = "y_plus",
+    .type = SCENE_LIST,
+    .def = "",
+    .lo = 0,
+    .hi = SCENE_NO_BOUND,
+    .flags = SCENE_Y_PLUS,
+    .unit = "-",
+    .help =
+        "Comma-separated y+ levels (up to 8) of the one-point PDFs of u', v', w' (MKM "
+        "1999 give them at y+ = 5, 10, 19, 30, 40, 59, 79, 98, 178): fluid particles in a slab at "
+        "each level and its mirror (v -> -v), binned in units of the local rms about the mean of "
+        "the averaged windows; stats.nc group pdfs (docs/stats-format.md). Empty = off."};
 static const struct scene_key_def key_bins = {
-    "pdfs", "bins", SCENE_INT, "40", 1,
-    1000,   0,      NULL,      "-",  "Bins of each PDF over -range .. range local rms."};
+    .section = "pdfs",
+    .name = "bins",
+    .type = SCENE_INT,
+    .def = "40",
+    .lo = 1,
+    .hi = 1000,
+    .unit = "-",
+    .help = "Bins of each PDF over -range .. range local rms."};
 static const struct scene_key_def key_range = {
-    "pdfs",
-    "range",
-    SCENE_DOUBLE,
-    "5",
-    0,
-    100,
-    SCENE_LO_OPEN,
-    NULL,
-    "rms",
-    "Half-width of the PDFs in units of the local rms (samples beyond it are counted in "
-    "outside)."};
+    .section = "pdfs",
+    .name = "range",
+    .type = SCENE_DOUBLE,
+    .def = "5",
+    .lo = 0,
+    .hi = 100,
+    .flags = SCENE_LO_OPEN,
+    .unit = "rms",
+    .help =
+        "Half-width of the PDFs in units of the local rms (samples beyond it are counted in "
+        "outside)."};
 static const struct scene_key_def key_fine = {
-    "pdfs",
-    "fine",
-    SCENE_DOUBLE,
-    "0.02",
-    0.001,
-    1,
-    0,
-    NULL,
-    "u_tau",
-    "Width of the fine bins of the raw per-window counts of u_i / stats.u_tau_ref (over -10 .. "
-    "35 for u, -10 .. 10 for v and w), rebinned in units of the rms at output: keep it well "
-    "below a PDF bin, 2 range / bins times the smallest rms (v near the wall: 0.01); the log "
-    "warns where it is above half of one."};
+    .section = "pdfs",
+    .name = "fine",
+    .type = SCENE_DOUBLE,
+    .def = "0.02",
+    .lo = 0.001,
+    .hi = 1,
+    .unit = "u_tau",
+    .help =
+        "Width of the fine bins of the raw per-window counts of u_i / stats.u_tau_ref (over -10 .. "
+        "35 for u, -10 .. 10 for v and w), rebinned in units of the rms at output: keep it well "
+        "below a PDF bin, 2 range / bins times the smallest rms (v near the wall: 0.01); the log "
+        "warns where it is above half of one."};
 static const struct scene_key_def key_thickness = {
-    "pdfs",
-    "thickness",
-    SCENE_DOUBLE,
-    "1",
-    0,
-    100,
-    SCENE_LO_OPEN,
-    NULL,
-    "dr",
-    "Thickness of the slab of particles sampled at each level, in units of dr."};
+    .section = "pdfs",
+    .name = "thickness",
+    .type = SCENE_DOUBLE,
+    .def = "1",
+    .lo = 0,
+    .hi = 100,
+    .flags = SCENE_LO_OPEN,
+    .unit = "dr",
+    .help = "Thickness of the slab of particles sampled at each level, in units of dr."};
 static const struct scene_key_def *const keys[] = {&key_y_plus, &key_bins, &key_range, &key_fine,
                                                    &key_thickness};
 

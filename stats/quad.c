@@ -247,20 +247,21 @@ done:
 
 /* The engine's scene key, section [quadrants] (docs/scenes.md is generated from it). */
 static const struct scene_key_def key_y_plus = {
-    "quadrants",
-    "y_plus",
-    SCENE_LIST,
-    "",
-    0,
-    SCENE_NO_BOUND,
-    SCENE_Y_PLUS,
-    NULL,
-    "-",
-    "Comma-separated y+ levels (up to 8) of the quadrant analysis of u'v' (Wallace et al. "
-    "1972, Willmarth & Lu 1972): in a slab of one dr at each level and its mirror, the "
-    "fluctuations about the plane average of each instant sorted into Q1 (outward), Q2 "
-    "(ejections), Q3 (inward) and Q4 (sweeps); stats.nc group quadrants (docs/stats-format.md). "
-    "Ejections and sweeps dominate in wall turbulence, not in particle noise. Empty = off."};
+    .section = "quadrants",
+    .name = "y_plus",
+    .type = SCENE_LIST,
+    .def = "",
+    .lo = 0,
+    .hi = SCENE_NO_BOUND,
+    .flags = SCENE_Y_PLUS,
+    .unit = "-",
+    .help =
+        "Comma-separated y+ levels (up to 8) of the quadrant analysis of u'v' (Wallace et al. "
+        "1972, Willmarth & Lu 1972): in a slab of one dr at each level and its mirror, the "
+        "fluctuations about the plane average of each instant sorted into Q1 (outward), Q2 "
+        "(ejections), Q3 (inward) and Q4 (sweeps); stats.nc group quadrants "
+        "(docs/stats-format.md). "
+        "Ejections and sweeps dominate in wall turbulence, not in particle noise. Empty = off."};
 static const struct scene_key_def *const keys[] = {&key_y_plus};
 
 /* The engine's table of operations (engine.h). */
