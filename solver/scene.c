@@ -489,6 +489,17 @@ static void build_table(void) {
     }
   for (size_t i = 0; i < sizeof keys_tail / sizeof keys_tail[0]; i++)
     add_entry(&keys_tail[i].d, keys_tail[i].offset, -1);
+  /* each key once, each section in one run of keys (docs/scenes.md has one table per section):
+     an engine's key in a section of the solver's or of another engine is a bug */
+  for (int k = 0; k < n_keys; k++)
+    for (int j = 0; j < k; j++) {
+      const struct scene_key_def *a = table[j].d, *b = table[k].d;
+      if (strcmp(a->section, b->section)) continue;
+      if (!strcmp(a->name, b->name)) die("scene key %s.%s is declared twice", b->section, b->name);
+      if (strcmp(table[k - 1].d->section, b->section))
+        die("scene key %s.%s: section [%s] is split in the scene's table", b->section, b->name,
+            b->section);
+    }
 }
 
 /** Parser state: where each key was set, and the error count. */
