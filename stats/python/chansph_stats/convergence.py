@@ -1,5 +1,5 @@
 """Error against run time: the running average of a run's main statistics and its standard error,
-window by window, with the projection to a target error (issue 43, point 4).
+window by window, with the projection to a target error.
 
 usage: chansph-stats convergence STATS.nc [--target E] [--log LOG] [--out DIR]
 
