@@ -14,6 +14,7 @@
 #include "alloc.h"
 #include "ckpt.h"
 #include "error.h"
+#include "euler.h"
 #include "init.h"
 #include "restart.h"
 #include "rotate.h"
@@ -102,12 +103,14 @@ static int check_average_start(const struct scene *old, const struct scene *now,
    checkpoint. */
 static int check_window(const struct scene *old, const struct scene *now, double t,
                         const char *path) {
-  if (old->stats_window == now->stats_window || t < old->t_average_start) return CHANSPH_OK;
+  const double was = scene_stats_num(old, &euler_key_window);
+  const double is = scene_stats_num(now, &euler_key_window);
+  if (was == is || t < old->t_average_start) return CHANSPH_OK;
   error_input(
       "--set stats.window=%g: key 'stats.window' cannot change on resume once averaging has "
       "begun (the checkpoint %s is at t = %.9g s, averaging began at %g s): the averaging "
       "windows would differ in length; keep %g, or start a new run",
-      now->stats_window, path, t, old->t_average_start, old->stats_window);
+      is, path, t, old->t_average_start, was);
   return CHANSPH_ERR;
 }
 
@@ -135,14 +138,18 @@ static void keep_window(struct output *o, const struct scene *old, double t) {
 static void keep_converged(struct output *o, const struct scene *old, const struct scene *now,
                            long step) {
   if (!o->converged) return;
-  if (old->target_stderr == now->target_stderr && old->target_profiles == now->target_profiles &&
-      old->target_corr_ratio == now->target_corr_ratio &&
-      old->target_windows == now->target_windows) {
+  static const struct scene_key_def *const target[] = {
+      &euler_key_target_stderr, &euler_key_target_profiles, &euler_key_target_corr_ratio,
+      &euler_key_target_windows};
+  int same = 1;
+  for (int i = 0; i < 4; i++)
+    same &= scene_stats_num(old, target[i]) == scene_stats_num(now, target[i]);
+  if (same) {
     output_log(o,
                "resume: the run ended at step %ld when its statistics met stats.target_stderr = "
                "%g: it stays finished (to go on, change the convergence target, e.g. --set "
                "stats.target_stderr=...)\n",
-               step, old->target_stderr);
+               step, scene_stats_num(old, &euler_key_target_stderr));
     return;
   }
   o->converged = 0;

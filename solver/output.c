@@ -111,29 +111,31 @@ static int open_files(struct output *o, const char *dir, const struct scene *sc,
   return CHANSPH_OK;
 }
 
-/* The scene's numeric keys by name, for the statistics engines (stats_scene.get). */
-static int scene_get(const void *scene, const char *key, double *v, int max) {
-  return scene_values(scene, key, v, max);
-}
-
 void output_stats_scene(const struct scene *sc, struct stats_scene *view) {
-  *view = (struct stats_scene){
-      .dim = sc->dim,
-      .delta = sc->delta,
-      .lx = sc->lx,
-      .lz = sc->lz,
-      .dr = sc->dr,
-      .h = scene_h(sc),
-      .nu = sc->nu,
-      .rho0 = sc->rho0,
-      .les = sc->les != LES_NONE,
-      .u_tau = sc->u_tau_ref > 0.0 ? sc->u_tau_ref : sqrt(sc->delta * fabs(sc->force)),
-      .t_average_start = sc->t_average_start,
-      .t_end = sc->t_end,
-      .bins = scene_bins(sc),
-      .columns = nbr_columns(sc),
-      .get = scene_get,
-      .scene = sc};
+  const double u_tau_ref = scene_stats_num(sc, &euler_key_u_tau_ref);
+  int n_keys = 0;
+  const struct scene_key_def *const *defs = scene_stats_defs(&n_keys);
+  *view =
+      (struct stats_scene){.dim = sc->dim,
+                           .delta = sc->delta,
+                           .lx = sc->lx,
+                           .lz = sc->lz,
+                           .dr = sc->dr,
+                           .h = scene_h(sc),
+                           .nu = sc->nu,
+                           .rho0 = sc->rho0,
+                           .les = sc->les != LES_NONE,
+                           .u_tau = u_tau_ref > 0.0 ? u_tau_ref : sqrt(sc->delta * fabs(sc->force)),
+                           .t_average_start = sc->t_average_start,
+                           .t_end = sc->t_end,
+                           .window = stats_window_length(scene_stats_num(sc, &euler_key_window),
+                                                         sc->t_average_start, sc->t_end),
+                           .bins = scene_bins(sc),
+                           .bins_uniform = sc->n_bins > 0,
+                           .columns = nbr_columns(sc),
+                           .n_keys = n_keys,
+                           .key_def = defs,
+                           .key_value = sc->stats_keys};
 }
 
 /* Shared by output_open and output_reopen: the files (rank 0), the engines (every rank). */
@@ -313,9 +315,11 @@ static void log_progress(struct output *o, struct sim *S, const struct diag *d) 
 
 /* The scene's convergence target; 0 if there is none. */
 static int target_of(const struct scene *sc, struct euler_target *tg) {
-  if (!(sc->target_stderr > 0.0) || !sc->stats_eulerian) return 0;
-  tg->rel_stderr = sc->target_stderr, tg->profiles = sc->target_profiles;
-  tg->corr_ratio = sc->target_corr_ratio, tg->windows = sc->target_windows;
+  const double rel = scene_stats_num(sc, &euler_key_target_stderr);
+  if (!(rel > 0.0) || !scene_stats_num(sc, &euler_key_eulerian)) return 0;
+  tg->rel_stderr = rel, tg->profiles = (int)scene_stats_num(sc, &euler_key_target_profiles);
+  tg->corr_ratio = scene_stats_num(sc, &euler_key_target_corr_ratio);
+  tg->windows = (int)scene_stats_num(sc, &euler_key_target_windows);
   return 1;
 }
 
@@ -324,15 +328,17 @@ static int target_of(const struct scene *sc, struct euler_target *tg) {
 static void log_target(struct output *o, const struct sim *S, const struct euler_progress *p) {
   const struct scene *sc = S->sc;
   static const char *const which[3] = {"u_mean and the -u'v' peak", "u_mean", "the -u'v' peak"};
+  struct euler_target tg = {0};
+  target_of(sc, &tg);
   char proj[320];
   const double done = S->t - o->t0, rate = done > 0.0 ? (timer_now() - o->wall0) / done : NAN;
   if (p->met) {
     snprintf(proj, sizeof proj, "target met");
-  } else if (sc->target_corr_ratio > 0.0 && !(p->ratio >= sc->target_corr_ratio)) {
+  } else if (tg.corr_ratio > 0.0 && !(p->ratio >= tg.corr_ratio)) {
     snprintf(proj, sizeof proj,
              "windows too short to count: window/correlation time %.3g < %g (increase "
              "stats.window)",
-             p->ratio, sc->target_corr_ratio);
+             p->ratio, tg.corr_ratio);
   } else if (!isfinite(p->t_reach)) {
     snprintf(proj, sizeof proj, "projection after 2 complete windows");
   } else {
@@ -347,7 +353,7 @@ static void log_target(struct output *o, const struct sim *S, const struct euler
   output_log(o,
              "target: relative stderr %g of %s: u_mean %.3g, -u'v' peak %.3g after %d "
              "windows; %s\n",
-             sc->target_stderr, which[sc->target_profiles], p->rel_u, p->rel_uv, p->windows, proj);
+             tg.rel_stderr, which[tg.profiles], p->rel_u, p->rel_uv, p->windows, proj);
 }
 
 /* Settings that would silently give nothing: say so at the start. */
@@ -541,7 +547,7 @@ void output_sample(struct output *o, struct sim *S) {
       output_log(o,
                  "converged: the statistics meet stats.target_stderr = %g at step %ld, t = "
                  "%.9g s; the run ends here\n",
-                 sc->target_stderr, S->step, S->t);
+                 tg.rel_stderr, S->step, S->t);
       o->converged = 1;
     }
   }

@@ -52,7 +52,7 @@ struct output {
 int output_open(struct output *o, const char *dir, const struct scene *sc, int overwrite);
 
 /** @brief The scene as the statistics engines see it (stats/contract.h): the channel's values,
- *         derived ones resolved, and the engines' own keys by name. */
+ *         derived ones resolved, and the engines' own keys with their definitions. */
 void output_stats_scene(const struct scene *sc, struct stats_scene *view);
 
 /**

@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "error.h"
+#include "euler.h"
 #include "nbr.h"
 #include "records.h"
 
@@ -165,7 +166,7 @@ int part_needed(enum part_need need, const struct scene *s) {
     case PN_WALL_TAU:
       return scene_wall_tau(s);
     case PN_EULERIAN:
-      return s->stats_eulerian;
+      return scene_stats_num(s, &euler_key_eulerian) != 0.0;
     case PN_SHIFTING:
       return s->shifting != SHIFT_NONE;
     case PN_QCRIT:

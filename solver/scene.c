@@ -17,26 +17,28 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "engine.h"
 #include "error.h"
+#include "euler.h"
 #include "walllaw.h"
 
-enum key_type { T_INT, T_LONG, T_DOUBLE, T_CHOICE, T_STRING, T_LIST };
-enum { REQUIRED = 1, LO_OPEN = 2 };
+/* Short names of the key types and flags of stats/contract.h, for the tables below. */
+#define T_INT SCENE_INT
+#define T_LONG SCENE_LONG
+#define T_DOUBLE SCENE_DOUBLE
+#define T_CHOICE SCENE_CHOICE
+#define T_STRING SCENE_STRING
+#define T_LIST SCENE_LIST
+enum { REQUIRED = SCENE_REQUIRED, LO_OPEN = SCENE_LO_OPEN };
+#define BIG SCENE_NO_BOUND
 
-/** One scene key: where it lives, its type, default, range and documentation. */
+/** One of the solver's own keys: its definition and the field of struct scene it sets. */
 struct key {
-  const char *section, *name;
-  enum key_type type;
-  const char *def; /*!< default as text; NULL for required keys */
-  double lo, hi;   /*!< allowed range (inclusive unless LO_OPEN) */
-  int flags;
-  const char *const *choices; /*!< T_CHOICE: the names, NULL-terminated; the value is the index */
-  const char *unit, *help;
+  struct scene_key_def d;
   size_t offset;
 };
 
 #define OFF(f) offsetof(struct scene, f)
-#define BIG 1e300
 /* The bounds of the physical keys where the physics is finite (SI units): a body acceleration,
    a speed and a kinematic viscosity beyond these are no channel flow, and would take the time
    step to zero (a run that never advances) */
@@ -65,494 +67,456 @@ static const char *const names_init_profile[] = {"rest", "laminar",   "reichardt
                                                  "wave", "synthetic", NULL};
 static const char *const names_init_density[] = {"keep", "rho0", NULL};
 static const char *const names_sph_diffusion[] = {"ferrand", "delta_sph", NULL};
-static const char *const names_stats_method[] = {"bins", "sph", NULL};
-static const char *const names_stats_target_profiles[] = {"both", "u_mean", "uv_peak", NULL};
 
-static const struct key keys[] = {
-    {"domain", "dimension", T_INT, NULL, 2, 3, REQUIRED, NULL, "-",
-     "Spatial dimension: 2 (x-y plane) or 3.", OFF(dim)},
-    {"domain", "delta", T_DOUBLE, "0.5", 0, BIG, LO_OPEN, NULL, "m",
-     "Channel half-width; the walls are at y = 0 and y = 2 delta.", OFF(delta)},
-    {"domain", "lx", T_DOUBLE, NULL, 0, BIG, REQUIRED | LO_OPEN, NULL, "m",
-     "Periodic length in the streamwise direction x; a multiple of dr, at least 6h.", OFF(lx)},
-    {"domain", "lz", T_DOUBLE, "0", 0, BIG, 0, NULL, "m",
-     "Periodic length in the spanwise direction z (3-D only; required there).", OFF(lz)},
-    {"domain", "dr", T_DOUBLE, NULL, 0, BIG, REQUIRED | LO_OPEN, NULL, "m",
-     "Initial particle spacing; 2 delta, lx and lz must be multiples of it.", OFF(dr)},
-    {"sph", "h_over_dr", T_DOUBLE, "1.3", 1.0, 2.5, 0, NULL, "-",
-     "Smoothing length over particle spacing (kernel support radius is 2h).", OFF(h_over_dr)},
-    {"sph", "kernel", T_CHOICE, "wendland_c2", 0, 0, 0, names_sph_kernel, "-",
-     "Kernel, support 2h: the Wendland C2 (thesis Eq. 2.63) or the Wendland C4 of Dehnen & Aly "
-     "(2012), smoother (its gradient vanishes as (1 - q/2)^5 at the edge), with smaller "
-     "zeroth-order errors than C2 at larger h/dr; C4 is 3-D only (its closed-form wall integrals "
-     "are, "
-     "solver/wall.h; docs/theory.md \"Kernels\").",
+/* The solver's keys before the engines': the domain, the scheme, the fluid, the drive, time,
+   initial state and output. */
+static const struct key keys_head[] = {
+    {{"domain", "dimension", T_INT, NULL, 2, 3, REQUIRED, NULL, "-",
+      "Spatial dimension: 2 (x-y plane) or 3."},
+     OFF(dim)},
+    {{"domain", "delta", T_DOUBLE, "0.5", 0, BIG, LO_OPEN, NULL, "m",
+      "Channel half-width; the walls are at y = 0 and y = 2 delta."},
+     OFF(delta)},
+    {{"domain", "lx", T_DOUBLE, NULL, 0, BIG, REQUIRED | LO_OPEN, NULL, "m",
+      "Periodic length in the streamwise direction x; a multiple of dr, at least 6h."},
+     OFF(lx)},
+    {{"domain", "lz", T_DOUBLE, "0", 0, BIG, 0, NULL, "m",
+      "Periodic length in the spanwise direction z (3-D only; required there)."},
+     OFF(lz)},
+    {{"domain", "dr", T_DOUBLE, NULL, 0, BIG, REQUIRED | LO_OPEN, NULL, "m",
+      "Initial particle spacing; 2 delta, lx and lz must be multiples of it."},
+     OFF(dr)},
+    {{"sph", "h_over_dr", T_DOUBLE, "1.3", 1.0, 2.5, 0, NULL, "-",
+      "Smoothing length over particle spacing (kernel support radius is 2h)."},
+     OFF(h_over_dr)},
+    {{"sph", "kernel", T_CHOICE, "wendland_c2", 0, 0, 0, names_sph_kernel, "-",
+      "Kernel, support 2h: the Wendland C2 (thesis Eq. 2.63) or the Wendland C4 of Dehnen & Aly "
+      "(2012), smoother (its gradient vanishes as (1 - q/2)^5 at the edge), with smaller "
+      "zeroth-order errors than C2 at larger h/dr; C4 is 3-D only (its closed-form wall integrals "
+      "are, "
+      "solver/wall.h; docs/theory.md \"Kernels\")."},
      OFF(kernel)},
-    {"sph", "xi", T_DOUBLE, "0", 0, BIG, 0, NULL, "-",
-     "Volume-diffusion constant xi of thesis Eq. 3.34; 0 selects the mixing-length value "
-     "1000 dr / (2 delta) (thesis Sec. 3.2, 6.1.1).",
+    {{"sph", "xi", T_DOUBLE, "0", 0, BIG, 0, NULL, "-",
+      "Volume-diffusion constant xi of thesis Eq. 3.34; 0 selects the mixing-length value "
+      "1000 dr / (2 delta) (thesis Sec. 3.2, 6.1.1)."},
      OFF(xi)},
-    {"sph", "diffusion", T_CHOICE, "ferrand", 0, 0, 0, names_sph_diffusion, "-",
-     "Pair form of the volume diffusion of the continuity equation: ferrand (thesis Eq. 3.34, "
-     "strength 1/xi, the pair weight grows with the pair distance r_ab) or delta_sph (the "
-     "delta-SPH strength of Antuono et al. (2010): 2 delta h in place of r_ab / xi, with the "
-     "same hydrostatic density difference as Fourtakas et al. (2019); docs/theory.md, "
-     "\"Continuity\").",
+    {{"sph", "diffusion", T_CHOICE, "ferrand", 0, 0, 0, names_sph_diffusion, "-",
+      "Pair form of the volume diffusion of the continuity equation: ferrand (thesis Eq. 3.34, "
+      "strength 1/xi, the pair weight grows with the pair distance r_ab) or delta_sph (the "
+      "delta-SPH strength of Antuono et al. (2010): 2 delta h in place of r_ab / xi, with the "
+      "same hydrostatic density difference as Fourtakas et al. (2019); docs/theory.md, "
+      "\"Continuity\")."},
      OFF(diffusion)},
-    {"sph", "delta", T_DOUBLE, "0.1", 0, 1, 0, NULL, "-",
-     "delta of sph.diffusion = delta_sph (0.1 is the delta-SPH literature's value).",
+    {{"sph", "delta", T_DOUBLE, "0.1", 0, 1, 0, NULL, "-",
+      "delta of sph.diffusion = delta_sph (0.1 is the delta-SPH literature's value)."},
      OFF(diff_delta)},
-    {"sph", "acoustic_damper", T_DOUBLE, "0", 0, 2, 0, NULL, "-",
-     "Acoustic damper alpha (Sun, Pilloton, Antuono & Colagrossi 2023): a bulk viscosity "
-     "zeta = alpha rho0 c0 h, applied as the pressure p - zeta div u with div u = -(1/rho) "
-     "D rho/Dt from the density change of the last step (without the volume diffusion's part); "
-     "it damps the particle-scale acoustic (dilatational) motion and leaves solenoidal motion "
-     "alone; the viscous time-step limit takes nu + zeta / rho0. 0 = off (docs/theory.md, "
-     "\"The acoustic damper\").",
+    {{"sph", "acoustic_damper", T_DOUBLE, "0", 0, 2, 0, NULL, "-",
+      "Acoustic damper alpha (Sun, Pilloton, Antuono & Colagrossi 2023): a bulk viscosity "
+      "zeta = alpha rho0 c0 h, applied as the pressure p - zeta div u with div u = -(1/rho) "
+      "D rho/Dt from the density change of the last step (without the volume diffusion's part); "
+      "it damps the particle-scale acoustic (dilatational) motion and leaves solenoidal motion "
+      "alone; the viscous time-step limit takes nu + zeta / rho0. 0 = off (docs/theory.md, "
+      "\"The acoustic damper\")."},
      OFF(damper)},
-    {"sph", "viscous", T_CHOICE, "morris", 0, 0, 0, names_sph_viscous, "-",
-     "Viscous operator: Morris (thesis Eq. 2.147) or Violeau (Eq. 2.100), both with the wall "
-     "shear term.",
+    {{"sph", "viscous", T_CHOICE, "morris", 0, 0, 0, names_sph_viscous, "-",
+      "Viscous operator: Morris (thesis Eq. 2.147) or Violeau (Eq. 2.100), both with the wall "
+      "shear term."},
      OFF(viscous)},
-    {"sph", "laplacian_norm", T_CHOICE, "wall_normal", 0, 0, 0, names_sph_laplacian_norm, "-",
-     "Normalisation of the viscous particle sum by its discrete second moment (plus the "
-     "analytic part behind the walls): wall_normal uses the y-y moment, exact for the mean "
-     "flow of a channel; trace uses the isotropic part; none is the plain operator of the "
-     "thesis (2.6% lattice error at h/dr = 1.3, docs/theory.md).",
+    {{"sph", "laplacian_norm", T_CHOICE, "wall_normal", 0, 0, 0, names_sph_laplacian_norm, "-",
+      "Normalisation of the viscous particle sum by its discrete second moment (plus the "
+      "analytic part behind the walls): wall_normal uses the y-y moment, exact for the mean "
+      "flow of a channel; trace uses the isotropic part; none is the plain operator of the "
+      "thesis (2.6% lattice error at h/dr = 1.3, docs/theory.md)."},
      OFF(lap_norm)},
-    {"sph", "wall_shear_weight", T_CHOICE, "discrete", 0, 0, 0, names_sph_wall_shear_weight, "-",
-     "Weight of the wall shear term of the Morris operator: |grad gamma_as| (analytic, thesis "
-     "Eq. 2.147) or the discrete first moment sum_b V_b (r_ab . n) F_ab, which makes the "
-     "operator exact for a linear velocity profile (docs/theory.md). Violeau always uses "
-     "the analytic weight.",
+    {{"sph", "wall_shear_weight", T_CHOICE, "discrete", 0, 0, 0, names_sph_wall_shear_weight, "-",
+      "Weight of the wall shear term of the Morris operator: |grad gamma_as| (analytic, thesis "
+      "Eq. 2.147) or the discrete first moment sum_b V_b (r_ab . n) F_ab, which makes the "
+      "operator exact for a linear velocity profile (docs/theory.md). Violeau always uses "
+      "the analytic weight."},
      OFF(wall_weight)},
-    {"sph", "wall_pressure_weight", T_CHOICE, "lattice", 0, 0, 0, names_sph_wall_pressure_weight,
-     "-",
-     "Weight of the pressure wall term: |grad gamma_as| (analytic, thesis Eq. 3.17); "
-     "max(|grad gamma_as|, sum_b V_b (r_ab . n) F_ab) of the current particles (consistent), "
-     "which keeps the first particle layer in place under a uniform pressure; or "
-     "|grad gamma_as| plus the excess of that discrete moment over it on the initial particle "
-     "lattice, as a function of the wall distance (lattice): the same equilibrium, but a "
-     "uniform pressure still resists wall-normal disorder (docs/theory.md).",
+    {{"sph", "wall_pressure_weight", T_CHOICE, "lattice", 0, 0, 0, names_sph_wall_pressure_weight,
+      "-",
+      "Weight of the pressure wall term: |grad gamma_as| (analytic, thesis Eq. 3.17); "
+      "max(|grad gamma_as|, sum_b V_b (r_ab . n) F_ab) of the current particles (consistent), "
+      "which keeps the first particle layer in place under a uniform pressure; or "
+      "|grad gamma_as| plus the excess of that discrete moment over it on the initial particle "
+      "lattice, as a function of the wall distance (lattice): the same equilibrium, but a "
+      "uniform pressure still resists wall-normal disorder (docs/theory.md)."},
      OFF(wall_pressure)},
-    {"sph", "pressure_gradient", T_CHOICE, "standard", 0, 0, 0, names_sph_pressure_gradient, "-",
-     "Pressure gradient: the symmetric Grad^{gamma,1} with its wall term (thesis Eq. 3.17), or "
-     "the first-order corrected difference form Eq. 2.90 (k = 0) with the matrix L of Eq. "
-     "2.88 built from fluid and vertex neighbours, exact for linear pressure fields and without "
-     "a wall term (Sec. 6.2.2-6.2.3; docs/theory.md).",
+    {{"sph", "pressure_gradient", T_CHOICE, "standard", 0, 0, 0, names_sph_pressure_gradient, "-",
+      "Pressure gradient: the symmetric Grad^{gamma,1} with its wall term (thesis Eq. 3.17), or "
+      "the first-order corrected difference form Eq. 2.90 (k = 0) with the matrix L of Eq. "
+      "2.88 built from fluid and vertex neighbours, exact for linear pressure fields and without "
+      "a wall term (Sec. 6.2.2-6.2.3; docs/theory.md)."},
      OFF(pgrad)},
-    {"sph", "shifting", T_CHOICE, "none", 0, 0, 0, names_sph_shifting, "-",
-     "Particle shifting after each position update: none, or the Fickian shift "
-     "delta r_a = -C h^2 grad C_a of Lind et al. (2012) with the anti-clustering term of "
-     "Skillen et al. (2013) / Sun et al. (2017, 2018) and the walls' part of grad C_a taken "
-     "from grad gamma with the pressure wall weight; at most 0.1 dr per step; velocities are "
-     "not changed (docs/theory.md, \"Particle shifting\").",
+    {{"sph", "shifting", T_CHOICE, "none", 0, 0, 0, names_sph_shifting, "-",
+      "Particle shifting after each position update: none, or the Fickian shift "
+      "delta r_a = -C h^2 grad C_a of Lind et al. (2012) with the anti-clustering term of "
+      "Skillen et al. (2013) / Sun et al. (2017, 2018) and the walls' part of grad C_a taken "
+      "from grad gamma with the pressure wall weight; at most 0.1 dr per step; velocities are "
+      "not changed (docs/theory.md, \"Particle shifting\")."},
      OFF(shifting)},
-    {"sph", "shift_coefficient", T_DOUBLE, "0.05", 0, 0.3, LO_OPEN, NULL, "-",
-     "Shifting coefficient C of delta r_a = -C h^2 grad C_a per step (sph.shifting = fickian). "
-     "0.05 relaxes a displaced particle per step as much as Sun et al. (2018)'s CFL Ma (2h)^2 "
-     "with h = 2 dr at CFL Ma = 0.08 (this code's cfl 0.8 at Mach 0.1) does; 0.5 is unstable "
-     "in 2-D (docs/theory.md).",
+    {{"sph", "shift_coefficient", T_DOUBLE, "0.05", 0, 0.3, LO_OPEN, NULL, "-",
+      "Shifting coefficient C of delta r_a = -C h^2 grad C_a per step (sph.shifting = fickian). "
+      "0.05 relaxes a displaced particle per step as much as Sun et al. (2018)'s CFL Ma (2h)^2 "
+      "with h = 2 dr at CFL Ma = 0.08 (this code's cfl 0.8 at Mach 0.1) does; 0.5 is unstable "
+      "in 2-D (docs/theory.md)."},
      OFF(shift_coef)},
-    {"sph", "shift_velocity", T_CHOICE, "keep", 0, 0, 0, names_sph_shift_velocity, "-",
-     "What a shift does to the velocity of the shifted particle: keep it, carry it to the "
-     "new position by the Taylor correction u_a += (delta r_a . grad) u_a (Lind et al. 2012, "
-     "Eq. 24) with the first-order corrected velocity gradient of the start of the step "
-     "(thesis Eq. 2.88-2.90). Kept, a shift across the mean shear adds dU/dy delta y to u "
-     "each step; corrected, the budgets' closure holds the correction's share (it is not a "
-     "force; docs/theory.md, \"Particle shifting\"). conservative: the momentum transport "
-     "of the transport-velocity formulation (Adami, Hu & Adams 2013, the divergence of "
-     "A = rho u (u~ - u) with dr = dt (u~ - u)), du_a = sum_b m_b [u_a (dr_a . grad w_ab) / "
-     "rho_a + u_b (dr_b . grad w_ab) / rho_b] over fluid pairs, which conserves momentum.",
+    {{"sph", "shift_velocity", T_CHOICE, "keep", 0, 0, 0, names_sph_shift_velocity, "-",
+      "What a shift does to the velocity of the shifted particle: keep it, carry it to the "
+      "new position by the Taylor correction u_a += (delta r_a . grad) u_a (Lind et al. 2012, "
+      "Eq. 24) with the first-order corrected velocity gradient of the start of the step "
+      "(thesis Eq. 2.88-2.90). Kept, a shift across the mean shear adds dU/dy delta y to u "
+      "each step; corrected, the budgets' closure holds the correction's share (it is not a "
+      "force; docs/theory.md, \"Particle shifting\"). conservative: the momentum transport "
+      "of the transport-velocity formulation (Adami, Hu & Adams 2013, the divergence of "
+      "A = rho u (u~ - u) with dr = dt (u~ - u)), du_a = sum_b m_b [u_a (dr_a . grad w_ab) / "
+      "rho_a + u_b (dr_b . grad w_ab) / rho_b] over fluid pairs, which conserves momentum."},
      OFF(shift_velocity)},
-    {"sph", "wall_collision", T_CHOICE, "stop", 0, 0, 0, names_sph_wall_collision, "-",
-     "What a fluid particle that reaches a wall in a step does: stop the run (exit 3, the "
-     "particle named), or reflect it specularly (y -> -y at y = 0, 2 delta - y at the upper "
-     "wall; its wall-normal velocity turned into the fluid, u and w kept) and go on, each "
-     "reflection named on stderr and counted in the log line. The wall's pressure term holds "
-     "particles off the wall only while their pressure is positive; with fluid.p_background = 0 "
-     "the acoustic noise can pull one onto it, about once in 10^10 particle-steps at dr+ = 6 "
-     "(docs/theory.md, \"A particle at the wall\").",
+    {{"sph", "wall_collision", T_CHOICE, "stop", 0, 0, 0, names_sph_wall_collision, "-",
+      "What a fluid particle that reaches a wall in a step does: stop the run (exit 3, the "
+      "particle named), or reflect it specularly (y -> -y at y = 0, 2 delta - y at the upper "
+      "wall; its wall-normal velocity turned into the fluid, u and w kept) and go on, each "
+      "reflection named on stderr and counted in the log line. The wall's pressure term holds "
+      "particles off the wall only while their pressure is positive; with fluid.p_background = 0 "
+      "the acoustic noise can pull one onto it, about once in 10^10 particle-steps at dr+ = 6 "
+      "(docs/theory.md, \"A particle at the wall\")."},
      OFF(wall_collision)},
-    {"sph", "wall_dmin", T_DOUBLE, "1", 0, BIG, LO_OPEN, NULL, "dr",
-     "Lower bound delta r of the wall distance in the wall shear term (thesis Eq. 2.148), in "
-     "units of dr.",
+    {{"sph", "wall_dmin", T_DOUBLE, "1", 0, BIG, LO_OPEN, NULL, "dr",
+      "Lower bound delta r of the wall distance in the wall shear term (thesis Eq. 2.148), in "
+      "units of dr."},
      OFF(wall_dmin)},
-    {"sph", "eta2", T_DOUBLE, "1e-4", 0, 1, 0, NULL, "h^2",
-     "Regularisation added to r^2 in the viscous term (thesis Sec. 2.3.3), in units of h^2.",
+    {{"sph", "eta2", T_DOUBLE, "1e-4", 0, 1, 0, NULL, "h^2",
+      "Regularisation added to r^2 in the viscous term (thesis Sec. 2.3.3), in units of h^2."},
      OFF(eta2)},
-    {"les", "model", T_CHOICE, "none", 0, 0, 0, names_les_model, "-",
-     "Sub-grid model: none (quasi-DNS: no model term is computed) or the Smagorinsky eddy "
-     "viscosity nu_r = l_S^2 S (thesis Eq. 5.45-5.47); needs sph.viscous = violeau (Eq. 2.100 "
-     "with variable viscosity).",
+    {{"les", "model", T_CHOICE, "none", 0, 0, 0, names_les_model, "-",
+      "Sub-grid model: none (quasi-DNS: no model term is computed) or the Smagorinsky eddy "
+      "viscosity nu_r = l_S^2 S (thesis Eq. 5.45-5.47); needs sph.viscous = violeau (Eq. 2.100 "
+      "with variable viscosity)."},
      OFF(les)},
-    {"les", "cs", T_DOUBLE, "0.065", 0, 1, LO_OPEN, NULL, "-",
-     "Smagorinsky constant C_S: 0.065 (Moin & Kim 1982, used in the thesis) or 0.158 (Lilly's "
-     "analysis for the Wendland kernel, thesis App. B).",
+    {{"les", "cs", T_DOUBLE, "0.065", 0, 1, LO_OPEN, NULL, "-",
+      "Smagorinsky constant C_S: 0.065 (Moin & Kim 1982, used in the thesis) or 0.158 (Lilly's "
+      "analysis for the Wendland kernel, thesis App. B)."},
      OFF(cs)},
-    {"les", "filter_width", T_DOUBLE, "2", 0, 10, LO_OPEN, NULL, "h",
-     "Filter width Delta_G in units of h (thesis Sec. 5.2.2.1: 2h for the Wendland kernel).",
+    {{"les", "filter_width", T_DOUBLE, "2", 0, 10, LO_OPEN, NULL, "h",
+      "Filter width Delta_G in units of h (thesis Sec. 5.2.2.1: 2h for the Wendland kernel)."},
      OFF(filter_h)},
-    {"les", "strain", T_CHOICE, "gradient", 0, 0, 0, names_les_strain, "-",
-     "Rate of strain S = (2 S:S)^(1/2) from the full velocity gradient (first-order corrected, "
-     "thesis Eq. 2.88-2.90) or from the Violeau-Issa estimate with its wall term (Eq. 5.48; "
-     "docs/theory.md).",
+    {{"les", "strain", T_CHOICE, "gradient", 0, 0, 0, names_les_strain, "-",
+      "Rate of strain S = (2 S:S)^(1/2) from the full velocity gradient (first-order corrected, "
+      "thesis Eq. 2.88-2.90) or from the Violeau-Issa estimate with its wall term (Eq. 5.48; "
+      "docs/theory.md)."},
      OFF(strain)},
-    {"les", "strain_lag", T_INT, "1", 0, 1, 0, NULL, "-",
-     "With strain = gradient: 1 forms the strain sums of the eddy viscosity and k_r inside the "
-     "force loop, from the neighbours and pair geometry it has already gathered, and applies "
-     "them at the next step (one time step of lag, as in codes that update nu_r from the "
-     "previous velocity field; the LES step then costs about as much as the quasi-DNS step; "
-     "docs/performance.md); the first step of a run, and of a resumed run whose checkpoint "
-     "lacks the values, computes them at the current state. 0: a separate pass at the current "
-     "state every step.",
+    {{"les", "strain_lag", T_INT, "1", 0, 1, 0, NULL, "-",
+      "With strain = gradient: 1 forms the strain sums of the eddy viscosity and k_r inside the "
+      "force loop, from the neighbours and pair geometry it has already gathered, and applies "
+      "them at the next step (one time step of lag, as in codes that update nu_r from the "
+      "previous velocity field; the LES step then costs about as much as the quasi-DNS step; "
+      "docs/performance.md); the first step of a run, and of a resumed run whose checkpoint "
+      "lacks the values, computes them at the current state. 0: a separate pass at the current "
+      "state every step."},
      OFF(strain_lag)},
-    {"les", "van_driest", T_INT, "1", 0, 1, 0, NULL, "-",
-     "van Driest damping l_S = C_S Delta_G (1 - exp(-y+/A+)) (thesis Eq. 5.50 with the sign "
-     "corrected), y+ from the local friction velocity of the nearest wall; also damps k_r.",
+    {{"les", "van_driest", T_INT, "1", 0, 1, 0, NULL, "-",
+      "van Driest damping l_S = C_S Delta_G (1 - exp(-y+/A+)) (thesis Eq. 5.50 with the sign "
+      "corrected), y+ from the local friction velocity of the nearest wall; also damps k_r."},
      OFF(van_driest)},
-    {"les", "a_plus", T_DOUBLE, "25", 0, BIG, LO_OPEN, NULL, "-", "A+ of the van Driest damping.",
+    {{"les", "a_plus", T_DOUBLE, "25", 0, BIG, LO_OPEN, NULL, "-", "A+ of the van Driest damping."},
      OFF(a_plus)},
-    {"les", "cy", T_DOUBLE, "0.044", 0, 1, 0, NULL, "-",
-     "Yoshizawa constant C_Y of the residual kinetic energy k_r = 2 C_Y (Delta_G S)^2 (thesis "
-     "Eq. 5.49), added to the pressure as 2/3 rho k_r (Eq. 5.42); 0 leaves it out.",
+    {{"les", "cy", T_DOUBLE, "0.044", 0, 1, 0, NULL, "-",
+      "Yoshizawa constant C_Y of the residual kinetic energy k_r = 2 C_Y (Delta_G S)^2 (thesis "
+      "Eq. 5.49), added to the pressure as 2/3 rho k_r (Eq. 5.42); 0 leaves it out."},
      OFF(cy)},
-    {"wall", "law", T_CHOICE, "laminar", 0, 0, 0, names_wall_law, "-",
-     "Wall law of the wall shear term: laminar (thesis Eq. 2.146-2.148, the particle's own "
-     "velocity), log law (Eq. 5.51, linear below y+ = 11.06) or Reichardt (Eq. 5.53); the "
-     "turbulent laws are solved for u_tau per near-wall particle and carried to the wall "
-     "vertices (Ferrand Eq. 38).",
+    {{"wall", "law", T_CHOICE, "laminar", 0, 0, 0, names_wall_law, "-",
+      "Wall law of the wall shear term: laminar (thesis Eq. 2.146-2.148, the particle's own "
+      "velocity), log law (Eq. 5.51, linear below y+ = 11.06) or Reichardt (Eq. 5.53); the "
+      "turbulent laws are solved for u_tau per near-wall particle and carried to the wall "
+      "vertices (Ferrand Eq. 38)."},
      OFF(wall_law)},
-    {"wall", "kappa", T_DOUBLE, "0.41", 0, 1, LO_OPEN, NULL, "-",
-     "von Karman constant of the wall laws (thesis Eq. 5.33).", OFF(kappa)},
-    {"wall", "b", T_DOUBLE, "5.2", -BIG, BIG, 0, NULL, "-",
-     "Intercept B of the log law (thesis Eq. 5.33).", OFF(log_b)},
-    {"fluid", "nu", T_DOUBLE, NULL, 0, NU_MAX, REQUIRED, NULL, "m^2/s",
-     "Kinematic viscosity (0: inviscid, e.g. the energy experiment of thesis Sec. 3.1.2).",
+    {{"wall", "kappa", T_DOUBLE, "0.41", 0, 1, LO_OPEN, NULL, "-",
+      "von Karman constant of the wall laws (thesis Eq. 5.33)."},
+     OFF(kappa)},
+    {{"wall", "b", T_DOUBLE, "5.2", -BIG, BIG, 0, NULL, "-",
+      "Intercept B of the log law (thesis Eq. 5.33)."},
+     OFF(log_b)},
+    {{"fluid", "nu", T_DOUBLE, NULL, 0, NU_MAX, REQUIRED, NULL, "m^2/s",
+      "Kinematic viscosity (0: inviscid, e.g. the energy experiment of thesis Sec. 3.1.2)."},
      OFF(nu)},
-    {"fluid", "rho0", T_DOUBLE, "1000", 0, BIG, LO_OPEN, NULL, "kg/m^3", "Reference density.",
+    {{"fluid", "rho0", T_DOUBLE, "1000", 0, BIG, LO_OPEN, NULL, "kg/m^3", "Reference density."},
      OFF(rho0)},
-    {"fluid", "c0", T_DOUBLE, NULL, 0, SPEED_MAX, REQUIRED | LO_OPEN, NULL, "m/s",
-     "Numerical speed of sound (about 10 times the largest velocity).", OFF(c0)},
-    {"fluid", "zeta", T_DOUBLE, "7", 1, 10, 0, NULL, "-",
-     "Exponent of the Tait equation of state (thesis Eq. 2.11).", OFF(zeta)},
-    {"fluid", "p_background", T_DOUBLE, "0.01", 0, 10, 0, NULL, "rho0 c0^2",
-     "Background pressure added to the Tait equation of state, in units of rho0 c0^2; it "
-     "gives the particle arrangement a restoring force and, with the lattice pressure wall "
-     "weight, stops the transverse instability of the sheared lattice (docs/theory.md). "
-     "For turbulence use 0: its pair stress destroys resolved turbulence within 0.15 "
-     "delta/u_tau (docs/validation/turbulent_channel.md).",
+    {{"fluid", "c0", T_DOUBLE, NULL, 0, SPEED_MAX, REQUIRED | LO_OPEN, NULL, "m/s",
+      "Numerical speed of sound (about 10 times the largest velocity)."},
+     OFF(c0)},
+    {{"fluid", "zeta", T_DOUBLE, "7", 1, 10, 0, NULL, "-",
+      "Exponent of the Tait equation of state (thesis Eq. 2.11)."},
+     OFF(zeta)},
+    {{"fluid", "p_background", T_DOUBLE, "0.01", 0, 10, 0, NULL, "rho0 c0^2",
+      "Background pressure added to the Tait equation of state, in units of rho0 c0^2; it "
+      "gives the particle arrangement a restoring force and, with the lattice pressure wall "
+      "weight, stops the transverse instability of the sheared lattice (docs/theory.md). "
+      "For turbulence use 0: its pair stress destroys resolved turbulence within 0.15 "
+      "delta/u_tau (docs/validation/turbulent_channel.md)."},
      OFF(p_background)},
-    {"fluid", "gravity_y", T_DOUBLE, "0", -ACCEL_MAX, ACCEL_MAX, 0, NULL, "m/s^2",
-     "Wall-normal body acceleration; enters the momentum equation, the wall pressure "
-     "(thesis Eq. 2.143, 3.63) and the volume diffusion (Eq. 3.61).",
+    {{"fluid", "gravity_y", T_DOUBLE, "0", -ACCEL_MAX, ACCEL_MAX, 0, NULL, "m/s^2",
+      "Wall-normal body acceleration; enters the momentum equation, the wall pressure "
+      "(thesis Eq. 2.143, 3.63) and the volume diffusion (Eq. 3.61)."},
      OFF(gravity_y)},
-    {"fluid", "nu_start", T_DOUBLE, "0", 0, NU_MAX, 0, NULL, "m^2/s",
-     "Viscosity schedule (Jimenez & Moin 1991, thesis Sec. 6.1.1): nu_start until "
-     "nu_ramp_begin, then linear in time to nu at nu_ramp_end; 0 = constant nu.",
+    {{"fluid", "nu_start", T_DOUBLE, "0", 0, NU_MAX, 0, NULL, "m^2/s",
+      "Viscosity schedule (Jimenez & Moin 1991, thesis Sec. 6.1.1): nu_start until "
+      "nu_ramp_begin, then linear in time to nu at nu_ramp_end; 0 = constant nu."},
      OFF(nu_start)},
-    {"fluid", "nu_ramp_begin", T_DOUBLE, "0", 0, BIG, 0, NULL, "s", "Start of the viscosity ramp.",
+    {{"fluid", "nu_ramp_begin", T_DOUBLE, "0", 0, BIG, 0, NULL, "s",
+      "Start of the viscosity ramp."},
      OFF(nu_ramp_begin)},
-    {"fluid", "nu_ramp_end", T_DOUBLE, "0", 0, BIG, 0, NULL, "s",
-     "End of the viscosity ramp (at least nu_ramp_begin).", OFF(nu_ramp_end)},
-    {"drive", "mode", T_CHOICE, "force", 0, 0, 0, names_drive_mode, "-",
-     "Drive the flow by a constant body force or by a controlled volume flux.", OFF(drive_mode)},
-    {"drive", "force", T_DOUBLE, "0", -ACCEL_MAX, ACCEL_MAX, 0, NULL, "m/s^2",
-     "Streamwise body acceleration in force mode (tau_w = rho delta force, thesis Eq. 5.14); "
-     "initial value in flux mode.",
+    {{"fluid", "nu_ramp_end", T_DOUBLE, "0", 0, BIG, 0, NULL, "s",
+      "End of the viscosity ramp (at least nu_ramp_begin)."},
+     OFF(nu_ramp_end)},
+    {{"drive", "mode", T_CHOICE, "force", 0, 0, 0, names_drive_mode, "-",
+      "Drive the flow by a constant body force or by a controlled volume flux."},
+     OFF(drive_mode)},
+    {{"drive", "force", T_DOUBLE, "0", -ACCEL_MAX, ACCEL_MAX, 0, NULL, "m/s^2",
+      "Streamwise body acceleration in force mode (tau_w = rho delta force, thesis Eq. 5.14); "
+      "initial value in flux mode."},
      OFF(force)},
-    {"drive", "u_bulk", T_DOUBLE, "0", -SPEED_MAX, SPEED_MAX, 0, NULL, "m/s",
-     "Target bulk velocity in flux mode.", OFF(u_bulk)},
-    {"drive", "controller", T_CHOICE, "eq3.43", 0, 0, 0, names_drive_controller, "-",
-     "Flux controller: thesis Eq. 3.43 (new, generalised to variable dt by Eq. 3.42) or the "
-     "older Eq. 3.38.",
+    {{"drive", "u_bulk", T_DOUBLE, "0", -SPEED_MAX, SPEED_MAX, 0, NULL, "m/s",
+      "Target bulk velocity in flux mode."},
+     OFF(u_bulk)},
+    {{"drive", "controller", T_CHOICE, "eq3.43", 0, 0, 0, names_drive_controller, "-",
+      "Flux controller: thesis Eq. 3.43 (new, generalised to variable dt by Eq. 3.42) or the "
+      "older Eq. 3.38."},
      OFF(controller)},
-    {"time", "t_end", T_DOUBLE, NULL, 0, BIG, REQUIRED | LO_OPEN, NULL, "s", "End time.",
+    {{"time", "t_end", T_DOUBLE, NULL, 0, BIG, REQUIRED | LO_OPEN, NULL, "s", "End time."},
      OFF(t_end)},
-    {"time", "dt", T_DOUBLE, "0", 0, BIG, 0, NULL, "s",
-     "Fixed time step; 0 selects the adaptive step of thesis Eq. 2.160-2.164.", OFF(dt_fixed)},
-    {"time", "cfl", T_DOUBLE, "0.8", 0, 2, LO_OPEN, NULL, "-",
-     "Factor of the acoustic limit dt <= cfl h / c0 (thesis Eq. 2.160; 0.8 after Violeau & "
-     "Leroy 2014).",
+    {{"time", "dt", T_DOUBLE, "0", 0, BIG, 0, NULL, "s",
+      "Fixed time step; 0 selects the adaptive step of thesis Eq. 2.160-2.164."},
+     OFF(dt_fixed)},
+    {{"time", "cfl", T_DOUBLE, "0.8", 0, 2, LO_OPEN, NULL, "-",
+      "Factor of the acoustic limit dt <= cfl h / c0 (thesis Eq. 2.160; 0.8 after Violeau & "
+      "Leroy 2014)."},
      OFF(cfl)},
-    {"time", "c_visc", T_DOUBLE, "0.125", 0, 1, LO_OPEN, NULL, "-",
-     "Factor of the viscous limit dt <= c_visc h^2 / nu (thesis Eq. 2.161).", OFF(c_visc)},
-    {"time", "c_force", T_DOUBLE, "0.25", 0, 1, LO_OPEN, NULL, "-",
-     "Factor of the force limit dt <= c_force sqrt(h / |a|) (thesis Eq. 2.162).", OFF(c_force)},
-    {"time", "c_gamma", T_DOUBLE, "0.005", 0, 1, 0, NULL, "-",
-     "Factor of the wall limit dt <= c_gamma / max|grad gamma . v| (thesis Eq. 2.163); 0 "
-     "disables it.",
+    {{"time", "c_visc", T_DOUBLE, "0.125", 0, 1, LO_OPEN, NULL, "-",
+      "Factor of the viscous limit dt <= c_visc h^2 / nu (thesis Eq. 2.161)."},
+     OFF(c_visc)},
+    {{"time", "c_force", T_DOUBLE, "0.25", 0, 1, LO_OPEN, NULL, "-",
+      "Factor of the force limit dt <= c_force sqrt(h / |a|) (thesis Eq. 2.162)."},
+     OFF(c_force)},
+    {{"time", "c_gamma", T_DOUBLE, "0.005", 0, 1, 0, NULL, "-",
+      "Factor of the wall limit dt <= c_gamma / max|grad gamma . v| (thesis Eq. 2.163); 0 "
+      "disables it."},
      OFF(c_gamma)},
-    {"time", "max_steps", T_LONG, "0", 0, 1e18, 0, NULL, "-",
-     "Stop after this many steps even if t_end is not reached (0 = no limit).", OFF(max_steps)},
-    {"init", "profile", T_CHOICE, "rest", 0, 0, 0, names_init_profile, "-",
-     "Initial mean velocity: at rest; the laminar Poiseuille profile of the force (force mode) "
-     "or of the target bulk velocity (flux mode); or Reichardt's turbulent profile (thesis Eq. "
-     "5.53) with u_tau = (force delta)^(1/2) (force mode) or the u_tau whose profile has the "
-     "target bulk velocity (flux mode); or the wall-normal wave v = init.wave sin(4 pi y / "
-     "(2 delta)) of the energy experiment of thesis Sec. 3.1.2; or synthetic: a synthetic-eddy "
-     "field (Jarrin et al. 2006) carrying the Lee & Moser Re_tau = 180 DNS mean profile U+(y+) "
-     "and Reynolds-stress tensor (u'u', v'v', w'w', u'v'), scaled with the u_tau above and "
-     "this scene's nu (3-D only; not divergence-free; docs/theory.md, \"Synthetic-eddy "
-     "start-up\").",
+    {{"time", "max_steps", T_LONG, "0", 0, 1e18, 0, NULL, "-",
+      "Stop after this many steps even if t_end is not reached (0 = no limit)."},
+     OFF(max_steps)},
+    {{"init", "profile", T_CHOICE, "rest", 0, 0, 0, names_init_profile, "-",
+      "Initial mean velocity: at rest; the laminar Poiseuille profile of the force (force mode) "
+      "or of the target bulk velocity (flux mode); or Reichardt's turbulent profile (thesis Eq. "
+      "5.53) with u_tau = (force delta)^(1/2) (force mode) or the u_tau whose profile has the "
+      "target bulk velocity (flux mode); or the wall-normal wave v = init.wave sin(4 pi y / "
+      "(2 delta)) of the energy experiment of thesis Sec. 3.1.2; or synthetic: a synthetic-eddy "
+      "field (Jarrin et al. 2006) carrying the Lee & Moser Re_tau = 180 DNS mean profile U+(y+) "
+      "and Reynolds-stress tensor (u'u', v'v', w'w', u'v'), scaled with the u_tau above and "
+      "this scene's nu (3-D only; not divergence-free; docs/theory.md, \"Synthetic-eddy "
+      "start-up\")."},
      OFF(init_profile)},
-    {"init", "wave", T_DOUBLE, "0", -SPEED_MAX, SPEED_MAX, 0, NULL, "m/s",
-     "Amplitude of the wall-normal wave of profile = wave (the thesis uses c0/10).",
+    {{"init", "wave", T_DOUBLE, "0", -SPEED_MAX, SPEED_MAX, 0, NULL, "m/s",
+      "Amplitude of the wall-normal wave of profile = wave (the thesis uses c0/10)."},
      OFF(init_wave)},
-    {"init", "streaks", T_DOUBLE, "0", 0, BIG, 0, NULL, "m/s",
-     "Amplitude of streamwise streaks u' = A 4 (y/2delta)(1 - y/2delta) cos(2 pi k z / lz) "
-     "(3-D; divergence-free).",
+    {{"init", "streaks", T_DOUBLE, "0", 0, BIG, 0, NULL, "m/s",
+      "Amplitude of streamwise streaks u' = A 4 (y/2delta)(1 - y/2delta) cos(2 pi k z / lz) "
+      "(3-D; divergence-free)."},
      OFF(init_streaks)},
-    {"init", "streak_kz", T_INT, "2", 1, 1e6, 0, NULL, "-", "Streak pairs across lz.",
+    {{"init", "streak_kz", T_INT, "2", 1, 1e6, 0, NULL, "-", "Streak pairs across lz."},
      OFF(init_streak_kz)},
-    {"init", "modes", T_DOUBLE, "0", 0, BIG, 0, NULL, "m/s",
-     "Amplitude of divergence-free sinusoidal modes: spanwise rolls from the stream function "
-     "psi(x, y) and, in 3-D, streamwise rolls from psi(y, z), both vanishing with their "
-     "normal derivative at the walls (thesis Sec. 6.1.1; docs/theory.md).",
+    {{"init", "modes", T_DOUBLE, "0", 0, BIG, 0, NULL, "m/s",
+      "Amplitude of divergence-free sinusoidal modes: spanwise rolls from the stream function "
+      "psi(x, y) and, in 3-D, streamwise rolls from psi(y, z), both vanishing with their "
+      "normal derivative at the walls (thesis Sec. 6.1.1; docs/theory.md)."},
      OFF(init_modes)},
-    {"init", "mode_kx", T_INT, "1", 1, 1e6, 0, NULL, "-", "Periods of the modes along lx.",
+    {{"init", "mode_kx", T_INT, "1", 1, 1e6, 0, NULL, "-", "Periods of the modes along lx."},
      OFF(init_mode_kx)},
-    {"init", "mode_kz", T_INT, "1", 1, 1e6, 0, NULL, "-", "Periods of the modes along lz.",
+    {{"init", "mode_kz", T_INT, "1", 1, 1e6, 0, NULL, "-", "Periods of the modes along lz."},
      OFF(init_mode_kz)},
-    {"init", "noise", T_DOUBLE, "0", 0, BIG, 0, NULL, "m/s",
-     "Amplitude of uniform random noise on each velocity component, from the counter-based "
-     "Philox generator (Random123) keyed by seed and particle id: independent of threads and "
-     "ranks.",
+    {{"init", "noise", T_DOUBLE, "0", 0, BIG, 0, NULL, "m/s",
+      "Amplitude of uniform random noise on each velocity component, from the counter-based "
+      "Philox generator (Random123) keyed by seed and particle id: independent of threads and "
+      "ranks."},
      OFF(init_noise)},
-    {"init", "seed", T_LONG, "1", 0, 1e15, 0, NULL, "-",
-     "Key of the random noise and of the synthetic eddies.", OFF(init_seed)},
-    {"init", "eddies", T_LONG, "0", 0, 1e8, 0, NULL, "-",
-     "Number N of synthetic eddies of profile = synthetic, placed in the box lx x (2 delta + "
-     "2 sigma) x lz (sigma = eddy_size delta); 0 = the box volume / sigma^3; at most 100 "
-     "times that plus 1000 (more gives the same Gaussian field at a growing cost).",
+    {{"init", "seed", T_LONG, "1", 0, 1e15, 0, NULL, "-",
+      "Key of the random noise and of the synthetic eddies."},
+     OFF(init_seed)},
+    {{"init", "eddies", T_LONG, "0", 0, 1e8, 0, NULL, "-",
+      "Number N of synthetic eddies of profile = synthetic, placed in the box lx x (2 delta + "
+      "2 sigma) x lz (sigma = eddy_size delta); 0 = the box volume / sigma^3; at most 100 "
+      "times that plus 1000 (more gives the same Gaussian field at a growing cost)."},
      OFF(init_eddies)},
-    {"init", "eddy_size", T_DOUBLE, "0.2", 0, BIG, LO_OPEN, NULL, "delta",
-     "Half-width sigma of the synthetic eddies (tent shape functions), in units of delta; at "
-     "most lx/2 and lz/2.",
+    {{"init", "eddy_size", T_DOUBLE, "0.2", 0, BIG, LO_OPEN, NULL, "delta",
+      "Half-width sigma of the synthetic eddies (tent shape functions), in units of delta; at "
+      "most lx/2 and lz/2."},
      OFF(init_eddy_size)},
-    {"init", "from", T_STRING, "", 0, 0, 0, NULL, "-",
-     "particles.nc of an earlier run with the same domain: with the same particle count its "
-     "positions and velocities are taken as they are (by id); otherwise its velocity field is "
-     "interpolated (linear moving least squares) onto this scene's lattice, e.g. a coarse LES to "
-     "start a finer "
-     "run. A relative path in a scene file is relative to the scene file's directory (on the "
-     "command line, to the working directory). Overrides profile; streaks, modes and noise are "
-     "added on top. A source that is not a state of the box is refused (exit 1): variables "
-     "not 1-D over 'particle', no particles, ids not 0..n-1 each once, a NaN or Inf, rho or "
-     "mass not positive, a position outside the box, a value equal to its _FillValue or "
-     "missing_value, a packed id. CF-packed variables (scale_factor, add_offset, as NCO's "
-     "ncpdq writes them) are unpacked, to the packing's precision (a note says so). The file's "
-     "run_id and time are recorded in stats.nc (init_from_run_id, init_from_time): `chansph "
-     "extract` joins a run only after the run whose final state it started from.",
+    {{"init", "from", T_STRING, "", 0, 0, 0, NULL, "-",
+      "particles.nc of an earlier run with the same domain: with the same particle count its "
+      "positions and velocities are taken as they are (by id); otherwise its velocity field is "
+      "interpolated (linear moving least squares) onto this scene's lattice, e.g. a coarse LES to "
+      "start a finer "
+      "run. A relative path in a scene file is relative to the scene file's directory (on the "
+      "command line, to the working directory). Overrides profile; streaks, modes and noise are "
+      "added on top. A source that is not a state of the box is refused (exit 1): variables "
+      "not 1-D over 'particle', no particles, ids not 0..n-1 each once, a NaN or Inf, rho or "
+      "mass not positive, a position outside the box, a value equal to its _FillValue or "
+      "missing_value, a packed id. CF-packed variables (scale_factor, add_offset, as NCO's "
+      "ncpdq writes them) are unpacked, to the packing's precision (a note says so). The file's "
+      "run_id and time are recorded in stats.nc (init_from_run_id, init_from_time): `chansph "
+      "extract` joins a run only after the run whose final state it started from."},
      OFF(init_from)},
-    {"init", "density", T_CHOICE, "keep", 0, 0, 0, names_init_density, "-",
-     "With init.from at the same particle count: keep the particles' densities, or (rho0) "
-     "shift them all by one constant so that their mean is fluid.rho0. A developed state may "
-     "carry a mean overpressure (the density's mean drifts slowly, over tens of turnovers), "
-     "which acts on the symmetric pressure gradient as a background pressure "
-     "(docs/validation/scheme_ab.md); rho0 starts without it.",
+    {{"init", "density", T_CHOICE, "keep", 0, 0, 0, names_init_density, "-",
+      "With init.from at the same particle count: keep the particles' densities, or (rho0) "
+      "shift them all by one constant so that their mean is fluid.rho0. A developed state may "
+      "carry a mean overpressure (the density's mean drifts slowly, over tens of turnovers), "
+      "which acts on the symmetric pressure gradient as a background pressure "
+      "(docs/validation/scheme_ab.md); rho0 starts without it."},
      OFF(init_density)},
-    {"output", "log_every", T_INT, "100", 1, 1e9, 0, NULL, "steps",
-     "Steps between progress lines (stdout and DIR/log.txt).", OFF(log_every)},
-    {"output", "series_every", T_INT, "10", 1, 1e9, 0, NULL, "steps",
-     "Steps between records of the time series in stats.nc.", OFF(series_every)},
-    {"output", "stats_every", T_INT, "10", 1, 1e9, 0, NULL, "steps",
-     "Steps between samples of the binned profiles.", OFF(stats_every)},
-    {"output", "write_every", T_DOUBLE, "0", 0, BIG, 0, NULL, "s",
-     "Simulated time between rewrites of stats.nc (0 = only at the end).", OFF(write_every)},
-    {"output", "t_average_start", T_DOUBLE, "0", 0, BIG, 0, NULL, "s",
-     "Start of the averaging window of the profiles (ends at t_end).", OFF(t_average_start)},
-    {"output", "n_bins", T_INT, "0", 0, 1e7, 0, NULL, "-",
-     "Wall-normal bins of the profiles, uniform between the walls; 0 = one bin of width dr "
-     "centred on each initial particle layer y = j dr (the strips of width dr/2 at the walls "
-     "join the first and last bins).",
+    {{"output", "log_every", T_INT, "100", 1, 1e9, 0, NULL, "steps",
+      "Steps between progress lines (stdout and DIR/log.txt)."},
+     OFF(log_every)},
+    {{"output", "series_every", T_INT, "10", 1, 1e9, 0, NULL, "steps",
+      "Steps between records of the time series in stats.nc."},
+     OFF(series_every)},
+    {{"output", "stats_every", T_INT, "10", 1, 1e9, 0, NULL, "steps",
+      "Steps between samples of the binned profiles."},
+     OFF(stats_every)},
+    {{"output", "write_every", T_DOUBLE, "0", 0, BIG, 0, NULL, "s",
+      "Simulated time between rewrites of stats.nc (0 = only at the end)."},
+     OFF(write_every)},
+    {{"output", "t_average_start", T_DOUBLE, "0", 0, BIG, 0, NULL, "s",
+      "Start of the averaging window of the profiles (ends at t_end)."},
+     OFF(t_average_start)},
+    {{"output", "n_bins", T_INT, "0", 0, 1e7, 0, NULL, "-",
+      "Wall-normal bins of the profiles, uniform between the walls; 0 = one bin of width dr "
+      "centred on each initial particle layer y = j dr (the strips of width dr/2 at the walls "
+      "join the first and last bins)."},
      OFF(n_bins)},
-    {"output", "particles", T_INT, "1", 0, 1, 0, NULL, "-",
-     "Write the final particle state to DIR/particles.nc (1) or not (0).", OFF(particles)},
-    {"output", "q_criterion", T_INT, "0", 0, 1, 0, NULL, "-",
-     "Add q_criterion to particles.nc and the snapshots: Q = (|Omega|^2 - |S|^2)/2 [1/s^2] of each "
-     "fluid "
-     "particle's first-order corrected velocity gradient (thesis Eq. 2.88-2.90), for vortex "
-     "identification (Hunt, Wray & Moin 1988: Q > 0 where rotation exceeds strain; an iso-surface "
-     "of Q in ParaView shows the vortices). Computed only when one of them is written.",
+    {{"output", "particles", T_INT, "1", 0, 1, 0, NULL, "-",
+      "Write the final particle state to DIR/particles.nc (1) or not (0)."},
+     OFF(particles)},
+    {{"output", "q_criterion", T_INT, "0", 0, 1, 0, NULL, "-",
+      "Add q_criterion to particles.nc and the snapshots: Q = (|Omega|^2 - |S|^2)/2 [1/s^2] of "
+      "each "
+      "fluid "
+      "particle's first-order corrected velocity gradient (thesis Eq. 2.88-2.90), for vortex "
+      "identification (Hunt, Wray & Moin 1988: Q > 0 where rotation exceeds strain; an iso-surface "
+      "of Q in ParaView shows the vortices). Computed only when one of them is written."},
      OFF(q_criterion)},
-    {"stats", "eulerian", T_INT, "1", 0, 1, 0, NULL, "-",
-     "Eulerian statistics: wall-normal profiles of means, Reynolds stresses, skewness, "
-     "flatness with standard errors, friction velocity and shear-stress balance "
-     "(docs/stats-format.md); sampled every output.stats_every steps from "
-     "output.t_average_start in output.n_bins bins.",
-     OFF(stats_eulerian)},
-    {"stats", "budget_every", T_INT, "5", 1, 1e9, 0, NULL, "samples",
-     "Every how many Eulerian samples also carries the momentum and Reynolds-stress budgets "
-     "and the wall shear stress (u_tau_wall): every stats.budget_every x output.stats_every "
-     "steps. A budget sample splits the pair forces into their conservative parts, which "
-     "costs about one more force pass (docs/performance.md, \"The budgets\"); 1 samples them "
-     "with every snapshot (the budget identity of every step needs 1 with output.stats_every "
-     "= 1). A short run through a transient needs 1 for its momentum budget to close: the "
-     "fluxes are averaged over the budget snapshots, the momentum change over their span, and "
-     "a few irregular snapshots miss it (the quick-start, t = 0-0.1 from a decelerating burst: "
-     "0.0087 u_tau^2 with 1, 0.058 with 5; jobs/scenes/quickstart.ini uses 1).",
-     OFF(budget_every)},
-    {"stats", "window", T_DOUBLE, "0", 0, BIG, 0, NULL, "s",
-     "Length of an averaging window: stats.nc keeps the sums of every window (re-average a "
-     "range with `chansph extract --window`), and the window means are the batch means of "
-     "the standard errors, so a window should span several correlation times (the log "
-     "reports the estimate). 0 = a tenth of t_end - t_average_start. Fixed once averaging "
-     "has begun: a resume keeps the length (also with a new t_end) and refuses a new value.",
-     OFF(stats_window)},
-    {"stats", "fold", T_INT, "0", 0, 1, 0, NULL, "-",
-     "Fold the upper half onto the lower one (y -> 2 delta - y, v -> -v) before binning; the "
-     "bins then cover 0 .. delta.",
-     OFF(stats_fold)},
-    {"stats", "method", T_CHOICE, "bins", 0, 0, 0, names_stats_method, "-",
-     "How particles make the profiles: bin sampling (thesis Eq. 5.54-5.55), or SPH "
-     "interpolation (Eq. 5.56) at the bin centres averaged over the plane, each particle "
-     "weighted by V_a times the plane integral of the kernel; the means are Eq. 5.56, the "
-     "stresses then also hold the mean-shear variation across the kernel (use bins for them).",
-     OFF(stats_method)},
-    {"stats", "u_tau_ref", T_DOUBLE, "0", 0, BIG, 0, NULL, "m/s",
-     "Friction velocity that places the y+ levels of the correlations and Lagrangian releases "
-     "(y = y+ nu / u_tau_ref); 0 = sqrt(delta drive.force), the force-balance value.",
-     OFF(u_tau_ref)},
-    {"stats", "target_stderr", T_DOUBLE, "0", 0, 1, 0, NULL, "-",
-     "Convergence target: once the standard errors relative to their profile (max "
-     "stderr(u_mean) / max |u_mean|, and stderr of -u'v' at its peak / the peak) are below "
-     "this, with at least target_windows complete windows of at least target_corr_ratio "
-     "correlation times, the run ends itself (checkpoint, stats.nc, exit 0). Checked when a "
-     "window closes; every convergence line of the log gives the projected simulated and wall "
-     "time to reach it. Needs stats.eulerian = 1. A resumed run that met it stays finished "
-     "unless a target key changes. 0 = off.",
-     OFF(target_stderr)},
-    {"stats", "target_profiles", T_CHOICE, "both", 0, 0, 0, names_stats_target_profiles, "-",
-     "Profiles of the convergence target: u_mean and the -u'v' peak, or one of them (a laminar "
-     "flow has no -u'v' to converge).",
-     OFF(target_profiles)},
-    {"stats", "target_corr_ratio", T_DOUBLE, "5", 0, BIG, 0, NULL, "-",
-     "Convergence target: smallest window length / correlation time for the standard errors "
-     "to count (shorter windows make them too small); 0 = no requirement.",
-     OFF(target_corr_ratio)},
-    {"stats", "target_windows", T_INT, "4", 2, 1e9, 0, NULL, "-",
-     "Convergence target: fewest complete windows (batches) for the standard errors to count.",
-     OFF(target_windows)},
-    {"correlations", "y_plus", T_LIST, "", 0, BIG, 0, NULL, "-",
-     "Comma-separated y+ levels (up to 8) of the two-point correlations and 1-D spectra "
-     "(thesis Eq. 5.57-5.59); each level and its mirror 2 delta - y are sampled. Empty = off.",
-     OFF(corr_y_plus)},
-    {"correlations", "nx", T_INT, "0", 0, 1e6, 0, NULL, "-",
-     "Points of the plane grid along x (bin averages, Eq. 5.54-5.55); 0 = lx / dr.", OFF(corr_nx)},
-    {"correlations", "nz", T_INT, "0", 0, 1e6, 0, NULL, "-",
-     "Points of the plane grid along z; 0 = lz / dr (1 in 2-D).", OFF(corr_nz)},
-    {"correlations", "thickness", T_DOUBLE, "1", 0, 100, LO_OPEN, NULL, "dr",
-     "Thickness of the slab of particles binned onto each plane, in units of dr.",
-     OFF(corr_thickness)},
-    {"quadrants", "y_plus", T_LIST, "", 0, BIG, 0, NULL, "-",
-     "Comma-separated y+ levels (up to 8) of the quadrant analysis of u'v' (Wallace et al. "
-     "1972, Willmarth & Lu 1972): in a slab of one dr at each level and its mirror, the "
-     "fluctuations about the plane average of each instant sorted into Q1 (outward), Q2 "
-     "(ejections), Q3 (inward) and Q4 (sweeps); stats.nc group quadrants (docs/stats-format.md). "
-     "Ejections and sweeps dominate in wall turbulence, not in particle noise. Empty = off.",
-     OFF(quad_y_plus)},
-    {"pdfs", "y_plus", T_LIST, "", 0, BIG, 0, NULL, "-",
-     "Comma-separated y+ levels (up to 8) of the one-point PDFs of u', v', w' (MKM "
-     "1999 give them at y+ = 5, 10, 19, 30, 40, 59, 79, 98, 178): fluid particles in a slab at "
-     "each level and its mirror (v -> -v), binned in units of the local rms about the mean of "
-     "the averaged windows; stats.nc group pdfs (docs/stats-format.md). Empty = off.",
-     OFF(pdf_y_plus)},
-    {"pdfs", "bins", T_INT, "40", 1, 1000, 0, NULL, "-",
-     "Bins of each PDF over -range .. range local rms.", OFF(pdf_bins)},
-    {"pdfs", "range", T_DOUBLE, "5", 0, 100, LO_OPEN, NULL, "rms",
-     "Half-width of the PDFs in units of the local rms (samples beyond it are counted in "
-     "outside).",
-     OFF(pdf_range)},
-    {"pdfs", "fine", T_DOUBLE, "0.02", 0.001, 1, 0, NULL, "u_tau",
-     "Width of the fine bins of the raw per-window counts of u_i / stats.u_tau_ref (over -10 .. "
-     "35 for u, -10 .. 10 for v and w), rebinned in units of the rms at output: keep it well "
-     "below a PDF bin, 2 range / bins times the smallest rms (v near the wall: 0.01); the log "
-     "warns where it is above half of one.",
-     OFF(pdf_fine)},
-    {"pdfs", "thickness", T_DOUBLE, "1", 0, 100, LO_OPEN, NULL, "dr",
-     "Thickness of the slab of particles sampled at each level, in units of dr.",
-     OFF(pdf_thickness)},
-    {"lagrangian", "y_plus", T_LIST, "", 0, BIG, 0, NULL, "-",
-     "Comma-separated y+ release levels (up to 8) of the Lagrangian statistics (thesis Sec. "
-     "5.2.3.2, 6.1.3): fluid particles within dr/2 of each level (and of its mirror) and "
-     "within dr/2 of x0 are tracked. Empty = off.",
-     OFF(lagr_y_plus)},
-    {"lagrangian", "x0", T_DOUBLE, "0", 0, BIG, 0, NULL, "m",
-     "Release plane: particles with |x - x0| < dr/2 are released.", OFF(lagr_x0)},
-    {"lagrangian", "horizon", T_DOUBLE, "1", 0, BIG, LO_OPEN, NULL, "s",
-     "How long each release is followed (the largest lag tau).", OFF(lagr_horizon)},
-    {"lagrangian", "release_every", T_DOUBLE, "0", 0, BIG, 0, NULL, "s",
-     "Time between release iterations; releases overlap when shorter than the horizon. 0 = "
-     "the horizon (consecutive, independent releases, thesis Sec. 6.1.3).",
-     OFF(lagr_release_every)},
-    {"lagrangian", "n_lags", T_INT, "50", 2, 1e5, 0, NULL, "-",
-     "Lag samples over the horizon (a particle is sampled at the first statistics sample "
-     "in each lag interval).",
-     OFF(lagr_n_lags)},
-    {"lagrangian", "pdf_x", T_LIST, "", 0, BIG, 0, NULL, "m",
-     "Comma-separated downstream distances x - x0 (up to 8) of the stations of the PDFs P(y; "
-     "x) (Eq. 5.67-5.68); empty = no PDFs.",
-     OFF(lagr_pdf_x)},
-    {"lagrangian", "pdf_bins", T_INT, "50", 2, 1e5, 0, NULL, "-",
-     "Bins of the PDFs P(y; x) across the channel.", OFF(lagr_pdf_bins)},
-    {"health", "every", T_INT, "1", 1, 1e9, 0, NULL, "steps",
-     "Steps between full health checks (NaN, wall crossing, CFL); 1 checks every step. "
-     "Whatever the interval, a state is checked before it is written or sampled (checkpoint, "
-     "snapshot, stats.nc, particles.nc, statistics sample, time-series row).",
+};
+
+/* The solver's keys after the engines': health checks, the run, checkpoints, snapshots. */
+static const struct key keys_tail[] = {
+    {{"health", "every", T_INT, "1", 1, 1e9, 0, NULL, "steps",
+      "Steps between full health checks (NaN, wall crossing, CFL); 1 checks every step. "
+      "Whatever the interval, a state is checked before it is written or sampled (checkpoint, "
+      "snapshot, stats.nc, particles.nc, statistics sample, time-series row)."},
      OFF(health_every)},
-    {"run", "threads", T_INT, "0", 0, 4096, 0, NULL, "-",
-     "OpenMP threads; 0 keeps OMP_NUM_THREADS (or all cores).", OFF(threads)},
-    {"run", "balance_every", T_INT, "100", 0, 1e9, 0, NULL, "steps",
-     "With several MPI ranks: steps between checks of the particles per rank (0 = never "
-     "re-partition). Results do not depend on the partition (docs/parallel.md).",
+    {{"run", "threads", T_INT, "0", 0, 4096, 0, NULL, "-",
+      "OpenMP threads; 0 keeps OMP_NUM_THREADS (or all cores)."},
+     OFF(threads)},
+    {{"run", "balance_every", T_INT, "100", 0, 1e9, 0, NULL, "steps",
+      "With several MPI ranks: steps between checks of the particles per rank (0 = never "
+      "re-partition). Results do not depend on the partition (docs/parallel.md)."},
      OFF(balance_every)},
-    {"run", "ranks", T_LIST, "", 1, 1e6, 0, NULL, "-",
-     "Px,Pz: the MPI ranks as Px x Pz blocks of whole cell pencils (Px along x, Pz along z; "
-     "Px Pz = the ranks; each block at least 4 cells of size h along a cut direction); empty = "
-     "the factorisation with the fewest ghosts per rank (logged). Results do not depend on it "
-     "(docs/parallel.md).",
+    {{"run", "ranks", T_LIST, "", 1, 1e6, 0, NULL, "-",
+      "Px,Pz: the MPI ranks as Px x Pz blocks of whole cell pencils (Px along x, Pz along z; "
+      "Px Pz = the ranks; each block at least 4 cells of size h along a cut direction); empty = "
+      "the factorisation with the fewest ghosts per rank (logged). Results do not depend on it "
+      "(docs/parallel.md)."},
      OFF(ranks)},
-    {"run", "partition", T_LIST, "", 1, 1e9, 0, NULL, "columns",
-     "Slabs only (Pz = 1): cell columns per rank at the start (up to 8 ranks, summing to the "
-     "columns of the grid, each at least 4); empty = an even split. The load balance may move "
-     "the cuts later; the results do not depend on them.",
+    {{"run", "partition", T_LIST, "", 1, 1e9, 0, NULL, "columns",
+      "Slabs only (Pz = 1): cell columns per rank at the start (up to 8 ranks, summing to the "
+      "columns of the grid, each at least 4); empty = an even split. The load balance may move "
+      "the cuts later; the results do not depend on them."},
      OFF(partition)},
-    {"run", "check_ids", T_INT, "0", 0, 1, 0, NULL, "-",
-     "Debug mode: after every step gather all particle ids on rank 0 and check that each id "
-     "0 .. N-1 is held by exactly one rank (none lost or duplicated by the migration); stops "
-     "with an internal error naming the step and the id otherwise.",
+    {{"run", "check_ids", T_INT, "0", 0, 1, 0, NULL, "-",
+      "Debug mode: after every step gather all particle ids on rank 0 and check that each id "
+      "0 .. N-1 is held by exactly one rank (none lost or duplicated by the migration); stops "
+      "with an internal error naming the step and the id otherwise."},
      OFF(check_ids)},
-    {"run", "balance_threshold", T_DOUBLE, "0.1", 0, 100, 0, NULL, "-",
-     "Re-partition the cell columns along x when the most loaded rank holds more than (1 + "
-     "threshold) times the mean particle count.",
+    {{"run", "balance_threshold", T_DOUBLE, "0.1", 0, 100, 0, NULL, "-",
+      "Re-partition the cell columns along x when the most loaded rank holds more than (1 + "
+      "threshold) times the mean particle count."},
      OFF(balance_threshold)},
     /* [checkpoint]: restart/ (docs/checkpoint-format.md, docs/batch-jobs.md) */
-    {"checkpoint", "every_steps", T_LONG, "0", 0, 1e18, 0, NULL, "steps",
-     "Steps between checkpoints in DIR/checkpoints (0 = not by steps). A run also checkpoints "
-     "at its end, on SIGTERM/SIGINT/SIGUSR1, a STOP file, --max-steps and --walltime.",
+    {{"checkpoint", "every_steps", T_LONG, "0", 0, 1e18, 0, NULL, "steps",
+      "Steps between checkpoints in DIR/checkpoints (0 = not by steps). A run also checkpoints "
+      "at its end, on SIGTERM/SIGINT/SIGUSR1, a STOP file, --max-steps and --walltime."},
      OFF(ckpt_every_steps)},
-    {"checkpoint", "every_minutes", T_DOUBLE, "30", 0, BIG, 0, NULL, "min",
-     "Wall-clock minutes between checkpoints (0 = not by time).", OFF(ckpt_every_minutes)},
-    {"checkpoint", "keep", T_INT, "3", 1, 1e6, 0, NULL, "-",
-     "Checkpoints kept in DIR/checkpoints; older ones are deleted after a successful write.",
+    {{"checkpoint", "every_minutes", T_DOUBLE, "30", 0, BIG, 0, NULL, "min",
+      "Wall-clock minutes between checkpoints (0 = not by time)."},
+     OFF(ckpt_every_minutes)},
+    {{"checkpoint", "keep", T_INT, "3", 1, 1e6, 0, NULL, "-",
+      "Checkpoints kept in DIR/checkpoints; older ones are deleted after a successful write."},
      OFF(ckpt_keep)},
-    {"snapshots", "every", T_DOUBLE, "0", 0, BIG, 0, NULL, "s",
-     "Simulated time between particle snapshots DIR/snapshots/snap_<step>.h5 with the index "
-     "DIR/snapshots/particles.xdmf for ParaView (0 = none; docs/formats.md).",
+    {{"snapshots", "every", T_DOUBLE, "0", 0, BIG, 0, NULL, "s",
+      "Simulated time between particle snapshots DIR/snapshots/snap_<step>.h5 with the index "
+      "DIR/snapshots/particles.xdmf for ParaView (0 = none; docs/formats.md)."},
      OFF(snap_every)},
 };
-enum { N_KEYS = sizeof keys / sizeof keys[0] };
+
+/** One key of the scene's table: its definition and where its value is: the field at offset
+    in struct scene (the solver's keys, slot -1) or stats_keys[slot] (an engine's key). */
+struct entry {
+  const struct scene_key_def *d;
+  size_t offset;
+  int slot;
+};
+
+/* The scene's one table: the solver's keys_head, the keys of each engine of stats_engines
+   (engine.h) in the order of that list, then keys_tail; built at the first use. */
+static struct entry table[SCENE_MAX_KEYS];
+static int n_keys;
+static const struct scene_key_def *stats_defs[SCENE_STATS_KEYS]; /* the engines' keys by slot */
+static int n_stats;
+
+static void add_entry(const struct scene_key_def *d, size_t offset, int slot) {
+  if (n_keys == SCENE_MAX_KEYS) die("the scene has more than SCENE_MAX_KEYS keys (scene.h)");
+  table[n_keys++] = (struct entry){.d = d, .offset = offset, .slot = slot};
+}
+
+static void build_table(void) {
+  if (n_keys) return;
+  for (size_t i = 0; i < sizeof keys_head / sizeof keys_head[0]; i++)
+    add_entry(&keys_head[i].d, keys_head[i].offset, -1);
+  int slot = 0;
+  for (int e = 0; e < stats_n_engines; e++)
+    for (int i = 0; i < stats_engines[e]->n_keys; i++) {
+      const struct scene_key_def *d = stats_engines[e]->keys[i];
+      if (d->type == SCENE_STRING || d->type == SCENE_LONG)
+        die("scene key %s.%s of the %s: an engine's key is an int, a number, a choice or a list",
+            d->section, d->name, stats_engines[e]->name);
+      if (slot == SCENE_STATS_KEYS)
+        die("the engines declare more than SCENE_STATS_KEYS scene keys (scene.h)");
+      stats_defs[slot] = d, n_stats = slot + 1;
+      add_entry(d, 0, slot++);
+    }
+  for (size_t i = 0; i < sizeof keys_tail / sizeof keys_tail[0]; i++)
+    add_entry(&keys_tail[i].d, keys_tail[i].offset, -1);
+  /* each key once, each section in one run of keys (docs/scenes.md has one table per section):
+     an engine's key in a section of the solver's or of another engine is a bug */
+  for (int k = 0; k < n_keys; k++)
+    for (int j = 0; j < k; j++) {
+      const struct scene_key_def *a = table[j].d, *b = table[k].d;
+      if (strcmp(a->section, b->section)) continue;
+      if (!strcmp(a->name, b->name)) die("scene key %s.%s is declared twice", b->section, b->name);
+      if (strcmp(table[k - 1].d->section, b->section))
+        die("scene key %s.%s: section [%s] is split in the scene's table", b->section, b->name,
+            b->section);
+    }
+}
 
 /** Parser state: where each key was set, and the error count. */
 struct parse_state {
   struct scene *s;
   const char *file;
-  int line;                    /*!< current line, counted by the reader */
-  int where[N_KEYS];           /*!< 0 = default, >0 = file line, -1 = --set */
-  int seen[N_KEYS];            /*!< given with an invalid value */
-  const char *set_text;        /*!< the --set argument being applied */
-  const char *set_arg[N_KEYS]; /*!< the --set argument that gave each key */
+  int line;                            /*!< current line, counted by the reader */
+  int where[SCENE_MAX_KEYS];           /*!< 0 = default, >0 = file line, -1 = --set */
+  int seen[SCENE_MAX_KEYS];            /*!< given with an invalid value */
+  const char *set_text;                /*!< the --set argument being applied */
+  const char *set_arg[SCENE_MAX_KEYS]; /*!< the --set argument that gave each key */
   int errors;
   FILE *fp;
   char section[64]; /*!< section of the last header line of the file */
@@ -582,14 +546,14 @@ static const struct removed_key *find_removed(const char *section, const char *n
 }
 
 static int find_key(const char *section, const char *name) {
-  for (int i = 0; i < N_KEYS; i++)
-    if (!strcmp(keys[i].section, section) && !strcmp(keys[i].name, name)) return i;
+  for (int i = 0; i < n_keys; i++)
+    if (!strcmp(table[i].d->section, section) && !strcmp(table[i].d->name, name)) return i;
   return -1;
 }
 
 static int known_section(const char *section) {
-  for (int i = 0; i < N_KEYS; i++)
-    if (!strcmp(keys[i].section, section)) return 1;
+  for (int i = 0; i < n_keys; i++)
+    if (!strcmp(table[i].d->section, section)) return 1;
   return 0;
 }
 
@@ -602,23 +566,17 @@ static void location(const struct parse_state *ps, int where, char *buf, size_t 
     snprintf(buf, n, "%s", ps->file);
 }
 
-/** Parse text into the field of key k; returns a message on failure, NULL on success. */
+/** Parse text into the value of key k; returns a message on failure, NULL on success. */
 static const char *set_value(struct scene *s, int k, const char *text) {
-  const struct key *K = &keys[k];
+  const struct scene_key_def *K = table[k].d;
   char *end = NULL;
-  void *field = (char *)s + K->offset;
+  const int slot = table[k].slot;
+  void *field = slot >= 0 ? (void *)&s->stats_keys[slot] : (void *)((char *)s + table[k].offset);
+  double v = 0.0;            /* a number, or a choice's index */
   if (K->type == T_STRING) { /* char[512] fields */
     if (strlen(text) >= 512) return "is longer than 511 characters";
     strcpy((char *)field, text);
     return NULL;
-  }
-  if (K->type == T_CHOICE) {
-    for (int idx = 0; K->choices[idx]; idx++)
-      if (!strcmp(K->choices[idx], text)) {
-        *(int *)field = idx;
-        return NULL;
-      }
-    return "is not one of the allowed choices";
   }
   if (K->type == T_LIST) {
     struct scene_list *L = field;
@@ -627,10 +585,10 @@ static const char *set_value(struct scene *s, int k, const char *text) {
       while (*c == ' ' || *c == '\t') c++;
       if (!*c) break;
       if (L->n == SCENE_LIST_MAX) return "has more than 8 entries";
-      const double v = strtod(c, &end);
+      const double x = strtod(c, &end);
       if (end == c) return "is not a comma-separated list of numbers";
-      if (!isfinite(v) || v < K->lo || v > K->hi) return "has an entry out of range";
-      L->v[L->n++] = v;
+      if (!isfinite(x) || x < K->lo || x > K->hi) return "has an entry out of range";
+      L->v[L->n++] = x;
       c = end;
       while (*c == ' ' || *c == '\t') c++;
       if (*c == ',')
@@ -640,15 +598,24 @@ static const char *set_value(struct scene *s, int k, const char *text) {
     }
     return NULL;
   }
-  const double v = strtod(text, &end);
-  if (end == text || *end != '\0') return "is not a number";
-  if (!isfinite(v)) return "is not finite";
-  if (K->type != T_DOUBLE && v != floor(v)) return "is not an integer";
-  /* a bound of +-BIG is no bound ("-inf" or "inf" in the range text): any finite value */
-  if ((K->lo > -BIG && v < K->lo) || (K->hi < BIG && v > K->hi) ||
-      ((K->flags & LO_OPEN) && v == K->lo))
-    return "is out of range";
-  if (K->type == T_INT)
+  if (K->type == T_CHOICE) {
+    int idx = 0;
+    while (K->choices[idx] && strcmp(K->choices[idx], text)) idx++;
+    if (!K->choices[idx]) return "is not one of the allowed choices";
+    v = idx;
+  } else {
+    v = strtod(text, &end);
+    if (end == text || *end != '\0') return "is not a number";
+    if (!isfinite(v)) return "is not finite";
+    if (K->type != T_DOUBLE && v != floor(v)) return "is not an integer";
+    /* a bound of +-BIG is no bound ("-inf" or "inf" in the range text): any finite value */
+    if ((K->lo > -BIG && v < K->lo) || (K->hi < BIG && v > K->hi) ||
+        ((K->flags & LO_OPEN) && v == K->lo))
+      return "is out of range";
+  }
+  if (slot >= 0)
+    *(struct scene_list *)field = (struct scene_list){.n = 1, .v = {v}};
+  else if (K->type == T_INT || K->type == T_CHOICE)
     *(int *)field = (int)v;
   else if (K->type == T_LONG)
     *(long *)field = (long)v;
@@ -657,7 +624,7 @@ static const char *set_value(struct scene *s, int k, const char *text) {
   return NULL;
 }
 
-static void range_text(const struct key *K, char *buf, size_t n) {
+static void range_text(const struct scene_key_def *K, char *buf, size_t n) {
   if (K->type == T_STRING) {
     snprintf(buf, n, "text");
     return;
@@ -683,9 +650,9 @@ static void report_value(struct parse_state *ps, int k, int where, const char *v
                          const char *why) {
   char loc[600], range[128];
   location(ps, where, loc, sizeof loc);
-  range_text(&keys[k], range, sizeof range);
-  error_input("%s: key '%s.%s': value '%s' %s (allowed: %s %s)", loc, keys[k].section, keys[k].name,
-              value, why, range, keys[k].unit);
+  range_text(table[k].d, range, sizeof range);
+  error_input("%s: key '%s.%s': value '%s' %s (allowed: %s %s)", loc, table[k].d->section,
+              table[k].d->name, value, why, range, table[k].d->unit);
   ps->errors++;
 }
 
@@ -922,17 +889,22 @@ static void validate(struct parse_state *ps) {
   if (s->t_average_start > s->t_end)
     inconsistent(ps, "output.t_average_start", "averaging start %g is after t_end = %g",
                  s->t_average_start, s->t_end);
-  if (s->target_stderr > 0.0 && !s->stats_eulerian)
+  const double target = scene_stats_num(s, &euler_key_target_stderr);
+  if (target > 0.0 && !scene_stats_num(s, &euler_key_eulerian))
     inconsistent(ps, "stats.target_stderr",
                  "a convergence target (%g) needs stats.eulerian = 1: it is met on the Eulerian "
                  "profiles",
-                 s->target_stderr);
-  if ((s->corr_y_plus.n || s->lagr_y_plus.n || s->quad_y_plus.n || s->pdf_y_plus.n) &&
-      s->u_tau_ref == 0.0 && (s->drive_mode == DRIVE_FLUX || s->force <= 0.0))
+                 target);
+  const double u_tau_ref = scene_stats_num(s, &euler_key_u_tau_ref);
+  int levels = 0; /* an engine's y+ levels are given */
+  for (int k = 0; k < n_keys; k++)
+    levels |= (table[k].d->flags & SCENE_Y_PLUS) && table[k].slot >= 0 &&
+              s->stats_keys[table[k].slot].n > 0;
+  if (levels && u_tau_ref == 0.0 && (s->drive_mode == DRIVE_FLUX || s->force <= 0.0))
     inconsistent(ps, "stats.u_tau_ref",
                  "y+ levels need stats.u_tau_ref > 0 unless a positive drive.force gives it "
                  "(u_tau_ref = %g, force = %g)",
-                 s->u_tau_ref, s->force);
+                 u_tau_ref, s->force);
   if (s->init_profile == INIT_SYNTHETIC) validate_synthetic(ps);
   if (s->dt_fixed > 0.0 && s->dt_fixed > s->t_end)
     inconsistent(ps, "time.dt", "fixed dt = %g is larger than t_end = %g", s->dt_fixed, s->t_end);
@@ -969,10 +941,12 @@ static void resolve_paths(struct parse_state *ps, const char *scene_path) {
  * paths in the text are relative to the directory of path. */
 static int load(struct scene *s, const char *path, FILE *fp, int file_paths, int n_set,
                 char *const *set) {
+  build_table();
   memset(s, 0, sizeof *s);
   struct parse_state ps = {.s = s, .file = path ? path : "(defaults)"};
-  for (int k = 0; k < N_KEYS; k++)
-    if (keys[k].def && set_value(s, k, keys[k].def)) die("bad default of key %s", keys[k].name);
+  for (int k = 0; k < n_keys; k++)
+    if (table[k].d->def && set_value(s, k, table[k].d->def))
+      die("bad default of key %s", table[k].d->name);
   if (path) {
     snprintf(s->path, sizeof s->path, "%s", path);
     ps.fp = fp;
@@ -1002,10 +976,10 @@ static int load(struct scene *s, const char *path, FILE *fp, int file_paths, int
     apply(&ps, sec, name, eq + 1, -1);
     ps.set_text = NULL;
   }
-  for (int k = 0; k < N_KEYS; k++)
-    if ((keys[k].flags & REQUIRED) && ps.where[k] == 0 && !ps.seen[k]) {
-      error_input("%s: missing required key '%s' in section [%s] (%s)", ps.file, keys[k].name,
-                  keys[k].section, keys[k].help);
+  for (int k = 0; k < n_keys; k++)
+    if ((table[k].d->flags & REQUIRED) && ps.where[k] == 0 && !ps.seen[k]) {
+      error_input("%s: missing required key '%s' in section [%s] (%s)", ps.file, table[k].d->name,
+                  table[k].d->section, table[k].d->help);
       ps.errors++;
     }
   if (ps.errors == 0 && file_paths) resolve_paths(&ps, path);
@@ -1025,13 +999,15 @@ int scene_load_text(struct scene *s, const char *name, const char *text, int n_s
 }
 
 int scene_key_count(void) {
-  return N_KEYS;
+  build_table();
+  return n_keys;
 }
 
 static void value_text(const struct scene *s, int k, char *buf, size_t n);
 
 void scene_key(const struct scene *s, int k, char *name, char *value) {
-  snprintf(name, 64, "%s.%s", keys[k].section, keys[k].name);
+  build_table();
+  snprintf(name, 64, "%s.%s", table[k].d->section, table[k].d->name);
   value_text(s, k, value, SCENE_VALUE_MAX);
 }
 
@@ -1060,47 +1036,50 @@ int scene_bins(const struct scene *s) {
 }
 
 const char *scene_choice(const char *key, int value) {
+  build_table();
   const char *dot = strchr(key, '.');
   char sec[32];
   snprintf(sec, sizeof sec, "%.*s", (int)(dot - key), key);
   const int k = find_key(sec, dot + 1);
-  if (k < 0 || keys[k].type != T_CHOICE || value < 0) return "?";
-  for (int i = 0; keys[k].choices[i]; i++)
-    if (i == value) return keys[k].choices[i];
+  if (k < 0 || table[k].d->type != T_CHOICE || value < 0) return "?";
+  for (int i = 0; table[k].d->choices[i]; i++)
+    if (i == value) return table[k].d->choices[i];
   return "?";
 }
 
-int scene_values(const struct scene *s, const char *key, double *v, int max) {
-  const char *dot = strchr(key, '.');
-  char sec[32];
-  if (!dot || dot - key >= (int)sizeof sec) return -1;
-  snprintf(sec, sizeof sec, "%.*s", (int)(dot - key), key);
-  const int k = find_key(sec, dot + 1);
-  if (k < 0 || keys[k].type == T_STRING) return -1;
-  const void *field = (const char *)s + keys[k].offset;
-  if (keys[k].type == T_LIST) {
-    const struct scene_list *L = field;
-    for (int i = 0; i < L->n && i < max; i++) v[i] = L->v[i];
-    return L->n;
-  }
-  if (max < 1) return 1;
-  v[0] = keys[k].type == T_DOUBLE ? *(const double *)field
-         : keys[k].type == T_LONG ? (double)*(const long *)field
-                                  : (double)*(const int *)field; /* T_INT, T_CHOICE */
-  return 1;
+const struct scene_list *scene_stats_value(const struct scene *s, const struct scene_key_def *key) {
+  build_table();
+  for (int k = 0; k < n_keys; k++)
+    if (table[k].d == key && table[k].slot >= 0) return &s->stats_keys[table[k].slot];
+  die("scene key %s.%s is not an engine's key", key->section, key->name);
+}
+
+double scene_stats_num(const struct scene *s, const struct scene_key_def *key) {
+  return scene_stats_value(s, key)->v[0];
+}
+
+const struct scene_key_def *const *scene_stats_defs(int *n) {
+  build_table();
+  *n = n_stats;
+  return stats_defs;
 }
 
 static void value_text(const struct scene *s, int k, char *buf, size_t n) {
-  const void *field = (const char *)s + keys[k].offset;
-  switch (keys[k].type) {
+  const struct scene_key_def *K = table[k].d;
+  const int slot = table[k].slot;
+  const void *field = slot >= 0 ? (const void *)&s->stats_keys[slot]
+                                : (const void *)((const char *)s + table[k].offset);
+  /* an engine's number is the one entry of its value */
+  const double num = slot >= 0 ? s->stats_keys[slot].v[0] : 0.0;
+  switch (K->type) {
     case T_INT:
-      snprintf(buf, n, "%d", *(const int *)field);
+      snprintf(buf, n, "%d", slot >= 0 ? (int)num : *(const int *)field);
       break;
     case T_LONG:
       snprintf(buf, n, "%ld", *(const long *)field);
       break;
     case T_DOUBLE: { /* the shortest text that reads back to the same double */
-      const double v = *(const double *)field;
+      const double v = slot >= 0 ? num : *(const double *)field;
       for (int digits = 15; digits <= 17; digits++) {
         snprintf(buf, n, "%.*g", digits, v);
         if (strtod(buf, NULL) == v) break;
@@ -1120,27 +1099,28 @@ static void value_text(const struct scene *s, int k, char *buf, size_t n) {
       break;
     case T_CHOICE: {
       char key[80];
-      snprintf(key, sizeof key, "%s.%s", keys[k].section, keys[k].name);
-      snprintf(buf, n, "%s", scene_choice(key, *(const int *)field));
+      snprintf(key, sizeof key, "%s.%s", K->section, K->name);
+      snprintf(buf, n, "%s", scene_choice(key, slot >= 0 ? (int)num : *(const int *)field));
       break;
     }
   }
 }
 
 char *scene_text(const struct scene *s) {
+  build_table();
   size_t cap = 8192, len = 0;
   char *out = mem_alloc(1, cap, "scene text");
   out[0] = '\0';
   const char *section = "";
-  for (int k = 0; k < N_KEYS; k++) {
+  for (int k = 0; k < n_keys; k++) {
     char val[600], line[800];
     value_text(s, k, val, sizeof val);
     int m = 0;
-    if (strcmp(section, keys[k].section)) {
-      section = keys[k].section;
+    if (strcmp(section, table[k].d->section)) {
+      section = table[k].d->section;
       m = snprintf(line, sizeof line, "%s[%s]\n", len ? "\n" : "", section);
     }
-    m += snprintf(line + m, sizeof line - m, "%s = %s\n", keys[k].name, val);
+    m += snprintf(line + m, sizeof line - m, "%s = %s\n", table[k].d->name, val);
     if (len + (size_t)m + 1 > cap) {
       cap *= 2;
       out = mem_realloc(out, cap, 1, "scene text");
@@ -1152,9 +1132,11 @@ char *scene_text(const struct scene *s) {
 }
 
 void scene_write_doc(FILE *f) {
+  build_table();
   fprintf(f,
           "# Scene reference\n\n"
-          "<!-- generated by `build/chansph scene-doc`; do not edit, edit solver/scene.c -->\n\n"
+          "<!-- generated by `build/chansph scene-doc`; do not edit, edit solver/scene.c or the "
+          "key table of the engine in stats/ -->\n\n"
           "A scene is an INI file (parsed with inih). Comments start with `#` or `;` at the "
           "start of a line, or `;` after a value or a section header.\n"
           "Any key can be overridden on the command line with `--set section.key=value`.\n"
@@ -1176,19 +1158,19 @@ void scene_write_doc(FILE *f) {
           "The fully resolved scene (defaults included) is written to `DIR/scene.used.ini` "
           "and into the `scene` attribute of `stats.nc`.\n");
   const char *section = "";
-  for (int k = 0; k < N_KEYS; k++) {
-    if (strcmp(section, keys[k].section)) {
-      section = keys[k].section;
+  for (int k = 0; k < n_keys; k++) {
+    if (strcmp(section, table[k].d->section)) {
+      section = table[k].d->section;
       fprintf(f,
               "\n## [%s]\n\n| key | default | allowed | unit | meaning |\n|---|---|---|---|---|\n",
               section);
     }
     char range[128];
-    range_text(&keys[k], range, sizeof range);
+    range_text(table[k].d, range, sizeof range);
     for (char *c = range; *c; c++)
       if (*c == '|') *c = '/';
-    fprintf(f, "| `%s` | %s | %s | %s | %s |\n", keys[k].name,
-            keys[k].def ? (keys[k].def[0] ? keys[k].def : "(empty)") : "**required**", range,
-            keys[k].unit, keys[k].help);
+    fprintf(f, "| `%s` | %s | %s | %s | %s |\n", table[k].d->name,
+            table[k].d->def ? (table[k].d->def[0] ? table[k].d->def : "(empty)") : "**required**",
+            range, table[k].d->unit, table[k].d->help);
   }
 }

@@ -8,6 +8,8 @@
 
 #include <stdio.h>
 
+#include "contract.h" /* struct scene_key_def, struct scene_list */
+
 enum drive_mode { DRIVE_FORCE = 0, DRIVE_FLUX = 1 };
 enum flux_controller { CONTROLLER_EQ343 = 0, CONTROLLER_EQ338 = 1 };
 enum viscous_form { VISCOUS_MORRIS = 0, VISCOUS_VIOLEAU = 1 };
@@ -36,13 +38,8 @@ enum shifting { SHIFT_NONE = 0, SHIFT_FICKIAN = 1 };
 enum shift_velocity { SHIFT_KEEP = 0, SHIFT_TAYLOR = 1, SHIFT_CONSERVATIVE = 2 };
 enum wall_collision { WALL_STOP = 0, WALL_REFLECT = 1 };
 
-enum { SCENE_LIST_MAX = 8 };
-
-/** A short list of numbers (a comma-separated scene value). */
-struct scene_list {
-  int n;                    /*!< entries */
-  double v[SCENE_LIST_MAX]; /*!< values */
-};
+/** Room for the keys the engines declare (struct stats_engine.keys), and for all the keys. */
+enum { SCENE_STATS_KEYS = 64, SCENE_MAX_KEYS = 256 };
 
 /** Every parameter of a run, with units. Derived quantities are marked. */
 struct scene {
@@ -128,36 +125,6 @@ struct scene {
   int n_bins;             /*!< wall-normal bins; 0 = 2 delta / dr - 1 */
   int particles;          /*!< write the final particle state to particles.nc (1) or not (0) */
   int q_criterion;        /*!< add the Q criterion to particles.nc (1) or not (0) */
-  /* [stats] */
-  int stats_eulerian;       /*!< Eulerian profiles on (1) or off (0) */
-  int budget_every;         /*!< Eulerian samples per budget sample (and wall-stress sample) */
-  double stats_window;      /*!< averaging window (batch) length [s]; 0 = a tenth of the average */
-  int stats_fold;           /*!< fold the upper half of the channel onto the lower one (1) */
-  int stats_method;         /*!< 0: bin sampling (Eq. 5.54-5.55), 1: SPH interpolation (Eq. 5.56) */
-  double u_tau_ref;         /*!< friction velocity placing y+ levels [m/s]; 0 = sqrt(delta force) */
-  double target_stderr;     /*!< stop once the relative standard errors are below this (0: off) */
-  int target_profiles;      /*!< 0: u_mean and the -u'v' peak, 1: u_mean, 2: the -u'v' peak */
-  double target_corr_ratio; /*!< minimum window length / correlation time for the target */
-  int target_windows;       /*!< minimum complete windows for the target */
-  /* [correlations] */
-  struct scene_list corr_y_plus; /*!< y+ levels of the two-point correlations (empty = off) */
-  struct scene_list quad_y_plus; /*!< y+ levels of the quadrant analysis (empty = off) */
-  int corr_nx, corr_nz;          /*!< plane grid; 0 = lx/dr, lz/dr */
-  double corr_thickness;         /*!< slab thickness around each level [dr] */
-  /* [pdfs] */
-  struct scene_list pdf_y_plus; /*!< y+ levels of the one-point PDFs (empty = off) */
-  int pdf_bins;                 /*!< PDF bins over +-pdf_range */
-  double pdf_range;             /*!< half-width of the PDFs [local rms] */
-  double pdf_fine;              /*!< fine bin width of the raw counts [u_tau_ref] */
-  double pdf_thickness;         /*!< slab thickness around each level [dr] */
-  /* [lagrangian] */
-  struct scene_list lagr_y_plus; /*!< release levels (empty = off) */
-  double lagr_x0;                /*!< release plane x0 [m] */
-  double lagr_horizon;           /*!< how long each release is followed [s] */
-  double lagr_release_every;     /*!< time between releases [s]; 0 = the horizon */
-  int lagr_n_lags;               /*!< lag samples over the horizon */
-  struct scene_list lagr_pdf_x;  /*!< downstream distances of the PDF stations [m] */
-  int lagr_pdf_bins;             /*!< bins of the PDFs P(y; x) */
   /* [health] */
   int health_every; /*!< steps between full health checks */
   /* [run] */
@@ -173,6 +140,12 @@ struct scene {
   int ckpt_keep;             /*!< checkpoints kept in DIR/checkpoints */
   /* [snapshots] */
   double snap_every; /*!< simulated time between particle snapshots [s]; 0 = none */
+
+  /* the statistics engines' sections ([stats], [correlations], [lagrangian], [quadrants],
+     [pdfs]): the values of the keys each engine declares (struct stats_engine.keys), in the
+     order of the scene's table; read through scene_stats_value() and, by the engines,
+     through struct stats_scene */
+  struct scene_list stats_keys[SCENE_STATS_KEYS];
 
   /* bookkeeping, not keys */
   char path[512]; /*!< scene file path */
@@ -243,14 +216,21 @@ char *scene_text(const struct scene *s);
 void scene_write_doc(FILE *f);
 
 /**
- * @brief The value(s) of a numeric key by name, as doubles (an integer exactly, a choice as its
- *        index, a list entry by entry).
- * @param[in] s scene
- * @param[in] key "section.key", e.g. "correlations.nx"
- * @param[out] v at most max values
- * @return the number of values the key holds (1 for a scalar), or -1 for an unknown or text key
+ * @brief The value of an engine's key (struct stats_engine.keys), found by its definition:
+ *        a list entry by entry, a number (a choice as its index) as its one entry. Dies if the
+ *        key is not an engine's key of the scene.
  */
-int scene_values(const struct scene *s, const char *key, double *v, int max);
+const struct scene_list *scene_stats_value(const struct scene *s, const struct scene_key_def *key);
+
+/** @brief The number (a choice as its index) of an engine's key: scene_stats_value()->v[0]. */
+double scene_stats_num(const struct scene *s, const struct scene_key_def *key);
+
+/**
+ * @brief The engines' keys of the scene's table, in the order of their values in
+ *        struct scene.stats_keys (the view of the statistics engines, struct stats_scene).
+ * @param[out] n how many
+ */
+const struct scene_key_def *const *scene_stats_defs(int *n);
 
 /** @brief Name of an enum value of a choice key, e.g. scene_choice("drive.mode", 1) = "flux". */
 const char *scene_choice(const char *key, int value);

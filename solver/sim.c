@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "error.h"
+#include "euler.h"
 #include "init.h"
 #include "output.h"
 #include "records.h"
@@ -169,7 +170,7 @@ int sim_create(struct sim *S, const struct scene *sc) {
     part_destroy(&S->P, &S->W);
     return CHANSPH_ERR;
   }
-  if (sc->stats_eulerian) S->wall_ax = part_alloc("wall_ax", sizeof(double));
+  if (scene_stats_num(sc, &euler_key_eulerian)) S->wall_ax = part_alloc("wall_ax", sizeof(double));
   init_origin(sc->init_from, &S->init_run_id, &S->init_time);
   S->qcrit_step = -1;
   S->wall_fx[0] = S->wall_fx[1] = NAN;
@@ -324,7 +325,8 @@ static void wall_force(struct sim *S) {
 }
 
 int sim_budget_sample(const struct scene *sc, long step) {
-  const long every = sc->stats_every, k = sc->budget_every;
+  const long every = sc->stats_every;
+  const long k = (long)scene_stats_num(sc, &euler_key_budget_every);
   if (step % every != 0) return 0;
   if (k <= 1) return 1;
   const long n = step / every; /* the statistics sample's number */

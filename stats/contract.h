@@ -4,7 +4,8 @@
  *        nothing an engine owns. One snapshot of the particles (struct stats_snapshot), the
  *        parts of the x-acceleration a snapshot may carry (enum stats_part, which the solver's
  *        per-particle parts of part.h are defined from), and the scene as the engines see it
- *        (struct stats_scene: the channel's values, and the engines' own keys by name).
+ *        (struct stats_scene: the channel's values and the engines' own keys), and the definition
+ *        of a scene key (struct scene_key_def), which each engine gives for its own keys.
  *
  * The engines include this header, base headers and their own; never an engine's header to
  * get the contract, and never a solver header (docs/architecture.md, "Layers").
@@ -88,13 +89,55 @@ struct stats_snapshot {
                                ordered by plane; MPI_COMM_NULL: the planes are not cut */
 };
 
+/** Types of a scene key (struct scene_key_def). */
+enum scene_key_type {
+  SCENE_INT,    /*!< an integer (int) */
+  SCENE_LONG,   /*!< an integer (long) */
+  SCENE_DOUBLE, /*!< a number */
+  SCENE_CHOICE, /*!< one of the names of choices; the value is its index */
+  SCENE_STRING, /*!< text (the solver's keys only) */
+  SCENE_LIST    /*!< up to SCENE_LIST_MAX comma-separated numbers */
+};
+
+/** Flags of a scene key: it has no default and must be given; its lower bound is excluded; it
+    is a list of y+ levels, which (when not empty) need a friction velocity (stats.u_tau_ref, or
+    a positive drive.force). */
+enum { SCENE_REQUIRED = 1, SCENE_LO_OPEN = 2, SCENE_Y_PLUS = 4 };
+
+/** A bound of +-SCENE_NO_BOUND is no bound: any finite value. */
+#define SCENE_NO_BOUND 1e300
+
+enum { SCENE_LIST_MAX = 8 };
+
+/** The value of a numeric key: a list entry by entry; a number (an integer exactly, a choice as
+    its index) as its one entry. */
+struct scene_list {
+  int n;                    /*!< entries */
+  double v[SCENE_LIST_MAX]; /*!< values */
+};
+
+/**
+ * One scene key, declared by the module that reads it: an engine declares its own keys beside
+ * its code (struct stats_engine.keys, engine.h); the scene (solver/scene.c) collects them
+ * into its one table, which parses, validates, documents and writes every key.
+ */
+struct scene_key_def {
+  const char *section, *name; /*!< "[section]" and "name" of the key */
+  enum scene_key_type type;   /*!< its type */
+  const char *def;            /*!< default as scene text; NULL for a required key */
+  double lo, hi;              /*!< allowed range (inclusive unless SCENE_LO_OPEN; list entries) */
+  int flags;                  /*!< SCENE_REQUIRED, SCENE_LO_OPEN, SCENE_Y_PLUS */
+  const char *const *choices; /*!< SCENE_CHOICE: the names, NULL-terminated */
+  const char *unit, *help;    /*!< unit and the line of docs/scenes.md */
+};
+
 /**
  * The scene as the engines see it: the channel, the fluid and the averaging as resolved
  * values (derived ones computed by the solver, so no engine repeats a formula of the scene),
- * and the keys of the engines' own sections ([stats], [correlations], [lagrangian], ...)
- * by name through get (stats_scene_num(), stats_scene_list() below, stats_scene.c). Each engine
- * builds
- * its configuration from it (struct stats_engine.init_scene, engine.h).
+ * and the values of the engines' own keys ([stats], [correlations], [lagrangian], ...), which
+ * an engine reads by its own key definitions (stats_scene_int() and its kin below,
+ * stats_scene.c). Each engine builds its configuration from it (struct
+ * stats_engine.init_scene, engine.h).
  */
 struct stats_scene {
   int dim;                /*!< 2 or 3 */
@@ -108,28 +151,36 @@ struct stats_scene {
   double u_tau;           /*!< friction velocity that places y+ levels [m/s] */
   double t_average_start; /*!< start of the averaging [s] */
   double t_end;           /*!< end of the run [s] */
+  double window;          /*!< length of an averaging window [s] (stats_window_length()) */
   int bins;               /*!< wall-normal bins: output.n_bins, or if that is 0 one per
                                particle layer, 2 delta / dr - 1 */
+  int bins_uniform;       /*!< 1: output.n_bins gave the bins (uniform between the walls) */
   int columns;            /*!< cell columns of the global grid along x (the Eulerian engine's
                                per-column sums) */
-  /** The value(s) of the scene key "section.key" (a number, a choice as its index, a list)
-      into v (at most max of them); returns how many the key holds, or -1 if it is not a
-      numeric key of the scene. */
-  int (*get)(const void *scene, const char *key, double *v, int max);
-  const void *scene; /*!< what get reads */
+  int n_keys;             /*!< the engines' keys */
+  const struct scene_key_def *const *key_def; /*!< their definitions, n_keys */
+  const struct scene_list *key_value;         /*!< and their values, n_keys */
 };
 
 /**
- * @brief A numeric scene key of an engine's own section ("correlations.nx"): its value (a
- *        choice as its index). Dies if the scene has no such key (a bug of the engine).
+ * @brief The value of an engine's key, found by its definition (the engine's own table).
+ *        Dies if the scene does not hold the key (an engine not in the list, a bug).
  */
-double stats_scene_num(const struct stats_scene *sc, const char *key);
+const struct scene_list *stats_scene_value(const struct stats_scene *sc,
+                                           const struct scene_key_def *key);
+
+/** @brief An integer or choice key of an engine (a choice as its index). */
+int stats_scene_int(const struct stats_scene *sc, const struct scene_key_def *key);
+
+/** @brief A number key of an engine. */
+double stats_scene_double(const struct stats_scene *sc, const struct scene_key_def *key);
 
 /**
- * @brief A list key of the scene ("lagrangian.pdf_x"): up to max values into v.
- * @return the number of values the key holds (dies if the scene has no such key)
+ * @brief A list key of an engine ("lagrangian.pdf_x"): up to max values into v.
+ * @return the number of values the key holds
  */
-int stats_scene_list(const struct stats_scene *sc, const char *key, double *v, int max);
+int stats_scene_list(const struct stats_scene *sc, const struct scene_key_def *key, double *v,
+                     int max);
 
 /**
  * @brief Wall-normal levels given in wall units by a list key ("correlations.y_plus"): y+ as
@@ -137,13 +188,13 @@ int stats_scene_list(const struct stats_scene *sc, const char *key, double *v, i
  * @param[out] y_plus,y up to max levels each
  * @return the number of levels (at most max)
  */
-int stats_scene_levels(const struct stats_scene *sc, const char *key, double *y_plus, double *y,
-                       int max);
+int stats_scene_levels(const struct stats_scene *sc, const struct scene_key_def *key,
+                       double *y_plus, double *y, int max);
 
 /**
  * @brief Length of an averaging window [s]: the key stats.window, or if that is 0 a tenth of
  *        t_end - t_average_start (a tenth of t_end, or 1 s, if that is not positive).
  */
-double stats_scene_window(const struct stats_scene *sc);
+double stats_window_length(double key, double t_average_start, double t_end);
 
 #endif

@@ -476,17 +476,60 @@ int corr_nc_read(struct corr *c, int ncid, char *err, size_t errlen) {
   return 0;
 }
 
+/* The engine's scene keys, section [correlations] (docs/scenes.md is generated from them). */
+static const struct scene_key_def key_y_plus = {
+    .section = "correlations",
+    .name = "y_plus",
+    .type = SCENE_LIST,
+    .def = "",
+    .lo = 0,
+    .hi = SCENE_NO_BOUND,
+    .flags = SCENE_Y_PLUS,
+    .unit = "-",
+    .help =
+        "Comma-separated y+ levels (up to 8) of the two-point correlations and 1-D spectra "
+        "(thesis Eq. 5.57-5.59); each level and its mirror 2 delta - y are sampled. Empty = off."};
+static const struct scene_key_def key_nx = {
+    .section = "correlations",
+    .name = "nx",
+    .type = SCENE_INT,
+    .def = "0",
+    .lo = 0,
+    .hi = 1e6,
+    .unit = "-",
+    .help = "Points of the plane grid along x (bin averages, Eq. 5.54-5.55); 0 = lx / dr."};
+static const struct scene_key_def key_nz = {
+    .section = "correlations",
+    .name = "nz",
+    .type = SCENE_INT,
+    .def = "0",
+    .lo = 0,
+    .hi = 1e6,
+    .unit = "-",
+    .help = "Points of the plane grid along z; 0 = lz / dr (1 in 2-D)."};
+static const struct scene_key_def key_thickness = {
+    .section = "correlations",
+    .name = "thickness",
+    .type = SCENE_DOUBLE,
+    .def = "1",
+    .lo = 0,
+    .hi = 100,
+    .flags = SCENE_LO_OPEN,
+    .unit = "dr",
+    .help = "Thickness of the slab of particles binned onto each plane, in units of dr."};
+static const struct scene_key_def *const keys[] = {&key_y_plus, &key_nx, &key_nz, &key_thickness};
+
 /* The configuration from the scene; returns its number of levels (0: the engine does not run). */
 static int config_of(const struct stats_scene *sc, struct corr_config *c) {
   memset(c, 0, sizeof *c);
-  c->n_levels = stats_scene_levels(sc, "correlations.y_plus", c->y_plus, c->y, CORR_MAX_LEVELS);
-  const int nx = (int)stats_scene_num(sc, "correlations.nx");
-  const int nz = (int)stats_scene_num(sc, "correlations.nz");
+  c->n_levels = stats_scene_levels(sc, &key_y_plus, c->y_plus, c->y, CORR_MAX_LEVELS);
+  const int nx = stats_scene_int(sc, &key_nx);
+  const int nz = stats_scene_int(sc, &key_nz);
   c->nx = nx > 0 ? nx : (int)floor(sc->lx / sc->dr + 0.5);
   c->nz = sc->dim == 2 ? 1 : nz > 0 ? nz : (int)floor(sc->lz / sc->dr + 0.5);
   c->lx = sc->lx, c->lz = sc->lz, c->delta = sc->delta, c->t_start = sc->t_average_start;
-  c->window = stats_scene_window(sc);
-  c->half = 0.5 * stats_scene_num(sc, "correlations.thickness") * sc->dr;
+  c->window = sc->window;
+  c->half = 0.5 * stats_scene_double(sc, &key_thickness) * sc->dr;
   return c->n_levels > 0 ? c->n_levels : 0;
 }
 
@@ -523,6 +566,8 @@ static int engine_write(const void *self, double t_reached, int ncid, char *err,
 }
 
 const struct stats_engine corr_engine = {.name = "two-point correlations",
+                                         .keys = keys,
+                                         .n_keys = sizeof keys / sizeof keys[0],
                                          .size = sizeof(struct corr),
                                          .init_scene = engine_init_scene,
                                          .estimate = engine_estimate,

@@ -4,9 +4,9 @@
  *        operations per engine, defined by the engine's own module next to its accumulators
  *        and its netCDF writer, and the one list of the engines (engines.c).
  *
- * Adding an engine: its module (state struct and configuration, the table below: built from
- * the scene, free, sample, checkpoint state, memory, writer; merging across ranks happens
- * inside its sample, through spar.h), its table declared in its header, and one line in
+ * Adding an engine: its module (state struct and configuration, its scene keys, the table
+ * below: built from the scene, free, sample, checkpoint state, memory, writer; merging across ranks
+ * happens inside its sample, through spar.h), its table declared in its header, and one line in
  * `stats_engines` in engines.c (docs/stats-format.md, "How to add a statistic").
  */
 #ifndef CHANSPH_ENGINE_H
@@ -14,6 +14,7 @@
 
 #include <stddef.h>
 
+struct scene_key_def;
 struct stats_scene;
 struct stats_snapshot;
 struct state_list;
@@ -22,6 +23,12 @@ struct state_list;
 struct stats_engine {
   const char *name; /*!< for messages */
   size_t size;      /*!< bytes of the engine's state (its struct) */
+  /** The engine's own scene keys, declared beside its code (contract.h): the scene
+      (solver/scene.c) collects them in the order of stats_engines, parses, checks, documents
+      and writes them, and the engine reads their values from struct stats_scene by these
+      definitions (stats_scene_int() and its kin). */
+  const struct scene_key_def *const *keys;
+  int n_keys; /*!< how many */
   /** Build the engine's configuration from the scene and set it up if the scene asks for it;
       returns 1 if it does, 0 if not (then self is left as it was and never used). */
   int (*init_scene)(void *self, const struct stats_scene *sc);

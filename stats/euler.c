@@ -2,6 +2,7 @@
 #include "euler.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -229,24 +230,52 @@ double euler_centre(const struct euler_config *cfg, int i) {
   return cfg->y0 + (i + 0.5) * (cfg->y1 - cfg->y0) / cfg->nb;
 }
 
+static void widen_mom(void *owner, int rank, const size_t *dims);
+
+/** One per-window array of struct euler: its checkpoint name, fields per record, the record
+    width an older checkpoint format may hold (0: none; after_read widens it), per bin (1) or
+    one record per window (0), where it is in struct euler, and whether a checkpoint of an
+    earlier format may lack it. */
+struct euler_array {
+  const char *name;
+  size_t len, len_old;
+  int per_bin;
+  size_t offset;
+  int optional;
+  void (*after_read)(void *owner, int rank, const size_t *dims);
+};
+
+/* The per-window arrays, in the order of enum EULER_ARRAYS (euler.h). */
+static const struct euler_array euler_arrays[EULER_ARRAYS] = {
+    {"stats/eulerian/windows", WIN_LEN, 0, 0, offsetof(struct euler, win), 0, NULL},
+    /* format 1.11 has 21 moments per record */
+    {"stats/eulerian/moments", MOM_LEN, MOM_LEN_1_11, 1, offsetof(struct euler, mom), 0, widen_mom},
+    {"stats/eulerian/snapshot_u", SCAL_LEN, 0, 1, offsetof(struct euler, snp), 0, NULL},
+    /* format 1.1 has no budget: zero rows, no budget profiles */
+    {"stats/eulerian/planes", PL_LEN, 0, 1, offsetof(struct euler, pln), 1, NULL},
+    /* format 1.4: before it, rows without the advective part */
+    {"stats/eulerian/planes_kinetic", KN_LEN, 0, 1, offsetof(struct euler, kin), 1, NULL},
+    /* format 1.6: before it, rows without the Reynolds-stress budget */
+    {"stats/eulerian/reynolds_budget", RW_LEN, 0, 1, offsetof(struct euler, rsb), 1, NULL},
+};
+
+/* The array a of e (a pointer to its member). */
+static double **array_of(struct euler *e, int a) {
+  return (double **)(void *)((char *)e + euler_arrays[a].offset);
+}
+
 /* Make room for rows 0..rows-1; new rows are zero. */
 static void reserve_rows(struct euler *e, size_t rows) {
   if (rows <= e->cap) return;
   const size_t nb = (size_t)e->cfg.nb, old = e->cap;
   size_t cap = old ? old : 8;
   while (cap < rows) cap *= 2;
-  e->win = mem_realloc(e->win, cap * WIN_LEN, sizeof(double), "Eulerian statistics");
-  e->mom = mem_realloc(e->mom, cap * nb * MOM_LEN, sizeof(double), "Eulerian statistics");
-  e->snp = mem_realloc(e->snp, cap * nb * SCAL_LEN, sizeof(double), "Eulerian statistics");
-  e->pln = mem_realloc(e->pln, cap * nb * PL_LEN, sizeof(double), "Eulerian statistics");
-  e->kin = mem_realloc(e->kin, cap * nb * KN_LEN, sizeof(double), "Eulerian statistics");
-  e->rsb = mem_realloc(e->rsb, cap * nb * RW_LEN, sizeof(double), "Eulerian statistics");
-  memset(e->win + old * WIN_LEN, 0, (cap - old) * WIN_LEN * sizeof(double));
-  memset(e->mom + old * nb * MOM_LEN, 0, (cap - old) * nb * MOM_LEN * sizeof(double));
-  memset(e->snp + old * nb * SCAL_LEN, 0, (cap - old) * nb * SCAL_LEN * sizeof(double));
-  memset(e->pln + old * nb * PL_LEN, 0, (cap - old) * nb * PL_LEN * sizeof(double));
-  memset(e->kin + old * nb * KN_LEN, 0, (cap - old) * nb * KN_LEN * sizeof(double));
-  memset(e->rsb + old * nb * RW_LEN, 0, (cap - old) * nb * RW_LEN * sizeof(double));
+  for (int a = 0; a < EULER_ARRAYS; a++) {
+    const size_t row = euler_arrays[a].len * (euler_arrays[a].per_bin ? nb : 1);
+    double **p = array_of(e, a);
+    *p = mem_realloc(*p, cap * row, sizeof(double), "Eulerian statistics");
+    memset(*p + old * row, 0, (cap - old) * row * sizeof(double));
+  }
   e->cap = cap;
 }
 
@@ -298,7 +327,7 @@ void euler_init(struct euler *e, const struct euler_config *cfg) {
 void euler_free(struct euler *e) {
   struct euler_work *k = e->work;
   if (k) free(k->part), free(k->mine), free(k->all), free(k->scr), free(k->node), free(k);
-  free(e->win), free(e->mom), free(e->snp), free(e->pln), free(e->kin), free(e->rsb);
+  for (int a = 0; a < EULER_ARRAYS; a++) free(*array_of(e, a));
   memset(e, 0, sizeof *e);
 }
 
@@ -988,20 +1017,20 @@ void euler_result_free(struct euler_result *res) {
   memset(res, 0, sizeof *res);
 }
 
-/* Reserve callbacks: the stored shape says how many rows the run had. */
-static void *reserve_win(void *owner, int rank, const size_t *dims) {
-  struct euler *e = owner;
-  if (rank != 2 || dims[0] < 1 || dims[1] != WIN_LEN) return NULL;
+/* The checkpoint reader's callback of every per-window array (state.h): checks the stored
+   shape (rows, bins, record width) and makes room for the rows it says the run had; the
+   windows' record also gives the closed windows. */
+static void *reserve_array(void *owner, int rank, const size_t *dims) {
+  const struct euler_array_owner *o = owner;
+  const struct euler_array *A = &euler_arrays[o->a];
+  struct euler *e = o->e;
+  if (rank != (A->per_bin ? 3 : 2) || (!A->per_bin && dims[0] < 1)) return NULL;
+  if (A->per_bin && dims[1] != (size_t)e->cfg.nb) return NULL;
+  const size_t width = dims[rank - 1];
+  if (width != A->len && !(A->len_old && width == A->len_old)) return NULL;
   reserve_rows(e, dims[0]);
-  e->nwin = dims[0] - 1;
-  return e->win;
-}
-static void *reserve_mom(void *owner, int rank, const size_t *dims) {
-  struct euler *e = owner;
-  if (rank != 3 || dims[1] != (size_t)e->cfg.nb || (dims[2] != MOM_LEN && dims[2] != MOM_LEN_1_11))
-    return NULL;
-  reserve_rows(e, dims[0]);
-  return e->mom;
+  if (!A->per_bin) e->nwin = dims[0] - 1;
+  return *array_of(e, o->a);
 }
 
 void euler_widen_moments(double *mom, size_t records, size_t width) {
@@ -1014,58 +1043,21 @@ void euler_widen_moments(double *mom, size_t records, size_t width) {
 }
 
 static void widen_mom(void *owner, int rank, const size_t *dims) {
-  struct euler *e = owner;
-  if (rank == 3) euler_widen_moments(e->mom, dims[0] * dims[1], dims[2]);
-}
-static void *reserve_snp(void *owner, int rank, const size_t *dims) {
-  struct euler *e = owner;
-  if (rank != 3 || dims[1] != (size_t)e->cfg.nb || dims[2] != SCAL_LEN) return NULL;
-  reserve_rows(e, dims[0]);
-  return e->snp;
-}
-
-static void *reserve_pln(void *owner, int rank, const size_t *dims) {
-  struct euler *e = owner;
-  if (rank != 3 || dims[1] != (size_t)e->cfg.nb || dims[2] != PL_LEN) return NULL;
-  reserve_rows(e, dims[0]);
-  return e->pln;
-}
-
-static void *reserve_kin(void *owner, int rank, const size_t *dims) {
-  struct euler *e = owner;
-  if (rank != 3 || dims[1] != (size_t)e->cfg.nb || dims[2] != KN_LEN) return NULL;
-  reserve_rows(e, dims[0]);
-  return e->kin;
-}
-
-static void *reserve_rsb(void *owner, int rank, const size_t *dims) {
-  struct euler *e = owner;
-  if (rank != 3 || dims[1] != (size_t)e->cfg.nb || dims[2] != RW_LEN) return NULL;
-  reserve_rows(e, dims[0]);
-  return e->rsb;
+  const struct euler_array_owner *o = owner;
+  if (rank == 3) euler_widen_moments(o->e->mom, dims[0] * dims[1], dims[2]);
 }
 
 void euler_state(struct euler *e, struct state_list *L) {
   const size_t rows = e->nwin + 1, nb = (size_t)e->cfg.nb;
-  const size_t dw[2] = {rows, WIN_LEN}, dm[3] = {rows, nb, MOM_LEN}, ds[3] = {rows, nb, SCAL_LEN};
-  struct state_field *f = state_add(L, "stats/eulerian/windows", STATE_F64, 2, dw, e->win, NULL);
-  f->reserve = reserve_win, f->owner = e;
-  f = state_add(L, "stats/eulerian/moments", STATE_F64, 3, dm, e->mom, NULL);
-  f->reserve = reserve_mom, f->after_read = widen_mom, f->owner = e; /* 1.11: 21 fields */
-  f = state_add(L, "stats/eulerian/snapshot_u", STATE_F64, 3, ds, e->snp, NULL);
-  f->reserve = reserve_snp, f->owner = e;
-  const size_t dp[3] = {rows, nb, PL_LEN};
-  f = state_add(L, "stats/eulerian/planes", STATE_F64, 3, dp, e->pln, NULL);
-  f->reserve = reserve_pln, f->owner = e;
-  f->optional = 1; /* checkpoints of format 1.1 have no budget: zero rows, no budget profiles */
-  const size_t dk[3] = {rows, nb, KN_LEN};
-  f = state_add(L, "stats/eulerian/planes_kinetic", STATE_F64, 3, dk, e->kin, NULL);
-  f->reserve = reserve_kin, f->owner = e;
-  f->optional = 1; /* format 1.4: before it, rows without the advective part */
-  const size_t dr[3] = {rows, nb, RW_LEN};
-  f = state_add(L, "stats/eulerian/reynolds_budget", STATE_F64, 3, dr, e->rsb, NULL);
-  f->reserve = reserve_rsb, f->owner = e;
-  f->optional = 1; /* format 1.6: before it, rows without the Reynolds-stress budget */
+  for (int a = 0; a < EULER_ARRAYS; a++) {
+    const struct euler_array *A = &euler_arrays[a];
+    const size_t dims[3] = {rows, A->per_bin ? nb : A->len, A->len};
+    e->owners[a] = (struct euler_array_owner){.e = e, .a = a};
+    struct state_field *f =
+        state_add(L, A->name, STATE_F64, A->per_bin ? 3 : 2, dims, *array_of(e, a), NULL);
+    f->reserve = reserve_array, f->after_read = A->after_read, f->owner = &e->owners[a];
+    f->optional = A->optional;
+  }
 }
 
 void euler_running_result(const struct euler *e, struct euler_result *res) {

@@ -79,6 +79,24 @@ enum { EULER_BINS = 0, EULER_SPH = 1 };
 
 enum { EULER_W1_N = 512 }; /*!< table points of the plane-averaged kernel over q in [0, 2] */
 
+/** The engine's scene keys, section [stats] (euler_nc.c): the solver reads the switch, the
+    budget interval, the window, u_tau_ref and the convergence target through them too. */
+extern const struct scene_key_def euler_key_eulerian, euler_key_budget_every, euler_key_window,
+    euler_key_fold, euler_key_method, euler_key_u_tau_ref, euler_key_target_stderr,
+    euler_key_target_profiles, euler_key_target_corr_ratio, euler_key_target_windows;
+
+/** The per-window arrays of struct euler (win, mom, snp, pln, kin, rsb), in the order of their
+    table in euler.c (checkpoint names, record widths, formats). */
+enum { EULER_ARRAYS = 6 };
+
+struct euler;
+/** What the checkpoint callbacks of one per-window array receive: the engine and the array's
+    line of the table in euler.c. */
+struct euler_array_owner {
+  struct euler *e; /*!< the engine */
+  int a;           /*!< the array, 0 .. EULER_ARRAYS - 1 */
+};
+
 /** The raw state: windows of per-bin moment records. */
 struct euler {
   struct euler_config cfg;
@@ -93,6 +111,7 @@ struct euler {
   void *work;                /*!< scratch of euler_sample across ranks (euler.c) */
   size_t nsub;               /*!< column subtrees gathered at the last snapshot (diagnostic) */
   double w1[EULER_W1_N + 1]; /*!< plane-averaged kernel W1(q), q = |y_a - y_i| / h (SPH) */
+  struct euler_array_owner owners[EULER_ARRAYS]; /*!< set by euler_state() */
 };
 
 /** Components of the Reynolds-stress budgets (EP_RSB + component * RS_NTERM + term). */

@@ -295,23 +295,163 @@ fail:
   return rc ? rc : NC_EINVAL;
 }
 
+static const char *const names_stats_method[] = {"bins", "sph", NULL};
+static const char *const names_stats_target_profiles[] = {"both", "u_mean", "uv_peak", NULL};
+
+/* The engine's scene keys, section [stats] (docs/scenes.md is generated from them); exported
+   by euler.h, since the solver reads the switch, the budget interval, the window, u_tau_ref and
+   the convergence target too. */
+const struct scene_key_def euler_key_eulerian = {
+    .section = "stats",
+    .name = "eulerian",
+    .type = SCENE_INT,
+    .def = "1",
+    .lo = 0,
+    .hi = 1,
+    .unit = "-",
+    .help =
+        "Eulerian statistics: wall-normal profiles of means, Reynolds stresses, skewness, "
+        "flatness with standard errors, friction velocity and shear-stress balance "
+        "(docs/stats-format.md); sampled every output.stats_every steps from "
+        "output.t_average_start in output.n_bins bins."};
+const struct scene_key_def euler_key_budget_every = {
+    .section = "stats",
+    .name = "budget_every",
+    .type = SCENE_INT,
+    .def = "5",
+    .lo = 1,
+    .hi = 1e9,
+    .unit = "samples",
+    .help =
+        "Every how many Eulerian samples also carries the momentum and Reynolds-stress budgets "
+        "and the wall shear stress (u_tau_wall): every stats.budget_every x output.stats_every "
+        "steps. A budget sample splits the pair forces into their conservative parts, which "
+        "costs about one more force pass (docs/performance.md, \"The budgets\"); 1 samples them "
+        "with every snapshot (the budget identity of every step needs 1 with output.stats_every "
+        "= 1). A short run through a transient needs 1 for its momentum budget to close: the "
+        "fluxes are averaged over the budget snapshots, the momentum change over their span, and "
+        "a few irregular snapshots miss it (the quick-start, t = 0-0.1 from a decelerating burst: "
+        "0.0087 u_tau^2 with 1, 0.058 with 5; jobs/scenes/quickstart.ini uses 1)."};
+const struct scene_key_def euler_key_window = {
+    .section = "stats",
+    .name = "window",
+    .type = SCENE_DOUBLE,
+    .def = "0",
+    .lo = 0,
+    .hi = SCENE_NO_BOUND,
+    .unit = "s",
+    .help =
+        "Length of an averaging window: stats.nc keeps the sums of every window (re-average a "
+        "range with `chansph extract --window`), and the window means are the batch means of "
+        "the standard errors, so a window should span several correlation times (the log "
+        "reports the estimate). 0 = a tenth of t_end - t_average_start. Fixed once averaging "
+        "has begun: a resume keeps the length (also with a new t_end) and refuses a new value."};
+const struct scene_key_def euler_key_fold = {
+    .section = "stats",
+    .name = "fold",
+    .type = SCENE_INT,
+    .def = "0",
+    .lo = 0,
+    .hi = 1,
+    .unit = "-",
+    .help =
+        "Fold the upper half onto the lower one (y -> 2 delta - y, v -> -v) before binning; the "
+        "bins then cover 0 .. delta."};
+const struct scene_key_def euler_key_method = {
+    .section = "stats",
+    .name = "method",
+    .type = SCENE_CHOICE,
+    .def = "bins",
+    .lo = 0,
+    .hi = 0,
+    .choices = names_stats_method,
+    .unit = "-",
+    .help =
+        "How particles make the profiles: bin sampling (thesis Eq. 5.54-5.55), or SPH "
+        "interpolation (Eq. 5.56) at the bin centres averaged over the plane, each particle "
+        "weighted by V_a times the plane integral of the kernel; the means are Eq. 5.56, the "
+        "stresses then also hold the mean-shear variation across the kernel (use bins for them)."};
+const struct scene_key_def euler_key_u_tau_ref = {
+    .section = "stats",
+    .name = "u_tau_ref",
+    .type = SCENE_DOUBLE,
+    .def = "0",
+    .lo = 0,
+    .hi = SCENE_NO_BOUND,
+    .unit = "m/s",
+    .help =
+        "Friction velocity that places the y+ levels of the correlations and Lagrangian releases "
+        "(y = y+ nu / u_tau_ref); 0 = sqrt(delta drive.force), the force-balance value."};
+const struct scene_key_def euler_key_target_stderr = {
+    .section = "stats",
+    .name = "target_stderr",
+    .type = SCENE_DOUBLE,
+    .def = "0",
+    .lo = 0,
+    .hi = 1,
+    .unit = "-",
+    .help =
+        "Convergence target: once the standard errors relative to their profile (max "
+        "stderr(u_mean) / max |u_mean|, and stderr of -u'v' at its peak / the peak) are below "
+        "this, with at least target_windows complete windows of at least target_corr_ratio "
+        "correlation times, the run ends itself (checkpoint, stats.nc, exit 0). Checked when a "
+        "window closes; every convergence line of the log gives the projected simulated and wall "
+        "time to reach it. Needs stats.eulerian = 1. A resumed run that met it stays finished "
+        "unless a target key changes. 0 = off."};
+const struct scene_key_def euler_key_target_profiles = {
+    .section = "stats",
+    .name = "target_profiles",
+    .type = SCENE_CHOICE,
+    .def = "both",
+    .lo = 0,
+    .hi = 0,
+    .choices = names_stats_target_profiles,
+    .unit = "-",
+    .help =
+        "Profiles of the convergence target: u_mean and the -u'v' peak, or one of them (a laminar "
+        "flow has no -u'v' to converge)."};
+const struct scene_key_def euler_key_target_corr_ratio = {
+    .section = "stats",
+    .name = "target_corr_ratio",
+    .type = SCENE_DOUBLE,
+    .def = "5",
+    .lo = 0,
+    .hi = SCENE_NO_BOUND,
+    .unit = "-",
+    .help =
+        "Convergence target: smallest window length / correlation time for the standard errors "
+        "to count (shorter windows make them too small); 0 = no requirement."};
+const struct scene_key_def euler_key_target_windows = {
+    .section = "stats",
+    .name = "target_windows",
+    .type = SCENE_INT,
+    .def = "4",
+    .lo = 2,
+    .hi = 1e9,
+    .unit = "-",
+    .help =
+        "Convergence target: fewest complete windows (batches) for the standard errors to count."};
+static const struct scene_key_def *const keys[] = {
+    &euler_key_eulerian,      &euler_key_budget_every,    &euler_key_window,
+    &euler_key_fold,          &euler_key_method,          &euler_key_u_tau_ref,
+    &euler_key_target_stderr, &euler_key_target_profiles, &euler_key_target_corr_ratio,
+    &euler_key_target_windows};
+
 /* The configuration from the scene: default bins are of width dr around each particle layer
    y = j dr (j = 1 .. 2delta/dr-1), the thin strips next to the walls joining the first and last
    bins; folded, the layers 1 .. delta/dr; with output.n_bins set: uniform bins between the
    walls (folded: between the wall and the centre). */
 static void config_of(const struct stats_scene *sc, struct euler_config *e) {
   memset(e, 0, sizeof *e);
-  const int fold = (int)stats_scene_num(sc, "stats.fold");
-  const double window = stats_scene_num(sc, "stats.window");
+  const int fold = stats_scene_int(sc, &euler_key_fold);
   e->fold = fold, e->delta = sc->delta, e->nu = sc->nu, e->rho0 = sc->rho0;
   e->area = sc->dim == 3 ? sc->lx * sc->lz : sc->lx;
   e->wall_layer = 0.5 * sc->dr;
   e->t_start = sc->t_average_start;
   e->les = sc->les;
-  e->method = (int)stats_scene_num(sc, "stats.method"), e->h = sc->h, e->dim = sc->dim;
-  e->window = window > 0.0 ? window : (sc->t_end - sc->t_average_start) / 10;
-  if (!(e->window > 0.0)) e->window = sc->t_end > 0 ? sc->t_end / 10 : 1.0;
-  if (stats_scene_num(sc, "output.n_bins") > 0) {
+  e->method = stats_scene_int(sc, &euler_key_method), e->h = sc->h, e->dim = sc->dim;
+  e->window = sc->window;
+  if (sc->bins_uniform) {
     e->nb = sc->bins, e->y0 = 0.0, e->y1 = (fold ? 1.0 : 2.0) * sc->delta;
   } else if (fold) {
     e->nb = (int)floor(sc->delta / sc->dr + 0.5), e->y0 = 0.5 * sc->dr;
@@ -323,7 +463,7 @@ static void config_of(const struct stats_scene *sc, struct euler_config *e) {
 
 /* The engine's table of operations (engine.h). */
 static int init_scene(void *self, const struct stats_scene *sc) {
-  if (!stats_scene_num(sc, "stats.eulerian")) return 0;
+  if (!stats_scene_int(sc, &euler_key_eulerian)) return 0;
   struct euler_config cfg;
   config_of(sc, &cfg);
   euler_init(self, &cfg);
@@ -340,7 +480,7 @@ double euler_scene_window(const struct stats_scene *sc) {
    first 8 rows at once, then doubled as windows close: at least the run's windows), twice: the
    accumulators and the stats.nc image built in memory when it is written. */
 static double estimate(const struct stats_scene *sc) {
-  if (!stats_scene_num(sc, "stats.eulerian")) return 0.0;
+  if (!stats_scene_int(sc, &euler_key_eulerian)) return 0.0;
   struct euler_config cfg;
   config_of(sc, &cfg);
   const double windows = ceil((sc->t_end - sc->t_average_start) / cfg.window - 1e-9) + 1.0;
@@ -382,6 +522,8 @@ static void log_lines(const void *self, char *buf, size_t len) {
 }
 
 const struct stats_engine euler_engine = {.name = "Eulerian profiles",
+                                          .keys = keys,
+                                          .n_keys = sizeof keys / sizeof keys[0],
                                           .size = sizeof(struct euler),
                                           .init_scene = init_scene,
                                           .estimate = estimate,

@@ -783,19 +783,97 @@ done:
   return rc;
 }
 
+/* The engine's scene keys, section [lagrangian] (docs/scenes.md is generated from them). */
+static const struct scene_key_def key_y_plus = {
+    .section = "lagrangian",
+    .name = "y_plus",
+    .type = SCENE_LIST,
+    .def = "",
+    .lo = 0,
+    .hi = SCENE_NO_BOUND,
+    .flags = SCENE_Y_PLUS,
+    .unit = "-",
+    .help =
+        "Comma-separated y+ release levels (up to 8) of the Lagrangian statistics (thesis Sec. "
+        "5.2.3.2, 6.1.3): fluid particles within dr/2 of each level (and of its mirror) and "
+        "within dr/2 of x0 are tracked. Empty = off."};
+static const struct scene_key_def key_x0 = {
+    .section = "lagrangian",
+    .name = "x0",
+    .type = SCENE_DOUBLE,
+    .def = "0",
+    .lo = 0,
+    .hi = SCENE_NO_BOUND,
+    .unit = "m",
+    .help = "Release plane: particles with |x - x0| < dr/2 are released."};
+static const struct scene_key_def key_horizon = {
+    .section = "lagrangian",
+    .name = "horizon",
+    .type = SCENE_DOUBLE,
+    .def = "1",
+    .lo = 0,
+    .hi = SCENE_NO_BOUND,
+    .flags = SCENE_LO_OPEN,
+    .unit = "s",
+    .help = "How long each release is followed (the largest lag tau)."};
+static const struct scene_key_def key_release_every = {
+    .section = "lagrangian",
+    .name = "release_every",
+    .type = SCENE_DOUBLE,
+    .def = "0",
+    .lo = 0,
+    .hi = SCENE_NO_BOUND,
+    .unit = "s",
+    .help =
+        "Time between release iterations; releases overlap when shorter than the horizon. 0 = "
+        "the horizon (consecutive, independent releases, thesis Sec. 6.1.3)."};
+static const struct scene_key_def key_n_lags = {
+    .section = "lagrangian",
+    .name = "n_lags",
+    .type = SCENE_INT,
+    .def = "50",
+    .lo = 2,
+    .hi = 1e5,
+    .unit = "-",
+    .help =
+        "Lag samples over the horizon (a particle is sampled at the first statistics sample "
+        "in each lag interval)."};
+static const struct scene_key_def key_pdf_x = {
+    .section = "lagrangian",
+    .name = "pdf_x",
+    .type = SCENE_LIST,
+    .def = "",
+    .lo = 0,
+    .hi = SCENE_NO_BOUND,
+    .unit = "m",
+    .help =
+        "Comma-separated downstream distances x - x0 (up to 8) of the stations of the PDFs P(y; "
+        "x) (Eq. 5.67-5.68); empty = no PDFs."};
+static const struct scene_key_def key_pdf_bins = {
+    .section = "lagrangian",
+    .name = "pdf_bins",
+    .type = SCENE_INT,
+    .def = "50",
+    .lo = 2,
+    .hi = 1e5,
+    .unit = "-",
+    .help = "Bins of the PDFs P(y; x) across the channel."};
+static const struct scene_key_def *const keys[] = {
+    &key_y_plus, &key_x0, &key_horizon, &key_release_every, &key_n_lags, &key_pdf_x, &key_pdf_bins};
+
 /* The engine's table of operations (engine.h). */
 static int config_of(const struct stats_scene *sc, struct lagr_config *cp) {
   struct lagr_config c;
   memset(&c, 0, sizeof c);
-  c.n_levels = stats_scene_levels(sc, "lagrangian.y_plus", c.y_plus, c.y, LAGR_MAX_LEVELS);
-  c.x0 = stats_scene_num(sc, "lagrangian.x0"), c.half = 0.5 * sc->dr, c.lx = sc->lx;
+  c.n_levels = stats_scene_levels(sc, &key_y_plus, c.y_plus, c.y, LAGR_MAX_LEVELS);
+  c.x0 = stats_scene_double(sc, &key_x0), c.half = 0.5 * sc->dr, c.lx = sc->lx;
   c.lz = sc->dim == 3 ? sc->lz : 0.0, c.delta = sc->delta;
-  c.horizon = stats_scene_num(sc, "lagrangian.horizon");
-  c.n_lags = (int)stats_scene_num(sc, "lagrangian.n_lags");
-  c.pdf_bins = (int)stats_scene_num(sc, "lagrangian.pdf_bins");
-  const double every = stats_scene_num(sc, "lagrangian.release_every");
+  c.horizon = stats_scene_double(sc, &key_horizon);
+  c.n_lags = stats_scene_int(sc, &key_n_lags);
+  c.pdf_bins = stats_scene_int(sc, &key_pdf_bins);
+  const double every = stats_scene_double(sc, &key_release_every);
   c.release_every = every > 0.0 ? every : c.horizon;
-  c.n_stations = stats_scene_list(sc, "lagrangian.pdf_x", c.station, LAGR_MAX_STATIONS);
+  c.n_stations = stats_scene_list(sc, &key_pdf_x, c.station, LAGR_MAX_STATIONS);
   c.t_start = sc->t_average_start;
   *cp = c;
   return c.n_levels > 0;
@@ -844,6 +922,8 @@ static int engine_warnings(const void *self, char *buf, size_t len) {
 }
 
 const struct stats_engine lagr_engine = {.name = "Lagrangian statistics",
+                                         .keys = keys,
+                                         .n_keys = sizeof keys / sizeof keys[0],
                                          .size = sizeof(struct lagr),
                                          .init_scene = engine_init_scene,
                                          .estimate = engine_estimate,

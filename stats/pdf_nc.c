@@ -238,17 +238,79 @@ int pdf_nc_read(struct pdf *p, int ncid, char *err, size_t errlen) {
   return 0;
 }
 
+/* The engine's scene keys, section [pdfs] (docs/scenes.md is generated from them). */
+static const struct scene_key_def key_y_plus = {
+    .section = "pdfs",
+    .name = "y_plus",
+    .type = SCENE_LIST,
+    .def = "",
+    .lo = 0,
+    .hi = SCENE_NO_BOUND,
+    .flags = SCENE_Y_PLUS,
+    .unit = "-",
+    .help =
+        "Comma-separated y+ levels (up to 8) of the one-point PDFs of u', v', w' (MKM "
+        "1999 give them at y+ = 5, 10, 19, 30, 40, 59, 79, 98, 178): fluid particles in a slab at "
+        "each level and its mirror (v -> -v), binned in units of the local rms about the mean of "
+        "the averaged windows; stats.nc group pdfs (docs/stats-format.md). Empty = off."};
+static const struct scene_key_def key_bins = {
+    .section = "pdfs",
+    .name = "bins",
+    .type = SCENE_INT,
+    .def = "40",
+    .lo = 1,
+    .hi = 1000,
+    .unit = "-",
+    .help = "Bins of each PDF over -range .. range local rms."};
+static const struct scene_key_def key_range = {
+    .section = "pdfs",
+    .name = "range",
+    .type = SCENE_DOUBLE,
+    .def = "5",
+    .lo = 0,
+    .hi = 100,
+    .flags = SCENE_LO_OPEN,
+    .unit = "rms",
+    .help =
+        "Half-width of the PDFs in units of the local rms (samples beyond it are counted in "
+        "outside)."};
+static const struct scene_key_def key_fine = {
+    .section = "pdfs",
+    .name = "fine",
+    .type = SCENE_DOUBLE,
+    .def = "0.02",
+    .lo = 0.001,
+    .hi = 1,
+    .unit = "u_tau",
+    .help =
+        "Width of the fine bins of the raw per-window counts of u_i / stats.u_tau_ref (over -10 .. "
+        "35 for u, -10 .. 10 for v and w), rebinned in units of the rms at output: keep it well "
+        "below a PDF bin, 2 range / bins times the smallest rms (v near the wall: 0.01); the log "
+        "warns where it is above half of one."};
+static const struct scene_key_def key_thickness = {
+    .section = "pdfs",
+    .name = "thickness",
+    .type = SCENE_DOUBLE,
+    .def = "1",
+    .lo = 0,
+    .hi = 100,
+    .flags = SCENE_LO_OPEN,
+    .unit = "dr",
+    .help = "Thickness of the slab of particles sampled at each level, in units of dr."};
+static const struct scene_key_def *const keys[] = {&key_y_plus, &key_bins, &key_range, &key_fine,
+                                                   &key_thickness};
+
 /* The engine's table of operations (engine.h). */
 static int engine_init_scene(void *self, const struct stats_scene *sc) {
   struct pdf_config c;
   memset(&c, 0, sizeof c);
-  c.n_levels = stats_scene_levels(sc, "pdfs.y_plus", c.y_plus, c.y, PDF_MAX_LEVELS);
-  c.half = 0.5 * stats_scene_num(sc, "pdfs.thickness") * sc->dr;
+  c.n_levels = stats_scene_levels(sc, &key_y_plus, c.y_plus, c.y, PDF_MAX_LEVELS);
+  c.half = 0.5 * stats_scene_double(sc, &key_thickness) * sc->dr;
   c.delta = sc->delta, c.t_start = sc->t_average_start, c.u_tau = sc->u_tau;
-  c.window = stats_scene_window(sc);
-  c.fine = stats_scene_num(sc, "pdfs.fine");
-  c.bins = (int)stats_scene_num(sc, "pdfs.bins");
-  c.range = stats_scene_num(sc, "pdfs.range");
+  c.window = sc->window;
+  c.fine = stats_scene_double(sc, &key_fine);
+  c.bins = stats_scene_int(sc, &key_bins);
+  c.range = stats_scene_double(sc, &key_range);
   if (!(c.n_levels > 0)) return 0;
   pdf_init(self, &c);
   return 1;
@@ -274,6 +336,8 @@ static int engine_write(const void *self, double t_reached, int ncid, char *err,
 }
 
 const struct stats_engine pdf_engine = {.name = "one-point PDFs",
+                                        .keys = keys,
+                                        .n_keys = sizeof keys / sizeof keys[0],
                                         .size = sizeof(struct pdf),
                                         .init_scene = engine_init_scene,
                                         .init = engine_init,

@@ -7,7 +7,8 @@ import sys
 
 from . import cli
 
-# tool name: (module, one line)
+# tool name: (module, one line); "module:function" where one module holds several tools (else
+# the function is main)
 TOOLS = {
     "compare": ("compare", "profiles of a run (stats.nc) against a DNS set (`chansph compare`)"),
     "windows": ("windows", "per-window turbulence indicators of a run"),
@@ -24,8 +25,10 @@ TOOLS = {
     "dns_c_table": ("dns_c_table", "write solver/dns_lm180.h from the Lee & Moser table"),
     "ckpt": ("ckpt_info", "summarise checkpoints (format, step, time, particles)"),
     "pdf_compare": ("pdf_compare", "one-point PDFs of u', v', w' against MKM Re_tau = 180"),
-    "spectra_compare": ("spectra_compare", "1-D spectra in x and z against MKM Re_tau = 180"),
-    "corr_compare": ("corr_compare", "two-point correlations in x and z against MKM Re_tau = 180"),
+    "spectra_compare": ("twopoint_compare:spectra_main",
+                        "1-D spectra in x and z against MKM Re_tau = 180"),
+    "corr_compare": ("twopoint_compare:corr_main",
+                     "two-point correlations in x and z against MKM Re_tau = 180"),
     "skewflat_compare": ("skewflat_compare", "skewness and flatness profiles against MKM 180"),
     "rs_budget": ("budget_compare", "Reynolds-stress budgets (rsb_*) against the MKM 180 balances"),
     "lagr_check": ("lagr_check", "the Lagrangian engine against exact dispersion laws"),
@@ -51,8 +54,9 @@ def main(argv=None, prog="chansph-stats"):
         print("error: %s\n%s" % ("unknown tool '%s'" % argv[0] if argv else "no tool given",
                                  USAGE), file=sys.stderr)
         return 1
-    tool = importlib.import_module("." + TOOLS[argv[0]][0], __package__)
-    return cli.run(tool.main, argv[1:], "%s %s" % (prog, argv[0])) or 0
+    module, _, function = TOOLS[argv[0]][0].partition(":")
+    tool = importlib.import_module("." + module, __package__)
+    return cli.run(getattr(tool, function or "main"), argv[1:], "%s %s" % (prog, argv[0])) or 0
 
 
 if __name__ == "__main__":

@@ -1,5 +1,5 @@
 """Error against run time: the running average of a run's main statistics and its standard error,
-window by window, with the projection to a target error (issue 43, point 4).
+window by window, with the projection to a target error.
 
 usage: chansph-stats convergence STATS.nc [--target E] [--log LOG] [--out DIR]
 
@@ -11,17 +11,27 @@ running average over the first n and its batch-means standard error over them ar
     from the window records of group eulerian;
   - the energy <u'u'>, <v'v'>, <w'w'> of the spectra at each level of group correlations (the
     y+ = 15 and 40 of the quick-start), the sum over k_x of each window's 1-D spectrum
-    divided by its planes, relative to its final value.
+    divided by its planes, relative to its final value;
+  - the main terms of the Reynolds-stress budgets at the bins nearest y+ = 15 and 30 (lower
+    half): production, pressure and viscous terms of uu, pressure and viscous terms of vv and
+    ww (rsb_*, wall units term nu / u_tau^4), each re-averaged over the first n windows from
+    the window records of group eulerian exactly as `chansph extract --window` does
+    (rs_merge.py, the Python side of euler_rs.c), with the batch-means standard error over
+    those windows; the last point covers every window of the file, the open one included, so
+    it is the file's own rsb_* and rsb_*_stderr (records of a format before 1.11: not drawn);
+  - T_L of each level and component of group lagrangian: the mean of the per-release values
+    and its standard error over the completed releases (T_L_release_mean, T_L_stderr), one
+    point at the time the file reached, counted in releases (stats.nc keeps the per-release
+    batches as running sums, not per release, so there is no earlier point; draw a history by
+    running the tool on stats.nc files written along the run, output.write_every); its
+    projection counts releases of lagrangian.release_every.
 The x axes are the simulated time at the end of the n-th window and, when the run's log is
 found (LOG, default log.txt beside STATS.nc; not for a joined file), the wall time spent to
 reach it (from the log's particle-steps/s). For each quantity the projection to a relative
 standard error E (default 0.01) assumes the n^-1/2 law of batch means: n (se / E / value)^2
-windows, printed as simulated (and wall) time.
-Not drawn: T_L and the Lagrangian functions (stats.nc keeps their per-release batches as
-running sums, not per release, so there is no history to redraw; their standard errors are in
-the file) and the Reynolds-stress budgets (their per-window terms need the budget records'
-local-mean reconstruction of the engine, euler_rs.c).
-Writes DIR/convergence.csv (quantity, windows, t_end, wall_s, value, stderr, relative) and
+windows (releases for T_L), printed as simulated (and wall) time.
+Writes DIR/convergence.csv (quantity, windows (releases for T_L), t_end, wall_s, value,
+stderr, relative) and
 DIR/convergence.png (relative standard error against simulated time, log-log, with the n^-1/2
 projection and the target), and prints the table of the last window with the projections.
 """
@@ -32,10 +42,15 @@ import numpy as np
 
 from . import cli
 from .cli import InputError
-from .merge import merged_profile
+from .merge import merged_moments, merged_profile
 from .ncfile import open_nc, read_windows
+from .rs_merge import COMPS, T, rs_range, rs_records
 
 PEAKS = ("u_rms+", "v_rms+", "w_rms+", "-u'v'+")
+# the budgets' main terms (component, term) and the heights of their bins
+BUDGET_TERMS = (("uu", "production"), ("uu", "pressure"), ("uu", "viscous"), ("vv", "pressure"),
+                ("vv", "viscous"), ("ww", "pressure"), ("ww", "viscous"))
+BUDGET_Y_PLUS = (15.0, 30.0)
 
 
 def batch_se(values):
@@ -97,6 +112,76 @@ def spectra_series(path):
     return out
 
 
+def budget_series(path):
+    """{quantity: [(n, t_end, value, se)]} of the budgets' main terms (wall units) over the
+    first n complete windows, the last point over every window of the file (empty without
+    budget records of the current layout: then a note says why)."""
+    r = read_windows(path)
+    with open_nc(path) as d:
+        rec = rs_records(d, path)
+        if rec is None:
+            if "reynolds_budget" in d["eulerian"].variables:
+                print("# budgets: the records are of a format before 1.11 (as chansph extract, "
+                      "not re-averaged): not drawn")
+            return {}
+        flags = np.asarray(d["eulerian"]["window_complete"][:]) > 0
+    rsb, cfg = rec
+    rows = [i for i in range(len(r["win"])) if r["done"][i]]
+    complete = [i for i in rows if flags[i]]
+    if len(complete) < 2:
+        return {}
+    whole = merged_moments(r, rows)
+    yplus = whole["y"] * r["ut"] / r["nu"]
+    lower = whole["ok"] & (whole["y"] < r["delta"])
+    if not lower.any():
+        return {}
+    bins = {yp: int(np.nanargmin(np.where(lower, np.abs(yplus - yp), np.inf)))
+            for yp in BUDGET_Y_PLUS}
+    ends = [complete[n - 1] for n in range(2, len(complete) + 1)]
+    if rows[-1] > ends[-1]:
+        ends.append(rows[-1])  # every window: the file's own rsb_*
+    scale = r["nu"] / r["ut"] ** 4
+    t_reached = r["t_reached"] if r["t_reached"] is not None else math.inf
+    out = {}
+    use = sorted(set(bins.values()))  # y+ 15 and 30 may fall in one bin (a coarse or slow run)
+    for last in ends:
+        value, se = rs_range(r, rsb, cfg, [i for i in rows if i <= last], flags, use)
+        n = sum(1 for i in complete if i <= last)
+        for b in use:
+            for c, t in BUDGET_TERMS:
+                k = (COMPS.index(c), T[t])
+                key = "%s_%s(y+ %.0f)" % (c, t, yplus[b])
+                out.setdefault(key, []).append(
+                    (n, min(r["win"][last, 1], t_reached), value[b][k] * scale, se[b][k] * scale))
+    return {q: ser for q, ser in out.items() if all(math.isfinite(p[2]) for p in ser)}
+
+
+def lagrangian_series(path):
+    """({quantity: [(releases, t, value, se)]}, {quantity: (t0, release spacing)}) of T_L per
+    level and component: one point, the file's per-release mean and its standard error."""
+    with open_nc(path) as d:
+        if "lagrangian" not in d.groups:
+            return {}, {}
+        g = d["lagrangian"]
+        if "T_L_release_mean" not in g.variables or "T_L_stderr" not in g.variables:
+            return {}, {}
+        mean = np.ma.filled(g["T_L_release_mean"][:].astype(float), np.nan)
+        se = np.ma.filled(g["T_L_stderr"][:].astype(float), np.nan)
+        yplus = np.asarray(g["y_plus"][:], float)
+        releases = int(g.releases)
+        every = float(g.release_every) if float(g.release_every) > 0 else float(g.horizon)
+        t = float(d.t_reached) if "t_reached" in d.ncattrs() else float(d.t_end)
+        t0 = float(d.t_average_start)
+    out, spacing = {}, {}
+    for lev, yp in enumerate(yplus):
+        for c, name in enumerate("uvw"):
+            if releases >= 2 and math.isfinite(mean[lev, c]) and math.isfinite(se[lev, c]):
+                key = "T_L_%s(y+ %g)" % (name, yp)
+                out[key] = [(releases, t, float(mean[lev, c]), float(se[lev, c]))]
+                spacing[key] = (t0, every)
+    return out, spacing
+
+
 def wall_clock(log, times):
     """Wall seconds at the simulated times (None without a usable log)."""
     if not log or not os.path.exists(log):
@@ -120,14 +205,20 @@ def main(argv, prog):
     a = p.parse_args(argv)
     series, wins = peak_series(a.stats)
     series.update(spectra_series(a.stats))
+    series.update(budget_series(a.stats))
+    lagr, spacing = lagrangian_series(a.stats)
+    series.update(lagr)
     log = a.log or os.path.join(os.path.dirname(os.path.abspath(a.stats)), "log.txt")
     out_dir = a.out or os.path.join(os.path.dirname(os.path.abspath(a.stats)), "convergence")
     os.makedirs(out_dir, exist_ok=True)
     length = float(np.median([w[1] - w[0] for w in wins]))
+    for q in series:
+        spacing.setdefault(q, (wins[0][0], length))
     rows = []
-    print("%-16s %8s %10s %12s %12s %9s %14s %14s" % ("quantity", "windows", "t_end", "value",
-                                                      "stderr", "relative", "windows needed",
-                                                      "t at target"))
+    width = max(16, max(len(q) for q in series))
+    print("%-*s %8s %10s %12s %12s %9s %14s %14s" % (width, "quantity", "windows", "t_end",
+                                                     "value", "stderr", "relative",
+                                                     "windows needed", "t at target"))
     for q, ser in series.items():
         ts = np.array([s[1] for s in ser])
         wall = wall_clock(log, ts)
@@ -137,41 +228,67 @@ def main(argv, prog):
         n, t, v, se = ser[-1]
         rel = abs(se / v) if v else math.nan
         need = n * (rel / a.target) ** 2 if math.isfinite(rel) else math.nan
-        t_at = wins[0][0] + need * length if math.isfinite(need) else math.nan
-        print("%-16s %8d %10.4g %12.5g %12.4g %9.4f %14.1f %14.4g" % (q, n, t, v, se, rel, need,
-                                                                      t_at))
+        t_at = spacing[q][0] + need * spacing[q][1] if math.isfinite(need) else math.nan
+        print("%-*s %8d %10.4g %12.5g %12.4g %9.4f %14.1f %14.4g" % (width, q, n, t, v, se, rel,
+                                                                     need, t_at))
+    if lagr:
+        print("# T_L: windows = completed releases, one point (no per-release history in "
+              "stats.nc); its projection counts releases")
     with open(os.path.join(out_dir, "convergence.csv"), "w") as f:
         f.write("# %s: running averages and batch-means standard errors; target %g\n"
                 "quantity,windows,t_end,wall_s,value,stderr,relative\n" % (a.stats, a.target))
         for r in rows:
             f.write("%s,%d,%.10g,%.10g,%.12g,%.10g,%.10g\n" % r)
     if not a.no_plot:
-        plot(series, a.target, length, os.path.join(out_dir, "convergence.png"), a.stats)
+        plot(series, a.target, spacing, os.path.join(out_dir, "convergence.png"), a.stats)
     print("wrote %s/convergence.csv%s" % (out_dir, "" if a.no_plot else " and convergence.png"))
     return 0
 
 
-def plot(series, target, length, path, title):
+def group_of(q):
+    """The panel of a quantity in the figure."""
+    if q in PEAKS:
+        return "profile peaks"
+    if q.startswith("E_"):
+        return "spectra (energy at each level)"
+    if q.startswith("T_L"):
+        return "T_L (one point per file)"
+    return "Reynolds-stress budgets (main terms)"
+
+
+def plot(series, target, spacing, path, title):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(7, 4.5))
-    for q, ser in series.items():
-        t = np.array([s[1] for s in ser])
-        rel = np.array([abs(s[3] / s[2]) if s[2] else np.nan for s in ser])
-        line, = ax.loglog(t, rel, "o-", ms=3, label=q)
-        if np.isfinite(rel[-1]) and rel[-1] > 0:  # the n^-1/2 projection from the last point
-            n = ser[-1][0]
-            need = n * (rel[-1] / target) ** 2
-            tt = np.linspace(t[-1], t[-1] + max(need - n, 0) * length, 20)
-            ax.loglog(tt, rel[-1] * np.sqrt(n / (n + (tt - t[-1]) / length)), "--",
-                      color=line.get_color(), lw=0.8)
-    ax.axhline(target, color="k", lw=0.8, ls=":", label="target %g" % target)
-    ax.set_xlabel("simulated time at the end of the window [s]")
-    ax.set_ylabel("relative standard error")
-    ax.set_title("%s: running averages (dashed: n^-1/2 projection)" % title, fontsize=8)
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=6, ncol=2)
+    groups = []
+    for q in series:
+        if group_of(q) not in groups:
+            groups.append(group_of(q))
+    cols = 1 if len(groups) == 1 else 2
+    rows = (len(groups) + cols - 1) // cols
+    fig, axes = plt.subplots(rows, cols, figsize=(7 * cols, 4.5 * rows), squeeze=False)
+    for g, ax in zip(groups, axes.flat):
+        for q, ser in series.items():
+            if group_of(q) != g:
+                continue
+            t = np.array([s[1] for s in ser])
+            rel = np.array([abs(s[3] / s[2]) if s[2] else np.nan for s in ser])
+            line, = ax.loglog(t, rel, "o-", ms=3, label=q)
+            if np.isfinite(rel[-1]) and rel[-1] > 0:  # the n^-1/2 projection from the last point
+                n, length = ser[-1][0], spacing[q][1]
+                need = n * (rel[-1] / target) ** 2
+                tt = np.linspace(t[-1], t[-1] + max(need - n, 0) * length, 20)
+                ax.loglog(tt, rel[-1] * np.sqrt(n / (n + (tt - t[-1]) / length)), "--",
+                          color=line.get_color(), lw=0.8)
+        ax.axhline(target, color="k", lw=0.8, ls=":", label="target %g" % target)
+        ax.set_xlabel("simulated time at the end of the window [s]")
+        ax.set_ylabel("relative standard error")
+        ax.set_title("%s: %s (dashed: n^-1/2 projection)" % (os.path.basename(title), g),
+                     fontsize=8)
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=6, ncol=2)
+    for ax in list(axes.flat)[len(groups):]:
+        ax.set_visible(False)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)

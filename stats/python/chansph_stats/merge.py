@@ -99,11 +99,12 @@ def local_slope(x, f, ok, i):
         f[j1] * (x0 - x2) / ((x1 - x0) * (x1 - x2)) + f[j2] * (x0 - x1) / ((x2 - x0) * (x2 - x1))
 
 
-def merged_profile(r, sel):
-    """Profiles of U+, u_rms+, v_rms+, w_rms+, -u'v'+ (force-balance wall units) over the windows
-    sel of a read_windows record: their counts, means and co-moments merged (Chan et al. 1979);
-    the stresses about the local mean U(y) = U + g (y - <y>) of each bin where the records hold
-    the co-moments with y (format 1.12, as chansph extract), else about the bin mean."""
+def merged_moments(r, sel):
+    """The profiles of the windows sel of a read_windows record in SI units, as chansph extract
+    forms them: ok (bins with samples), y (mean position), u, v, w (means), uu, vv, ww, uv
+    (NaN where a bin has no sample): the counts, means and co-moments merged (Chan et al.
+    1979); the stresses about the local mean U(y) = U + g (y - <y>) of each bin where the
+    records hold the co-moments with y (format 1.12), else about the bin mean."""
     mom = r["mom"]
     n = mom[sel][:, :, MOM_N].sum(axis=0)
     ok = n > 0
@@ -129,9 +130,20 @@ def merged_profile(r, sel):
                 continue
             for c, (p, q) in enumerate(pairs):
                 c2[b, c] += -g[p] * cy[b, q] - g[q] * cy[b, p] + g[p] * g[q] * cyy[b]
-    y = np.where(ok, mean[:, 5], np.nan)
-    u = np.where(ok, mean[:, 0], np.nan)
-    uu, vv, ww, uv = (np.where(ok, c2[:, c] / nn, np.nan) for c in range(4))
+    out = {"ok": ok, "y": np.where(ok, mean[:, 5], np.nan)}
+    for k, name in enumerate(("u", "v", "w")):
+        out[name] = np.where(ok, mean[:, k], np.nan)
+    for c, name in enumerate(("uu", "vv", "ww", "uv")):
+        out[name] = np.where(ok, c2[:, c] / nn, np.nan)
+    return out
+
+
+def merged_profile(r, sel):
+    """Profiles of U+, u_rms+, v_rms+, w_rms+, -u'v'+ (force-balance wall units) over the windows
+    sel of a read_windows record (merged_moments); the upper half of an unfolded file mirrored
+    onto the lower one."""
+    m = merged_moments(r, sel)
+    y, u, uu, vv, ww, uv = (m[k] for k in ("y", "u", "uu", "vv", "ww", "uv"))
     delta, ut = r["delta"], r["ut"]
     if not r["fold"]:
         up = y > delta
