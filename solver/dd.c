@@ -122,11 +122,12 @@ static int choose_blocks(struct dd *d, const struct scene *sc) {
     const int px = sc->ranks.n == 2 ? (int)sc->ranks.v[0] : 0,
               pz = sc->ranks.n == 2 ? (int)sc->ranks.v[1] : 0;
     if (px < 1 || pz < 1 || (double)px * pz != (double)d->size) {
-      error_input("%s: key 'run.ranks': %s; this run has %d MPI ranks, so Px x Pz = %d "
-                  "(or leave it empty for the factorisation with the fewest ghosts; on resume: "
-                  "--set run.ranks=Px,Pz or --set run.ranks=)",
-                  path, sc->ranks.n == 2 ? "Px x Pz differs from the ranks" : "two entries Px,Pz",
-                  d->size, d->size);
+      error_input(
+          "%s: key 'run.ranks': %s; this run has %d MPI ranks, so Px x Pz = %d "
+          "(or leave it empty for the factorisation with the fewest ghosts; on resume: "
+          "--set run.ranks=Px,Pz or --set run.ranks=)",
+          path, sc->ranks.n == 2 ? "Px x Pz differs from the ranks" : "two entries Px,Pz", d->size,
+          d->size);
       return CHANSPH_ERR;
     }
     if (sc->dim == 2 && pz > 1) {
@@ -135,11 +136,12 @@ static int choose_blocks(struct dd *d, const struct scene *sc) {
       return CHANSPH_ERR;
     }
     if (ghost_pencils(px, pz, d->ncol, d->nplane) < 0.0) {
-      error_input("%s: key 'run.ranks': %d x %d blocks of %d columns (domain.lx) and %d planes "
-                  "(domain.lz) of size h: each block needs at least %d columns and %d planes "
-                  "along a cut direction, so at most %d x %d ranks",
-                  path, px, pz, d->ncol, d->nplane, 2 * R, 2 * R, d->ncol / (2 * R),
-                  sc->dim == 3 ? d->nplane / (2 * R) : 1);
+      error_input(
+          "%s: key 'run.ranks': %d x %d blocks of %d columns (domain.lx) and %d planes "
+          "(domain.lz) of size h: each block needs at least %d columns and %d planes "
+          "along a cut direction, so at most %d x %d ranks",
+          path, px, pz, d->ncol, d->nplane, 2 * R, 2 * R, d->ncol / (2 * R),
+          sc->dim == 3 ? d->nplane / (2 * R) : 1);
       return CHANSPH_ERR;
     }
     d->px = px, d->pz = pz;
@@ -156,14 +158,16 @@ static int choose_blocks(struct dd *d, const struct scene *sc) {
   if (best < 0.0) {
     const int mx = d->ncol / (2 * R), mz = sc->dim == 3 ? d->nplane / (2 * R) : 1;
     if (sc->dim == 3)
-      error_input("%s: keys 'domain.lx', 'domain.lz': %d cell columns and %d planes of size h; "
-                  "a block needs at least %d columns along x and %d planes along z where "
-                  "they are cut, so at most %d x %d = %d ranks; this run has %d",
-                  path, d->ncol, d->nplane, 2 * R, 2 * R, mx, mz, mx * mz, d->size);
+      error_input(
+          "%s: keys 'domain.lx', 'domain.lz': %d cell columns and %d planes of size h; "
+          "a block needs at least %d columns along x and %d planes along z where "
+          "they are cut, so at most %d x %d = %d ranks; this run has %d",
+          path, d->ncol, d->nplane, 2 * R, 2 * R, mx, mz, mx * mz, d->size);
     else
-      error_input("%s: key 'domain.lx': %d cell columns of size h; a slab needs at least %d, "
-                  "so at most %d ranks; this run has %d",
-                  path, d->ncol, 2 * R, mx, d->size);
+      error_input(
+          "%s: key 'domain.lx': %d cell columns of size h; a slab needs at least %d, "
+          "so at most %d ranks; this run has %d",
+          path, d->ncol, 2 * R, mx, d->size);
     return CHANSPH_ERR;
   }
   return CHANSPH_OK;
@@ -175,7 +179,8 @@ static void set_neighbours(struct dd *d) {
   const int px = d->px, pz = d->pz;
   d->dir[0].width = px > 1 ? NBR_REACH : 0, d->dir[1].width = pz > 1 ? NBR_REACH : 0;
   d->dir[0].lo = d->bz * px + (d->bx + px - 1) % px, d->dir[0].hi = d->bz * px + (d->bx + 1) % px;
-  d->dir[1].lo = ((d->bz + pz - 1) % pz) * px + d->bx, d->dir[1].hi = ((d->bz + 1) % pz) * px + d->bx;
+  d->dir[1].lo = ((d->bz + pz - 1) % pz) * px + d->bx,
+  d->dir[1].hi = ((d->bz + 1) % pz) * px + d->bx;
   d->nnb = 0;
   for (int dz = -1; dz <= 1; dz++)
     for (int dx = -1; dx <= 1; dx++) {
@@ -318,8 +323,8 @@ static size_t migrate_near(struct dd *d, const int *scount, const int *sdisp) {
   timer_push("halo:wait");
   for (int k = 0; k < n; k++) {
     CHECK_MPI(MPI_Irecv(&rc[k], 1, MPI_INT, d->nb_rank[k], TAG_MCNT, MPI_COMM_WORLD, &req[k]));
-    CHECK_MPI(MPI_Isend(&scount[d->nb_rank[k]], 1, MPI_INT, d->nb_rank[k], TAG_MCNT,
-                        MPI_COMM_WORLD, &req[n + k]));
+    CHECK_MPI(MPI_Isend(&scount[d->nb_rank[k]], 1, MPI_INT, d->nb_rank[k], TAG_MCNT, MPI_COMM_WORLD,
+                        &req[n + k]));
   }
   CHECK_MPI(MPI_Waitall(2 * n, req, MPI_STATUSES_IGNORE));
   size_t total = 0, off[8];
@@ -327,8 +332,7 @@ static size_t migrate_near(struct dd *d, const int *scount, const int *sdisp) {
   reserve_buf(&d->rbuf, &d->cap_rbuf, total);
   for (int k = 0; k < n; k++) {
     const int r = d->nb_rank[k];
-    CHECK_MPI(
-        MPI_Irecv(d->rbuf + off[k], rc[k], MPI_DOUBLE, r, TAG_MREC, MPI_COMM_WORLD, &req[k]));
+    CHECK_MPI(MPI_Irecv(d->rbuf + off[k], rc[k], MPI_DOUBLE, r, TAG_MREC, MPI_COMM_WORLD, &req[k]));
     CHECK_MPI(MPI_Isend(d->sbuf + sdisp[r], scount[r], MPI_DOUBLE, r, TAG_MREC, MPI_COMM_WORLD,
                         &req[n + k]));
   }
@@ -495,8 +499,8 @@ static void exchange(struct dd *d, int k, int nf, void (*pack_fn)(const void *, 
   reserve_buf(&d->rbuf, &d->cap_rbuf, nr * (size_t)nf);
   MPI_Request req[4];
   /* my lower halo comes from the lower neighbour's message upwards, and vice versa */
-  CHECK_MPI(MPI_Irecv(d->rbuf, (int)(D->nrecv[0] * nf), MPI_DOUBLE, D->lo, thi, MPI_COMM_WORLD,
-                      &req[0]));
+  CHECK_MPI(
+      MPI_Irecv(d->rbuf, (int)(D->nrecv[0] * nf), MPI_DOUBLE, D->lo, thi, MPI_COMM_WORLD, &req[0]));
   CHECK_MPI(MPI_Irecv(d->rbuf + D->nrecv[0] * nf, (int)(D->nrecv[1] * nf), MPI_DOUBLE, D->hi, tlo,
                       MPI_COMM_WORLD, &req[1]));
   for (int s = 0, off = 0; s < 2; off += (int)D->nsend[s], s++) {
@@ -672,8 +676,8 @@ static void gather_pencils(const struct dd *d, const double *mine, size_t len, d
   if (d->size == 1) {
     for (int izl = 0; izl < nzo; izl++)
       for (int lc = 0; lc < nxo; lc++)
-        memcpy(all + ((size_t)lc * d->nplane + izl) * len,
-               mine + ((size_t)izl * nxo + lc) * len, len * sizeof(double));
+        memcpy(all + ((size_t)lc * d->nplane + izl) * len, mine + ((size_t)izl * nxo + lc) * len,
+               len * sizeof(double));
     return;
   }
   int *cnt = mem_alloc(2 * (size_t)d->size, sizeof(int), "domain decomposition"),
@@ -684,8 +688,8 @@ static void gather_pencils(const struct dd *d, const double *mine, size_t len, d
     dsp[r] = off, off += cnt[r];
   }
   double *buf = mem_alloc(npen * len, sizeof(double), "domain decomposition");
-  CHECK_MPI(MPI_Allgatherv(mine, cnt[d->rank], MPI_DOUBLE, buf, cnt, dsp, MPI_DOUBLE,
-                           MPI_COMM_WORLD));
+  CHECK_MPI(
+      MPI_Allgatherv(mine, cnt[d->rank], MPI_DOUBLE, buf, cnt, dsp, MPI_DOUBLE, MPI_COMM_WORLD));
   for (int r = 0; r < d->size; r++) {
     const int bx = r % d->px, bz = r / d->px;
     const int x0 = d->fx[bx], nx = d->fx[bx + 1] - x0, z0 = d->fz[bz], nz = d->fz[bz + 1] - z0;

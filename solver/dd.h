@@ -41,35 +41,35 @@ typedef void (*dd_reserve_fn)(void *ctx, size_t n);
 
 /** The halo exchange along one cut direction (x or z) in the current step. */
 struct dd_dir {
-  int width;           /*!< halo columns (planes) per side; 0: the direction is not cut */
-  int lo, hi;          /*!< the neighbouring ranks below and above (periodic) */
-  size_t nsend[2];     /*!< slots sent below (0) and above (1) */
-  size_t cap_send[2];  /*!< their capacity */
-  size_t *send[2];     /*!< the slots (owned, or x ghosts in the z direction), in cell order */
-  size_t nrecv[2];     /*!< ghosts received from below (0) and above (1) */
-  size_t first;        /*!< the slot of this direction's first ghost */
-  uint32_t *cnt[4];    /*!< particles per edge cell: sent below, above; received from below,
-                            above (nbr_halo_cells' order) */
-  size_t ncnt;         /*!< edge cells per side */
-  size_t cap_cnt;      /*!< their capacity */
+  int width;          /*!< halo columns (planes) per side; 0: the direction is not cut */
+  int lo, hi;         /*!< the neighbouring ranks below and above (periodic) */
+  size_t nsend[2];    /*!< slots sent below (0) and above (1) */
+  size_t cap_send[2]; /*!< their capacity */
+  size_t *send[2];    /*!< the slots (owned, or x ghosts in the z direction), in cell order */
+  size_t nrecv[2];    /*!< ghosts received from below (0) and above (1) */
+  size_t first;       /*!< the slot of this direction's first ghost */
+  uint32_t *cnt[4];   /*!< particles per edge cell: sent below, above; received from below,
+                           above (nbr_halo_cells' order) */
+  size_t ncnt;        /*!< edge cells per side */
+  size_t cap_cnt;     /*!< their capacity */
 };
 
 /** The decomposition and the halo bookkeeping of the current step. */
 struct dd {
-  int rank, size;        /*!< this rank, ranks */
-  int px, pz;            /*!< blocks along x and z (size = px pz) */
-  int bx, bz;            /*!< this rank's block: rank = bz px + bx */
-  int ncol, nplane;      /*!< global cell columns along x, planes along z */
-  int *fx, *fz;          /*!< first column of each block column (fx[px] = ncol), first plane of
-                              each block row (fz[pz] = nplane) */
-  struct dd_dir dir[2];  /*!< the x and z halo exchanges */
-  int nnb, nb_rank[8];   /*!< the distinct neighbouring ranks (3 x 3 blocks around, not self) */
-  MPI_Comm comm_x;       /*!< the block row (the ranks of this bz, by bx); MPI_COMM_NULL if
-                              px = 1 or pz = 1 (the statistics' contract.h) */
-  MPI_Comm comm_z;       /*!< the block column (the ranks of this bx, by bz); MPI_COMM_NULL
-                              if pz = 1 */
-  dd_reserve_fn reserve; /*!< grows the simulation's per-particle arrays */
-  void *ctx;             /*!< its argument */
+  int rank, size;           /*!< this rank, ranks */
+  int px, pz;               /*!< blocks along x and z (size = px pz) */
+  int bx, bz;               /*!< this rank's block: rank = bz px + bx */
+  int ncol, nplane;         /*!< global cell columns along x, planes along z */
+  int *fx, *fz;             /*!< first column of each block column (fx[px] = ncol), first plane of
+                                 each block row (fz[pz] = nplane) */
+  struct dd_dir dir[2];     /*!< the x and z halo exchanges */
+  int nnb, nb_rank[8];      /*!< the distinct neighbouring ranks (3 x 3 blocks around, not self) */
+  MPI_Comm comm_x;          /*!< the block row (the ranks of this bz, by bx); MPI_COMM_NULL if
+                                 px = 1 or pz = 1 (the statistics' contract.h) */
+  MPI_Comm comm_z;          /*!< the block column (the ranks of this bx, by bz); MPI_COMM_NULL
+                                 if pz = 1 */
+  dd_reserve_fn reserve;    /*!< grows the simulation's per-particle arrays */
+  void *ctx;                /*!< its argument */
   size_t cap_ghost, *ghost; /*!< the ghost slot of each received record (x, then z) */
   size_t *row, cap_row;     /*!< per-row offsets (scratch) */
   double *sbuf, *rbuf;

@@ -559,7 +559,8 @@ static void log_rebalance(struct output *o, const struct sim *S) {
   const struct dd *dd = &S->dd;
   char cols[256] = "", planes[256] = "";
   for (int r = 0, k = 0; r < dd->px && k < (int)sizeof cols - 16; r++)
-    k += snprintf(cols + k, sizeof cols - (size_t)k, "%s%d", r ? " " : "", dd->fx[r + 1] - dd->fx[r]);
+    k += snprintf(cols + k, sizeof cols - (size_t)k, "%s%d", r ? " " : "",
+                  dd->fx[r + 1] - dd->fx[r]);
   for (int r = 0, k = 0; r < dd->pz && k < (int)sizeof planes - 16; r++)
     k += snprintf(planes + k, sizeof planes - (size_t)k, "%s%d", r ? " " : "",
                   dd->fz[r + 1] - dd->fz[r]);
@@ -647,11 +648,13 @@ static void log_decomposition(struct output *o, struct sim *S, double wall) {
   CHECK_MPI(MPI_Allreduce(x, mx, 3, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD));
   CHECK_MPI(MPI_Allreduce(x, sum, 3, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD));
   output_log(o,
-             "decomposition: %d ranks (%d x %d blocks), %d x %d cell pencils; halo exchange and migration %.3f s "
+             "decomposition: %d ranks (%d x %d blocks), %d x %d cell pencils; halo exchange and "
+             "migration %.3f s "
              "(max over ranks, %.1f%% of the wall time); %.2f MB sent in all; %.0f particles "
              "migrated; %ld re-partitions (last imbalance %.3f)\n",
-             d->size, d->px, d->pz, d->ncol, d->nplane, mx[0], wall > 0 ? 100.0 * mx[0] / wall : 0.0, sum[1] / 1048576.0,
-             sum[2], d->rebalances, d->imbalance);
+             d->size, d->px, d->pz, d->ncol, d->nplane, mx[0],
+             wall > 0 ? 100.0 * mx[0] / wall : 0.0, sum[1] / 1048576.0, sum[2], d->rebalances,
+             d->imbalance);
 }
 
 int output_finish(struct output *o, struct sim *S) {

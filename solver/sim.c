@@ -179,9 +179,9 @@ int sim_create(struct sim *S, const struct scene *sc) {
   return CHANSPH_OK;
 }
 
-/* Partition the grid's pencils over the ranks (blocks), keep this rank's particles, set up the grid. From a
-   checkpoint read on several ranks (block = 1), this rank holds the slots of its id block
-   (sim_state), which migrate to their owners. */
+/* Partition the grid's pencils over the ranks (blocks), keep this rank's particles, set up the
+   grid. From a checkpoint read on several ranks (block = 1), this rank holds the slots of its id
+   block (sim_state), which migrate to their owners. */
 static int sim_distribute(struct sim *S, int block) {
   if (dd_init(&S->dd, S->sc, sim_reserve, S)) return CHANSPH_ERR;
   const struct nbr_range r = dd_range(&S->dd);

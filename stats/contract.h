@@ -44,11 +44,11 @@ enum { STATS_ACC = 3 * STATS_PARTS };
  * (comm_x, or comm without plane cuts) own contiguous column ranges in rank order covering
  * 0 .. ncol - 1, those of a block column (comm_z) contiguous plane ranges in rank order; within
  * a column the particles appear plane by plane in the same order on any decomposition; the
- * scalars are the same on all ranks. The engine state then comes out bitwise identical on every rank and for
- * any number of ranks. col = NULL puts every particle in column col0; with ncol = 0 as well
- * (the layout left unset by an initialiser) the layout is one rank owning column 0.
- * comm = MPI_COMM_NULL (or left zero by an initialiser, or MPI not initialised) is serial and
- * makes no MPI call.
+ * scalars are the same on all ranks. The engine state then comes out bitwise identical on every
+ * rank and for any number of ranks. col = NULL puts every particle in column col0; with ncol = 0 as
+ * well (the layout left unset by an initialiser) the layout is one rank owning column 0. comm =
+ * MPI_COMM_NULL (or left zero by an initialiser, or MPI not initialised) is serial and makes no MPI
+ * call.
  */
 struct stats_snapshot {
   size_t n;                   /*!< particles */

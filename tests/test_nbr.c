@@ -399,9 +399,9 @@ static int check_threads(const char *name, int n_set, char **set) {
     part_permute(&P, 0, n, perm);
     struct nbr nb;
     {
-    const struct nbr_range whole = nbr_whole(&s);
-    nbr_init(&nb, &s, n, &whole);
-  }
+      const struct nbr_range whole = nbr_whole(&s);
+      nbr_init(&nb, &s, n, &whole);
+    }
     for (int pass = 0; pass < 2; pass++) {
       int64_t *id = malloc(n * sizeof *id);
       size_t *start = malloc((nb.ncell_own + 1) * sizeof *start);
