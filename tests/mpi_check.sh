@@ -17,7 +17,7 @@
 #   resume_too_many  a 1-rank checkpoint resumed on more ranks than its slabs allow: the same
 #                    message, exit 1, the checkpoints untouched
 #   blocks     x-z blocks (run.ranks = Px,Pz) of 2-4 ranks, and 2 x 2 with 2 threads: equal 1 rank
-#   blocks_many      the same on 6, 8, 9, 12 and 16 ranks (every factorisation that fits), 4 x 4
+#   blocks_many      the same (30 steps) on 6, 8, 9, 12 and 16 ranks (every factorisation that fits), 4 x 4
 #                    with 2 threads
 #   blocks_resume    a checkpoint of 2 x 2 resumed on 1, 3 x 1, 1 x 3 and 2 x 2: each equals the
 #                    uninterrupted 1-rank run; on 3 ranks with its run.ranks: exit 1, nothing written
@@ -222,11 +222,11 @@ case $case in
   blocks | blocks_many) # x-z blocks: every Px x Pz equals 1 rank, bitwise (stats.nc, particles.nc, checkpoint)
     scene=$scenes/les395_smoke.ini
     if [ "$case" = blocks ]; then # 18 x 12 pencils
-      lz=1.6 layouts="1,2 1,3 2,2"
+      lz=1.6 layouts="1,2 1,3 2,2" steps=60
     else # 18 x 16 pencils: 6, 8, 9, 12 and 16 ranks
-      lz=2.2 layouts="3,2 2,3 4,2 2,4 3,3 4,3 3,4 4,4"
+      lz=2.2 layouts="3,2 2,3 4,2 2,4 3,3 4,3 3,4 4,4" steps=30
     fi
-    args=(--set domain.lx=2.4 --set domain.lz=$lz --set time.max_steps=60 --set output.stats_every=5
+    args=(--set domain.lx=2.4 --set domain.lz=$lz --set time.max_steps=$steps --set output.stats_every=5
       "${all_engines[@]}")
     mpi 1 run "$scene" --out r1 --overwrite "${args[@]}" > r1.txt 2>&1 || { tail r1.txt; echo "FAIL: 1 rank"; exit 1; }
     for l in $layouts; do
@@ -234,14 +234,14 @@ case $case in
       mpi "$np" run "$scene" --out "r$l" --overwrite "${args[@]}" --set run.ranks=$l > "r$l.txt" 2>&1 ||
         { tail "r$l.txt"; echo "FAIL: $l"; exit 1; }
       grep -h "^decomposition: $np MPI ranks" "r$l/log.txt"
-      compare r1 "r$l" 60 noscene
+      compare r1 "r$l" $steps noscene
     done
     l=2,2 # hybrid: blocks with 2 threads each
     [ "$case" = blocks_many ] && l=4,4
     np=$((${l%,*} * ${l#*,}))
     OMP_NUM_THREADS=2 mpi "$np" run "$scene" --out "r${l}t2" --overwrite "${args[@]}" --set run.ranks=$l \
       > "r${l}t2.txt" 2>&1 || { tail "r${l}t2.txt"; echo "FAIL: $l x 2 threads"; exit 1; }
-    compare r1 "r${l}t2" 60 noscene
+    compare r1 "r${l}t2" $steps noscene
     ;;
   blocks_resume | blocks_resume_many) # a checkpoint of one decomposition resumed on others
     scene=$scenes/les395_smoke.ini
