@@ -423,7 +423,7 @@ void dd_migrate(struct dd *d, struct particles *P, const struct nbr *nb) {
 /* The edge cells of direction k on side s (0: the lowest columns or planes of the block, sent
    to the lower neighbour; 1: the highest), in the receiver's halo cell order (nbr.h): x, per
    row (izl, iy) the width columns; z, per plane k and row iy the extended columns (the x halo
-   included: the corners). Calls fn(c, i, arg) for edge cell i, local cell c. */
+   included: the corners). Returns the local cell of edge cell i. */
 static size_t edge_cell(const struct nbr *nb, int k, int side, size_t i) {
   const size_t ny = (size_t)nb->ny;
   if (k == 0) {
