@@ -390,25 +390,37 @@ static int stencil_ranges(const struct nbr *nb, size_t c, struct cand_range *r) 
   /* the x cells of the stencil are one unshifted run of local cells (owned, or of one row of
      the z halo) away from the ends of the block along x and of the grid */
   const int inner = lc >= R && lc < nb->nxo - R && gx >= R && gx < nb->nx - R;
+  const int ylo = iy - R < 0 ? 0 : iy - R, yhi = iy + R >= nb->ny ? nb->ny - 1 : iy + R;
   int n = 0;
   for (int dz = dz_lo; dz <= dz_hi; dz++) {
     const int gz = nb->iz0 + izl + dz;
     const double sz = stencil_shift(gz, nb->nz, nb->lz);
     const int jz = gz < 0 ? gz + nb->nz : gz >= nb->nz ? gz - nb->nz : gz; /* global plane */
-    for (int dy = -R; dy <= R; dy++) {
-      const int jy = iy + dy;
-      if (jy < 0 || jy >= nb->ny) continue;
-      if (inner) {
-        const size_t c0 = nbr_local_cell(nb, lc - R, jy, izl + dz);
-        r[n++] = (struct cand_range){nb->start[c0], nb->start[c0 + 2 * R + 1], 0.0, sz, jy, jz};
-        continue;
+    int zl = izl + dz; /* local plane, wrapped where the block is the whole grid in z */
+    if (!nb->hz) zl = jz;
+    if (inner) { /* one run of 2R + 1 cells a row: the rows are an arithmetic sequence */
+      const size_t c0 = nbr_local_cell(nb, lc - R, ylo, zl), st = nbr_row_stride(nb, lc - R, zl);
+      for (int jy = ylo; jy <= yhi; jy++) {
+        const size_t c = c0 + (size_t)(jy - ylo) * st;
+        r[n++] = (struct cand_range){nb->start[c], nb->start[c + 2 * R + 1], 0.0, sz, jy, jz};
       }
-      for (int dx = -R; dx <= R; dx++) {
-        const size_t cc = nbr_local_cell(nb, lc + dx, jy, izl + dz);
-        const double sx = stencil_shift(gx + dx, nb->nx, nb->lx);
-        r[n++] = (struct cand_range){nb->start[cc], nb->start[cc + 1], sx, sz, jy, jz};
-      }
+      continue;
     }
+    size_t cc[2 * NBR_REACH + 1], st[2 * NBR_REACH + 1];
+    double sx[2 * NBR_REACH + 1];
+    for (int dx = -R; dx <= R; dx++) {
+      int xl = lc + dx; /* local column, wrapped where the block is the whole grid in x */
+      if (!nb->hx)
+        while (xl < 0 || xl >= nb->nx) xl += xl < 0 ? nb->nx : -nb->nx;
+      cc[dx + R] = nbr_local_cell(nb, xl, ylo, zl);
+      st[dx + R] = nbr_row_stride(nb, xl, zl);
+      sx[dx + R] = stencil_shift(gx + dx, nb->nx, nb->lx);
+    }
+    for (int jy = ylo; jy <= yhi; jy++)
+      for (int k = 0; k < 2 * R + 1; k++) {
+        const size_t c = cc[k] + (size_t)(jy - ylo) * st[k];
+        r[n++] = (struct cand_range){nb->start[c], nb->start[c + 1], sx[k], sz, jy, jz};
+      }
   }
   return n;
 }

@@ -187,8 +187,10 @@ size_t nbr_halo_cells(struct nbr *nb, int dir, size_t first, const uint32_t *con
  *        inside the grid: any lc, izl); owned, x halo or z halo.
  */
 static inline size_t nbr_local_cell(const struct nbr *nb, int lc, int iy, int izl) {
-  if (!nb->hx) lc = (lc % nb->nx + nb->nx) % nb->nx;
-  if (!nb->hz) izl = (izl % nb->nz + nb->nz) % nb->nz;
+  if (!nb->hx) /* wrap: lc lies within a stencil's reach of the grid (no division) */
+    while (lc < 0 || lc >= nb->nx) lc += lc < 0 ? nb->nx : -nb->nx;
+  if (!nb->hz)
+    while (izl < 0 || izl >= nb->nz) izl += izl < 0 ? nb->nz : -nb->nz;
   if (izl >= 0 && izl < nb->nzo) {
     if (lc >= 0 && lc < nb->nxo) return ((size_t)izl * nb->ny + iy) * nb->nxo + lc;
     const int h = lc < 0 ? lc + nb->hx : nb->hx + lc - nb->nxo;
@@ -196,6 +198,14 @@ static inline size_t nbr_local_cell(const struct nbr *nb, int lc, int iy, int iz
   }
   const int sk = izl < 0 ? izl + nb->hz : nb->hz + izl - nb->nzo; /* s hz + k */
   return nb->ncell_x + ((size_t)sk * nb->ny + iy) * (nb->nxo + 2 * nb->hx) + (lc + nb->hx);
+}
+
+/** @brief The step of nbr_local_cell(nb, lc, iy, izl) from row iy to iy + 1 (lc and izl as
+    there, already wrapped): a column of cells is an arithmetic sequence in every part of the
+    block. */
+static inline size_t nbr_row_stride(const struct nbr *nb, int lc, int izl) {
+  if (izl >= 0 && izl < nb->nzo) return lc >= 0 && lc < nb->nxo ? (size_t)nb->nxo : 2u * nb->hx;
+  return (size_t)nb->nxo + 2u * nb->hx;
 }
 
 /** @brief Owned cell of local column lc (0 .. nxo-1) and local plane izl (0 .. nzo-1):
