@@ -4,123 +4,194 @@
 Time per step on P ranks (one core each; with threads, read "rank" as "core"):
 
     T(P) = t_c N / P                      computation (gather loops over the rank's particles)
-         + G(P) (t_g + b / B)              ghosts: pack, unpack, sort, and the bytes on the wire
+         + G(P) (t_g + b / B)              ghosts: pack, unpack, and the bytes on the wire
          + m(P) alpha                      point-to-point messages (latency)
          + (3 log2 P + 4) alpha            three allreduces (dt, nu_max, and whether every
                                            migrating particle goes to a neighbour) and the
-                                           migration's four neighbour messages (counts, records)
+                                           migration's neighbour messages
 
-G(P) ghosts per rank: slabs of whole cell columns along x (implemented):
-    G = 2 sides * w * ly * lz * n,   w = NBR_REACH cells of size ~h = 2 h,  n = 1 / dr^3,
-independent of P: the halo does not shrink when the slabs get thinner. x-z blocks
-(Px x Pz ranks, not implemented) for comparison:
-    G = (2 w lz / Pz + 2 w lx / Px + 4 w^2) ly n.
-Slabs stop at P = ncol / (2 NBR_REACH) (each rank owns 4 columns or more).
+G(P) ghosts per rank, for Px x Pz blocks of whole cell pencils (cells of size h along x and z,
+the wall-normal direction whole; slabs are Px x 1), as the code counts them (dd.c,
+ghost_pencils): a cut direction has a halo of R = 2 cells on each side, the z halo includes the
+corners,
 
-Constants measured on this machine (tests/bench_mpi.sh; `chansph bench`, 3-D, 99 840 particles):
-    t_c  per particle-step and core (1 rank x 1 thread) for the bench scene, and for the LES of
-         les395_small (107 ms per step on 2 threads for 41 250 particles)
-    t_g  local cost per ghost per step (mean halo time of the 2-rank bench / its ghosts)
-    b    bytes per ghost per step (kB sent per rank per step / ghosts)
+    G = [2 hx nzo + 2 hz (nxo + 2 hx)] pencils x (ly cx cz / dr^3) particles per pencil,
+    nxo = ncol / Px, nzo = nplane / Pz, hx = R if Px > 1, hz = R if Pz > 1,
+
+and Px x Pz is the code's own choice (the factorisation with the fewest ghosts whose blocks
+have at least 2R columns and planes where cut): slabs while they have fewer ghosts, then
+blocks; at most (ncol / 4) x (nplane / 4) ranks.
+
+Constants measured on this machine (`chansph bench`, 3-D, 99 840 particles; tests/bench_halo.sh):
+    t_c  per particle-step and core (1 rank x 1 thread) for the bench scene, the LES of
+         les395_small, and the wide box's Wendland C4 kernel at h = 2 dr (the A/B's cost)
+    t_g  local cost per ghost per step (the halo's own work on a 16-core node / its ghosts)
+    b    bytes sent per ghost per step and m messages per step and rank: slabs and blocks,
+         measured (docs/perf/halo_les395x4.csv, tests/bench_halo.sh)
 Assumed for a cluster (InfiniBand HDR class): B = 10 GB/s per rank, alpha = 2 us.
 
 usage: docs/parallel_model.py [--out docs/parallel_scaling.png]
+       docs/parallel_model.py --measured CSV   (the ghosts of tests/bench_halo.sh against G)
 """
 import argparse
+import csv
 import math
+
+R = 2  # NBR_REACH: halo cells per side of a cut direction; a block needs 2 R where cut
 
 # measured (docs/parallel.md, "Measured on this machine")
 T_C_BENCH = 194.3e-3 / 99840  # s per particle-step per core, bench scene (1 x 1)
 T_C_LES = 107e-3 * 2 / 41250  # s per particle-step per core, les395_small LES (1 x 2 threads)
-GHOSTS_BENCH = 2 * 2 * (1.6 / 49) * 1.0 * 1.0 / 0.025 ** 3  # 2 sides x 2 cols x ly x lz x n
+T_C_C4 = 900.0 * 2 / 558e6  # wide box, Wendland C4 at h = 2 dr: 558 M particle-steps a turnover
+#                             in 900 s on 2 threads (docs/validation/scheme_ab.md, delta_0.2)
 # s per ghost per step: the halo's own work (migration, ghosts, refreshes; not the MPI waits) of
 # a rank of mcf1 on 16 ranks x 1 thread of a 16-core node, 12.8 ms for 2 x 2 columns of ghosts
-# (docs/perf/node16.csv; it was 4.07 ms for the bench scene's ghosts on 2 ranks
-# before the halo was threaded and lost its ghost sort, 0.49 us per ghost)
+# (docs/perf/node16.csv)
 GHOSTS_MCF1 = 2 * 2 * (3.140625 / 154) * 2.0 * 1.0 / 0.015625 ** 3
 T_G = 12.8e-3 / GHOSTS_MCF1
-B_GHOST = 1479.8e3 / GHOSTS_BENCH  # bytes per ghost per step (9 doubles built, 12 refreshed)
-MSG_SLAB = 8  # point-to-point messages per step and rank (bench, 2 ranks)
+# bytes per ghost per step and messages per step and rank, measured with tests/bench_halo.sh on
+# les395_small x 4 (docs/perf/halo_les395x4.csv; 16 x 1 slabs and 4 x 4 blocks)
+B_GHOST_SLAB = 220.0  # 1924 kB for 8 750 ghosts (16 x 1)
+B_GHOST_BLOCK = 218.0  # 1689 kB for 7 734 ghosts (4 x 4)
+MSG_SLAB = 14.2  # 2 neighbours: halo, 2 refreshes, counts, migration
+MSG_BLOCK = 28.2  # 4 neighbours: x then z passes of each exchange, migration
 # assumed cluster network
 BW = 10e9
 ALPHA = 2e-6
 
 SCENES = {  # name: (lx, ly, lz, dr, h_over_dr, t_c)
     "mcf1 (1.66 M, quasi-DNS)": (3.140625, 2.0, 1.0, 0.015625, 1.3, T_C_BENCH),
-    "les1000 (4.98 M, LES)": (6.28, 2.0, 3.14, 0.02, 1.3, T_C_LES),
+    "wide box dr+ = 3 (1.21 M, C4)": (2.0, 2.0, 1.4, 1.0 / 60, 2.0, T_C_C4),
+    "les550 (1.29 M, LES)": (2 * math.pi, 2.0, math.pi, 1.0 / 32, 1.3, T_C_LES),
 }
+RANKS = (2, 4, 8, 16, 32, 64, 128, 256, 512, 1024, 2048, 4096)
 
 
-def columns(lx, h):
-    return int(math.floor(lx / h * (1 + 1e-12)))
+def cells(l, h):
+    """Cells of size >= h along a periodic direction of length l (nbr_whole)."""
+    return int(math.floor(l / h * (1 + 1e-12)))
 
 
-def step_time(p, lx, ly, lz, dr, hr, t_c, blocks=False):
+def ghost_pencils(px, pz, ncol, nplane):
+    """Ghost pencils per rank of Px x Pz blocks, or None if a block is thinner than 2 R."""
+    if (px > 1 and ncol < 2 * R * px) or (pz > 1 and nplane < 2 * R * pz):
+        return None
+    hx, hz = (R if px > 1 else 0), (R if pz > 1 else 0)
+    nxo, nzo = ncol / px, nplane / pz
+    return 2.0 * hx * nzo + 2.0 * hz * (nxo + 2.0 * hx)
+
+
+def choose(p, ncol, nplane):
+    """The code's Px x Pz for p ranks (fewest ghosts; ties: more along x), or None."""
+    best = None
+    for px in range(p, 0, -1):
+        if p % px:
+            continue
+        g = ghost_pencils(px, p // px, ncol, nplane)
+        if g is not None and (best is None or g < best[0] - 1e-9):
+            best = (g, px, p // px)
+    return best
+
+
+def step_time(p, lx, ly, lz, dr, hr, t_c, slabs=False):
+    """(T, comm, px, pz) per step on p ranks, or None where the blocks do not fit."""
     h = hr * dr
     n = 1.0 / dr ** 3
     N = lx * ly * lz * n
-    w = 2 * h
+    ncol, nplane = cells(lx, h), cells(lz, h)
     if p == 1:
-        return t_c * N, 0.0
-    if not blocks:
-        g = 2 * w * ly * lz * n
-        m = MSG_SLAB
+        return t_c * N, 0.0, 1, 1
+    if slabs:
+        g = ghost_pencils(p, 1, ncol, nplane)
+        best = None if g is None else (g, p, 1)
     else:
-        px = max(1, int(round(math.sqrt(p * lx / lz))))
-        pz = max(1, p // px)
-        g = (2 * w * lz / pz + 2 * w * lx / px + 4 * w * w) * ly * n
-        m = 4 * MSG_SLAB  # 8 neighbours instead of 2
-    comm = g * (T_G + B_GHOST / BW) + m * ALPHA + (3 * math.log2(p) + 4) * ALPHA
-    return t_c * N / p + comm, comm
+        best = choose(p, ncol, nplane)
+    if best is None:
+        return None
+    gp, px, pz = best
+    G = gp * ly * (lx / ncol) * (lz / nplane) * n
+    b, m = (B_GHOST_SLAB, MSG_SLAB) if pz == 1 else (B_GHOST_BLOCK, MSG_BLOCK)
+    comm = G * (T_G + b / BW) + m * ALPHA + (3 * math.log2(p) + 4) * ALPHA
+    return t_c * N / p + comm, comm, px, pz
 
 
 def table():
     rows = []
     for name, (lx, ly, lz, dr, hr, t_c) in SCENES.items():
-        ncol = columns(lx, hr * dr)
-        pmax = ncol // 4
-        t1, _ = step_time(1, lx, ly, lz, dr, hr, t_c)
-        print("%s: %d cell columns, slabs up to %d ranks; T(1) = %.2f s per step"
-              % (name, ncol, pmax, t1))
-        print("  %6s %10s %10s %8s %10s   %s" % ("ranks", "T [ms]", "comm [ms]", "comm %",
-                                                  "efficiency", "decomposition"))
+        h = hr * dr
+        ncol, nplane = cells(lx, h), cells(lz, h)
+        t1 = step_time(1, lx, ly, lz, dr, hr, t_c)[0]
+        print("%s: %d x %d cell pencils, slabs up to %d ranks, blocks up to %d; T(1) = %.2f s "
+              "per step" % (name, ncol, nplane, ncol // (2 * R),
+                            (ncol // (2 * R)) * (nplane // (2 * R)), t1))
+        print("  %6s %9s %10s %10s %8s %10s %16s" % ("ranks", "Px x Pz", "T [ms]", "comm [ms]",
+                                                   "comm %", "efficiency", "slabs: eff."))
         cross = None
-        for p in (2, 4, 8, 16, 32, 64, 128, 256, 512, 1000):
-            blocks = p > pmax
-            t, c = step_time(p, lx, ly, lz, dr, hr, t_c, blocks)
+        pmax = (ncol // (2 * R)) * (nplane // (2 * R))
+        for p in [q for q in RANKS if q < pmax] + [pmax]:
+            r = step_time(p, lx, ly, lz, dr, hr, t_c)
+            if r is None:
+                continue
+            t, c, px, pz = r
+            rs = step_time(p, lx, ly, lz, dr, hr, t_c, slabs=True)
             eff = t1 / (p * t)
             if cross is None and c > t - c:
                 cross = p
-            rows.append((name, p, t, c, eff, blocks))
-            print("  %6d %10.2f %10.2f %7.1f%% %9.1f%%   %s" % (p, 1e3 * t, 1e3 * c, 100 * c / t,
-                                                                 100 * eff,
-                                                                 "x-z blocks (model)" if blocks
-                                                                 else "slabs"))
-        print("  communication exceeds computation from about %s ranks" % (cross or "> 1000"))
+            rows.append((name, p, t, c, eff, px, pz, None if rs is None else t1 / (p * rs[0])))
+            print("  %6d %9s %10.2f %10.3f %7.1f%% %9.1f%% %16s"
+                  % (p, "%d x %d" % (px, pz), 1e3 * t, 1e3 * c, 100 * c / t, 100 * eff,
+                     "-" if rs is None else "%.1f%%" % (100 * t1 / (p * rs[0]))))
+        print("  communication exceeds computation from about %d ranks" % cross if cross else
+              "  communication stays below computation up to the last row (the most ranks: "
+              "%d x %d blocks of 4 x 4 pencils)" % (ncol // (2 * R), nplane // (2 * R)))
     return rows
 
 
 def weak():
-    """Weak scaling: the box grows along x with the ranks (les395-size slab per rank)."""
-    print("weak scaling, slabs: 41 250 particles per rank (les395_small per rank, LES)")
-    lx1, ly, lz, dr, hr = 3.125, 2.0, 1.5625, 0.0625, 1.3
-    t1, _ = step_time(1, lx1, ly, lz, dr, hr, T_C_LES)
+    """Weak scaling: the box grows along x and z with the ranks (les395-size block per rank)."""
+    print("weak scaling, blocks: 41 250 particles per rank (les395_small per rank, LES)")
+    lx1, ly, lz1, dr, hr = 3.125, 2.0, 1.5625, 0.0625, 1.3
+    t1 = step_time(1, lx1, ly, lz1, dr, hr, T_C_LES)[0]
     out = []
-    for p in (1, 2, 8, 32, 128, 512, 1000):
-        t, c = step_time(p, lx1 * p, ly, lz, dr, hr, T_C_LES)
+    for p in (1, 4, 16, 64, 256, 1024, 4096):
+        q = int(round(math.sqrt(p)))
+        r = step_time(p, lx1 * q, ly, lz1 * q, dr, hr, T_C_LES)
+        t, c = r[0], r[1]
         out.append((p, t1 / t))
-        print("  %5d ranks: %.1f ms per step, efficiency %.1f%% (comm %.2f ms)"
-              % (p, 1e3 * t, 100 * t1 / t, 1e3 * c))
+        print("  %5d ranks (%d x %d): %.1f ms per step, efficiency %.1f%% (comm %.2f ms)"
+              % (p, r[2], r[3], 1e3 * t, 100 * t1 / t, 1e3 * c))
     return out
+
+
+def measured(path):
+    """The ghosts per owned particle of tests/bench_halo.sh's runs against the model's pencils,
+    and the bytes per ghost and messages per step the model takes from them."""
+    print("%6s %8s %9s %11s %11s %10s %12s %9s" % ("ranks", "layout", "Px x Pz", "ghosts/own",
+                                                 "model", "B/ghost", "messages", "kB sent"))
+    for r in csv.DictReader(open(path)):
+        px, pz, ncol, nplane = (int(r[k]) for k in ("px", "pz", "ncol", "nplane"))
+        gp = ghost_pencils(px, pz, ncol, nplane)
+        model = gp / ((ncol / px) * (nplane / pz))
+        bpg = 1e3 * float(r["kB_mean"]) / float(r["ghosts_mean"])
+        print("%6s %8s %9s %11.3f %11.3f %10.0f %12s %9.0f"
+              % (r["ranks"], r["layout"], "%d x %d" % (px, pz), float(r["ghosts_per_owned"]),
+                 model, bpg, "%s (max %s)" % (r["messages_mean"], r["messages_max"]),
+                 float(r["kB_mean"])))
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
     ap.add_argument("--out", help="PNG of the strong-scaling efficiency")
-    a = ap.parse_args()
-    print("constants: t_c %.3g us (bench), %.3g us (LES) per particle-step; t_g %.3g us and "
-          "%.0f B per ghost per step; B = %.0f GB/s, alpha = %.0f us"
-          % (1e6 * T_C_BENCH, 1e6 * T_C_LES, 1e6 * T_G, B_GHOST, BW / 1e9, 1e6 * ALPHA))
+    ap.add_argument("--measured", help="CSV of tests/bench_halo.sh: print it against the model")
+    a, _ = ap.parse_known_args()  # bench_halo.sh passes its scene and --set too: not needed
+    if a.measured:
+        measured(a.measured)
+        return
+    print("constants: t_c %.3g us (bench), %.3g us (LES), %.3g us (C4) per particle-step; t_g "
+          "%.3g us; %.0f / %.0f B per ghost and %.1f / %.1f messages per step (slabs / blocks); "
+          "B = %.0f GB/s, alpha = %.0f us"
+          % (1e6 * T_C_BENCH, 1e6 * T_C_LES, 1e6 * T_C_C4, 1e6 * T_G, B_GHOST_SLAB, B_GHOST_BLOCK,
+             MSG_SLAB, MSG_BLOCK, BW / 1e9, 1e6 * ALPHA))
     rows = table()
     wk = weak()
     if a.out:
@@ -128,15 +199,20 @@ def main():
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
         fig, ax = plt.subplots(1, 2, figsize=(10, 4))
-        for name in SCENES:
-            ps = [r[1] for r in rows if r[0] == name]
-            ax[0].semilogx(ps, [100 * r[4] for r in rows if r[0] == name], "o-", label=name)
+        for k, name in enumerate(SCENES):
+            rr = [r for r in rows if r[0] == name]
+            ax[0].semilogx([r[1] for r in rr], [100 * r[4] for r in rr], "o-", color="C%d" % k,
+                           label=name)
+            sl = [r for r in rr if r[7] is not None]
+            ax[0].semilogx([r[1] for r in sl], [100 * r[7] for r in sl], ":", color="C%d" % k)
         ax[0].axhline(50, color="grey", lw=0.5)
+        ax[0].set_xscale("log", base=2)
         ax[0].set_xlabel("ranks")
         ax[0].set_ylabel("strong-scaling efficiency [%]")
-        ax[0].set_title("strong scaling (slabs, then x-z blocks)")
-        ax[0].legend()
+        ax[0].set_title("strong scaling: blocks (dotted: slabs only)")
+        ax[0].legend(fontsize=8)
         ax[1].semilogx([w[0] for w in wk], [100 * w[1] for w in wk], "s-")
+        ax[1].set_xscale("log", base=2)
         ax[1].set_xlabel("ranks")
         ax[1].set_ylabel("weak-scaling efficiency [%]")
         ax[1].set_title("weak scaling, 41 250 particles per rank")

@@ -285,7 +285,8 @@ void dd_take_block(struct dd *d, struct particles *P, const struct nbr *nb, size
     if (a != lo + a) copy_slot(P, a, lo + a);
   P->n = n, P->n_ghost = 0;
   dd_migrate(d, P, nb);
-  d->seconds = d->bytes = 0.0, d->messages = d->migrated = 0; /* the run's counters start here */
+  d->seconds = d->bytes = d->ghosts = 0.0; /* the run's counters start here */
+  d->messages = d->migrated = d->halos = 0;
 }
 
 /* The slots of the particles this rank keeps (dest[a] < 0) or sends (dest[a] >= 0), each list
@@ -611,6 +612,7 @@ void dd_halo(struct dd *d, struct particles *P, struct nbr *nb) {
   for (int k = 0; k < 2; k++)
     if (d->dir[k].width) next = halo_dir(d, P, nb, k, next);
   d->seconds += MPI_Wtime() - t0;
+  d->ghosts += (double)P->n_ghost, d->halos++;
   timer_pop();
 }
 

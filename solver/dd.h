@@ -79,6 +79,8 @@ struct dd {
   double bytes;     /*!< bytes sent by this rank */
   long messages;    /*!< messages sent by this rank */
   long migrated;    /*!< particles this rank sent to another owner */
+  double ghosts;    /*!< ghosts this rank received, summed over the halo builds */
+  long halos;       /*!< halo builds (steps) counted */
   long rebalances;  /*!< re-partitions done */
   double imbalance; /*!< last max / mean particles per rank */
 };

@@ -469,6 +469,7 @@ void output_resume(struct output *o, struct sim *S) {
   o->t0 = S->t, o->last_step = o->step0 = S->step;
   output_log(o, "chansph %s: resumed at step %ld, t = %.9g s: %zu fluid + %zu vertex particles\n",
              CHANSPH_VERSION, S->step, S->t, S->P.n_fluid, S->P.n_vertex);
+  if (S->dd.size > 1) log_blocks(o, S); /* the decomposition may differ from the last job's */
   warn_settings(o, S);
 }
 
@@ -655,6 +656,18 @@ static void log_decomposition(struct output *o, struct sim *S, double wall) {
              d->size, d->px, d->pz, d->ncol, d->nplane, mx[0],
              wall > 0 ? 100.0 * mx[0] / wall : 0.0, sum[1] / 1048576.0, sum[2], d->rebalances,
              d->imbalance);
+  /* per rank and step (docs/parallel_model.py's b G and m): bytes sent, messages, ghosts */
+  const double ns = d->halos > 0 ? (double)d->halos : 1.0;
+  double y[4] = {d->bytes / ns, (double)d->messages / ns, d->ghosts / ns, (double)S->P.n}, my[4],
+         sy[4];
+  CHECK_MPI(MPI_Allreduce(y, my, 4, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD));
+  CHECK_MPI(MPI_Allreduce(y, sy, 4, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD));
+  const double P = d->size;
+  output_log(o,
+             "halo per rank and step (mean, max over ranks; %ld steps): %.1f kB, %.1f kB sent in "
+             "%.1f, %.1f messages; %.0f, %.0f ghosts; ghosts / owned %.3f\n",
+             d->halos, sy[0] / P / 1e3, my[0] / 1e3, sy[1] / P, my[1], sy[2] / P, my[2],
+             sy[3] > 0 ? sy[2] / sy[3] : 0.0);
 }
 
 int output_finish(struct output *o, struct sim *S) {

@@ -22,7 +22,8 @@ exec "$@"
 X
 cat > "$fake/mpirun" << 'X'
 #!/usr/bin/env bash
-while [[ $1 == -* ]]; do [[ $1 == -np || $1 == --bind-to ]] && shift; shift; done
+echo "mpirun $*" >> "${MPIRUN_LOG:-/dev/null}"
+while [[ $1 == -* ]]; do [[ $1 == -np || $1 == --bind-to || $1 == --hostfile ]] && shift; shift; done
 exec "$@"
 X
 printf '#!/usr/bin/env bash\necho "1-00:00:00"\n' > "$fake/squeue"
@@ -74,11 +75,13 @@ cp "$ref/scene.used.ini" "$runs/batch_scene.ini"
 status=0
 for kind in slurm pbs; do
   d=$runs/batch_$kind
-  rm -rf "$d" "$d.jobs"
+  rm -rf "$d" "$d.jobs" "$d.mpirun"
   script=$here/jobs/$kind/chansph.$([ $kind = slurm ] && echo sbatch || echo pbs)
+  # PBS: the node file of select=2:ncpus=8:mpiprocs=2 (2 nodes, 2 MPI processes each)
+  printf 'n1\nn1\nn2\nn2\n' > "$runs/batch_nodefile"
   (cd "$here" && PATH=$fake:$PATH RUN_DIR=$d SCENE=$runs/batch_scene.ini CHANSPH=$chansph \
     CHAIN_SCRIPT=$script CHANSPH_ARGS="--max-steps 60" SLURM_JOB_ID=100 PBS_JOBID=100.server \
-    bash "$script" > "$d.log" 2>&1)
+    PBS_NODEFILE=$runs/batch_nodefile MPIRUN_LOG=$d.mpirun bash "$script" > "$d.log" 2>&1)
   rc=$?
   jobs=$(($(cat "$d.jobs" 2> /dev/null | wc -l) + 1))
   done_line=$(grep 'chain: .* done after' "$d.log")
@@ -100,6 +103,11 @@ for kind in slurm pbs; do
     }
   done < "$d.jobs"
   head -n 1 "$d.jobs"
+  if [ $kind = pbs ]; then # the ranks and nodes of the allocation reach mpirun
+    grep -q -- "^mpirun -np 4 --hostfile $runs/batch_nodefile --bind-to none " "$d.mpirun" ||
+      { echo "FAIL: pbs: mpirun not started with the node file's 4 ranks:"; head -n 2 "$d.mpirun"; status=1; }
+    head -n 1 "$d.mpirun" | cut -c1-80
+  fi
   for f in stats.nc particles.nc; do
     diff <("$(dirname "$0")/nc_content.sh" "$ref/$f") <("$(dirname "$0")/nc_content.sh" "$d/$f") \
       > /dev/null || { echo "FAIL: $kind $f differs"; status=1; }

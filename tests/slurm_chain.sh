@@ -8,7 +8,12 @@
 # into jobs of 40 steps (3 jobs), and checks that
 #   - every job of the chain has the user's options (scontrol show job of each job),
 #   - every job ends COMPLETED with exit code 0 (the jobcomp/filetxt record of every job),
-#   - the chain ends with the stats.nc and particles.nc of an uninterrupted run.
+#   - the chain ends with the stats.nc and particles.nc of an uninterrupted run;
+# and a third chain, of a 3-D scene, on 4 ranks (mpirun) as 2 x 2 x-z blocks (CHANSPH_ARGS="--set run.ranks=2,2"),
+# stopped after 2 jobs (CHAIN_MAX_JOBS), then continued by a second submission as 4 x 1 slabs
+# (the decomposition changed between jobs): it too ends with the uninterrupted run's files.
+# The node is declared with 4 CPUs whatever it has (SlurmdParameters=config_overrides), so that
+# the 4 ranks fit a 2-core machine.
 # Nothing is installed: without slurm-wlm and munge (Debian packages), or when not run as root
 # (slurmd must start jobs as their user), the test is skipped with exit 77. jobs/setup.sh does not
 # install SLURM; docs/batch-jobs.md says how to run this test.
@@ -54,7 +59,7 @@ for _ in $(seq 50); do [ -S "$d/munge.sock" ] && break; sleep 0.1; done
 # slurm.conf: this node with its real CPUs and memory (slurmd -C), no cgroups, no accounting
 # database; jobcomp/filetxt records the final state of every job
 h=$(hostname -s)
-node=$(slurmd -C | grep '^NodeName=')
+node=$(slurmd -C | grep '^NodeName=' | sed -E 's/CPUs=[0-9]+/CPUs=4/; s/SocketsPerBoard=[0-9]+/SocketsPerBoard=1/; s/CoresPerSocket=[0-9]+/CoresPerSocket=4/; s/ThreadsPerCore=[0-9]+/ThreadsPerCore=1/')
 cat > "$d/slurm.conf" << EOF
 ClusterName=chansphtest
 SlurmctldHost=$h
@@ -81,6 +86,7 @@ JobCompLoc=$d/log/jobcomp.txt
 SelectType=select/cons_tres
 SelectTypeParameters=CR_Core
 ReturnToService=2
+SlurmdParameters=config_overrides
 MinJobAge=3600
 KillWait=5
 $node State=UNKNOWN
@@ -153,6 +159,47 @@ for launch in srun mpirun; do
     diff <("$here/tests/nc_content.sh" "$ref/$f") <("$here/tests/nc_content.sh" "$run/$f") \
       > /dev/null || { echo "FAIL: $launch: $f differs from the uninterrupted run"; status=1; }
   done
+done
+# x-z blocks: 4 ranks as 2 x 2 for two jobs, then the chain continued as 4 x 1 slabs, on a 3-D
+# scene (les395_smoke in an 18 x 12 pencil box, 120 steps) against its uninterrupted run
+ref=$d/ref_blocks
+"$chansph" run "$here/jobs/scenes/les395_smoke.ini" --out "$ref" --set domain.lx=2.4 \
+  --set domain.lz=1.6 --set time.max_steps=120 > /dev/null || fail "reference run (blocks)"
+cp "$ref/scene.used.ini" "$d/scene3.ini"
+run=$d/run_blocks
+name=chansph-slurm-test-blocks
+submit() { # CHANSPH_ARGS, CHAIN_MAX_JOBS
+  (cd "$here" && RUN_DIR=$run SCENE=$d/scene3.ini CHANSPH=$chansph CHAIN_LAUNCH=mpirun \
+    CHAIN_SCRIPT=$here/jobs/slurm/chansph.sbatch CHANSPH_ARGS="$1" CHAIN_MAX_JOBS=$2 \
+    sbatch --parsable --export=ALL --time=15 --cpus-per-task=1 --ntasks=4 \
+    --job-name="$name" --output="$d/log/blocks-%j.out" jobs/slurm/chansph.sbatch)
+}
+wait_chain() {
+  for _ in $(seq 480); do
+    [ -z "$(squeue -h -n "$name")" ] && return 0
+    sleep 0.5
+  done
+  fail "the blocks chain did not end within 4 minutes: $(squeue)"
+}
+first=$(submit "--max-steps 40 --set run.ranks=2,2" 2) || fail "sbatch (blocks)"
+echo "blocks: submitted job $first (2 x 2, two jobs)"
+wait_chain
+n22=$(grep -c "^decomposition: 4 MPI ranks as 2 x 2 blocks" "$run/log.txt")
+[ "$n22" -ge 2 ] || { echo "FAIL: blocks: $n22 job(s) on 2 x 2 in the log, expected 2"; status=1; }
+[ -f "$run/particles.nc" ] && grep -q "done after" "$d"/log/blocks-*.out &&
+  { echo "FAIL: blocks: the chain ended within the 2 jobs; nothing left to change"; status=1; }
+second=$(submit "--max-steps 40 --set run.ranks=4,1" 100) || fail "sbatch (blocks, second)"
+echo "blocks: submitted job $second (4 x 1 slabs, to the end)"
+wait_chain
+grep -q "^decomposition: 4 MPI ranks as 4 x 1 blocks" "$run/log.txt" ||
+  { echo "FAIL: blocks: no job ran as 4 x 1"; status=1; }
+grep -h "chain: .* done after" "$d"/log/blocks-*.out ||
+  { echo "FAIL: blocks: no 'done' line"; status=1; }
+grep -h "^decomposition: 4 MPI ranks" "$run/log.txt" | cut -c1-60 | uniq -c
+for f in stats.nc particles.nc; do # all but the scene text, whose run.ranks is 4,1 here
+  diff <("$here/tests/nc_content.sh" "$ref/$f" | grep -v ':scene = ') \
+    <("$here/tests/nc_content.sh" "$run/$f" | grep -v ':scene = ') > /dev/null ||
+    { echo "FAIL: blocks: $f differs from the uninterrupted run"; status=1; }
 done
 [ $status -eq 0 ] && echo PASS || fail "see above"
 exit $status
