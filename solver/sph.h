@@ -171,6 +171,16 @@ void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb
                 const struct walls *W, double fx, struct force_info *info);
 
 /**
+ * @brief sph.pressure_gradient = kgc: the correction matrix B_a of every owned particle (fluid
+ *        and vertex) from its list and the analytic part behind the walls, blended towards the
+ *        identity where ill-conditioned (kgc.c, term_pressure.h); after sph_walls (the volumes),
+ *        before the force pass. The caller then refreshes the ghosts' copies (PR_KGC).
+ * @param[in] M model
+ * @param[in,out] P particles (kgc_xx ... kgc_zz of slots 0 .. n-1)
+ * @param[in] nb neighbour list
+ */
+void sph_kgc_matrices(const struct model *M, struct particles *P, const struct nbr *nb);
+/**
  * @brief The conservative split of the budget parts (budget_pairs.c): after a sampled force pass
  *        (P->sx_live) and the refresh PR_BUDGET, replaces the pair parts of P->sx by the
  *        antisymmetric parts of the fluid pair forces, (f_ab - f_ba)/2, and adds the rest to
