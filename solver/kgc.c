@@ -8,8 +8,10 @@
  * behind the walls (kgc_moment_behind, as the Laplacian normalisation's part behind the walls,
  * docs/theory.md): in the continuum A_a = I at any wall distance, so B corrects only the
  * discreteness of the arrangement, not the truncation of the support by a wall (gamma_a and the
- * wall term do that). Vertex particles get their B the same way, for their fluid neighbours'
- * pair terms. The weight w of the blend: kgc_blend.
+ * wall term do that). Near the walls the deviation of the initial lattice's A from its value far
+ * from them is subtracted (kgc_lattice_correction), so that the whole lattice has one B. Vertex
+ * particles get their B the same way, for their fluid neighbours' pair terms. The weight w of the
+ * blend: kgc_blend.
  *
  * Determinism: each particle's sum runs over its own list in list order (nbr.h), a gather; the
  * ghosts' copies are refreshed at PR_KGC. B depends on the positions and volumes only and is
@@ -50,6 +52,7 @@ void sph_kgc_matrices(const struct model *M, struct particles *P, const struct n
     double A[6], B[6];
     kgc_moment(M, P, nb, a, A);
     kgc_moment_behind(&M->k, M->dim, M->k.inv_h, P->y[a], M->ly, A);
+    kgc_lattice_correction(M, P->kind[a] == KIND_VERTEX, P->y[a], A);
     kgc_blend(M->dim, A, B);
     P->kgc_xx[a] = B[0], P->kgc_xy[a] = B[1], P->kgc_xz[a] = B[2];
     P->kgc_yy[a] = B[3], P->kgc_yz[a] = B[4], P->kgc_zz[a] = B[5];

@@ -61,6 +61,23 @@ static inline void kgc_moment_behind(const struct kernel *K, int dim, double ih,
   if (dim == 3) A[5] -= mt;
 }
 
+/** The lattice correction of the kgc moment matrix of a particle at height y (vertex: on a
+    wall): the deviation of the initial lattice's moment matrix near each wall from its value far
+    from the walls (model.lat_kxx, lat_kyy, kgc_vxx, kgc_vyy) subtracted from A, so that every
+    particle of the initial lattice, vertices included, gets the same B and a uniform pressure
+    leaves the lattice in equilibrium as in the symmetric form (docs/theory.md). */
+static inline void kgc_lattice_correction(const struct model *M, int vertex, double y,
+                                          double A[6]) {
+  const double ih = M->k.inv_h, q[2] = {y * ih, (M->ly - y) * ih};
+  for (int w = 0; w < 2; w++) {
+    const int on = vertex && q[w] < 1e-9;
+    const double dxx = on ? M->kgc_vxx : sph_lattice_table(M, M->lat_kxx, q[w]);
+    const double dyy = on ? M->kgc_vyy : sph_lattice_table(M, M->lat_kyy, q[w]);
+    A[0] -= dxx, A[3] -= dyy;
+    if (M->dim == 3) A[5] -= dxx;
+  }
+}
+
 /**
  * @brief The kgc correction matrix B = w A^-1 + (1 - w) I (as {xx, xy, xz, yy, yz, zz}; 2-D: the
  *        z entries of the identity) of a moment matrix A, with w from the lower Gershgorin bound
