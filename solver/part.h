@@ -57,7 +57,8 @@ struct particles {
   double *sx;
   /** The configurational part of sx's pressure part (3 per particle, x y z): the pressure pair
       forces' 2 p_a / rho_a^2 sum_b m_b grad W_ab, which vanishes for a uniform arrangement (the
-      scheme's pressure noise; sph_budget_pairs); NULL without Eulerian statistics. */
+      scheme's pressure noise; sph.pressure_gradient = kgc: p_a sum_b V_b (B_a + B_b) grad W_ab /
+      rho_a with the gamma weights, sph_budget_pairs); NULL without Eulerian statistics. */
   double *sxn;
   int sx_live; /*!< 1: sx holds the values of the last force pass (a sampled step) */
   /** The viscous prefactor of each component (vis k_x, vis kappa, vis k_z of term_viscous.h) of
