@@ -43,7 +43,7 @@ struct fctx {
   const struct nbr *nb;
   const struct walls *W;
   struct pair_view arrays;    /*!< the particle arrays as a pair view (nl set per particle) */
-  int corrected;              /*!< the corrected pressure gradient */
+  int pgrad;                  /*!< the pressure-gradient form (enum pressure_gradient) */
   double fx;                  /*!< driving acceleration (time-step limit only) [m/s^2] */
   double *wall_ax;            /*!< x-acceleration from the walls, or NULL */
   double *sx;                 /*!< parts of the x-acceleration (enum part_sx), or NULL */
@@ -58,10 +58,10 @@ struct fsums {
 };
 
 /** Sums over the neighbours j0 .. j1-1 of particle a (view V) for the operator `visc`, the
-    corrected (`corr`) or symmetric pressure gradient, with (`fluid`) or without the volume
-    diffusion, the kernel `shape`; `gathered` as for the view. VK_LES_LAG keeps F_ab and r_ab in
-    geo (enum GEO_F ..., ld apart) for the velocity-gradient sums. Always inlined with constant
-    flags: one specialised loop per combination. */
+    pressure-gradient form `corr` (enum pressure_gradient; kgc: arrays only, `gathered` = 0), with
+   (`fluid`) or without the volume diffusion, the kernel `shape`; `gathered` as for the view.
+   VK_LES_LAG keeps F_ab and r_ab in geo (enum GEO_F ..., ld apart) for the velocity-gradient sums.
+   Always inlined with constant flags: one specialised loop per combination. */
 static inline __attribute__((always_inline)) void pair_sums(const struct fctx *C, size_t a,
                                                             const struct pair_view *V, double *geo,
                                                             int ld, int j0, int j1,
@@ -77,11 +77,14 @@ static inline __attribute__((always_inline)) void pair_sums(const struct fctx *C
   const double *restrict m = V->f[REC_M], *restrict pr2 = V->f[REC_PR2];
   const double *restrict c = V->f[REC_C], *restrict nur = V->f[REC_NUR];
   const int32_t *restrict nl = V->nl;
+  const int kgc = corr == PGRAD_KGC; /* the neighbours' B (through the list: arrays only) */
+  const double *restrict bxx = P->kgc_xx, *restrict bxy = P->kgc_xy, *restrict bxz = P->kgc_xz;
+  const double *restrict byy = P->kgc_yy, *restrict byz = P->kgc_yz, *restrict bzz = P->kgc_zz;
   const double eta2 = M->eta2, nu = M->nu, np2 = M->dim + 2.0, dgrav = diffusion_dgrav(M);
   const double dlr = M->diff_lr, dlc = M->diff_lc;
   const double xa = P->x[a], ya = P->y[a], za = P->z[a], ua = P->u[a], va = P->v[a];
   const double wa = P->w[a], ra = P->rho[a], pa = P->pr2[a], ca = P->c[a], ira = 1.0 / ra;
-  const double pm_a = corr ? pa * ra * ra : 0.0;
+  const double pm_a = corr == PGRAD_CORRECTED ? pa * ra * ra : 0.0;
   const int les = visc == VK_LES || visc == VK_LES_LAG, keep = visc == VK_LES_LAG;
   const double mu_a = les ? ra * (nu + P->nur[a]) : 0.0;
   double *restrict gf = geo + (size_t)GEO_F * ld, *restrict gx = geo + (size_t)GEO_X * ld;
@@ -89,14 +92,21 @@ static inline __attribute__((always_inline)) void pair_sums(const struct fctx *C
   double gpx = 0, gpy = 0, gpz = 0, vx = 0, vy = 0, vz = 0, mo2 = 0, moyy = 0, mo1 = 0;
   double diff = 0, m1x = 0, m2x = 0, m1z = 0, m2z = 0;
   double axx = 0, axy = 0, axz = 0, ayy = 0, ayz = 0, azz = 0, gcx = 0, gcy = 0, gcz = 0;
+  double gbx = 0, gby = 0, gbz = 0;
 #pragma omp simd reduction(+ : gpx, gpy, gpz, vx, vy, vz, mo2, moyy, mo1, diff, m1x, m2x, m1z, \
-                               m2z, axx, axy, axz, ayy, ayz, azz, gcx, gcy, gcz)
+                               m2z, axx, axy, axz, ayy, ayz, azz, gcx, gcy, gcz, gbx, gby, gbz)
   for (int j = j0; j < j1; j++) {
     const int32_t b = pair_index(gathered, nl, j);
     const struct pair g = pair_at_shape(&F, shape, xa - x[b], ya - y[b], za - z[b]);
     const double vb = vol[b], rb = rho[b];
     if (keep) gf[j] = g.f, gx[j] = g.dx, gy[j] = g.dy, gz[j] = g.dz;
-    if (corr) { /* term_pressure.h, corrected form */
+    if (kgc) { /* term_pressure.h, kgc form */
+      const struct v3 d = pressure_kgc_pair(&g, vb, pr2[b], rb);
+      gcx += d.x, gcy += d.y, gcz += d.z;
+      const double bb[6] = {bxx[b], bxy[b], bxz[b], byy[b], byz[b], bzz[b]};
+      const struct v3 t = pressure_kgc_matrix_pair(&g, vb, bb);
+      gbx += t.x, gby += t.y, gbz += t.z;
+    } else if (corr == PGRAD_CORRECTED) { /* term_pressure.h, corrected form */
       const struct sym3 t = gradient_moment(&g, vb);
       axx += t.xx, axy += t.xy, axz += t.xz, ayy += t.yy, ayz += t.yz, azz += t.zz;
       const struct v3 d = pressure_corrected_pair(&g, vb, pr2[b], rb, pm_a);
@@ -123,7 +133,8 @@ static inline __attribute__((always_inline)) void pair_sums(const struct fctx *C
     if (fluid)
       diff += diffusion_pair(&g, vb, ca, c[b], ra - rb, dgrav, dlr, dlc); /* term_diffusion.h */
   }
-  out->p = (struct pressure_sums){{gpx, gpy, gpz}, {axx, axy, axz, ayy, ayz, azz}, {gcx, gcy, gcz}};
+  out->p = (struct pressure_sums){
+      {gpx, gpy, gpz}, {axx, axy, axz, ayy, ayz, azz}, {gcx, gcy, gcz}, {gbx, gby, gbz}};
   out->v = (struct viscous_sums){{vx, vy, vz}, {mo2, moyy, mo1}, m1x, m2x, m1z, m2z};
   out->diff = diff;
 }
@@ -141,7 +152,7 @@ static void force_finish(const struct fctx *C, size_t a, const struct fsums *s,
   double awall = viscous_finish(&vn, &s->v, &sv->v, &acc);
   const struct viscous_wall_moments wm = {s->v.mom.z + sv->v.mom.z, s->v.m1x + sv->v.m1x,
                                           s->v.m1z + sv->v.m1z};
-  const double gv = pressure_wall(M, P, C->W, a, wm.mom1, &acc.y);
+  const double gv = pressure_wall(M, P, C->W, a, wm.mom1, &acc);
   viscous_wall(M, P, C->W, a, &vn, &wm, &acc, &awall);
   acc.y += M->gy;
   P->ax[a] = acc.x, P->ay[a] = acc.y, P->az[a] = acc.z;
@@ -210,15 +221,18 @@ static inline __attribute__((always_inline)) void force_range(const struct fctx 
                      C->nur_next + a0, C->kr_next + a0);
 }
 
-/** force_range for one operator, kernel shape and data path, with the pressure form of the run. */
+/** force_range for one operator, kernel shape and data path, with the pressure form of the run
+    (kgc reads the neighbours' B through the list: the arrays path only, force_loop_of). */
 static inline __attribute__((always_inline)) void force_chunk(const struct fctx *C, size_t a0,
                                                               size_t a1, double mx[2],
                                                               const int visc, const int shape,
                                                               const int gathered) {
-  if (C->corrected)
-    force_range(C, a0, a1, mx, visc, 1, shape, gathered);
+  if (C->pgrad == PGRAD_CORRECTED)
+    force_range(C, a0, a1, mx, visc, PGRAD_CORRECTED, shape, gathered);
+  else if (!gathered && C->pgrad == PGRAD_KGC)
+    force_range(C, a0, a1, mx, visc, PGRAD_KGC, shape, 0);
   else
-    force_range(C, a0, a1, mx, visc, 0, shape, gathered);
+    force_range(C, a0, a1, mx, visc, PGRAD_STANDARD, shape, gathered);
 }
 
 /** One force loop over the particles a0 .. a1-1; each is built for several instruction sets
@@ -280,18 +294,10 @@ enum { FORCE_CHUNK = TURB_CHUNK };
 void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb,
                 const struct walls *W, double fx, struct force_info *info) {
   timer_push("forces");
-  const force_loop loop = force_loop_of(M, records_fast());
-  const struct fctx C = {M,
-                         P,
-                         nb,
-                         W,
-                         pair_view_arrays(P, NULL),
-                         M->pgrad == PGRAD_CORRECTED,
-                         fx,
-                         info->wall_ax,
-                         info->sx,
-                         P->nur_next,
-                         P->kr_next};
+  const force_loop loop = force_loop_of(M, records_fast() && M->pgrad != PGRAD_KGC);
+  const struct fctx C = {
+      M,        P,           nb,        W, pair_view_arrays(P, NULL), M->pgrad, fx, info->wall_ax,
+      info->sx, P->nur_next, P->kr_next};
   const size_t n = P->n, nchunk = (n + FORCE_CHUNK - 1) / FORCE_CHUNK;
   double amax2 = 0.0, gvmax = 0.0;
 #pragma omp parallel for schedule(dynamic, 4) reduction(max : amax2, gvmax)

@@ -117,6 +117,12 @@ const struct part_field part_fields[] = {
     {F(vfx), "budget_vf_x", NULL, PT_F64, 1, 0, PN_EULERIAN, 0, 0, NULL, NULL, 0, PR_BUDGET},
     {F(vfy), "budget_vf_y", NULL, PT_F64, 1, 0, PN_EULERIAN, 0, 0, NULL, NULL, 0, PR_BUDGET},
     {F(vfz), "budget_vf_z", NULL, PT_F64, 1, 0, PN_EULERIAN, 0, 0, NULL, NULL, 0, PR_BUDGET},
+    {F(kgc_xx), "kgc_b_xx", NULL, PT_F64, 1, 0, PN_KGC, 0, 0, NULL, NULL, 0, PR_KGC},
+    {F(kgc_xy), "kgc_b_xy", NULL, PT_F64, 1, 0, PN_KGC, 0, 0, NULL, NULL, 0, PR_KGC},
+    {F(kgc_xz), "kgc_b_xz", NULL, PT_F64, 1, 0, PN_KGC, 0, 0, NULL, NULL, 0, PR_KGC},
+    {F(kgc_yy), "kgc_b_yy", NULL, PT_F64, 1, 0, PN_KGC, 0, 0, NULL, NULL, 0, PR_KGC},
+    {F(kgc_yz), "kgc_b_yz", NULL, PT_F64, 1, 0, PN_KGC, 0, 0, NULL, NULL, 0, PR_KGC},
+    {F(kgc_zz), "kgc_b_zz", NULL, PT_F64, 1, 0, PN_KGC, 0, 0, NULL, NULL, 0, PR_KGC},
     {F(tmp), "sort_scratch", NULL, PT_F64, 1, 0, PN_CORE, 0, 0, NULL, NULL, 0, 0},
     {F(id), "id", NULL, PT_I64, 1, PF_PERMUTE | PF_MIGRATE | PF_GHOST, PN_CORE, 0, 0, NULL, NULL, 0,
      0},
@@ -173,6 +179,8 @@ int part_needed(enum part_need need, const struct scene *s) {
       return s->q_criterion;
     case PN_DAMPER:
       return s->damper > 0.0;
+    case PN_KGC:
+      return s->pgrad == PGRAD_KGC;
   }
   return 0;
 }

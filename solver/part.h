@@ -57,7 +57,8 @@ struct particles {
   double *sx;
   /** The configurational part of sx's pressure part (3 per particle, x y z): the pressure pair
       forces' 2 p_a / rho_a^2 sum_b m_b grad W_ab, which vanishes for a uniform arrangement (the
-      scheme's pressure noise; sph_budget_pairs); NULL without Eulerian statistics. */
+      scheme's pressure noise; sph.pressure_gradient = kgc: p_a sum_b V_b (B_a + B_b) grad W_ab /
+      rho_a with the gamma weights, sph_budget_pairs); NULL without Eulerian statistics. */
   double *sxn;
   int sx_live; /*!< 1: sx holds the values of the last force pass (a sampled step) */
   /** The viscous prefactor of each component (vis k_x, vis kappa, vis k_z of term_viscous.h) of
@@ -84,6 +85,11 @@ struct particles {
   /** output.q_criterion: Q = (|Omega|^2 - |S|^2)/2 of the corrected velocity gradient, set just
       before particles.nc is written (turb_q_criterion) [1/s^2]; NULL otherwise */
   double *qcrit;
+  /** sph.pressure_gradient = kgc: the correction matrix B of each fluid and vertex particle
+      (sph_kgc_matrices, term_pressure.h), one array per entry {xx, xy, xz, yy, yz, zz}; set from
+      the positions and volumes before every force pass (ghosts: PR_KGC), so neither permuted
+      nor checkpointed; NULL otherwise [-] */
+  double *kgc_xx, *kgc_xy, *kgc_xz, *kgc_yy, *kgc_yz, *kgc_zz;
   /* sort scratch */
   double *tmp;
   int64_t *tmp_i;
@@ -143,7 +149,8 @@ enum part_need {
   PN_EULERIAN,   /*!< Eulerian statistics (the momentum budget's parts) */
   PN_SHIFTING,   /*!< particle shifting */
   PN_QCRIT,      /*!< output.q_criterion */
-  PN_DAMPER      /*!< sph.acoustic_damper > 0 */
+  PN_DAMPER,     /*!< sph.acoustic_damper > 0 */
+  PN_KGC         /*!< sph.pressure_gradient = kgc */
 };
 
 /** The refreshes of the ghosts' copies within a step (dd_refresh): after the pass that sets a
@@ -157,7 +164,9 @@ enum part_refresh {
   PR_KR = 16,      /*!< after sph_kr_pressure: p/rho^2 and the wall pressure with 2/3 rho k_r */
   PR_BUDGET = 32,  /*!< after a sampled force pass: gamma and the viscous prefactors that the
                         conservative split of the budget reads (sph_budget_pairs) */
-  PR_SHIFT = 64    /*!< after shift_compute: the shifts that shift_velocity_conservative reads */
+  PR_SHIFT = 64,   /*!< after shift_compute: the shifts that shift_velocity_conservative reads */
+  PR_KGC = 128     /*!< after sph_kgc_matrices: the correction matrices the kgc pressure gradient
+                        reads at the neighbours */
 };
 
 /** One per-particle array of struct particles. Adding a field: the member in struct particles

@@ -54,7 +54,7 @@ static const char *const names_sph_laplacian_norm[] = {"wall_normal", "trace", "
 static const char *const names_sph_wall_shear_weight[] = {"discrete", "analytic", NULL};
 static const char *const names_sph_wall_pressure_weight[] = {"lattice", "consistent", "analytic",
                                                              NULL};
-static const char *const names_sph_pressure_gradient[] = {"standard", "corrected", NULL};
+static const char *const names_sph_pressure_gradient[] = {"standard", "corrected", "kgc", NULL};
 static const char *const names_sph_shifting[] = {"none", "fickian", NULL};
 static const char *const names_sph_shift_velocity[] = {"keep", "taylor", "conservative", NULL};
 static const char *const names_sph_wall_collision[] = {"stop", "reflect", NULL};
@@ -147,7 +147,11 @@ static const struct key keys_head[] = {
       "Pressure gradient: the symmetric Grad^{gamma,1} with its wall term (thesis Eq. 3.17), or "
       "the first-order corrected difference form Eq. 2.90 (k = 0) with the matrix L of Eq. "
       "2.88 built from fluid and vertex neighbours, exact for linear pressure fields and without "
-      "a wall term (Sec. 6.2.2-6.2.3; docs/theory.md)."},
+      "a wall term (Sec. 6.2.2-6.2.3), or the conservative kernel-gradient-corrected form kgc, "
+      "-(1/(gamma_a rho_a)) sum_b V_b (p_a B_b + p_b B_a) grad w_ab with its wall term, B the "
+      "inverse of the moment matrix (walls included) blended towards the identity where it is "
+      "ill-conditioned: antisymmetric in a and b and exact for the first-order part of a linear "
+      "pressure field (docs/theory.md)."},
      OFF(pgrad)},
     {{"sph", "shifting", T_CHOICE, "none", 0, 0, 0, names_sph_shifting, "-",
       "Particle shifting after each position update: none, or the Fickian shift "

@@ -31,7 +31,7 @@ enum init_profile {
 enum init_density { INIT_DENSITY_KEEP = 0, INIT_DENSITY_RHO0 = 1 };
 enum les_model { LES_NONE = 0, LES_SMAGORINSKY = 1 };
 enum les_strain { STRAIN_GRADIENT = 0, STRAIN_VIOLEAU_ISSA = 1 };
-enum pressure_gradient { PGRAD_STANDARD = 0, PGRAD_CORRECTED = 1 };
+enum pressure_gradient { PGRAD_STANDARD = 0, PGRAD_CORRECTED = 1, PGRAD_KGC = 2 };
 /** Pair form of the volume diffusion (term_diffusion.h). */
 enum diffusion_form { DIFFUSION_FERRAND = 0, DIFFUSION_DELTA_SPH = 1 };
 enum shifting { SHIFT_NONE = 0, SHIFT_FICKIAN = 1 };

@@ -80,6 +80,10 @@ static void update_state(struct sim *S, int restored, double dt) {
   sph_walls(&S->M, P, &S->nb, &S->W);
   dd_refresh(&S->dd, P, &S->W, PR_WALLS); /* vertex ghosts and wall values */
   model_update(S);
+  if (S->M.pgrad == PGRAD_KGC) { /* the correction matrices the kgc pressure gradient reads */
+    sph_kgc_matrices(&S->M, P, &S->nb);
+    dd_refresh(&S->dd, P, &S->W, PR_KGC);
+  }
   if (records_fast()) records_pack(P, P->n + P->n_ghost); /* what the force pass gathers */
 }
 

@@ -9,6 +9,7 @@
  * (the kernel is symmetric about the foot) and second order otherwise.
  */
 #include "sph.h"
+#include "term_pressure.h"
 
 #include <math.h>
 
@@ -98,6 +99,29 @@ double sph_violeau_moment(const struct model *M, double q) {
   return (1.0 - t) * M->vio_m2[k] + t * M->vio_m2[k + 1];
 }
 
+/* The kgc moment matrix of layer j of the initial lattice (j = 0: the vertex row, half volume),
+   its fluid and vertex neighbours plus the analytic part behind the wall (kgc_moment_behind),
+   less the lattice's value far from the walls: tangential (*dxx) and wall-normal (*dyy). */
+static void kgc_lattice_layer(const struct model *M, int j, int reach, double *dxx, double *dyy) {
+  const struct kernel *K = &M->k;
+  const double dr = M->dr, vol = pow(dr, M->dim);
+  const int l0 = M->dim == 3 ? -reach : 0, l1 = M->dim == 3 ? reach : 0;
+  double A[6] = {0, 0, 0, 0, 0, 0}, axx = 0.0, ayy = 0.0; /* near the wall, far from it */
+  for (int k = j - reach; k <= j + reach; k++)
+    for (int i = -reach; i <= reach; i++)
+      for (int l = l0; l <= l1; l++) {
+        if (k == j && i == 0 && l == 0) continue;
+        const double dx = i * dr, dy = (j - k) * dr, r = sqrt((i * i + l * l) * dr * dr + dy * dy);
+        const double f = kernel_f(K, r);
+        axx -= vol * f * dx * dx, ayy -= vol * f * dy * dy;
+        if (k < 0) continue;
+        const double v = k == 0 ? 0.5 * vol : vol;
+        A[0] -= v * f * dx * dx, A[3] -= v * f * dy * dy;
+      }
+  kgc_moment_behind(K, M->dim, K->inv_h, j * dr, 1e300, A);
+  *dxx = A[0] - axx, *dyy = A[3] - ayy;
+}
+
 void sph_lattice_excess_table(struct model *M) {
   const struct kernel *K = &M->k;
   const double dr = M->dr, ih = K->inv_h, vol = pow(dr, M->dim);
@@ -117,12 +141,14 @@ void sph_lattice_excess_table(struct model *M) {
         }
     }
     const double q = j * dr * ih;
+    kgc_lattice_layer(M, j, reach, &M->lat_kxx[n], &M->lat_kyy[n]);
     M->lat_q[n] = q;
     M->lat_e[n] = fmax(0.0, mom1 - wall_dgamma_of(&M->k, q) * ih);
     M->lat_s[n] = mom1s - wall_dgamma_of(&M->k, q) * ih;
     n++;
   }
-  M->lat_q[n] = 2.0, M->lat_e[n] = M->lat_s[n] = 0.0;
+  M->lat_q[n] = 2.0, M->lat_e[n] = M->lat_s[n] = M->lat_kxx[n] = M->lat_kyy[n] = 0.0;
+  kgc_lattice_layer(M, 0, reach, &M->kgc_vxx, &M->kgc_vyy);
   M->n_lat = n + 1;
 }
 

@@ -54,12 +54,18 @@ struct model {
   /** the same (signed, not clipped) for the particle shift's moment, whose pair weight has the
       anti-clustering factor 1 + R (w_ab / w(dr))^n (shift.h) [1/m] */
   double lat_s[LATTICE_KNOTS];
-  int shifting;       /*!< enum shifting */
-  int shift_velocity; /*!< enum shift_velocity: what a shift does to the velocities */
-  int wall_reflect;   /*!< 1: a particle that reaches a wall is reflected (else the run stops) */
-  double shift_ch2;   /*!< C h^2 of delta r = -C h^2 grad C_a [m^2] */
-  double shift_iwdr;  /*!< 1 / w(dr), the anti-clustering term's reference [m^dim] */
-  double shift_max;   /*!< largest shift per step [m] */
+  /** kgc (term_pressure.h): the moment matrix of the initial lattice, fluid and vertex
+      neighbours plus the analytic part behind the wall, minus its value far from the walls, in
+      the tangential (xx = zz) and wall-normal (yy) directions at the layers lat_q; subtracted
+      from A_a so that every particle of the lattice gets the same B (kgc_lattice_correction) */
+  double lat_kxx[LATTICE_KNOTS], lat_kyy[LATTICE_KNOTS];
+  double kgc_vxx, kgc_vyy; /*!< the same for the vertex row (q = 0) */
+  int shifting;            /*!< enum shifting */
+  int shift_velocity;      /*!< enum shift_velocity: what a shift does to the velocities */
+  int wall_reflect;  /*!< 1: a particle that reaches a wall is reflected (else the run stops) */
+  double shift_ch2;  /*!< C h^2 of delta r = -C h^2 grad C_a [m^2] */
+  double shift_iwdr; /*!< 1 / w(dr), the anti-clustering term's reference [m^dim] */
+  double shift_max;  /*!< largest shift per step [m] */
 };
 
 /** 1 if height y lies on or behind a wall (y <= 0 or y >= ly): a fluid particle there has
@@ -170,6 +176,16 @@ double sph_vertex_sums(const struct model *M, const struct particles *P, const s
 void sph_forces(const struct model *M, struct particles *P, const struct nbr *nb,
                 const struct walls *W, double fx, struct force_info *info);
 
+/**
+ * @brief sph.pressure_gradient = kgc: the correction matrix B_a of every owned particle (fluid
+ *        and vertex) from its list and the analytic part behind the walls, blended towards the
+ *        identity where ill-conditioned (kgc.c, term_pressure.h); after sph_walls (the volumes),
+ *        before the force pass. The caller then refreshes the ghosts' copies (PR_KGC).
+ * @param[in] M model
+ * @param[in,out] P particles (kgc_xx ... kgc_zz of slots 0 .. n-1)
+ * @param[in] nb neighbour list
+ */
+void sph_kgc_matrices(const struct model *M, struct particles *P, const struct nbr *nb);
 /**
  * @brief The conservative split of the budget parts (budget_pairs.c): after a sampled force pass
  *        (P->sx_live) and the refresh PR_BUDGET, replaces the pair parts of P->sx by the

@@ -3,14 +3,24 @@
  * @brief The pressure gradient of the momentum equation: its pair terms, the per-particle
  *        finish, the wall term, the budget part and the wall's time-step rate.
  *
- * Two forms (scene key sph.pressure_gradient):
+ * Three forms (scene key sph.pressure_gradient):
  *  - symmetric: -(1/gamma_a) sum_b m_b (p_a/rho_a^2 + p_b/rho_b^2) grad w_ab plus the wall term
  *    (Grad^{gamma,1} of thesis Eq. 3.17, k = 1), with the weight of the wall term of
  *    sph.wall_pressure_weight (docs/theory.md);
  *  - corrected: -(1/rho_a) L_a sum_b V_b (p_b - p_a) grad w_ab (Eq. 2.88-2.90, k = 0) over fluid
  *    and vertex neighbours, exact for a linear pressure, without a wall term. L_a is factorised
  *    once per particle (sph_sym_factor) and applied to the whole sum and, on sampled steps, to
- *    its fluid part for the budget.
+ *    its fluid part for the budget;
+ *  - kgc (kernel-gradient corrected, conservative): -(1/(gamma_a rho_a)) sum_b V_b (p_a B_b +
+ *    p_b B_a) F_ab r_ab over fluid and vertex neighbours plus the wall term
+ *    (1/(gamma_a rho_a)) (p_a + p_s) B_a W_as n_s (the wall's B taken as B_a), with W_as the
+ *    weight of the symmetric form. B_a = w L_a + (1 - w) I is the inverse of the moment matrix
+ *    of the whole support (fluid, vertices and the analytic part behind the walls) blended
+ *    towards the identity where it is ill-conditioned (kgc_blend), set per particle before the
+ *    force pass (sph_kgc_matrices, kgc.c). With B = I it is the volume form of the symmetric
+ *    one, and it is antisymmetric in a and b; for a linear pressure its first-order part
+ *    B_a sum_b V_b (p_b - p_a) F_ab r_ab = B_a A_a grad p is exact (w = 1), the rest
+ *    p_a sum_b V_b (B_a + B_b) F_ab r_ab is the configurational error (docs/theory.md).
  * Hooks: pressure_pair / pressure_corrected_pair (the pair contributions, summed by the force
  * loop into struct pressure_sums), pressure_finish (the acceleration), pressure_wall (the wall
  * term and |grad gamma_as . v_a| of the wall time-step limit, Eq. 2.163), pressure_budget
@@ -26,8 +36,108 @@
 struct pressure_sums {
   struct v3 gp;  /*!< symmetric form: sum of pressure_pair */
   struct sym3 A; /*!< corrected form: the moment matrix (gradient_moment) */
-  struct v3 gc;  /*!< corrected form: the pressure difference sums (gradient_difference) */
+  struct v3 gc;  /*!< corrected form: the pressure difference sums (gradient_difference); kgc:
+                      sum_b V_b p_b F_ab r_ab (pressure_kgc_pair) */
+  struct v3 gb;  /*!< kgc: sum_b V_b B_b F_ab r_ab (pressure_kgc_matrix_pair) */
 };
+
+/** The conditioning bounds of the kgc blend (kgc_blend): the lower Gershgorin bound of the
+    smallest eigenvalue of A_a (1 for a full support in the continuum, 0.974 on the lattice at
+    h/dr = 1.3) below which B_a is the identity (KGC_LAM0) and above which it is L_a (KGC_LAM1),
+    linear between. */
+#define KGC_LAM0 0.3
+#define KGC_LAM1 0.6
+
+/** The moment matrix behind the walls: the analytic part -int F r (x) r dV of the half-spaces
+    behind both walls at y and ly - y from a particle at height y (diagonal: xx = zz, yy;
+    wall_moment2, wall_moment_yy), added to a discrete A (as {xx, xy, xz, yy, yz, zz}). */
+static inline void kgc_moment_behind(const struct kernel *K, int dim, double ih, double y,
+                                     double ly, double A[6]) {
+  const double qb = y * ih, qt = (ly - y) * ih;
+  const double myy = wall_moment_yy_of(K, qb) + wall_moment_yy_of(K, qt);
+  const double mtr = wall_moment2_of(K, qb) + wall_moment2_of(K, qt);
+  const double mt = (mtr - myy) / (dim - 1); /* each tangential direction */
+  A[0] -= mt, A[3] -= myy;
+  if (dim == 3) A[5] -= mt;
+}
+
+/** The lattice correction of the kgc moment matrix of a particle at height y (vertex: on a
+    wall): the deviation of the initial lattice's moment matrix near each wall from its value far
+    from the walls (model.lat_kxx, lat_kyy, kgc_vxx, kgc_vyy) subtracted from A, so that every
+    particle of the initial lattice, vertices included, gets the same B and a uniform pressure
+    leaves the lattice in equilibrium as in the symmetric form (docs/theory.md). */
+static inline void kgc_lattice_correction(const struct model *M, int vertex, double y,
+                                          double A[6]) {
+  const double ih = M->k.inv_h, q[2] = {y * ih, (M->ly - y) * ih};
+  for (int w = 0; w < 2; w++) {
+    const int on = vertex && q[w] < 1e-9;
+    const double dxx = on ? M->kgc_vxx : sph_lattice_table(M, M->lat_kxx, q[w]);
+    const double dyy = on ? M->kgc_vyy : sph_lattice_table(M, M->lat_kyy, q[w]);
+    A[0] -= dxx, A[3] -= dyy;
+    if (M->dim == 3) A[5] -= dxx;
+  }
+}
+
+/**
+ * @brief The kgc correction matrix B = w A^-1 + (1 - w) I (as {xx, xy, xz, yy, yz, zz}; 2-D: the
+ *        z entries of the identity) of a moment matrix A, with w from the lower Gershgorin bound
+ *        lam = min_i (A_ii - sum_{j != i} |A_ij|) of its smallest eigenvalue: w = 0 for
+ *        lam <= KGC_LAM0, 1 for lam >= KGC_LAM1, linear between. A cheap bound that needs no
+ *        eigenvalues, and conservative: it blends only where A may be nearly singular.
+ */
+static inline void kgc_blend(int dim, const double A[6], double B[6]) {
+  const double ax = fabs(A[1]), az = dim == 3 ? fabs(A[2]) : 0.0, ayz = dim == 3 ? fabs(A[4]) : 0.0;
+  double lam = fmin(A[0] - ax - az, A[3] - ax - ayz);
+  if (dim == 3) lam = fmin(lam, A[5] - az - ayz);
+  const double w = fmin(1.0, fmax(0.0, (lam - KGC_LAM0) / (KGC_LAM1 - KGC_LAM0)));
+  const double I[6] = {1.0, 0.0, 0.0, 1.0, 0.0, 1.0};
+  if (w <= 0.0) {
+    for (int k = 0; k < 6; k++) B[k] = I[k];
+    return;
+  }
+  struct sym_solve f;
+  sph_sym_factor(dim, A, &f);
+  double c0[3], c1[3], c2[3];
+  sph_sym_apply(&f, (const double[3]){1.0, 0.0, 0.0}, c0);
+  sph_sym_apply(&f, (const double[3]){0.0, 1.0, 0.0}, c1);
+  sph_sym_apply(&f, (const double[3]){0.0, 0.0, 1.0}, c2);
+  const double L[6] = {
+      c0[0], c0[1], dim == 3 ? c0[2] : 0.0, c1[1], dim == 3 ? c1[2] : 0.0, dim == 3 ? c2[2] : 1.0};
+  for (int k = 0; k < 6; k++) B[k] = w * L[k] + (1.0 - w) * I[k];
+}
+
+/** kgc, pressure part: V_b p_b F_ab r_ab (p_b = pr2_b rho_b^2); B_a applies in the finish. */
+static inline struct v3 pressure_kgc_pair(const struct pair *g, double vb, double pr2b, double rb) {
+  const double s = vb * pr2b * rb * rb * g->f;
+  return (struct v3){s * g->dx, s * g->dy, s * g->dz};
+}
+
+/** kgc, matrix part: V_b B_b F_ab r_ab (B_b of neighbour b: b[6] as {xx, xy, xz, yy, yz, zz});
+    p_a applies in the finish. */
+static inline struct v3 pressure_kgc_matrix_pair(const struct pair *g, double vb,
+                                                 const double b[6]) {
+  const double s = vb * g->f;
+  return (struct v3){s * (b[0] * g->dx + b[1] * g->dy + b[2] * g->dz),
+                     s * (b[1] * g->dx + b[3] * g->dy + b[4] * g->dz),
+                     s * (b[2] * g->dx + b[4] * g->dy + b[5] * g->dz)};
+}
+
+/** B_a of particle a of P (kgc). */
+static inline void pressure_kgc_of(const struct particles *P, size_t a, double b[6]) {
+  b[0] = P->kgc_xx[a], b[1] = P->kgc_xy[a], b[2] = P->kgc_xz[a];
+  b[3] = P->kgc_yy[a], b[4] = P->kgc_yz[a], b[5] = P->kgc_zz[a];
+}
+
+/** kgc: -(1/(gamma_a rho_a)) (p_a gb + B_a gc) of the sums gc, gb. */
+static inline struct v3 pressure_kgc_acc(const struct particles *P, size_t a, struct v3 gc,
+                                         struct v3 gb) {
+  double b[6];
+  pressure_kgc_of(P, a, b);
+  const double ra = P->rho[a], pa = P->pr2[a] * ra * ra, s = -1.0 / (P->gam[a] * ra);
+  return (struct v3){s * (pa * gb.x + b[0] * gc.x + b[1] * gc.y + b[2] * gc.z),
+                     s * (pa * gb.y + b[1] * gc.x + b[3] * gc.y + b[4] * gc.z),
+                     s * (pa * gb.z + b[2] * gc.x + b[4] * gc.y + b[5] * gc.z)};
+}
 
 /** Pressure gradient, symmetric form (thesis Eq. 3.17, particle part):
     m_b (p_a/rho_a^2 + p_b/rho_b^2) F_ab r_ab, to be multiplied by -1/gamma_a. */
@@ -49,6 +159,10 @@ static inline struct v3 pressure_corrected_pair(const struct pair *g, double vb,
 static inline struct v3 pressure_finish(const struct model *M, const struct particles *P, size_t a,
                                         const struct pressure_sums *s,
                                         const struct pressure_sums *sv, struct sym_solve *L) {
+  if (M->pgrad == PGRAD_KGC)
+    return pressure_kgc_acc(
+        P, a, (struct v3){s->gc.x + sv->gc.x, s->gc.y + sv->gc.y, s->gc.z + sv->gc.z},
+        (struct v3){s->gb.x + sv->gb.x, s->gb.y + sv->gb.y, s->gb.z + sv->gb.z});
   if (M->pgrad == PGRAD_CORRECTED) { /* -(1/rho_a) L_a g, L_a = A^-1 (Eq. 2.88, 2.90, k = 0) */
     const double A[6] = {s->A.xx + sv->A.xx, s->A.xy + sv->A.xy, s->A.xz + sv->A.xz,
                          s->A.yy + sv->A.yy, s->A.yz + sv->A.yz, s->A.zz + sv->A.zz};
@@ -65,11 +179,12 @@ static inline struct v3 pressure_finish(const struct model *M, const struct part
 }
 
 /** The pressure wall term of the symmetric form (Eq. 3.17, k = 1) of fluid particle a added to
-    *aya, with the wall values at its foot; mom1: the discrete first moment sum_b V_b y_ab F_ab
-    (viscous_sums). Returns max over the walls of |grad gamma_as . v_a| for the wall time-step
-    limit (Eq. 2.163), in either form. */
+    *acc, with the wall values at its foot; mom1: the discrete first moment sum_b V_b y_ab F_ab
+    (viscous_sums). kgc: (1/(gamma_a rho_a)) (p_a + p_s) W_as B_a n_s with the same weight W_as
+    (the wall's B taken as B_a: the wall term of the B = I form, turned by B_a). Returns max over
+    the walls of |grad gamma_as . v_a| for the wall time-step limit (Eq. 2.163), in every form. */
 static inline double pressure_wall(const struct model *M, const struct particles *P,
-                                   const struct walls *W, size_t a, double mom1, double *aya) {
+                                   const struct walls *W, size_t a, double mom1, struct v3 *acc) {
   const double ya = P->y[a], va = P->v[a], pa = P->pr2[a];
   const double ig = 1.0 / P->gam[a];
   const int corrected = M->pgrad == PGRAD_CORRECTED;
@@ -88,7 +203,11 @@ static inline double pressure_wall(const struct model *M, const struct particles
                             ? dg + sph_lattice_table(M, M->lat_e, q)
                         : M->wall_pressure == WALL_PRESSURE_CONSISTENT ? fmax(dg, ny * mom1)
                                                                        : dg;
-      *aya += ig * rs * (pa + ps / (rs * rs)) * pw * ny;
+      if (M->pgrad == PGRAD_KGC) { /* (1/(gamma_a rho_a)) (p_a + p_s) pw B_a n */
+        const double ra = P->rho[a], t = ig / ra * (pa * ra * ra + ps) * pw * ny;
+        acc->x += t * P->kgc_xy[a], acc->y += t * P->kgc_yy[a], acc->z += t * P->kgc_yz[a];
+      } else
+        acc->y += ig * rs * (pa + ps / (rs * rs)) * pw * ny;
     }
     const double g = fabs(dg * va);
     if (g > gv) gv = g;
@@ -101,6 +220,7 @@ static inline double pressure_wall(const struct model *M, const struct particles
     pressure_finish, which the fluid and vertex parts share). */
 static inline struct v3 pressure_budget(const struct model *M, const struct particles *P, size_t a,
                                         const struct pressure_sums *s, const struct sym_solve *L) {
+  if (M->pgrad == PGRAD_KGC) return pressure_kgc_acc(P, a, s->gc, s->gb);
   if (M->pgrad == PGRAD_CORRECTED) { /* -(1/rho_a) L_a g, g of the fluid neighbours only */
     const double gc[3] = {s->gc.x, s->gc.y, s->gc.z};
     double gr[3];

@@ -109,6 +109,12 @@ add_executable(test_damper test_damper.c)
 target_link_libraries(test_damper PRIVATE chansph_core)
 add_test(NAME unit_damper COMMAND test_damper)
 set_tests_properties(unit_damper PROPERTIES LABELS unit)
+# the kgc pressure gradient (sph.pressure_gradient = kgc, term_pressure.h): a linear pressure on a
+# disordered lattice, momentum conservation, a fluid at rest between the walls, against symmetric
+add_executable(test_kgc test_kgc.c)
+target_link_libraries(test_kgc PRIVATE chansph_core)
+add_test(NAME unit_kgc COMMAND test_kgc)
+set_tests_properties(unit_kgc PROPERTIES LABELS unit)
 
 #   test_uncertainty: standard errors of the Lagrangian, quadrant and Eulerian engines against
 #                the exact ones of synthetic AR(1) and Gaussian signals, within 20% (issue 43)
