@@ -235,9 +235,9 @@ static void note_absent(struct output *o, const struct state_list *L, const char
       m += (size_t)snprintf(list + m, sizeof list - m, "%s%s", m ? ", " : "", L->f[i].name);
   if (!list[0]) return;
   output_log(o,
-             "resume: note: %s lacks %s (an earlier checkpoint format): what %s accumulates "
+             "resume: note: %s lacks %s (an earlier checkpoint format): what %s "
              "starts at this resume, t = %.9g%s; stats.nc says so (attribute resumed_without)\n",
-             path, list, strchr(list, ',') ? "they" : "it", t,
+             path, list, strchr(list, ',') ? "they accumulate" : "it accumulates", t,
              strstr(list, "reynolds_budget") ? " (the Reynolds-stress budgets cover only the "
                                                "windows after it)"
                                              : "");

@@ -71,7 +71,7 @@ void lagr_init(struct lagr *g, const struct lagr_config *cfg) {
 
 void lagr_free(struct lagr *g) {
   free(g->sums), free(g->slot_sums), free(g->slots), free(g->tl), free(g->pdf);
-  free(g->rb), free(g->slot_pdf), free(g->pdf_rb);
+  free(g->rb), free(g->slot_pdf), free(g->pdf_rb), free(g->tl_rel), free(g->tl_rel_t);
   free(g->tracks), free(g->index), free(g->mine), free(g->all);
   memset(g, 0, sizeof *g);
 }
@@ -171,10 +171,27 @@ static void release_batches(struct lagr *g, int slot) {
   }
 }
 
-static void retire(struct lagr *g, int slot) {
+/* Room for n releases in the history of T_L (both arrays; at least one row, so that an empty
+   history still has memory for the checkpoint's state list). */
+static void reserve_history(struct lagr *g, size_t n) {
+  if (n <= g->rel_cap && g->tl_rel) return;
+  size_t cap = g->rel_cap ? g->rel_cap : 64;
+  while (cap < n) cap *= 2;
+  const size_t row = (size_t)g->cfg.n_levels * 3;
+  g->tl_rel = mem_realloc(g->tl_rel, cap * row, sizeof(double), "Lagrangian T_L history");
+  g->tl_rel_t = mem_realloc(g->tl_rel_t, cap, sizeof(double), "Lagrangian T_L history");
+  g->rel_cap = cap;
+}
+
+/* Retire the release of slot, completed at simulated time t: its sums join the merged ones, its
+   T_L the batches and the history, its lag functions and PDF the per-release batches. */
+static void retire(struct lagr *g, int slot, double t_end) {
   const int nl = g->cfg.n_levels;
   const double dtau = g->cfg.horizon / g->cfg.n_lags;
   release_batches(g, slot);
+  reserve_history(g, g->n_rel + 1);
+  double *hist = g->tl_rel + g->n_rel * (size_t)nl * 3;
+  g->tl_rel_t[g->n_rel++] = t_end;
   memset(slot_pdf(g, slot), 0, slot_pdf_len(g) * sizeof(double));
   double *rho = mem_calloc(g->nlag, sizeof(double), "Lagrangian engine");
   for (int l = 0; l < nl; l++) {
@@ -190,6 +207,7 @@ static void retire(struct lagr *g, int slot) {
       }
       const double t = lagr_tl(rho, g->nlag, dtau);
       if (isfinite(t)) scal_add(g->tl + ((size_t)l * 3 + (size_t)i) * SCAL_LEN, t);
+      hist[l * 3 + i] = isfinite(t) ? t : NAN;
     }
   }
   free(rho);
@@ -362,7 +380,7 @@ void lagr_sample(struct lagr *g, const struct stats_snapshot *s) {
       }
       S[SL_LAST_K] = k;
     }
-    if (k >= c->n_lags) retire(g, sl);
+    if (k >= c->n_lags) retire(g, sl, s->t);
   }
   if (due) {
     int slot = -1;
@@ -379,6 +397,21 @@ static void *reserve_tr(void *owner, int rank, const size_t *dims) {
   reserve_tracks(g, dims[0] ? dims[0] : 1);
   g->ntracks = dims[0];
   return g->tracks;
+}
+
+/* The history of T_L in a checkpoint (format 1.13): tl_release first (it sets the length),
+   then tl_release_time, which must have as many rows. */
+static void *reserve_tl_rel(void *owner, int rank, const size_t *dims) {
+  struct lagr *g = owner;
+  if (rank != 3 || dims[1] != (size_t)g->cfg.n_levels || dims[2] != 3) return NULL;
+  reserve_history(g, dims[0]);
+  g->n_rel = dims[0];
+  return g->tl_rel;
+}
+
+static void *reserve_tl_rel_t(void *owner, int rank, const size_t *dims) {
+  struct lagr *g = owner;
+  return rank == 1 && dims[0] == g->n_rel ? g->tl_rel_t : NULL;
 }
 
 /* The sums of a checkpoint of format <= 1.9 (records of width LG_LEN_1_6 up to format 1.6,
@@ -450,6 +483,14 @@ void lagr_state(struct lagr *g, struct state_list *L) {
   state_add(L, "stats/lagrangian/release_batches", STATE_F64, 3, drb, g->rb, NULL)->optional = 1;
   state_add(L, "stats/lagrangian/slot_pdf", STATE_F64, 2, dsp, g->slot_pdf, NULL)->optional = 1;
   state_add(L, "stats/lagrangian/pdf_batches", STATE_F64, 3, dpb, g->pdf_rb, NULL)->optional = 1;
+  /* format 1.13: each completed release's own T_L and the time it completed; absent before
+     (the history then holds the releases completed after the resume) */
+  reserve_history(g, 1);
+  const size_t dh[3] = {g->n_rel, nl, 3}, dht[1] = {g->n_rel};
+  f = state_add(L, "stats/lagrangian/tl_release", STATE_F64, 3, dh, g->tl_rel, "s");
+  f->reserve = reserve_tl_rel, f->owner = g, f->optional = 1;
+  f = state_add(L, "stats/lagrangian/tl_release_time", STATE_F64, 1, dht, g->tl_rel_t, "s");
+  f->reserve = reserve_tl_rel_t, f->owner = g, f->optional = 1;
   state_add(L, "stats/lagrangian/next_release", STATE_F64, 0, NULL, &g->next_release, "s");
   state_add(L, "stats/lagrangian/releases", STATE_F64, 0, NULL, &g->releases, NULL);
 }
@@ -577,6 +618,32 @@ static int write_integral_times(const struct lagr *g, int gr, int dl, int dc, co
   }
   free(a);
   CK(rc);
+done:
+  return rc;
+}
+
+/* The history of T_L: each completed release's own T_L per level and component (release order,
+   dimension release, its coordinate the time each completed). Its mean over the finite values
+   is T_L_release_mean, their standard deviation / sqrt(count) T_L_stderr, unless the run
+   resumed from a checkpoint without the history (format <= 1.12): then it holds the releases
+   completed after the resume only. */
+static int write_history(const struct lagr *g, int gr, int dl, int dc, char *err, size_t errlen) {
+  const size_t n = g->n_rel, row = (size_t)g->cfg.n_levels * 3;
+  int rc = NC_NOERR, dr, v;
+  CK(nc_def_dim(gr, "release", n, &dr)); /* 0: unlimited, of length 0 */
+  CK(ncout_def(gr, "release", NC_DOUBLE, 1, &dr, "s",
+               "simulated time at which the release completed (its last lag sampled)", &v));
+  if (n) CK(nc_put_var_double(gr, v, g->tl_rel_t));
+  const int d3[3] = {dr, dl, dc};
+  CK(ncout_def(gr, "T_L_release", NC_DOUBLE, 3, d3, "s",
+               "Lagrangian integral time of u, v, w (Eq. 5.61) of each completed release, from "
+               "its own rho_L, in release order",
+               &v));
+  CK(ncout_fill(gr, v));
+  if (n) {
+    const size_t st[3] = {0, 0, 0}, ct[3] = {n, (size_t)g->cfg.n_levels, 3};
+    CK(ncout_put_filled(gr, v, st, ct, g->tl_rel, n * row));
+  }
 done:
   return rc;
 }
@@ -776,6 +843,7 @@ int lagr_nc_write(const struct lagr *g, int ncid, char *err, size_t errlen) {
     CK(put_rows(gr, v, l, nlag, fn + ((size_t)l * LF_LEN + LF_TAU) * nlag));
   /* each names its own failing call in err */
   if ((rc = write_integral_times(g, gr, dl, dc, tl, err, errlen)) != NC_NOERR ||
+      (rc = write_history(g, gr, dl, dc, err, errlen)) != NC_NOERR ||
       (ns > 0 && (rc = write_pdfs(g, gr, dl, tmp, err, errlen)) != NC_NOERR))
     goto done;
 done:
@@ -909,7 +977,8 @@ static size_t engine_bytes(const void *self) {
          nl * LF_LEN * g->nlag * SCAL_LEN * d + ns * slot_pdf_len(g) * d +
          nl * nst * ((size_t)g->cfg.pdf_bins + 2) * SCAL_LEN * d +
          nl * nst * ((size_t)g->cfg.pdf_bins + 3) * d + g->cap * TR_LEN * d +
-         g->index_len * sizeof(long) + (g->mine_cap + g->all_cap) * LAGR_REC * d;
+         g->index_len * sizeof(long) + (g->mine_cap + g->all_cap) * LAGR_REC * d +
+         g->rel_cap * (nl * 3 + 1) * d;
 }
 
 static int engine_write(const void *self, double t_reached, int ncid, char *err, size_t errlen) {

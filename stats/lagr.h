@@ -103,6 +103,12 @@ struct lagr {
   double *slot_sums;   /*!< [slot][level][lag][LG_LEN] active releases */
   double *slots;       /*!< [slot][SL_LEN] */
   double *tl;          /*!< [level][3][3] Welford of the per-release T_L over releases */
+  double *tl_rel;      /*!< [release][level][3] each completed release's own T_L, in release
+                            order (NaN where not finite; checkpoint format 1.13) [s] */
+  double *tl_rel_t;    /*!< [release] the simulated time at which it completed [s] */
+  size_t n_rel;        /*!< releases in that history: the completed ones (those completed
+                            since the resume after a resume from format <= 1.12) */
+  size_t rel_cap;      /*!< its capacity (releases) */
   double *rb;          /*!< [level][LF_LEN][lag][3] Welford over the completed releases of each
                             release's own lag functions (checkpoint format 1.12) */
   double *slot_pdf;    /*!< [slot][level][station][pdf_bins + 3] the active releases'

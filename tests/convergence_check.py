@@ -4,11 +4,12 @@ all the complete windows must be the batch-means error recomputed here from the 
 moments with numpy (each window's own C2_uv / count at the bin of the merged peak, force-balance
 wall units), and its projection n (se / (E value))^2 windows.
 Then on a short run of its own (the 3-D Poiseuille scene, 0.5 s of 0.1 s windows, budgets at
-every sample, Lagrangian releases every 0.1 s, unfolded): the budgets' main terms re-averaged
+every sample, Lagrangian releases every 0.05 s over 0.1 s, unfolded): the budgets' main terms re-averaged
 by the tool over every window must be the file's own rsb_* and rsb_*_stderr (the C engine's
 reconstruction, euler_rs.c) at their bins, their running average must move (the first point
-is not the last), and T_L must be the file's per-release mean and standard error over its
-releases.
+is not the last), and T_L's curve must be the running mean and standard error (std / sqrt(n))
+of the file's history T_L_release recomputed here, point by point at the times the releases
+completed, its last point the file's T_L_release_mean and T_L_stderr.
 usage: convergence_check.py REPO OUT CHANSPH"""
 import csv
 import math
@@ -59,8 +60,8 @@ res = subprocess.run([chansph, "run", os.path.join(repo, "jobs/scenes/poiseuille
                       "--set", "output.t_average_start=0.1", "--set", "stats.window=0.1",
                       "--set", "stats.u_tau_ref=0.6", "--set", "stats.budget_every=1",
                       "--set", "output.stats_every=2", "--set", "lagrangian.y_plus=1,2",
-                      "--set", "lagrangian.horizon=0.2", "--set", "lagrangian.release_every=0.1",
-                      "--set", "lagrangian.n_lags=10", "--set", "fluid.nu=0.01"], capture_output=True, text=True)
+                      "--set", "lagrangian.horizon=0.1", "--set", "lagrangian.release_every=0.05",
+                      "--set", "lagrangian.n_lags=5", "--set", "fluid.nu=0.01"], capture_output=True, text=True)
 if res.returncode != 0:
     sys.exit("FAIL: the run exited %d: %s" % (res.returncode, res.stderr[-2000:]))
 f = os.path.join(run, "stats.nc")
@@ -106,20 +107,35 @@ with netCDF4.Dataset(f) as d:
             checked += 1
     lg = d["lagrangian"]
     releases = int(lg.releases)
+    hist = np.ma.filled(lg["T_L_release"][:].astype(float), np.nan)
+    hist_t = np.asarray(lg["release"][:], float)
+    if hist.shape[0] != releases:
+        ok = False
+        print("FAIL: the history holds %d rows of %d releases" % (hist.shape[0], releases))
     for lev, yp in enumerate(np.asarray(lg["y_plus"][:], float)):
         for k, comp in enumerate("uvw"):
             m = float(np.ma.filled(lg["T_L_release_mean"][lev, k], np.nan))
             e = float(np.ma.filled(lg["T_L_stderr"][lev, k], np.nan))
             name = "T_L_%s(y+ %g)" % (comp, yp)
-            if not (math.isfinite(m) and math.isfinite(e)):
-                good = name not in series
+            use = np.isfinite(hist[:, lev, k])
+            v, tv = hist[use, lev, k], hist_t[use]
+            ser = series.get(name)
+            if len(v) < 2:
+                good = ser is None and not math.isfinite(e)
             else:
-                ser = series.get(name)
-                good = (ser is not None and len(ser) == 1 and ser[0][0] == releases and
-                        abs(ser[0][3] / m - 1) < 1e-9 and abs(ser[0][4] / e - 1) < 1e-9)
+                # every point: the running mean and std / sqrt(n) of the first n finite
+                # releases, at the time the n-th completed; the last one the file's
+                want = [(n, tv[n - 1], np.mean(v[:n]), np.std(v[:n], ddof=1) / math.sqrt(n))
+                        for n in range(2, len(v) + 1)]
+                good = ser is not None and len(ser) == len(want) and all(
+                    p[0] == w[0] and abs(p[1] - w[1]) <= 1e-9 * w[1] and abs(p[3] - w[2]) <= 1e-9 * abs(w[2]) and
+                    abs(p[4] - w[3]) <= 1e-9 * abs(w[3]) for p, w in zip(ser, want))
+                good = good and abs(ser[-1][3] / m - 1) < 1e-9 and abs(ser[-1][4] / e - 1) < 1e-9
                 checked += 1
-            print("%s: file %.6g +- %.6g over %d releases: %s" % (name, m, e, releases,
-                                                                  "PASS" if good else "FAIL"))
+            print("%s: file %.6g +- %.6g over %d releases (%d finite); curve of %d points, last "
+                  "%s: %s" % (name, m, e, releases, len(v), len(ser) if ser else 0,
+                              "%.6g +- %.6g at t = %.4g" % (ser[-1][3], ser[-1][4], ser[-1][1])
+                              if ser else "-", "PASS" if good else "FAIL"))
             ok &= good
 if checked < 15:
     ok = False

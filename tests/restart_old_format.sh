@@ -7,7 +7,12 @@
 # batches of the Lagrangian and quadrant standard errors; <= 1.9 the sums of the interval-mean velocities
 # (stats/lagrangian/sums and slot_sums: 53 -> 47 per record), <= 1.8 also those of the actual
 # lags (-> 46), <= 1.7 the correlation engine's window records (stats/correlations/windows,
-# window_samples, window_spectra_1d), <= 1.6 the sums of the displacements (-> 43).
+# window_samples, window_spectra_1d), <= 1.6 the sums of the displacements (-> 43); every
+# mode (<= 1.12) the history of T_L (stats/lagrangian/tl_release, tl_release_time; 1.13).
+#   lagr112: group lagrangian bit for bit (the batches too), except the history of T_L
+#     (T_L_release, release), which holds only the releases completed after the resume: the
+#     last rows of the uninterrupted run's, bit for bit, fewer (N1 after the first release
+#     completed); the log says what was lacking.
 #   lagr16, lagr18, lagr19: group lagrangian bit for bit, except the variables the old records
 #     cannot give: rate_var_* (and for 1.8 lag_time_mean, for 1.6 also disp_mean_*,
 #     disp_var_*), fill values where the stored sums had samples (at least one) and otherwise
@@ -16,25 +21,27 @@
 #     uu_bin .. vw_bin, which equal the uninterrupted run's bit for bit), the means bit for
 #     bit; groups lagrangian and quadrants bit for bit except their standard errors and batch
 #     counts, which count only the releases and windows completed after the resume (fewer).
-#     (In every mode the Lagrangian standard errors and batch counts are left out of the
-#     bitwise comparison for the same reason.)
+#     (In every mode but lagr112 the Lagrangian standard errors and batch counts are left out
+#     of the bitwise comparison for the same reason; in every mode the history of T_L is
+#     compared as in lagr112.)
 #   corr17: group correlations bit for bit, except n_batches, which counts only the complete
 #     windows after the one of the resume (fewer than the uninterrupted run's), the
 #     *_stderr, which are fill values with fewer than 2 batches and finite otherwise, and the
 #     window records of stats.nc (dimension window), which start at the window of the resume
 #     (flagged partial, not complete) and then equal the uninterrupted run's rows bit for bit.
-# usage: restart_old_format.sh stats111|lagr16|lagr18|lagr19|corr17 CHANSPH SCENE RUNS N1 [--set k=v ...]
+# usage: restart_old_format.sh stats111|lagr112|lagr16|lagr18|lagr19|corr17 CHANSPH SCENE RUNS N1 [--set k=v ...]
 set -u
 export CHANSPH_RUN_ID=compare-test
 mode=$1 chansph=$2 scene=$3 runs=$4 n1=$5
 shift 5
 case $mode in
+  lagr112) minor=12 part=$runs/lagr_format112_part ;;
   lagr16) minor=6 part=$runs/lagr_format16_part ;;
   lagr18) minor=8 part=$runs/lagr_format18_part ;;
   lagr19) minor=9 part=$runs/lagr_format19_part ;;
   corr17) minor=7 part=$runs/corr_format17_part ;;
   stats111) minor=11 part=$runs/stats_format111_part ;;
-  *) echo "usage: $0 stats111|lagr16|lagr18|lagr19|corr17 CHANSPH SCENE RUNS N1 [--set k=v ...]"; exit 2 ;;
+  *) echo "usage: $0 stats111|lagr112|lagr16|lagr18|lagr19|corr17 CHANSPH SCENE RUNS N1 [--set k=v ...]"; exit 2 ;;
 esac
 full=$runs/bitwise_allstats_full
 rm -rf "$part"
@@ -48,7 +55,14 @@ import numpy as np
 path, minor = sorted(glob.glob(sys.argv[1] + "/checkpoints/ckpt_*.h5"))[-1], int(sys.argv[2])
 done = []
 with h5py.File(path, "a") as h:
-    assert h.attrs["format_version_minor"] == 12, h.attrs["format_version_minor"]
+    assert h.attrs["format_version_minor"] == 13, h.attrs["format_version_minor"]
+    for k in ("tl_release", "tl_release_time"):
+        del h["stats/lagrangian/" + k]
+    done.append("no history of T_L")
+    if minor == 12:
+        h.attrs["format_version_minor"] = np.int32(minor)
+        print("%s: rewritten as format 1.12 (%s)" % (path, "; ".join(done)))
+        sys.exit(0)
     a = h["stats/eulerian/moments"][()]
     assert a.shape[2] == 25, a.shape
     del h["stats/eulerian/moments"]
@@ -74,6 +88,8 @@ print("%s: rewritten as format 1.%d (%s)" % (path, minor, "; ".join(done)))
 PYEOF
 "$chansph" resume "$part" > "$part.log" 2>&1 || { echo "FAIL: resume"; cat "$part.log"; exit 1; }
 grep -q "resume: from .*ckpt_0*$n1.h5" "$part.log" || { echo "FAIL: not resumed from step $n1"; cat "$part.log"; exit 1; }
+grep -q "resume: note: .*ckpt_0*$n1.h5 lacks .*stats/lagrangian/tl_release, stats/lagrangian/tl_release_time.* (an earlier checkpoint format)" "$part/log.txt" ||
+  { echo "FAIL: the log does not say that the history of T_L starts at the resume"; grep "resume" "$part/log.txt"; exit 1; }
 /usr/bin/python3 - "$full/stats.nc" "$part/stats.nc" "$mode" <<'PYEOF'
 import sys
 import netCDF4
@@ -105,12 +121,22 @@ def fewer_batches(a, b, names):
 def lagr(a, b, unknown):
     """Group lagrangian: the variables starting with one of unknown may be fill values where
     the uninterrupted run has a value (at least one of each such family), the rest bitwise
-    but the batches of format 1.12 (fewer in b)."""
+    but the batches of format 1.12 (fewer in b; lagr112: bitwise too) and the history of T_L
+    (format 1.13: b's rows the last of a's, fewer)."""
     bad, nan = [], {u: 0 for u in unknown}
-    if not fewer_batches(a, b, ("release_batches", "pdf_release_batches")):
+    if mode != "lagr112" and not fewer_batches(a, b, ("release_batches", "pdf_release_batches")):
         bad.append("release_batches (not fewer after the resume)")
+    na, nb = len(a.dimensions["release"]), len(b.dimensions["release"])
+    if not (0 < nb < na if mode == "lagr112" else nb <= na):
+        bad.append("history of T_L: %d releases after the resume of %d" % (nb, na))
     for k, v in a.variables.items():
-        if batched(k):
+        if "release" in v.dimensions:
+            x, y = v[:], b.variables[k][:]
+            if nb <= na and not np.array_equal(np.ma.filled(x[na - nb:], np.nan),
+                                              np.ma.filled(y, np.nan), equal_nan=True):
+                bad.append(k + " (not the uninterrupted run's last rows)")
+            continue
+        if batched(k) and mode != "lagr112":
             continue
         x, y = v[:], b.variables[k][:]
         if x.dtype.kind != "f":
@@ -127,10 +153,10 @@ def lagr(a, b, unknown):
         bad += [] if same else [k]
     ok = not bad and all(n > 0 for n in nan.values()) if unknown else not bad
     print("%s: group lagrangian of the run resumed from format 1.%s sums: %s; fill values "
-          "(unknown) in %s, the others equal" %
-          ("PASS" if ok else "FAIL", mode[-1],
+          "(unknown) in %s, the others equal; history of T_L: %d of %d releases" %
+          ("PASS" if ok else "FAIL", mode[5:] if mode.startswith("lagr1") else "11",
            "bitwise equal" if not bad else "DIFFERENT: " + ", ".join(bad),
-           ", ".join("%d of %s*" % (n, u) for u, n in nan.items())))
+           ", ".join("%d of %s*" % (n, u) for u, n in nan.items()), nb, na))
     return ok
 
 
@@ -216,7 +242,8 @@ if mode == "stats111":
 elif mode == "corr17":
     ok = corr(fa.groups["correlations"], fb.groups["correlations"])
 else:
-    unknown = ["rate_var_"] + (["lag_time_mean"] if mode != "lagr19" else []) + \
+    unknown = [] if mode == "lagr112" else ["rate_var_"] + \
+        (["lag_time_mean"] if mode != "lagr19" else []) + \
         (["disp_mean_", "disp_var_"] if mode == "lagr16" else [])
     ok = lagr(fa.groups["lagrangian"], fb.groups["lagrangian"], unknown)
 sys.exit(0 if ok else 1)

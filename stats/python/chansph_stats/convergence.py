@@ -19,12 +19,14 @@ running average over the first n and its batch-means standard error over them ar
     (rs_merge.py, the Python side of euler_rs.c), with the batch-means standard error over
     those windows; the last point covers every window of the file, the open one included, so
     it is the file's own rsb_* and rsb_*_stderr (records of a format before 1.11: not drawn);
-  - T_L of each level and component of group lagrangian: the mean of the per-release values
-    and its standard error over the completed releases (T_L_release_mean, T_L_stderr), one
-    point at the time the file reached, counted in releases (stats.nc keeps the per-release
-    batches as running sums, not per release, so there is no earlier point; draw a history by
-    running the tool on stats.nc files written along the run, output.write_every); its
-    projection counts releases of lagrangian.release_every.
+  - T_L of each level and component of group lagrangian: from the history T_L_release
+    (each completed release's own T_L, checkpoint format 1.13), the running mean of the finite
+    per-release values over the first n and its standard error (their standard deviation /
+    sqrt(n)), at the time the n-th completed (coordinate release), counted in releases; the
+    last point is the file's T_L_release_mean and T_L_stderr. Files without the whole history
+    (older formats, or a resume from an older checkpoint) give one point, T_L_release_mean and
+    T_L_stderr at the time the file reached. The projection counts releases of
+    lagrangian.release_every.
 The x axes are the simulated time at the end of the n-th window and, when the run's log is
 found (LOG, default log.txt beside STATS.nc; not for a joined file), the wall time spent to
 reach it (from the log's particle-steps/s). For each quantity the projection to a relative
@@ -157,14 +159,18 @@ def budget_series(path):
 
 
 def lagrangian_series(path):
-    """({quantity: [(releases, t, value, se)]}, {quantity: (t0, release spacing)}) of T_L per
-    level and component: one point, the file's per-release mean and its standard error."""
+    """({quantity: [(releases, t, value, se)]}, {quantity: (t0, release spacing)}, history) of
+    T_L per level and component: from the history T_L_release (checkpoint format 1.13), the
+    running mean of the finite per-release values over the first n and its standard error, at
+    the time the n-th of them completed, for every n from 2; without a whole history (older
+    files, or a resume from an older checkpoint: fewer rows than releases) one point, the
+    file's T_L_release_mean and T_L_stderr at the time it reached (history False)."""
     with open_nc(path) as d:
         if "lagrangian" not in d.groups:
-            return {}, {}
+            return {}, {}, False
         g = d["lagrangian"]
         if "T_L_release_mean" not in g.variables or "T_L_stderr" not in g.variables:
-            return {}, {}
+            return {}, {}, False
         mean = np.ma.filled(g["T_L_release_mean"][:].astype(float), np.nan)
         se = np.ma.filled(g["T_L_stderr"][:].astype(float), np.nan)
         yplus = np.asarray(g["y_plus"][:], float)
@@ -172,14 +178,29 @@ def lagrangian_series(path):
         every = float(g.release_every) if float(g.release_every) > 0 else float(g.horizon)
         t = float(d.t_reached) if "t_reached" in d.ncattrs() else float(d.t_end)
         t0 = float(d.t_average_start)
+        hist = hist_t = None
+        if "T_L_release" in g.variables and "release" in g.variables:
+            hist = np.ma.filled(g["T_L_release"][:].astype(float), np.nan)
+            hist_t = np.asarray(g["release"][:], float)
+    whole = hist is not None and hist.shape[0] == releases
+    if hist is not None and not whole:
+        print("# T_L: the history holds %d of the %d releases (the run resumed from a checkpoint "
+              "without it): one point per quantity" % (hist.shape[0], releases))
     out, spacing = {}, {}
     for lev, yp in enumerate(yplus):
         for c, name in enumerate("uvw"):
-            if releases >= 2 and math.isfinite(mean[lev, c]) and math.isfinite(se[lev, c]):
-                key = "T_L_%s(y+ %g)" % (name, yp)
+            key = "T_L_%s(y+ %g)" % (name, yp)
+            if whole:
+                use = np.isfinite(hist[:, lev, c])
+                v, tv = hist[use, lev, c], hist_t[use]
+                ser = [(n, float(tv[n - 1]), float(np.mean(v[:n])), batch_se(v[:n]))
+                       for n in range(2, len(v) + 1)]
+                if ser:
+                    out[key], spacing[key] = ser, (t0, every)
+            elif releases >= 2 and math.isfinite(mean[lev, c]) and math.isfinite(se[lev, c]):
                 out[key] = [(releases, t, float(mean[lev, c]), float(se[lev, c]))]
                 spacing[key] = (t0, every)
-    return out, spacing
+    return out, spacing, whole
 
 
 def wall_clock(log, times):
@@ -206,7 +227,7 @@ def main(argv, prog):
     series, wins = peak_series(a.stats)
     series.update(spectra_series(a.stats))
     series.update(budget_series(a.stats))
-    lagr, spacing = lagrangian_series(a.stats)
+    lagr, spacing, lagr_history = lagrangian_series(a.stats)
     series.update(lagr)
     log = a.log or os.path.join(os.path.dirname(os.path.abspath(a.stats)), "log.txt")
     out_dir = a.out or os.path.join(os.path.dirname(os.path.abspath(a.stats)), "convergence")
@@ -231,8 +252,11 @@ def main(argv, prog):
         t_at = spacing[q][0] + need * spacing[q][1] if math.isfinite(need) else math.nan
         print("%-*s %8d %10.4g %12.5g %12.4g %9.4f %14.1f %14.4g" % (width, q, n, t, v, se, rel,
                                                                      need, t_at))
-    if lagr:
-        print("# T_L: windows = completed releases, one point (no per-release history in "
+    if lagr and lagr_history:
+        print("# T_L: windows = releases with a finite T_L, the running mean of the history "
+              "T_L_release at the time each completed; its projection counts releases")
+    elif lagr:
+        print("# T_L: windows = completed releases, one point (no whole per-release history in "
               "stats.nc); its projection counts releases")
     with open(os.path.join(out_dir, "convergence.csv"), "w") as f:
         f.write("# %s: running averages and batch-means standard errors; target %g\n"
@@ -252,7 +276,7 @@ def group_of(q):
     if q.startswith("E_"):
         return "spectra (energy at each level)"
     if q.startswith("T_L"):
-        return "T_L (one point per file)"
+        return "T_L (running mean over the releases)"
     return "Reynolds-stress budgets (main terms)"
 
 
