@@ -7,7 +7,7 @@
  * number of ranks that wrote it or will read it. Rank r names the ids of its block
  * (sim_id_block, sim.h). A running simulation first sends every owned particle to the rank
  * whose block holds it (dd_exchange) and places what arrives by id; before the particles are
- * distributed (a resume), the block is read straight into the slots of the full initial arrays
+ * distributed (a resume), the block is read straight into the slots sim_create() built for it
  * and sim_restored() migrates the particles to their owners.
  */
 #include <mpi.h>
@@ -118,7 +118,7 @@ void sim_state(struct sim *S, struct state_list *L) {
   /* the particle datasets hold the ids 0 .. N-1 in order (the file does not depend on the
      number of ranks); each rank names its id block. A running simulation first sends its
      particles to the block owners; before sim_distribute the block is read into the slots
-     lo .. hi-1 of the full initial arrays (sim_restored then migrates the particles) */
+     0 .. hi-lo-1 that sim_create built for it (sim_restored then migrates the particles) */
   const size_t N = P->n_fluid + P->n_vertex, nv = P->n_vertex;
   int rank = 0, size = 1;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
@@ -130,8 +130,8 @@ void sim_state(struct sim *S, struct state_list *L) {
   void *const *g = (void *const *)S->gather;
   const size_t n[1] = {hi - lo};
   struct state_field *fid, *fkind;
-  fid = state_add(L, "particles/id", STATE_I64, 1, n, blocks ? g[G_ID] : P->id + lo, NULL);
-  fkind = state_add(L, "particles/kind", STATE_U8, 1, n, blocks ? g[G_KIND] : P->kind + lo, NULL);
+  fid = state_add(L, "particles/id", STATE_I64, 1, n, blocks ? g[G_ID] : P->id, NULL);
+  fkind = state_add(L, "particles/kind", STATE_U8, 1, n, blocks ? g[G_KIND] : P->kind, NULL);
   fid->offset = fkind->offset = lo, fid->total = fkind->total = N;
   int idx[SIM_GATHER];
   const int nf = ckpt_fields(P, idx);
@@ -141,7 +141,7 @@ void sim_state(struct sim *S, struct state_list *L) {
     snprintf(name, sizeof name, "particles/%s", pf->name);
     double *data = part_field_ptr(P, pf);
     struct state_field *fi =
-        state_add(L, name, STATE_F64, 1, n, blocks ? g[G_FIELDS + c] : data + lo, pf->units);
+        state_add(L, name, STATE_F64, 1, n, blocks ? g[G_FIELDS + c] : data, pf->units);
     fi->offset = lo, fi->total = N, fi->optional = pf->optional;
   }
   if (S->M.strain_lag) { /* whether nu_r and k_r hold the values the next step applies (format

@@ -288,7 +288,7 @@ static int try_one(const char *dir, struct candidate *cd, int n_set, char *const
   bare.init_from[0] = '\0';
   /* nor build (and announce) an initial profile: the checkpoint holds the velocities */
   bare.init_profile = INIT_REST, bare.init_noise = bare.init_modes = bare.init_streaks = 0.0;
-  if (sim_create(S, &bare)) {
+  if (sim_create(S, &bare, 1)) {
     *fatal = 1;
     return CHANSPH_ERR;
   }

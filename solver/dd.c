@@ -228,6 +228,14 @@ int dd_init(struct dd *d, const struct scene *sc, dd_reserve_fn reserve, void *c
   return CHANSPH_OK;
 }
 
+double dd_share(const struct dd *d) {
+  if (d->size == 1) return 1.0;
+  const double nxo = d->fx[d->bx + 1] - d->fx[d->bx], nzo = d->fz[d->bz + 1] - d->fz[d->bz];
+  const double hx = d->dir[0].width, hz = d->dir[1].width;
+  const double pencils = (nxo + 2.0 * hx) * (nzo + 2.0 * hz);
+  return 1.5 * pencils / ((double)d->ncol * (double)d->nplane); /* sim_distribute's room */
+}
+
 struct nbr_range dd_range(const struct dd *d) {
   return (struct nbr_range){d->fx[d->bx], d->fx[d->bx + 1] - d->fx[d->bx], d->dir[0].width,
                             d->fz[d->bz], d->fz[d->bz + 1] - d->fz[d->bz], d->dir[1].width};

@@ -95,6 +95,10 @@ struct dd {
  */
 int dd_init(struct dd *d, const struct scene *sc, dd_reserve_fn reserve, void *ctx);
 
+/** @brief This rank's share of the particles with its halo and the room its arrays keep to grow
+           (a half), for the memory check before anything is built: 1 on one rank. */
+double dd_share(const struct dd *d);
+
 /** @brief This rank's block as a cell range of the grid (nbr_set_range). */
 struct nbr_range dd_range(const struct dd *d);
 

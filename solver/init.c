@@ -3,12 +3,15 @@
 #include "alloc.h"
 
 #include <Random123/philox.h>
+#include <limits.h>
 #include <math.h>
+#include <mpi.h>
 #include <netcdf.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "dd.h"
 #include "dns_lm180.h"
 #include "error.h"
 #include "kernel.h"
@@ -83,8 +86,10 @@ static double scene_text_value(const char *text, const char *section, const char
   return NAN;
 }
 
+/* The particles of init.from this rank holds: after reading, its slice first .. first+n-1 of
+   the file's total (in file order); after the exchange, the ones its particles need. */
 struct source {
-  size_t n;
+  size_t n, first, total;
   double *col[8]; /* x y z u v w rho mass */
   long long *id;
   double lx, ly, lz, h;
@@ -108,10 +113,11 @@ static int source_var_ok(int nc, int vid, int dimid) {
 }
 
 /** Variable vid (name) of file path as values: CF packing (scale_factor, add_offset, as NCO's
-    ncpdq writes it) applied to the n raw values col; a value equal to its _FillValue or
-    missing_value is missing: an error. *packed is set if it was packed. */
+    ncpdq writes it) applied to the n raw values col (particles first ..); a value equal to its
+    _FillValue or missing_value is missing: *miss (if none yet) becomes the error text and
+    *at the particle's index in the file. *packed is set if it was packed. */
 static int unpack_column(int nc, int vid, const char *path, const char *name, double *col, size_t n,
-                         int *packed) {
+                         size_t first, int *packed, char *miss, size_t nmiss, size_t *at) {
   double scale = 1.0, offset = 0.0, fill[2];
   const int has_scale = !nc_get_att_double(nc, vid, "scale_factor", &scale);
   const int has_offset = !nc_get_att_double(nc, vid, "add_offset", &offset);
@@ -129,20 +135,81 @@ static int unpack_column(int nc, int vid, const char *path, const char *name, do
   }
   for (size_t b = 0; b < n; b++) {
     for (int k = 0; k < 2; k++)
-      if (has_fill[k] && col[b] == fill[k]) {
-        error_input(
-            "%s (init.from): variable '%s' is missing at index %zu (its %s): not a "
-            "usable initial state",
-            path, name, b, k ? "missing_value" : "_FillValue");
-        return CHANSPH_ERR;
+      if (has_fill[k] && col[b] == fill[k] && !miss[0]) {
+        snprintf(miss, nmiss,
+                 "%s (init.from): variable '%s' is missing at index %zu (its %s): not a "
+                 "usable initial state",
+                 path, name, first + b, k ? "missing_value" : "_FillValue");
+        *at = first + b;
       }
     col[b] = col[b] * scale + offset;
   }
   return CHANSPH_OK;
 }
 
-/** Read the 'scene' attribute and the columns of particles.nc into src (src->n particles). */
-static int read_columns(const char *path, struct source *src, char **text) {
+/* ---- the source read in slices, one per rank, and sent to the ranks that need it ---- */
+
+/** The fluid particles of a freshly built part: the first slots (part_create_part). */
+static size_t local_fluid(const struct particles *P) {
+  size_t a = 0;
+  while (a < P->n && P->kind[a] == KIND_FLUID) a++;
+  return a;
+}
+
+/** The rank's slice [*lo, *hi) of n items (as the checkpoint's id blocks, sim.h). */
+static void slice(int r, int size, size_t n, size_t *lo, size_t *hi) {
+  *lo = (size_t)((unsigned long long)r * n / (unsigned)size);
+  *hi = (size_t)((unsigned long long)(r + 1) * n / (unsigned)size);
+}
+
+/** The ranks agree on the first error in the file (smallest key over the ranks; LONG_MAX:
+    none here), whose text the rank that found it gives rank 0 to print. Collective. */
+static int first_error(const struct init_owner *own, long key, const char *text) {
+  if (own->size == 1) {
+    if (key == LONG_MAX) return CHANSPH_OK;
+    error_input("%s", text);
+    return CHANSPH_ERR;
+  }
+  struct {
+    long key;
+    int rank;
+  } in = {key, own->rank}, out;
+  CHECK_MPI(MPI_Allreduce(&in, &out, 1, MPI_LONG_INT, MPI_MINLOC, MPI_COMM_WORLD));
+  if (out.key == LONG_MAX) return CHANSPH_OK;
+  char buf[2048] = "";
+  if (own->rank == out.rank) snprintf(buf, sizeof buf, "%s", text);
+  CHECK_MPI(MPI_Bcast(buf, sizeof buf, MPI_CHAR, out.rank, MPI_COMM_WORLD));
+  error_input("%s", buf);
+  return CHANSPH_ERR;
+}
+
+/** Whether every rank says ok. Collective. */
+static int all_ok(const struct init_owner *own, int ok) {
+  if (own->size > 1)
+    CHECK_MPI(MPI_Allreduce(MPI_IN_PLACE, &ok, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD));
+  return ok;
+}
+
+/** Send record a (R doubles) to rank dest[a] (several records may go to one rank), in the
+    order given; returns what arrives (part_alloc), *got records. Collective. */
+static double *send_records(const struct init_owner *own, const int *dest, size_t n,
+                            const double *rec, size_t R, size_t *got) {
+  if (own->size > 1) return dd_exchange(own->size, dest, n, rec, R, got);
+  double *buf = part_alloc("init_records", (n ? n : 1) * R * sizeof(double));
+  memcpy(buf, rec, n * R * sizeof(double));
+  *got = n;
+  return buf;
+}
+
+static int cmp_first(const void *a, const void *b) {
+  const double x = *(const double *)a, y = *(const double *)b;
+  return (x > y) - (x < y);
+}
+
+/** Read the 'scene' attribute and this rank's slice of the columns of particles.nc into src
+    (rank r of size: the particles r total / size .. (r+1) total / size - 1). */
+static int read_columns(const char *path, struct source *src, char **text,
+                        const struct init_owner *own) {
   int nc, rc, dimid, vid;
   if ((rc = nc_open(path, NC_NOWRITE, &nc))) {
     error_input("%s (init.from): cannot open: %s", path, nc_strerror(rc));
@@ -155,7 +222,13 @@ static int read_columns(const char *path, struct source *src, char **text) {
     *text = mem_calloc(alen + 1, 1, "initial state");
     ok = *text && !nc_get_att_text(nc, NC_GLOBAL, "scene", *text);
   }
-  src->n = n;
+  src->total = n;
+  slice(own->rank, own->size, n, &src->first, &n);
+  n -= src->first, src->n = n;
+  const size_t start[1] = {src->first}, count[1] = {n};
+  char miss[1024] = "";
+  size_t at = 0;
+  long key = LONG_MAX; /* the first missing value: by variable, then by index */
   for (int c = 0; ok && c < 9; c++) {
     if (!nc_inq_varid(nc, source_names[c], &vid) && !source_var_ok(nc, vid, dimid)) {
       error_input("%s (init.from): variable '%s' is not 1-D over dimension 'particle' (%zu)", path,
@@ -166,15 +239,17 @@ static int read_columns(const char *path, struct source *src, char **text) {
     if (c < 8) {
       src->col[c] = mem_alloc(1, (n ? n : 1) * sizeof(double), "initial state");
       ok = src->col[c] && !nc_inq_varid(nc, source_names[c], &vid) &&
-           !nc_get_var_double(nc, vid, src->col[c]);
+           (!n || !nc_get_vara_double(nc, vid, start, count, src->col[c]));
       int packed = 0;
-      if (ok && unpack_column(nc, vid, path, source_names[c], src->col[c], n, &packed)) {
+      if (ok && unpack_column(nc, vid, path, source_names[c], src->col[c], n, src->first, &packed,
+                              miss, sizeof miss, &at)) {
         CHECK_NC(nc_close(nc));
         free(*text), source_free(src);
         *text = NULL;
         return CHANSPH_ERR;
       }
       src->packed += packed;
+      if (miss[0] && key == LONG_MAX) key = (long)((size_t)c * src->total + at);
     } else if (!nc_inq_varid(nc, "id", &vid) && (!nc_inq_att(nc, vid, "scale_factor", NULL, NULL) ||
                                                  !nc_inq_att(nc, vid, "add_offset", NULL, NULL))) {
       error_input(
@@ -187,17 +262,23 @@ static int read_columns(const char *path, struct source *src, char **text) {
       return CHANSPH_ERR;
     } else {
       src->id = mem_alloc(1, (n ? n : 1) * sizeof(long long), "initial state");
-      ok = src->id && !nc_inq_varid(nc, "id", &vid) && !nc_get_var_longlong(nc, vid, src->id);
+      ok = src->id && !nc_inq_varid(nc, "id", &vid) &&
+           (!n || !nc_get_vara_longlong(nc, vid, start, count, src->id));
     }
     if (!ok)
       error_input("%s (init.from): variable '%s' missing or unreadable", path, source_names[c]);
   }
   CHECK_NC(nc_close(nc));
-  if (!ok) {
+  if (!all_ok(own, ok)) { /* a rank could not read its slice */
     error_input(
         "%s (init.from): not a chansph particles.nc (needs dimension 'particle', "
         "variables x y z u v w rho mass id over it and the 'scene' attribute)",
         path);
+    free(*text), source_free(src);
+    *text = NULL;
+    return CHANSPH_ERR;
+  }
+  if (first_error(own, key, miss)) {
     free(*text), source_free(src);
     *text = NULL;
     return CHANSPH_ERR;
@@ -229,48 +310,78 @@ static size_t source_bad_particle(const struct source *src, const char **what, i
 }
 
 /** Refuse a source that is not a state of the box: no particles, ids not a permutation of
-    0..n-1, a value not finite, rho or mass not positive, a position outside the box. */
-static int check_source(const char *path, const struct source *src) {
-  if (src->n == 0) {
+    0..n-1, a value not finite, rho or mass not positive, a position outside the box. Each
+    rank checks its slice; the ids go to the ranks of their id blocks to find repeats; the
+    first failure in file order is reported. Collective. */
+static int check_source(const char *path, const struct source *src, const struct init_owner *own) {
+  if (src->total == 0) {
     error_input("%s (init.from): no particles: not a usable initial state", path);
     return CHANSPH_ERR;
   }
   const char *what = "";
   int c = 0;
   const size_t b = source_bad_particle(src, &what, &c);
+  char text[2048] = "";
   if (b < src->n) {
     char box[96] = "";
     if (c < 3 && src->dim == 3)
       snprintf(box, sizeof box, " the box [0, %g) x (0, %g) x [0, %g)", src->lx, src->ly, src->lz);
     else if (c < 3)
       snprintf(box, sizeof box, " the box [0, %g) x (0, %g)", src->lx, src->ly);
-    error_input(
-        "%s (init.from): variable '%s' of particle id %lld %s%s (%g): not a usable "
-        "initial state",
-        path, source_names[c], src->id[b], what, box, src->col[c][b]);
-    return CHANSPH_ERR;
+    snprintf(text, sizeof text,
+             "%s (init.from): variable '%s' of particle id %lld %s%s (%g): not a usable "
+             "initial state",
+             path, source_names[c], src->id[b], what, box, src->col[c][b]);
   }
-  unsigned char *seen = mem_calloc(src->n, 1, "initial state");
-  int rc = CHANSPH_OK;
-  for (size_t k = 0; k < src->n && rc == CHANSPH_OK; k++) {
+  TRY(first_error(own, b < src->n ? (long)(src->first + b) : LONG_MAX, text));
+  /* the first index (file order) whose id is out of range or was seen at a smaller index */
+  const size_t N = src->total;
+  long key = LONG_MAX;
+  long long bad_id = 0;
+  int *dest = mem_alloc(1, (src->n ? src->n : 1) * sizeof *dest, "initial state");
+  double *rec = mem_alloc(1, (src->n ? 2 * src->n : 1) * sizeof *rec, "initial state");
+  size_t m = 0;
+  for (size_t k = 0; k < src->n; k++) {
     const long long id = src->id[k];
-    if (id < 0 || (unsigned long long)id >= src->n || seen[id]) {
-      error_input("%s (init.from): particle id %lld %s: the ids must be 0..%zu, each once", path,
-                  id, id < 0 || (unsigned long long)id >= src->n ? "out of range" : "repeated",
-                  src->n - 1);
-      rc = CHANSPH_ERR;
-    } else {
-      seen[id] = 1;
+    if (id < 0 || (unsigned long long)id >= N) {
+      if (key == LONG_MAX) key = (long)(src->first + k), bad_id = id;
+      continue;
     }
+    size_t lo, hi;
+    int r = (int)((unsigned long long)id * (unsigned)own->size / N);
+    for (slice(r, own->size, N, &lo, &hi); (size_t)id >= hi; slice(++r, own->size, N, &lo, &hi)) {
+    }
+    for (; (size_t)id < lo; slice(--r, own->size, N, &lo, &hi)) {
+    }
+    dest[m] = r, rec[2 * m] = (double)(src->first + k), rec[2 * m + 1] = (double)id, m++;
   }
-  free(seen);
-  return rc;
+  size_t got;
+  double *in = send_records(own, dest, m, rec, 2, &got);
+  free(dest), free(rec);
+  size_t lo, hi;
+  slice(own->rank, own->size, N, &lo, &hi);
+  double *first = mem_alloc(1, (hi > lo ? hi - lo : 1) * sizeof *first, "initial state");
+  for (size_t i = lo; i < hi; i++) first[i - lo] = -1.0;
+  for (size_t k = 0; k < got; k++) { /* the smallest index of each id; a larger one repeats it */
+    const double at = in[2 * k];
+    const size_t id = (size_t)in[2 * k + 1];
+    double *f = &first[id - lo];
+    const double later = *f < 0.0 ? -1.0 : fmax(*f, at);
+    if (*f < 0.0 || at < *f) *f = at;
+    if (later >= 0.0 && (long)later < key) key = (long)later, bad_id = (long long)id;
+  }
+  part_free(in), free(first);
+  snprintf(text, sizeof text,
+           "%s (init.from): particle id %lld %s: the ids must be 0..%zu, each once", path, bad_id,
+           bad_id < 0 || (unsigned long long)bad_id >= N ? "out of range" : "repeated", N - 1);
+  return first_error(own, key, text);
 }
 
-static int read_source(const char *path, const struct scene *sc, struct source *src) {
+static int read_source(const char *path, const struct scene *sc, struct source *src,
+                       const struct init_owner *own) {
   memset(src, 0, sizeof *src);
   char *text = NULL;
-  TRY(read_columns(path, src, &text));
+  TRY(read_columns(path, src, &text, own));
   const double dim = scene_text_value(text, "domain", "dimension");
   const double delta = scene_text_value(text, "domain", "delta");
   const double lx = scene_text_value(text, "domain", "lx");
@@ -290,7 +401,7 @@ static int read_source(const char *path, const struct scene *sc, struct source *
   }
   src->dim = sc->dim, src->lx = lx, src->ly = 2.0 * delta, src->lz = sc->dim == 3 ? lz : 1.0;
   src->h = hdr * dr;
-  if (check_source(path, src) != CHANSPH_OK) {
+  if (check_source(path, src, own) != CHANSPH_OK) {
     source_free(src);
     return CHANSPH_ERR;
   }
@@ -337,12 +448,29 @@ static int solve_small(int m, double A[4][4], double R[4][3], double out[3]) {
   return 0;
 }
 
-/** Interpolation of the source velocity onto the fluid particles of P (linear moving least
-    squares with the source's kernel). */
-static void interpolate(const struct source *src, struct particles *P) {
+/* The interpolation's cells: of size 2 h of the source or larger, nx x ny x nz. */
+static void source_cells(const struct source *src, int *nx, int *ny, int *nz) {
   const double cell = 2.0 * src->h;
-  const int nx = (int)fmax(1.0, floor(src->lx / cell)), ny = (int)fmax(1.0, floor(src->ly / cell));
-  const int nz = src->dim == 3 ? (int)fmax(1.0, floor(src->lz / cell)) : 1;
+  *nx = (int)fmax(1.0, floor(src->lx / cell)), *ny = (int)fmax(1.0, floor(src->ly / cell));
+  *nz = src->dim == 3 ? (int)fmax(1.0, floor(src->lz / cell)) : 1;
+}
+
+/* The cell column (x, z) of a source particle at x, z (wrapped into the box), as interpolate
+   sorts it. */
+static void source_column(const struct source *src, int nx, int nz, double x, double z, int *ix,
+                          int *iz) {
+  const double xb = x - src->lx * floor(x / src->lx);
+  const double zb = src->dim == 3 ? z - src->lz * floor(z / src->lz) : 0.0;
+  *ix = (int)fmin(nx - 1, fmax(0, floor(xb / src->lx * nx)));
+  *iz = (int)fmin(nz - 1, fmax(0, floor(zb / src->lz * nz)));
+}
+
+/** Interpolation of the source velocity onto the first nf particles of P (fluid; linear moving
+    least squares with the source's kernel). src holds every source particle of the cells
+    around them, in file order. */
+static void interpolate(const struct source *src, struct particles *P, size_t nf) {
+  int nx, ny, nz;
+  source_cells(src, &nx, &ny, &nz);
   const size_t ncell = (size_t)nx * ny * nz;
   size_t *start = mem_calloc(ncell + 1, sizeof *start, "initial state"),
          *fill = mem_alloc(1, ncell * sizeof *fill, "initial state");
@@ -366,7 +494,7 @@ static void interpolate(const struct source *src, struct particles *P) {
   const struct kernel K = kernel_make(src->dim, src->h);
   const int rz = src->dim == 3 ? 1 : 0;
 #pragma omp parallel for schedule(static)
-  for (size_t a = 0; a < P->n_fluid; a++) {
+  for (size_t a = 0; a < nf; a++) {
     const double xa = P->x[a], ya = P->y[a], za = P->z[a];
     const int cx = (int)fmin(nx - 1, floor(xa / src->lx * nx));
     const int cy = (int)fmin(ny - 1, floor(ya / src->ly * ny));
@@ -432,7 +560,7 @@ void init_origin(const char *path, char **run_id, double *time) {
   *run_id = id ? id : text_copy("unknown");
 }
 
-double init_source_bytes(const struct scene *sc, double *count) {
+double init_source_bytes(const struct scene *sc, int ranks, double *count) {
   int nc, d;
   size_t n = 0;
   *count = 0.0;
@@ -440,46 +568,161 @@ double init_source_bytes(const struct scene *sc, double *count) {
   if (nc_inq_dimid(nc, "particle", &d) || nc_inq_dimlen(nc, d, &n)) n = 0;
   CHECK_NC(nc_close(nc));
   *count = (double)n;
-  /* x y z u v w rho mass and id (8 bytes each), the ids' check (1) */
-  return (double)n * (9.0 * 8.0 + 1.0);
+  /* this rank's slice: x y z u v w rho mass and id (8 bytes each), the records sent and
+     received for the id check (2 x 2 x 8) and for the owners (2 x 9 x 8), the id check's
+     first indices (8) */
+  return (double)n / (ranks > 0 ? ranks : 1) * (9.0 * 8.0 + 32.0 + 144.0 + 8.0);
+}
+
+/** The mean of the densities of the fluid particles of every rank, the same on any number of
+    ranks: each density is split into its integer part and its fraction in units of 2^-64,
+    summed as integers (exact, in any order), and rounded once. */
+static double mean_density(const struct particles *P, size_t nf, const struct init_owner *own) {
+  long long whole = 0;
+  unsigned long long part[2] = {0, 0}; /* the fractions' sum in units of 2^-32 and 2^-64 */
+  for (size_t a = 0; a < nf; a++) {
+    const double ip = floor(P->rho[a]);
+    const unsigned long long f = (unsigned long long)ldexp(P->rho[a] - ip, 64); /* < 2^64 */
+    whole += (long long)ip;
+    part[0] += f >> 32, part[1] += f & 0xffffffffULL;
+  }
+  unsigned long long n = nf;
+  if (own->size > 1) {
+    CHECK_MPI(MPI_Allreduce(MPI_IN_PLACE, &whole, 1, MPI_LONG_LONG, MPI_SUM, MPI_COMM_WORLD));
+    CHECK_MPI(
+        MPI_Allreduce(MPI_IN_PLACE, part, 2, MPI_UNSIGNED_LONG_LONG, MPI_SUM, MPI_COMM_WORLD));
+    CHECK_MPI(MPI_Allreduce(MPI_IN_PLACE, &n, 1, MPI_UNSIGNED_LONG_LONG, MPI_SUM, MPI_COMM_WORLD));
+  }
+  const long double sum =
+      (long double)whole + ldexpl((long double)part[0], -32) + ldexpl((long double)part[1], -64);
+  return (double)(sum / (long double)n);
 }
 
 /** init.density = rho0: shift every fluid particle's density by one constant so that their
-    mean is rho0 (summed in id order: the same on every rank), removing the mean overpressure
-    of a developed state (docs/validation/scheme_ab.md). */
-static void shift_density(const struct scene *sc, struct particles *P) {
-  double sum = 0.0;
-  for (size_t a = 0; a < P->n_fluid; a++) sum += P->rho[a];
-  const double shift = sc->rho0 - sum / (double)P->n_fluid;
-  for (size_t a = 0; a < P->n_fluid; a++) P->rho[a] += shift;
+    mean is rho0 (mean_density: the same on every rank), removing the mean overpressure of a
+    developed state (docs/validation/scheme_ab.md). */
+static void shift_density(const struct scene *sc, struct particles *P, size_t nf,
+                          const struct init_owner *own) {
+  const double shift = sc->rho0 - mean_density(P, nf, own);
+  for (size_t a = 0; a < nf; a++) P->rho[a] += shift;
   msg("init: densities shifted by %.6g kg/m^3 to the mean rho0 = %.6g (init.density = rho0)\n",
       shift, sc->rho0);
 }
 
-static int from_file(const struct scene *sc, struct particles *P) {
+/** Same resolution: each source particle goes to the rank owning its position and becomes the
+    fluid particle of its id there (in id order, as the lattice it replaces); the vertices stay. */
+static void place_state(struct source *src, const struct scene *sc, struct particles *P, size_t nf,
+                        const struct init_owner *own) {
+  enum { R = 8 }; /* id x y z u v w rho */
+  int *dest = mem_alloc(1, (src->n ? src->n : 1) * sizeof *dest, "initial state");
+  double *rec = mem_alloc(1, (src->n ? src->n : 1) * R * sizeof *rec, "initial state");
+  for (size_t b = 0; b < src->n; b++) {
+    double *r = rec + b * R;
+    r[0] = (double)src->id[b]; /* ids below 2^53 are exact */
+    for (int c = 0; c < 7; c++) r[1 + c] = src->col[c][b];
+    dest[b] = own->owner ? own->owner(own->ctx, r[1], r[3]) : 0;
+  }
+  source_free(src);
+  size_t got;
+  double *in = send_records(own, dest, src->n, rec, R, &got);
+  free(dest), free(rec);
+  qsort(in, got, R * sizeof(double), cmp_first); /* by id */
+  /* the vertices after the new fluid particles */
+  const size_t nv = P->n - nf;
+  if (got + nv > P->cap) part_reserve(P, got + nv);
+  part_move(P, got, nf, nv);
+  P->n = got + nv;
+  const double mass = sc->rho0 * pow(sc->dr, sc->dim);
+  for (size_t a = 0; a < got; a++) {
+    const double *r = in + a * R;
+    P->id[a] = (int64_t)r[0], P->kind[a] = KIND_FLUID, P->m[a] = mass, P->gam[a] = 1.0;
+    P->x[a] = r[1], P->y[a] = r[2], P->z[a] = r[3];
+    P->u[a] = r[4], P->v[a] = r[5], P->w[a] = r[6], P->rho[a] = r[7];
+  }
+  part_free(in);
+}
+
+/** In range lo .. hi of a periodic index of period n. */
+static int in_periodic(int c, int lo, int hi, int n) {
+  if (hi - lo + 1 >= n) return 1;
+  return (c >= lo && c <= hi) || (c + n >= lo && c + n <= hi) || (c - n >= lo && c - n <= hi);
+}
+
+/** Another resolution: each rank receives the source particles of the cells around its fluid
+    particles' cells (a source particle may go to several ranks), in file order. */
+static void gather_cells(struct source *src, const struct particles *P, size_t nf,
+                         const struct init_owner *own) {
+  int nx, ny, nz;
+  source_cells(src, &nx, &ny, &nz);
+  int box[4] = {INT_MAX, INT_MIN, INT_MAX, INT_MIN}; /* this rank's cells +- 1: x lo hi, z lo hi */
+  for (size_t a = 0; a < nf; a++) {
+    int ix, iz;
+    source_column(src, nx, nz, P->x[a], P->z[a], &ix, &iz);
+    box[0] = ix - 1 < box[0] ? ix - 1 : box[0], box[1] = ix + 1 > box[1] ? ix + 1 : box[1];
+    box[2] = iz - 1 < box[2] ? iz - 1 : box[2], box[3] = iz + 1 > box[3] ? iz + 1 : box[3];
+  }
+  int *boxes = mem_alloc(4 * (size_t)own->size, sizeof *boxes, "initial state");
+  if (own->size > 1)
+    CHECK_MPI(MPI_Allgather(box, 4, MPI_INT, boxes, 4, MPI_INT, MPI_COMM_WORLD));
+  else
+    memcpy(boxes, box, sizeof box);
+  enum { R = 9 }; /* index x y z u v w rho mass */
+  size_t m = 0, cap = src->n ? src->n : 1;
+  int *dest = mem_alloc(1, cap * sizeof *dest, "initial state");
+  double *rec = mem_alloc(1, cap * R * sizeof *rec, "initial state");
+  for (size_t b = 0; b < src->n; b++) {
+    int ix, iz;
+    source_column(src, nx, nz, src->col[0][b], src->col[2][b], &ix, &iz);
+    for (int r = 0; r < own->size; r++) {
+      const int *q = boxes + 4 * r;
+      if (q[0] > q[1] || !in_periodic(ix, q[0], q[1], nx) || !in_periodic(iz, q[2], q[3], nz))
+        continue;
+      if (m == cap) {
+        cap *= 2;
+        dest = mem_realloc(dest, cap, sizeof *dest, "initial state");
+        rec = mem_realloc(rec, cap * R, sizeof *rec, "initial state");
+      }
+      rec[m * R] = (double)(src->first + b);
+      for (int c = 0; c < 8; c++) rec[m * R + 1 + c] = src->col[c][b];
+      dest[m++] = r;
+    }
+  }
+  free(boxes);
+  size_t got;
+  double *in = send_records(own, dest, m, rec, R, &got);
+  free(dest), free(rec);
+  qsort(in, got, R * sizeof(double), cmp_first); /* file order */
+  for (int c = 0; c < 8; c++) {
+    free(src->col[c]);
+    src->col[c] = mem_alloc(1, (got ? got : 1) * sizeof(double), "initial state");
+    for (size_t k = 0; k < got; k++) src->col[c][k] = in[k * R + 1 + c];
+  }
+  free(src->id), src->id = NULL;
+  src->n = got;
+  part_free(in);
+}
+
+static int from_file(const struct scene *sc, struct particles *P, size_t nf,
+                     const struct init_owner *own) {
   struct source src;
-  TRY(read_source(sc->init_from, sc, &src));
+  TRY(read_source(sc->init_from, sc, &src, own));
   if (src.packed)
     msg("init: %d variables of %s were CF-packed (scale_factor, add_offset): unpacked to the "
         "packing's precision\n",
         src.packed, sc->init_from);
-  if (src.n == P->n_fluid) { /* same resolution: the state itself, by id */
-    for (size_t b = 0; b < src.n; b++) {
-      /* fresh lattice: fluid particle a has id a; the ids are a permutation (check_source) */
-      const size_t a = (size_t)src.id[b];
-      P->x[a] = src.col[0][b], P->y[a] = src.col[1][b], P->z[a] = src.col[2][b];
-      P->u[a] = src.col[3][b], P->v[a] = src.col[4][b], P->w[a] = src.col[5][b];
-      P->rho[a] = src.col[6][b];
-    }
-    msg("init: positions, velocities and densities of %zu particles from %s\n", src.n,
+  if (src.total == P->n_fluid) { /* same resolution: the state itself, by id */
+    place_state(&src, sc, P, nf, own);
+    msg("init: positions, velocities and densities of %zu particles from %s\n", src.total,
         sc->init_from);
-    if (sc->init_density == INIT_DENSITY_RHO0) shift_density(sc, P);
+    nf = local_fluid(P);
+    if (sc->init_density == INIT_DENSITY_RHO0) shift_density(sc, P, nf, own);
   } else {
-    interpolate(&src, P);
-    msg("init: velocity interpolated from %zu particles of %s onto %zu particles\n", src.n,
+    gather_cells(&src, P, nf, own);
+    interpolate(&src, P, nf);
+    msg("init: velocity interpolated from %zu particles of %s onto %zu particles\n", src.total,
         sc->init_from, P->n_fluid);
+    source_free(&src);
   }
-  source_free(&src);
   return CHANSPH_OK;
 }
 
@@ -618,11 +861,11 @@ void init_sem_velocity(const struct init_sem *E, const struct scene *sc, double 
   vel[2] = ut * a33 * xi[2];
 }
 
-static void synthetic(const struct scene *sc, double ut, struct particles *P) {
+static void synthetic(const struct scene *sc, double ut, struct particles *P, size_t nf) {
   struct init_sem E;
   init_sem_make(&E, sc);
 #pragma omp parallel for schedule(static)
-  for (size_t a = 0; a < P->n_fluid; a++) {
+  for (size_t a = 0; a < nf; a++) {
     double vel[3];
     init_sem_velocity(&E, sc, ut, P->x[a], P->y[a], P->z[a], vel);
     P->u[a] = vel[0], P->v[a] = vel[1], P->w[a] = vel[2];
@@ -637,26 +880,30 @@ static void synthetic(const struct scene *sc, double ut, struct particles *P) {
   init_sem_free(&E);
 }
 
-int init_fields(const struct scene *sc, struct particles *P) {
+int init_fields(const struct scene *sc, struct particles *P, const struct init_owner *own) {
+  const struct init_owner one = {NULL, NULL, 0, 1};
+  if (!own) own = &one;
   const struct wall_law_def L = wall_law_make(WALL_LAW_REICHARDT, sc->kappa, sc->log_b);
   const double ut = sc->init_profile == INIT_REICHARDT || sc->init_profile == INIT_SYNTHETIC
                         ? init_reichardt_utau(sc)
                         : 0.0;
   if (sc->init_from[0]) {
-    TRY(from_file(sc, P));
+    TRY(from_file(sc, P, local_fluid(P), own));
   } else if (sc->init_profile == INIT_SYNTHETIC) {
-    synthetic(sc, ut, P);
+    synthetic(sc, ut, P, local_fluid(P));
   } else {
-    for (size_t a = 0; a < P->n_fluid; a++) P->u[a] = mean_u(sc, &L, ut, P->y[a]);
+    const size_t nf = local_fluid(P);
+    for (size_t a = 0; a < nf; a++) P->u[a] = mean_u(sc, &L, ut, P->y[a]);
     if (sc->init_profile == INIT_WAVE) /* thesis Sec. 3.1.2 */
-      for (size_t a = 0; a < P->n_fluid; a++)
+      for (size_t a = 0; a < nf; a++)
         P->v[a] = sc->init_wave * sin(4.0 * M_PI * P->y[a] / (2.0 * sc->delta));
   }
   const double two_d = 2.0 * sc->delta;
   const double alpha = 2.0 * M_PI * sc->init_mode_kx / sc->lx;
   const double beta = sc->dim == 3 ? 2.0 * M_PI * sc->init_mode_kz / sc->lz : 0.0;
   const double bs = sc->dim == 3 ? 2.0 * M_PI * sc->init_streak_kz / sc->lz : 0.0;
-  for (size_t a = 0; a < P->n_fluid; a++) {
+  const size_t nf = local_fluid(P); /* this rank's fluid particles: the first slots */
+  for (size_t a = 0; a < nf; a++) {
     const double eta = P->y[a] / two_d, x = P->x[a], z = P->z[a];
     if (sc->init_streaks > 0.0 && sc->dim == 3)
       P->u[a] += sc->init_streaks * 4.0 * eta * (1.0 - eta) * cos(bs * z);

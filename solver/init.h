@@ -10,14 +10,25 @@
 #include "part.h"
 #include "scene.h"
 
+/** The ranks of a run and which of them owns a position (the blocks of the decomposition):
+    init.from is read in slices, one per rank, and its particles sent to the ranks that need
+    them. */
+struct init_owner {
+  int (*owner)(const void *ctx, double x, double z); /*!< NULL: rank 0 (one rank) */
+  const void *ctx;
+  int rank, size;
+};
+
 /**
  * @brief Set the velocities (and, from an earlier run of the same resolution, positions and
- *        densities) of the fluid particles of a freshly created lattice.
+ *        densities) of the fluid particles of a freshly created lattice (or of this rank's
+ *        block of it). Collective over own's ranks with init.from.
  * @param[in] sc scene
- * @param[in,out] P particles as created by part_create
+ * @param[in,out] P particles as created by part_create or part_create_part (fluid first)
+ * @param[in] own the ranks and the owner of a position; NULL: one rank
  * @return CHANSPH_OK, or CHANSPH_ERR after a message naming the file (init.from)
  */
-int init_fields(const struct scene *sc, struct particles *P);
+int init_fields(const struct scene *sc, struct particles *P, const struct init_owner *own);
 
 /**
  * @brief The state a run starts from, for the provenance of its statistics (chansph extract
@@ -33,12 +44,13 @@ int init_fields(const struct scene *sc, struct particles *P);
 void init_origin(const char *path, char **run_id, double *time);
 
 /**
- * @brief Memory reading the init.from file needs (its columns, ids and checks), from the
- *        length of its dimension 'particle', before anything is read (a lower bound; 0 without
- *        init.from or if the file cannot be opened: reading it reports that).
+ * @brief Memory reading the init.from file needs on one of `ranks` ranks (its slice of the
+ *        columns and ids, the records sent and received, the id check), from the length of its
+ *        dimension 'particle', before anything is read (a lower bound; 0 without init.from or
+ *        if the file cannot be opened: reading it reports that).
  * @param[out] count its particles
  */
-double init_source_bytes(const struct scene *sc, double *count);
+double init_source_bytes(const struct scene *sc, int ranks, double *count);
 
 /**
  * @brief The friction velocity of the Reichardt initial profile: (force delta)^(1/2) in force

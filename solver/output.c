@@ -443,6 +443,23 @@ static void log_blocks(struct output *o, const struct sim *S) {
              ghosts / (nxo * nzo));
 }
 
+/* The measured start-up memory: the peak resident memory of the ranks once the particles are
+   built (or read) and distributed, the part of it the start-up added (above the process's peak
+   before sim_create: binary, MPI, libraries), and that part per owned + ghost particle. */
+static void log_memory(struct output *o, const struct sim *S) {
+  const double peak = mem_peak_resident(), local = (double)(S->P.n + S->P.n_ghost);
+  const double x[3] = {peak, peak - S->rss_before, (peak - S->rss_before) / (local > 0 ? local : 1)};
+  double mx[3], sum[3];
+  CHECK_MPI(MPI_Allreduce(x, mx, 3, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD));
+  CHECK_MPI(MPI_Allreduce(x, sum, 3, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD));
+  const int n = S->dd.size;
+  output_log(o,
+             "memory: start-up peak resident %.1f MB a rank (mean of %d; max %.1f MB), of which "
+             "the start-up %.1f MB (mean; max %.1f MB), %.0f bytes per owned + ghost particle "
+             "(mean; max %.0f)\n",
+             sum[0] / n / 1e6, n, mx[0] / 1e6, sum[1] / n / 1e6, mx[1] / 1e6, sum[2] / n, mx[2]);
+}
+
 void output_begin(struct output *o, struct sim *S) {
   struct diag d;
   record(o, S, &d);
@@ -458,6 +475,7 @@ void output_begin(struct output *o, struct sim *S) {
              "memory: the large allocations need at least %.4g GB per rank (checked before "
              "the start against 80%% of the machine's memory)\n",
              sim_memory_estimate(S->sc) / 1e9);
+  log_memory(o, S);
   if (S->dd.size > 1) log_blocks(o, S);
   warn_settings(o, S);
   log_progress(o, S, &d);
@@ -469,6 +487,7 @@ void output_resume(struct output *o, struct sim *S) {
   o->t0 = S->t, o->last_step = o->step0 = S->step;
   output_log(o, "chansph %s: resumed at step %ld, t = %.9g s: %zu fluid + %zu vertex particles\n",
              CHANSPH_VERSION, S->step, S->t, S->P.n_fluid, S->P.n_vertex);
+  log_memory(o, S);
   if (S->dd.size > 1) log_blocks(o, S); /* the decomposition may differ from the last job's */
   warn_settings(o, S);
 }

@@ -228,43 +228,89 @@ double part_bytes(const struct scene *s, double *count) {
   return n * per;
 }
 
+/* The lattice particle of id a, fluid (slot a of the whole lattice, i j k order) or vertex. */
+static void lattice_particle(struct particles *P, size_t slot, const struct scene *s, int nx,
+                             int ny, int nz, size_t a) {
+  const double dr = s->dr, mass = s->rho0 * pow(dr, s->dim);
+  const double zc = s->dim == 3 ? 0.5 * dr : 0.0;
+  const size_t nf = (size_t)nx * (size_t)(ny - 1) * (size_t)nz;
+  if (a < nf) {
+    const size_t k = a % (size_t)nz, j = 1 + (a / (size_t)nz) % (size_t)(ny - 1),
+                 i = a / ((size_t)nz * (size_t)(ny - 1));
+    P->x[slot] = (i + 0.5) * dr, P->y[slot] = j * dr, P->z[slot] = k * dr + zc;
+    P->m[slot] = mass, P->gam[slot] = 1.0, P->kind[slot] = KIND_FLUID;
+  } else {
+    const size_t v = a - nf, k = v % (size_t)nz, i = (v / (size_t)nz) % (size_t)nx,
+                 wall = v / ((size_t)nz * (size_t)nx);
+    P->x[slot] = (i + 0.5) * dr, P->y[slot] = wall ? 2.0 * s->delta : 0.0;
+    P->z[slot] = k * dr + zc;
+    P->m[slot] = 0.5 * mass, P->gam[slot] = 0.5, P->kind[slot] = KIND_VERTEX;
+  }
+  P->rho[slot] = s->rho0, P->id[slot] = (int64_t)a;
+}
+
+/* Whether the lattice particle of id a is in the selection (NULL: every particle). */
+static int selected(const struct part_select *sel, const struct scene *s, int nx, int ny, int nz,
+                    size_t a) {
+  if (!sel) return 1;
+  if (a < sel->lo || a >= sel->hi) return 0;
+  if (!sel->keep) return 1;
+  struct particles one;
+  double x, y, z, m, g, rho;
+  int64_t id;
+  uint8_t kind;
+  one.x = &x, one.y = &y, one.z = &z, one.m = &m, one.gam = &g, one.rho = &rho, one.id = &id;
+  one.kind = &kind;
+  lattice_particle(&one, 0, s, nx, ny, nz, a);
+  return sel->keep(sel->ctx, x, z);
+}
+
 void part_create(struct particles *P, struct walls *W, const struct scene *s) {
+  part_create_part(P, W, s, NULL);
+}
+
+void part_create_part(struct particles *P, struct walls *W, const struct scene *s,
+                      const struct part_select *sel) {
   const int nx = (int)floor(s->lx / s->dr + 0.5);
   const int ny = (int)floor(2.0 * s->delta / s->dr + 0.5);
   const int nz = s->dim == 3 ? (int)floor(s->lz / s->dr + 0.5) : 1;
   memset(P, 0, sizeof *P);
   P->n_fluid = (size_t)nx * (size_t)(ny - 1) * (size_t)nz;
   P->n_vertex = 2 * (size_t)nx * (size_t)nz;
-  P->n = P->n_fluid + P->n_vertex;
-  P->cap = P->n;
+  const size_t N = P->n_fluid + P->n_vertex;
+  /* count, allocate, fill: the lattice in id order, each particle tested (no full lattice) */
+  size_t n = 0;
+  if (!sel) {
+    n = N;
+  } else if (!sel->keep) {
+    n = (sel->hi < N ? sel->hi : N) - (sel->lo < N ? sel->lo : N);
+  } else {
+    for (size_t a = 0; a < N; a++) n += (size_t)selected(sel, s, nx, ny, nz, a);
+  }
+  P->n = n, P->cap = n ? n : 1;
   struct array t[N_ARRAYS_MAX];
   for (size_t i = 0, na = arrays(P, t); i < na; i++)
-    if (t[i].core) *t[i].p = part_alloc(t[i].label, P->n * t[i].elem);
-
-  const double dr = s->dr, mass = s->rho0 * pow(dr, s->dim);
-  const double zc = s->dim == 3 ? 0.5 * dr : 0.0;
-  size_t a = 0;
-  for (int i = 0; i < nx; i++)
-    for (int j = 1; j < ny; j++)
-      for (int k = 0; k < nz; k++, a++) {
-        P->x[a] = (i + 0.5) * dr, P->y[a] = j * dr, P->z[a] = k * dr + zc;
-        P->rho[a] = s->rho0, P->m[a] = mass, P->gam[a] = 1.0;
-        P->id[a] = (int64_t)a, P->kind[a] = KIND_FLUID;
-      }
+    if (t[i].core) *t[i].p = part_alloc(t[i].label, P->cap * t[i].elem);
+  size_t slot = 0;
+  const size_t a0 = sel && !sel->keep ? sel->lo : 0,
+               a1 = sel && !sel->keep && sel->hi < N ? sel->hi : N;
+  for (size_t a = a0; a < a1; a++)
+    if (!sel || !sel->keep || selected(sel, s, nx, ny, nz, a))
+      lattice_particle(P, slot++, s, nx, ny, nz, a);
   memset(W, 0, sizeof *W); /* the optional wall arrays stay NULL (part_alloc_optional) */
   W->nx = nx, W->nz = nz;
   for (int i = 0; i < wall_n_fields; i++)
     if (wall_fields[i].need == PN_CORE)
       *(double **)((char *)W + wall_fields[i].off) =
           part_alloc(wall_fields[i].label, P->n_vertex * sizeof(double));
-  for (int wall = 0; wall < 2; wall++)
-    for (int i = 0; i < nx; i++)
-      for (int k = 0; k < nz; k++, a++) {
-        P->x[a] = (i + 0.5) * dr, P->y[a] = wall ? 2.0 * s->delta : 0.0, P->z[a] = k * dr + zc;
-        P->rho[a] = s->rho0, P->m[a] = 0.5 * mass, P->gam[a] = 0.5;
-        P->id[a] = (int64_t)a, P->kind[a] = KIND_VERTEX;
-        W->rho[a - P->n_fluid] = s->rho0;
-      }
+  for (size_t v = 0; v < P->n_vertex; v++) W->rho[v] = s->rho0; /* every rank: all walls */
+}
+
+void part_move(struct particles *P, size_t to, size_t from, size_t n) {
+  struct array t[N_ARRAYS_MAX];
+  for (size_t i = 0, na = arrays(P, t); i < na; i++)
+    if (*t[i].p)
+      memmove((char *)*t[i].p + to * t[i].elem, (char *)*t[i].p + from * t[i].elem, n * t[i].elem);
 }
 
 void part_alloc_optional(struct particles *P, struct walls *W, const struct scene *s) {

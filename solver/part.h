@@ -237,9 +237,9 @@ void part_free(void *ptr);
 void part_memory_report(FILE *f);
 
 /**
- * @brief Memory the particles of a scene need on a rank (every rank builds the initial
- *        lattice), before anything is allocated: a lower bound from the per-particle arrays,
- *        the step's scratch, the neighbour lists and the checkpoint's copies.
+ * @brief Memory the particles of a whole scene need (on one rank; several ranks need their
+ *        share of it, dd_share), before anything is allocated: a lower bound from the
+ *        per-particle arrays, the step's scratch, the neighbour lists and the checkpoint's copies.
  * @param[out] count number of particles (fluid and wall vertices)
  * @return bytes
  */
@@ -254,6 +254,23 @@ double part_bytes(const struct scene *s, double *count);
  */
 void part_create(struct particles *P, struct walls *W, const struct scene *s);
 
+/** Which particles of the lattice a rank builds (part_create_part): the ids lo .. hi-1 that
+    keep(ctx, x, z) accepts (keep NULL: all of them). */
+struct part_select {
+  size_t lo, hi;
+  int (*keep)(const void *ctx, double x, double z);
+  const void *ctx;
+};
+
+/**
+ * @brief part_create() for the particles of sel only, in id order (fluid, then vertices):
+ *        a rank builds its block of the decomposition (keep: the owner of the position's
+ *        cell column), or the slots of its checkpoint id block (lo, hi) before a resume reads
+ *        them. n_fluid and n_vertex stay the whole run's; the wall arrays hold every vertex.
+ */
+void part_create_part(struct particles *P, struct walls *W, const struct scene *s,
+                      const struct part_select *sel);
+
 /**
  * @brief Make every per-particle array hold at least n slots (grows by half again; keeps the
  *        contents of slots 0 .. P->n + P->n_ghost - 1).
@@ -265,6 +282,10 @@ void part_reserve(struct particles *P, size_t n);
  *        e.g. to give back the memory of the full initial lattice once a rank kept its part.
  */
 void part_resize(struct particles *P, size_t cap);
+
+/** @brief Move the n slots from .. from+n-1 of every allocated array to to .. to+n-1 (the
+           ranges may overlap; the slots must fit the capacity). */
+void part_move(struct particles *P, size_t to, size_t from, size_t n);
 
 /** @brief Free everything part_create() and part_alloc_optional() allocated. */
 void part_destroy(struct particles *P, struct walls *W);

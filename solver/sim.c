@@ -100,18 +100,20 @@ static int ranks_on_node(void) {
 /** Before any allocation: refuse a scene whose large allocations (lower bounds) on the ranks of
     this node need more than 80% of the machine's memory (sysconf physical pages), naming the
     keys of the largest and the sizes; a clear refusal, not the OOM killer of a shared node.
-    Every rank builds the full initial lattice and its own statistics engines, so a node's need
-    is its ranks' sum. The rest is for the system, MPI and what the bounds leave out: the peak
-    resident memory measured was 1.0 (2-D, dr = 0.002) to 1.25 (3-D, dr = 0.00625) times the
-    bound (docs/performance.md, "Memory check of a scene"). */
-static int check_memory(const struct scene *sc) {
+    Every rank builds the particles of its block (sim_share: with its halo and the room the
+    arrays grow by) and its own statistics engines, so a node's need is its ranks' sum. The
+    rest is for the system, MPI and what the bounds leave out: the peak resident memory measured
+    was 1.0 (2-D, dr = 0.002) to 1.25 (3-D, dr = 0.00625) times the bound (docs/performance.md,
+    "Memory check of a scene"). */
+static int check_memory(const struct scene *sc, const struct dd *d) {
   enum { M_PARTS, M_EULER, M_CORR, M_LAGR, M_EDDIES, M_SOURCE, M_N };
   double n = 0.0, src = 0.0, bytes[M_N];
-  bytes[M_PARTS] = part_bytes(sc, &n), bytes[M_EDDIES] = init_bytes(sc);
+  bytes[M_PARTS] = part_bytes(sc, &n) * dd_share(d), bytes[M_EDDIES] = init_bytes(sc);
   output_stats_bytes(sc, &bytes[M_EULER], &bytes[M_CORR], &bytes[M_LAGR]);
-  bytes[M_SOURCE] = init_source_bytes(sc, &src);
+  bytes[M_SOURCE] = init_source_bytes(sc, d->size, &src);
   char what[M_N][160];
-  snprintf(what[M_PARTS], sizeof what[0], "%.4g particles", n);
+  snprintf(what[M_PARTS], sizeof what[0], "%.4g particles (of %.4g) with their halo",
+           n * dd_share(d), n);
   snprintf(what[M_EULER], sizeof what[0],
            "the Eulerian statistics of %d bins (x %d cell columns, per window with the "
            "Reynolds-stress budgets)",
@@ -119,7 +121,8 @@ static int check_memory(const struct scene *sc) {
   snprintf(what[M_CORR], sizeof what[0], "the correlation grids");
   snprintf(what[M_LAGR], sizeof what[0], "the Lagrangian records (levels x lags x release slots)");
   snprintf(what[M_EDDIES], sizeof what[0], "%.4g synthetic eddies", init_sem_count(sc));
-  snprintf(what[M_SOURCE], sizeof what[0], "the %.4g particles of %.100s", src, sc->init_from);
+  snprintf(what[M_SOURCE], sizeof what[0], "this rank's share of the %.4g particles of %.100s", src,
+           sc->init_from);
   static const char *const keys[M_N] = {
       "keys 'domain.lx', 'domain.delta', 'domain.lz', 'domain.dr'",
       "keys 'output.n_bins', 'domain.lx', 'stats.window'",
@@ -128,7 +131,7 @@ static int check_memory(const struct scene *sc) {
       "'lagrangian.release_every'",
       "keys 'init.eddies', 'init.eddy_size'",
       "key 'init.from'"};
-  static const char *const remedy[M_N] = {"use a smaller domain or a larger dr",
+  static const char *const remedy[M_N] = {"use a smaller domain or a larger dr, or more ranks",
                                           "use fewer bins or longer windows",
                                           "use fewer grid points or levels",
                                           "use fewer levels or lags, or release less often",
@@ -145,8 +148,8 @@ static int check_memory(const struct scene *sc) {
   const double have = pages > 0 && page > 0 ? (double)pages * (double)page : INFINITY;
   if (total * ranks <= 0.8 * have) return CHANSPH_OK;
   error_input(
-      "%s: %s: %s need at least %.3g GB per MPI rank (every rank builds the initial "
-      "lattice and its statistics; %.3g GB in all, %.3g GB for the %d rank%s on this "
+      "%s: %s: %s need at least %.3g GB per MPI rank (every rank builds its block of the "
+      "particles and its statistics; %.3g GB in all, %.3g GB for the %d rank%s on this "
       "node), more than the %.3g GB (80%%) of the %.3g GB of memory of this machine: %s",
       sc->path[0] ? sc->path : "(scene)", keys[k], what[k], bytes[k] / 1e9, total / 1e9,
       total * ranks / 1e9, ranks, ranks > 1 ? "s" : "", 0.8 * have / 1e9, have / 1e9,
@@ -155,23 +158,55 @@ static int check_memory(const struct scene *sc) {
   return CHANSPH_ERR;
 }
 
-/** The memory estimate of a scene on this rank (what check_memory adds up) [bytes]. */
+/** The memory estimate of a scene on one rank of one (what check_memory adds up) [bytes]. */
 double sim_memory_estimate(const struct scene *sc) {
   double n, src, e, c, l;
   output_stats_bytes(sc, &e, &c, &l);
-  return part_bytes(sc, &n) + init_bytes(sc) + init_source_bytes(sc, &src) + e + c + l;
+  return part_bytes(sc, &n) + init_bytes(sc) + init_source_bytes(sc, 1, &src) + e + c + l;
 }
 
-int sim_create(struct sim *S, const struct scene *sc) {
+/* Whether this rank owns the cell column of a position (part_select, init_owner). */
+static int owns_position(const void *ctx, double x, double z) {
+  const struct sim *S = ctx;
+  nbr_wrap_position(&S->nb, &x, &z);
+  return dd_owner(&S->dd, nbr_column(&S->nb, x), nbr_plane(&S->nb, z)) == S->dd.rank;
+}
+
+/* The rank that owns the cell column of a position (init_owner). */
+static int owner_of_position(const void *ctx, double x, double z) {
+  const struct sim *S = ctx;
+  nbr_wrap_position(&S->nb, &x, &z);
+  return dd_owner(&S->dd, nbr_column(&S->nb, x), nbr_plane(&S->nb, z));
+}
+
+int sim_create(struct sim *S, const struct scene *sc, int resume) {
   memset(S, 0, sizeof *S);
-  TRY(check_memory(sc));
   S->sc = sc;
+  S->rss_before = mem_peak_resident(); /* the log's start-up memory (output.c) */
+  /* the blocks and the grid first: each rank builds only its part of the particles */
+  if (dd_init(&S->dd, sc, sim_reserve, S)) return CHANSPH_ERR;
+  const struct nbr_range r = dd_range(&S->dd);
+  nbr_init(&S->nb, sc, 0, &r); /* sized in sim_distribute, for this rank's part */
+  S->grid = 1;
+  if (check_memory(sc, &S->dd)) {
+    sim_free(S);
+    return CHANSPH_ERR;
+  }
   sph_model_init(&S->M, sc);
-  /* every rank builds the same full initial state; sim_distribute keeps its own columns */
-  part_create(&S->P, &S->W, sc);
+  /* a fresh start: the lattice particles of this rank's block; a resume: the slots of its
+     checkpoint id block (sim_state reads them; sim_restored migrates them to their owners) */
+  struct part_select sel = {0, SIZE_MAX, owns_position, S};
+  if (resume) {
+    double n;
+    part_bytes(sc, &n);
+    sim_id_block(S->dd.rank, S->dd.size, (size_t)n, &sel.lo, &sel.hi);
+    sel.keep = NULL;
+  }
+  part_create_part(&S->P, &S->W, sc, S->dd.size > 1 ? &sel : NULL);
   part_alloc_optional(&S->P, &S->W, sc); /* the arrays of the modules the scene turns on */
-  if (init_fields(sc, &S->P)) {
-    part_destroy(&S->P, &S->W);
+  const struct init_owner own = {owner_of_position, S, S->dd.rank, S->dd.size};
+  if (init_fields(sc, &S->P, &own)) {
+    sim_free(S);
     return CHANSPH_ERR;
   }
   if (scene_stats_num(sc, &euler_key_eulerian)) S->wall_ax = part_alloc("wall_ax", sizeof(double));
@@ -183,22 +218,16 @@ int sim_create(struct sim *S, const struct scene *sc) {
   return CHANSPH_OK;
 }
 
-/* Partition the grid's pencils over the ranks (blocks), keep this rank's particles, set up the
-   grid. From a checkpoint read on several ranks (block = 1), this rank holds the slots of its id
-   block (sim_state), which migrate to their owners. */
+/* Keep this rank's particles and size the arrays and the grid for them. From a checkpoint read
+   on several ranks (block = 1), this rank holds the slots of its id block (sim_state), which
+   migrate to their owners. */
 static int sim_distribute(struct sim *S, int block) {
-  if (dd_init(&S->dd, S->sc, sim_reserve, S)) return CHANSPH_ERR;
-  const struct nbr_range r = dd_range(&S->dd);
-  nbr_init(&S->nb, S->sc, 0, &r); /* sized below, for this rank's part */
-  if (block && S->dd.size > 1) {
-    size_t lo, hi;
-    sim_id_block(S->dd.rank, S->dd.size, S->P.n_fluid + S->P.n_vertex, &lo, &hi);
-    dd_take_block(&S->dd, &S->P, &S->nb, lo, hi - lo);
-  } else {
-    dd_keep_owned(&S->dd, &S->P, &S->nb);
-  }
-  /* several ranks: give back the full lattice's memory, keeping room for the ghosts and the
-     particles that arrive (the arrays grow by half again when needed) */
+  if (block && S->dd.size > 1)
+    dd_take_block(&S->dd, &S->P, &S->nb, 0, S->P.n);
+  else
+    dd_keep_owned(&S->dd, &S->P, &S->nb); /* built as owned: wraps the positions */
+  /* several ranks: room for the ghosts and the particles that arrive (the arrays grow by half
+     again when needed) */
   if (S->dd.size > 1) part_resize(&S->P, S->P.n + S->P.n / 2);
   sim_reserve(S, S->P.n);
   S->distributed = 1;
@@ -206,7 +235,7 @@ static int sim_distribute(struct sim *S, int block) {
 }
 
 int sim_init(struct sim *S, const struct scene *sc) {
-  TRY(sim_create(S, sc));
+  TRY(sim_create(S, sc, 0));
   if (sim_distribute(S, 0)) {
     sim_free(S);
     return CHANSPH_ERR;
@@ -216,7 +245,7 @@ int sim_init(struct sim *S, const struct scene *sc) {
 }
 
 void sim_free(struct sim *S) {
-  if (S->distributed) nbr_free(&S->nb), dd_free(&S->dd);
+  if (S->grid) nbr_free(&S->nb), dd_free(&S->dd);
   for (int k = 0; k < SIM_GATHER; k++) free(S->gather[k]);
   for (int k = 0; k < 5; k++) part_free(S->scratch[k]);
   part_free(S->ksum_new);

@@ -39,7 +39,9 @@ struct sim {
                                  force pass (NaN if not sampled) [N, N/m in 2-D] */
   char violation[384];      /*!< a fixed dt broke a stability limit, or the step is zero: what,
                                  where (else empty) */
-  int distributed;          /*!< 1 after the particles were split over the ranks */
+  int grid;                 /*!< 1 once the blocks and the grid are set up (sim_create) */
+  double rss_before;        /*!< peak resident memory before sim_create [bytes] (the log) */
+  int distributed;          /*!< 1 after the particles were sized for this rank's part */
   long qcrit_step;          /*!< step whose Q criterion P.qcrit holds (-1: none yet) */
   long reflections;         /*!< wall reflections on this rank since the process began
                                  (sph.wall_collision = reflect) */
@@ -77,11 +79,14 @@ double sim_viscosity(const struct scene *sc, double t);
 int sim_init(struct sim *S, const struct scene *sc);
 
 /**
- * @brief The full initial state on this rank (particles, fields, drive), not yet split over
- *        the ranks and without neighbours: sim_init() continues from it, a resume reads a
- *        checkpoint into it (sim_state) and continues with sim_restored().
+ * @brief The blocks of the decomposition and this rank's part of the initial state: the
+ *        particles of its block (resume = 0; init.from read in slices and sent to the owners)
+ *        or the slots of its checkpoint id block (resume = 1), fields and drive; without
+ *        neighbours. sim_init() continues from it, a resume reads a checkpoint into it
+ *        (sim_state) and continues with sim_restored().
+ * @return CHANSPH_OK, or CHANSPH_ERR after a message (too many ranks, memory, init.from)
  */
-int sim_create(struct sim *S, const struct scene *sc);
+int sim_create(struct sim *S, const struct scene *sc, int resume);
 
 /** @brief The memory check's estimate of a scene's large allocations on one rank (lower bounds:
            particles, statistics engines, synthetic eddies, the init.from state) [bytes]. */

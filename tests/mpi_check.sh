@@ -24,6 +24,10 @@
 #   blocks_resume_many  the same from 4 x 2 to 1, 3 x 1, 2 x 3
 #   blocks_kill      3 x 2 blocks, SIGKILL of one rank at random moments (checkpoints every 4
 #                    steps), resumed each time: equals the uninterrupted 1-rank run
+#   init_from  3-D LES started from another run's particles.nc (init.from), each rank reading
+#              only its own part: at the same resolution (with init.density = rho0) and at
+#              another (the velocity interpolated), on 1, 3 and 2 x 2 ranks: equal; a source with
+#              a repeated id on 2 ranks: exit 1, the message once, nothing written
 #   ckpt_resume      3-D LES: 100 steps on 2 ranks (parallel HDF5 checkpoint), resumed on 3 ranks
 #                    and on 1 rank to step 200; both equal the uninterrupted 1-rank run
 #   ckpt_write_fail  2 ranks under a file-size limit: exit 74, a message, previous checkpoint
@@ -249,6 +253,36 @@ case $case in
     OMP_NUM_THREADS=2 mpi "$np" run "$scene" --out "r${l}t2" --overwrite "${args[@]}" --set run.ranks=$l \
       > "r${l}t2.txt" 2>&1 || { tail "r${l}t2.txt"; echo "FAIL: $l x 2 threads"; exit 1; }
     compare r1 "r${l}t2" $steps noscene
+    ;;
+  init_from) # every rank reads its own part of the source: any decomposition starts the same
+    scene=$scenes/les395_smoke.ini
+    args=(--set domain.lx=2.4 --set domain.lz=1.6 --set output.stats_every=5 "${all_engines[@]}")
+    mpi 1 run "$scene" --out src --overwrite "${args[@]}" --set time.max_steps=20 > src.txt 2>&1 ||
+      { tail src.txt; echo "FAIL: source run"; exit 1; }
+    cp src/particles.nc dup.nc && /usr/bin/python3 -c "
+import h5py
+with h5py.File('dup.nc', 'r+') as f:
+    f['id'][5] = f['id'][6]" || { echo "FAIL: cannot edit the source"; exit 1; }
+    for res in same other; do
+      extra=(--set "init.from=$PWD/src/particles.nc" --set time.max_steps=20)
+      if [ $res = same ]; then extra+=(--set init.density=rho0); else extra+=(--set domain.dr=0.08); fi
+      for l in 1 3,1 2,2; do
+        np=$((${l%,*} * ${l#*,}))
+        ranks=(--set run.ranks=$l)
+        [ "$l" = 1 ] && ranks=()
+        mpi "$np" run "$scene" --out "r${res}_$l" --overwrite "${args[@]}" "${extra[@]}" "${ranks[@]}" \
+          > "r${res}_$l.txt" 2>&1 || { tail "r${res}_$l.txt"; echo "FAIL: $res resolution on $l"; exit 1; }
+        [ "$l" = 1 ] && grep -h "init: " "r${res}_$l.txt"
+        [ "$l" = 1 ] || compare "r${res}_1" "r${res}_$l" 20 noscene
+      done
+    done
+    mpi 2 run "$scene" --out rbad "${args[@]}" --set "init.from=$PWD/dup.nc" > rbad.txt 2>&1
+    rc=$?
+    [ $rc -eq 1 ] || { cat rbad.txt; echo "FAIL: a repeated id on 2 ranks: exit $rc, expected 1"; exit 1; }
+    n=$(grep -c "dup.nc (init.from): particle id [0-9]* repeated" rbad.txt)
+    [ "$n" = 1 ] || { cat rbad.txt; echo "FAIL: the message $n times, expected once"; exit 1; }
+    [ -z "$(ls -A rbad 2> /dev/null)" ] || { ls rbad; echo "FAIL: rbad has content"; exit 1; }
+    echo "ok: $(grep -h "repeated" rbad.txt)"
     ;;
   blocks_resume | blocks_resume_many) # a checkpoint of one decomposition resumed on others
     scene=$scenes/les395_smoke.ini

@@ -43,12 +43,12 @@ int main(int argc, char **argv) {
 
   /* threads: 1 and 2, bitwise */
   omp_set_num_threads(1);
-  if (init_fields(&sc, &P)) return 1;
+  if (init_fields(&sc, &P, NULL)) return 1;
   double *ref = malloc(3 * n * sizeof(double));
   memcpy(ref, P.u, n * sizeof(double)), memcpy(ref + n, P.v, n * sizeof(double));
   memcpy(ref + 2 * n, P.w, n * sizeof(double));
   omp_set_num_threads(2);
-  if (init_fields(&sc, &P)) return 1;
+  if (init_fields(&sc, &P, NULL)) return 1;
   const int same = !memcmp(ref, P.u, n * sizeof(double)) &&
                    !memcmp(ref + n, P.v, n * sizeof(double)) &&
                    !memcmp(ref + 2 * n, P.w, n * sizeof(double));
@@ -61,7 +61,7 @@ int main(int argc, char **argv) {
   static double sum[NS][NL][4], cnt[NL], mom[NL][NB][5], bcnt[NL][NB];
   for (int e = 0; e < NS; e++) {
     sc.init_seed = 7 + e;
-    if (e > 0 && init_fields(&sc, &P)) return 1;
+    if (e > 0 && init_fields(&sc, &P, NULL)) return 1;
     for (size_t a = 0; a < n; a++) {
       const int up = P.y[a] > sc.delta;
       const int l = (int)lround((up ? 2.0 * sc.delta - P.y[a] : P.y[a]) / dr) - 1;

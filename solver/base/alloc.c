@@ -3,6 +3,7 @@
 
 #include <stdint.h>
 #include <stdlib.h>
+#include <sys/resource.h>
 
 #include "error.h"
 
@@ -31,4 +32,10 @@ void *mem_realloc(void *p, size_t n, size_t size, const char *label) {
   void *q = realloc(p, bytes);
   if (!q) die("out of memory: %s (%zu bytes)", label, bytes);
   return q;
+}
+
+double mem_peak_resident(void) {
+  struct rusage u;
+  if (getrusage(RUSAGE_SELF, &u)) return 0.0;
+  return (double)u.ru_maxrss * 1024.0; /* kilobytes on Linux */
 }

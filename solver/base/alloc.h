@@ -30,4 +30,7 @@ void *mem_calloc(size_t n, size_t size, const char *label);
  */
 void *mem_realloc(void *p, size_t n, size_t size, const char *label);
 
+/** @brief The process's peak resident memory so far [bytes] (getrusage ru_maxrss; 0 if unknown). */
+double mem_peak_resident(void);
+
 #endif
