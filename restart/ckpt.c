@@ -3,7 +3,6 @@
 #include "alloc.h"
 
 #include <errno.h>
-#include <fcntl.h>
 #include <hdf5.h>
 #include <mpi.h>
 #include <stdarg.h>
@@ -12,8 +11,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <unistd.h>
 
+#include "durable.h"
 #include "error.h"
 
 /** Identity of the run (ckpt_set_run_id), written into every file; "" = none. */
@@ -231,52 +230,8 @@ static int write_field(hid_t file, const struct state_field *f, hid_t gcpl, int 
   return rc < 0 ? -1 : 0;
 }
 
-/* fsync a file or a directory by name. */
-static int sync_path(const char *path, int dir) {
-  const int fd = open(path, dir ? O_RDONLY | O_DIRECTORY : O_RDONLY);
-  if (fd < 0) return -1;
-  const int rc = fsync(fd);
-  close(fd);
-  return rc;
-}
-
 int ckpt_agree(int rc, char *err, size_t errlen) {
-  int me = 0, size = 1, first = 0;
-  MPI_Comm_rank(MPI_COMM_WORLD, &me);
-  MPI_Comm_size(MPI_COMM_WORLD, &size);
-  int mine = rc ? me : size;
-  CHECK_MPI(MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD));
-  if (first == size) return 0;
-  if (errlen > 0 && me != first) err[0] = '\0';
-  CHECK_MPI(MPI_Bcast(err, (int)errlen, MPI_CHAR, first, MPI_COMM_WORLD));
-  return 1;
-}
-
-/* Directory of a path, fsync'ed after a rename. */
-static int sync_dir(const char *path, char *err, size_t errlen) {
-  char dir[4096];
-  snprintf(dir, sizeof dir, "%s", path);
-  char *slash = strrchr(dir, '/');
-  if (slash) *slash = '\0';
-  if (sync_path(slash ? dir : ".", 1)) {
-    snprintf(err, errlen, "cannot fsync directory %s: %s", slash ? dir : ".", strerror(errno));
-    return 1;
-  }
-  return 0;
-}
-
-/* Parallel writes: rank 0 first makes sure the file fits (file-size limit, free space) by
-   allocating its estimated size, because HDF5 1.10 cannot fail cleanly inside a collective
-   write: an I/O error on one rank leaves the others waiting in HDF5's own MPI calls. */
-static int probe_space(const char *tmp, size_t bytes, char *err, size_t errlen) {
-  const int fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  int e = fd < 0 ? errno : posix_fallocate(fd, 0, (off_t)bytes);
-  if (fd >= 0 && close(fd) && !e) e = errno;
-  if (!e) return 0;
-  snprintf(err, errlen, "cannot write checkpoint %s (%s; %zu bytes needed)", tmp, strerror(e),
-           bytes);
-  remove(tmp);
-  return 1;
+  return durable_agree(rc, err, errlen);
 }
 
 /* Serial (par = 0): the file is built in memory (HDF5 core driver) and written to disk when it
@@ -356,7 +311,7 @@ static int write_content(hid_t file, hid_t gcpl, const char *format, const struc
 /* After the close: fsync the temporary file, rename it to path, fsync the directory (rank 0);
    on failure the temporary file is removed. */
 static int commit_file(const char *path, int rc, const struct wctx *w) {
-  if (w->me == 0 && !rc && sync_path(w->tmp, 0)) {
+  if (w->me == 0 && !rc && durable_sync(w->tmp, 0)) {
     snprintf(w->err, w->errlen, "cannot fsync %s %s: %s", w->noun, w->tmp, strerror(errno));
     rc = 1;
   }
@@ -365,7 +320,7 @@ static int commit_file(const char *path, int rc, const struct wctx *w) {
     rc = 1;
   }
   if (w->me == 0 && rc) remove(w->tmp);
-  if (w->me == 0 && !rc) rc = sync_dir(path, w->err, w->errlen);
+  if (w->me == 0 && !rc) rc = durable_sync_dir(path, w->err, w->errlen);
   if (w->par) rc = ckpt_agree(rc, w->err, w->errlen);
   return rc;
 }
@@ -385,10 +340,11 @@ static int write_file(const char *path, const char *format, const struct state_l
   const hid_t gcpl = H5Pcreate(H5P_GROUP_CREATE);
   CHECK_H5(H5Pset_obj_track_times(fcpl, 0));
   CHECK_H5(H5Pset_obj_track_times(gcpl, 0));
-  if (par) { /* the state, the scene and room for the metadata (4 kB a dataset, 64 kB) */
+  if (par) { /* rank 0 makes sure it fits first (durable_probe): the state, the scene and room
+                for the metadata (4 kB a dataset, 64 kB) */
     const size_t need = ckpt_state_bytes(L) + (scene ? strlen(scene) : 0) +
                         4096 * (size_t)(L->n + 1) + ((size_t)1 << 16);
-    if (ckpt_agree(me == 0 ? probe_space(tmp, need, err, errlen) : 0, err, errlen)) {
+    if (ckpt_agree(me == 0 ? durable_probe(tmp, need, w.noun, err, errlen) : 0, err, errlen)) {
       H5Pclose(fcpl), H5Pclose(fapl), H5Pclose(gcpl);
       return 1;
     }
@@ -424,11 +380,16 @@ int ckpt_write(const char *path, const struct state_list *L, const char *scene, 
   return write_file(path, CKPT_FORMAT, L, scene, step, time, 0, err, errlen);
 }
 
-int ckpt_write_all(const char *path, const struct state_list *L, const char *scene, long step,
-                   double time, char *err, size_t errlen) {
+int ckpt_write_fields_all(const char *path, const char *format, const struct state_list *L,
+                          const char *scene, long step, double time, char *err, size_t errlen) {
   int size = 1;
   MPI_Comm_size(MPI_COMM_WORLD, &size);
-  return write_file(path, CKPT_FORMAT, L, scene, step, time, size > 1, err, errlen);
+  return write_file(path, format, L, scene, step, time, size > 1, err, errlen);
+}
+
+int ckpt_write_all(const char *path, const struct state_list *L, const char *scene, long step,
+                   double time, char *err, size_t errlen) {
+  return ckpt_write_fields_all(path, CKPT_FORMAT, L, scene, step, time, err, errlen);
 }
 
 static int get_attr_int(hid_t obj, const char *name, hid_t mtype, void *v) {

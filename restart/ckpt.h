@@ -78,6 +78,7 @@ int ckpt_write_all(const char *path, const struct state_list *L, const char *sce
 /**
  * @brief Agree on an outcome over MPI_COMM_WORLD: returns 1 on every rank if rc was nonzero on
  *        any, with err (size errlen) replaced by the lowest failing rank's message. Collective.
+ *        (durable_agree, solver/base/durable.h, which the netCDF writers share.)
  */
 int ckpt_agree(int rc, char *err, size_t errlen);
 
@@ -88,6 +89,15 @@ int ckpt_agree(int rc, char *err, size_t errlen);
  */
 int ckpt_write_fields(const char *path, const char *format, const struct state_list *L,
                       const char *scene, long step, double time, char *err, size_t errlen);
+
+/**
+ * @brief ckpt_write_fields() collectively, as ckpt_write_all() writes a checkpoint: every rank
+ *        of MPI_COMM_WORLD calls it, each distributed field holding this rank's rows; on one
+ *        rank the serial writer (the same bytes as ckpt_write_fields()), on several parallel
+ *        HDF5. Every rank returns the same result and message (particle snapshots).
+ */
+int ckpt_write_fields_all(const char *path, const char *format, const struct state_list *L,
+                          const char *scene, long step, double time, char *err, size_t errlen);
 
 /**
  * @brief Open a checkpoint and check it: HDF5 structure, format name, version (a newer major

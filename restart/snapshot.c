@@ -122,6 +122,17 @@ static int write_xdmf(const char *sdir, size_t n, const struct snap_scalar *sc, 
   return rc;
 }
 
+/* Make the snapshot directory (rank 0); every rank returns the outcome. */
+static int snap_dir(const char *sdir, int root) {
+  int rc = CHANSPH_OK;
+  if (root && mkdir(sdir, 0777) && errno != EEXIST) {
+    error_input("%s: cannot create the snapshot directory (%s)", sdir, strerror(errno));
+    rc = CHANSPH_ERR;
+  }
+  CHECK_MPI(MPI_Bcast(&rc, 1, MPI_INT, 0, MPI_COMM_WORLD));
+  return rc;
+}
+
 int snapshot_write(const char *dir, struct sim *S) {
   timer_push("snapshot");
   const struct particles *P = &S->P;
@@ -138,48 +149,46 @@ int snapshot_write(const char *dir, struct sim *S) {
   int ns = 0;
   for (int k = 0; k < NS_MAX; k++)
     if (all[k].src) sc[ns++] = all[k];
-  /* gathered on rank 0 by id, which writes the file */
+  /* each rank the rows of its id block, by id; the ranks write the file together (no gather) */
   const int NC = 6 + ns;
   const double *src[NC_MAX] = {P->x, P->y, P->z, P->u, P->v, P->w};
   for (int k = 0; k < ns; k++) src[6 + k] = sc[k].src;
-  double *g = root ? mem_alloc(1, (size_t)NC * n * sizeof *g, "particle snapshot") : NULL;
-  if (root && !g) die("out of memory writing a snapshot");
-  dd_gather_fluid(&S->dd, P, NC, src, g);
-  int rc = CHANSPH_OK;
-  if (root) {
-    double *pos = mem_alloc(1, 3 * n * sizeof *pos, "particle snapshot"),
-           *vel = mem_alloc(1, 3 * n * sizeof *vel, "particle snapshot");
-    int64_t *id = mem_alloc(1, n * sizeof *id, "particle snapshot");
-    for (size_t r = 0; r < n; r++) {
-      for (int k = 0; k < 3; k++)
-        pos[3 * r + k] = g[k * n + r], vel[3 * r + k] = g[(3 + k) * n + r];
-      id[r] = (int64_t)r;
-    }
-    struct state_list L = {0};
-    const size_t d1[1] = {n}, d2[2] = {n, 3};
-    state_add(&L, "id", STATE_I64, 1, d1, id, NULL);
-    state_add(&L, "position", STATE_F64, 2, d2, pos, "m");
-    state_add(&L, "velocity", STATE_F64, 2, d2, vel, "m/s");
-    for (int k = 0; k < ns; k++)
-      state_add(&L, sc[k].name, STATE_F64, 1, d1, g + (size_t)(6 + k) * n, sc[k].units);
-    char sdir[4096], path[4200], err[2048];
-    snprintf(sdir, sizeof sdir, "%s/snapshots", dir);
-    snprintf(path, sizeof path, "%s/snap_%010ld.h5", sdir, S->step);
-    if (mkdir(sdir, 0777) && errno != EEXIST) {
-      error_input("%s: cannot create the snapshot directory (%s)", sdir, strerror(errno));
-      rc = CHANSPH_ERR;
-    } else if (ckpt_write_fields(path, "chansph-snapshot", &L, NULL, S->step, S->t, err,
-                                 sizeof err)) {
-      error_input("%s", err);
-      rc = CHANSPH_ERR;
-    } else if (write_xdmf(sdir, n, sc, ns)) {
-      error_input("%s/particles.xdmf: cannot write (%s)", sdir, strerror(errno));
-      rc = CHANSPH_ERR;
-    }
-    state_free(&L);
-    free(pos), free(vel), free(id);
+  size_t lo, hi;
+  dd_id_block(S->dd.rank, S->dd.size, n, &lo, &hi);
+  const size_t nb = hi - lo, m = nb ? nb : 1;
+  double *g = mem_alloc(1, (size_t)NC * m * sizeof *g, "particle snapshot");
+  dd_block_fluid(&S->dd, P, NC, src, lo, hi, g);
+  double *pos = mem_alloc(1, 3 * m * sizeof *pos, "particle snapshot"),
+         *vel = mem_alloc(1, 3 * m * sizeof *vel, "particle snapshot");
+  int64_t *id = mem_alloc(1, m * sizeof *id, "particle snapshot");
+  for (size_t r = 0; r < nb; r++) {
+    for (int k = 0; k < 3; k++)
+      pos[3 * r + k] = g[k * nb + r], vel[3 * r + k] = g[(3 + k) * nb + r];
+    id[r] = (int64_t)(lo + r);
   }
-  free(g);
+  struct state_list L = {0};
+  const size_t d1[1] = {nb}, d2[2] = {nb, 3};
+  state_add(&L, "id", STATE_I64, 1, d1, id, NULL);
+  state_add(&L, "position", STATE_F64, 2, d2, pos, "m");
+  state_add(&L, "velocity", STATE_F64, 2, d2, vel, "m/s");
+  for (int k = 0; k < ns; k++)
+    state_add(&L, sc[k].name, STATE_F64, 1, d1, g + (size_t)(6 + k) * nb, sc[k].units);
+  for (int i = 0; i < L.n; i++) L.f[i].offset = lo, L.f[i].total = n; /* rows lo .. hi-1 */
+  char sdir[4096], path[4200], err[2048];
+  snprintf(sdir, sizeof sdir, "%s/snapshots", dir);
+  snprintf(path, sizeof path, "%s/snap_%010ld.h5", sdir, S->step);
+  int rc = snap_dir(sdir, root);
+  if (!rc &&
+      ckpt_write_fields_all(path, "chansph-snapshot", &L, NULL, S->step, S->t, err, sizeof err)) {
+    if (root) error_input("%s", err);
+    rc = CHANSPH_ERR;
+  }
+  if (!rc && root && write_xdmf(sdir, n, sc, ns)) {
+    error_input("%s/particles.xdmf: cannot write (%s)", sdir, strerror(errno));
+    rc = CHANSPH_ERR;
+  }
+  state_free(&L);
+  free(pos), free(vel), free(id), free(g);
   CHECK_MPI(MPI_Bcast(&rc, 1, MPI_INT, 0, MPI_COMM_WORLD));
   timer_pop();
   return rc;

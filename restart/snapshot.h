@@ -16,7 +16,10 @@
 int snapshot_due(const struct sim *S);
 
 /**
- * @brief Write the snapshot of the current step atomically and rewrite the XDMF index.
+ * @brief Write the snapshot of the current step atomically and rewrite the XDMF index. Every
+ *        rank sends its fluid particles to the owners of their id blocks (dd_block_fluid) and
+ *        the ranks write the file together (ckpt_write_fields_all), each its block; rank 0 then
+ *        rewrites the index. Collective.
  * @param[in] dir run directory
  * @param[in,out] S simulation (with output.q_criterion the Q criterion is computed first)
  * @return CHANSPH_OK, or CHANSPH_ERR with a message naming the file

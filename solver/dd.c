@@ -856,35 +856,45 @@ size_t dd_check_ids(const struct dd *d, const struct particles *P, size_t n_tota
   return (size_t)t;
 }
 
-void dd_gather_fluid(const struct dd *d, const struct particles *P, int nf, const double *const *f,
-                     double *out) {
-  const size_t n = P->n_fluid, rec = (size_t)nf + 1;
+int dd_id_owner(int64_t id, int size, size_t N) {
+  int r = (int)((unsigned long long)id * (unsigned)size / N); /* a guess, then the exact block */
+  size_t lo, hi;
+  for (dd_id_block(r, size, N, &lo, &hi); (size_t)id >= hi; dd_id_block(++r, size, N, &lo, &hi)) {
+  }
+  for (; (size_t)id < lo; dd_id_block(--r, size, N, &lo, &hi)) {
+  }
+  return r;
+}
+
+void dd_block_fluid(const struct dd *d, const struct particles *P, int nf, const double *const *f,
+                    size_t lo, size_t hi, double *out) {
+  const size_t N = P->n_fluid, R = (size_t)nf + 1, nb = hi - lo;
   size_t mine = 0;
   for (size_t a = 0; a < P->n; a++) mine += P->kind[a] == KIND_FLUID;
-  double *buf = mem_alloc((mine ? mine : 1) * rec, sizeof(double), "domain decomposition");
+  /* records: the id (its bits), then the fields */
+  int *dest = mem_alloc(mine ? mine : 1, sizeof(int), "particle output");
+  double *rec = part_alloc("output_send", (mine ? mine : 1) * R * sizeof(double));
   for (size_t a = 0, k = 0; a < P->n; a++) {
     if (P->kind[a] != KIND_FLUID) continue;
-    buf[k * rec] = (double)P->id[a]; /* ids below 2^53 are exact */
-    for (int c = 0; c < nf; c++) buf[k * rec + 1 + c] = f[c][a];
+    dest[k] = dd_id_owner(P->id[a], d->size, N);
+    memcpy(&rec[k * R], &P->id[a], sizeof(double));
+    for (int c = 0; c < nf; c++) rec[k * R + 1 + (size_t)c] = f[c][a];
     k++;
   }
-  int cnt = (int)(mine * rec), *cnts = NULL, *disp = NULL;
-  double *all = NULL;
-  if (d->rank == 0) {
-    cnts = mem_alloc((size_t)d->size, sizeof(int), "domain decomposition");
-    disp = mem_alloc((size_t)d->size, sizeof(int), "domain decomposition");
-    all = mem_alloc((n ? n : 1) * rec, sizeof(double), "domain decomposition");
+  size_t got;
+  double *buf = dd_exchange(d->size, dest, mine, rec, R, &got);
+  part_free(rec), free(dest);
+  if (got != nb)
+    die("particle output: %zu fluid particles arrived for the %zu ids %zu..", got, nb, lo);
+  for (size_t i = 0; i < nb; i++) { /* by id: the same rows on any number of ranks */
+    int64_t id;
+    memcpy(&id, &buf[i * R], sizeof id);
+    if (id < (int64_t)lo || id >= (int64_t)hi)
+      die("particle output: fluid id %lld outside the block %zu..%zu", (long long)id, lo, hi - 1);
+    for (int c = 0; c < nf; c++)
+      out[(size_t)c * nb + (size_t)(id - (int64_t)lo)] = buf[i * R + 1 + (size_t)c];
   }
-  CHECK_MPI(MPI_Gather(&cnt, 1, MPI_INT, cnts, 1, MPI_INT, 0, MPI_COMM_WORLD));
-  if (d->rank == 0)
-    for (int r = 0, off = 0; r < d->size; off += cnts[r], r++) disp[r] = off;
-  CHECK_MPI(MPI_Gatherv(buf, cnt, MPI_DOUBLE, all, cnts, disp, MPI_DOUBLE, 0, MPI_COMM_WORLD));
-  if (d->rank == 0)
-    for (size_t k = 0; k < n; k++) {
-      const size_t id = (size_t)all[k * rec]; /* fluid ids are 0 .. n_fluid-1 */
-      for (int c = 0; c < nf; c++) out[(size_t)c * n + id] = all[k * rec + 1 + c];
-    }
-  free(buf), free(cnts), free(disp), free(all);
+  part_free(buf);
 }
 
 double *dd_exchange(int size, const int *dest, size_t n, const double *rec, size_t R, size_t *got) {

@@ -150,12 +150,28 @@ void dd_refresh(struct dd *d, const struct particles *P, const struct walls *W, 
 void dd_sum(const struct dd *d, const struct nbr *nb, int nv, const double *const *x, double *out);
 
 /**
- * @brief Gather nf per-particle arrays of the fluid particles of all ranks on rank 0, by id:
- *        out[k * n_fluid + id] = f[k] of the fluid particle id. Collective.
- * @param[out] out rank 0: nf * n_fluid values (other ranks: unused, may be NULL)
+ * @brief The id block of rank r of size ranks over the ids 0 .. N-1: lo .. hi-1, in rank order
+ *        and as even as integer division makes them. The checkpoints (sim_id_block), particles.nc
+ *        and the snapshots hold the ids in order, each rank writing its block.
  */
-void dd_gather_fluid(const struct dd *d, const struct particles *P, int nf, const double *const *f,
-                     double *out);
+static inline void dd_id_block(int r, int size, size_t N, size_t *lo, size_t *hi) {
+  *lo = (size_t)((unsigned long long)r * N / (unsigned)size);
+  *hi = (size_t)((unsigned long long)(r + 1) * N / (unsigned)size);
+}
+
+/** @brief The rank whose id block (dd_id_block over N ids, size ranks) holds id. */
+int dd_id_owner(int64_t id, int size, size_t N);
+
+/**
+ * @brief Send nf per-particle arrays of this rank's fluid particles to the ranks whose id blocks
+ *        (dd_id_block over n_fluid; fluid ids are 0 .. n_fluid-1) hold them, and place what
+ *        arrives by id: out[c (hi - lo) + id - lo] = f[c] of the fluid particle id, for this
+ *        rank's block lo .. hi-1. Collective (dd_exchange). Each rank holds its block only: the
+ *        particle files are written in parallel, nothing is gathered on one rank.
+ * @param[out] out nf (hi - lo) values
+ */
+void dd_block_fluid(const struct dd *d, const struct particles *P, int nf, const double *const *f,
+                    size_t lo, size_t hi, double *out);
 
 /**
  * @brief Debug check: every id 0 .. n_total-1 is owned by exactly one rank (gathered on rank 0).

@@ -635,28 +635,36 @@ static int write_particles(struct output *o, struct sim *S) {
     src[NC] = part_field_ptr(P, f), names[NC] = f->name, long_names[NC] = f->long_name;
     units[NC++] = f->off == offsetof(struct particles, m) && S->sc->dim == 2 ? "kg/m" : f->units;
   }
-  const int root = rank0();
-  double *buf = root ? mem_alloc(1, n * (size_t)NC * sizeof *buf, "output") : NULL;
-  if (root && !buf) die("out of memory writing particles.nc");
-  dd_gather_fluid(&S->dd, P, NC, src, buf); /* rank 0: by id */
-  int rc = CHANSPH_OK;
-  if (root) {
-    long long *ids = mem_alloc(1, n * sizeof *ids, "output");
-    for (size_t r = 0; r < n; r++) ids[r] = (long long)r;
-    const double *cols[NC_MAX];
-    for (int c = 0; c < NC; c++) cols[c] = buf + (size_t)c * n;
-    char date[32];
-    date_now(date, sizeof date);
-    const struct nc_attr attrs[] = {
-        {"time", NULL, S->t, 0}, {"step", NULL, (double)S->step, 1}, PROVENANCE_ATTRS(o, S, date)};
-    char path[4096], err[4096];
-    snprintf(path, sizeof path, "%s/particles.nc", o->dir);
-    rc = ncout_columns(path, "chansph particle state", "particle", n, NC, names, long_names, units,
-                       cols, ids, attrs, sizeof attrs / sizeof attrs[0], err, sizeof err);
-    free(ids);
-    if (rc) error_input("%s", err);
-  }
-  free(buf);
+  /* each rank the rows of its id block, by id; on several ranks they write the file together
+     (ncout_columns_par: no gather on one rank), on one the serial writer */
+  size_t lo, hi;
+  dd_id_block(S->dd.rank, S->dd.size, n, &lo, &hi);
+  const size_t nb = hi - lo, m = nb ? nb : 1;
+  double *buf = mem_alloc(1, m * (size_t)NC * sizeof *buf, "output");
+  dd_block_fluid(&S->dd, P, NC, src, lo, hi, buf);
+  long long *ids = mem_alloc(1, m * sizeof *ids, "output");
+  for (size_t r = 0; r < nb; r++) ids[r] = (long long)(lo + r);
+  const double *cols[NC_MAX];
+  for (int c = 0; c < NC; c++) cols[c] = buf + (size_t)c * nb;
+  char date[32];
+  date_now(date, sizeof date);
+  const struct nc_attr attrs[] = {
+      {"time", NULL, S->t, 0}, {"step", NULL, (double)S->step, 1}, PROVENANCE_ATTRS(o, S, date)};
+  const struct ncout_table t = {.title = "chansph particle state",
+                                .dim = "particle",
+                                .n = n,
+                                .ncol = NC,
+                                .names = names,
+                                .long_names = long_names,
+                                .units = units,
+                                .attrs = attrs,
+                                .nattrs = (int)(sizeof attrs / sizeof attrs[0])};
+  char path[4096], err[4096];
+  snprintf(path, sizeof path, "%s/particles.nc", o->dir);
+  const int rc = S->dd.size > 1 ? ncout_columns_par(path, &t, lo, nb, cols, ids, err, sizeof err)
+                                : ncout_columns(path, &t, cols, ids, err, sizeof err);
+  if (rc && rank0()) error_input("%s", err); /* the ranks agree on the outcome and message */
+  free(ids), free(buf);
   return agree(rc ? CHANSPH_ERR : CHANSPH_OK);
 }
 

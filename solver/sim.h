@@ -113,8 +113,7 @@ int sim_budget_sample(const struct scene *sc, long step);
 /** Checkpoint id blocks: rank r of size holds the ids [r N / size, (r+1) N / size) of the
     particle datasets (restart/layout.c). */
 static inline void sim_id_block(int r, int size, size_t N, size_t *lo, size_t *hi) {
-  *lo = (size_t)((unsigned long long)r * N / (unsigned)size);
-  *hi = (size_t)((unsigned long long)(r + 1) * N / (unsigned)size);
+  dd_id_block(r, size, N, lo, hi); /* the blocks of the particle files too */
 }
 
 /**

@@ -1,10 +1,11 @@
 /**
  * @file ncout.h
  * @brief The low-level netCDF-4 helpers of chansph's files (CF variables, fill values, labels,
- *        cell bounds, global attributes, the atomic commit) and the column files (particle
- *        snapshots). Files are built in memory, written to NAME.tmp, synced and renamed, so a
- *        reader or a crash never sees a half-written file and the previous version survives a
- *        failure. The stats.nc writer is stats_nc.h; this file knows no engine.
+ *        cell bounds, global attributes, the atomic commit) and the column files (particles.nc).
+ *        Files are built in memory, written to NAME.tmp, synced and renamed, so a reader or a
+ *        crash never sees a half-written file and the previous version survives a failure; a
+ *        column file of several ranks is written by them together (ncout_columns_par) with the
+ *        same rules. The stats.nc writer is stats_nc.h; this file knows no engine.
  */
 #ifndef CHANSPH_NCOUT_H
 #define CHANSPH_NCOUT_H
@@ -59,26 +60,46 @@ int ncout_link_stderr(int ncid);
  */
 int ncout_commit(int ncid, const char *tmp, const char *path, char *err, size_t errlen);
 
+/** What a column file holds besides its data (ncout_columns, ncout_columns_par). */
+struct ncout_table {
+  const char *title;             /*!< global attribute title (the file also gets Conventions =
+                                      CF-1.8, source) */
+  const char *dim;               /*!< the rows' dimension */
+  size_t n;                      /*!< rows in the file */
+  int ncol;                      /*!< columns (doubles) */
+  const char *const *names;      /*!< column names */
+  const char *const *long_names; /*!< column descriptions (attribute long_name; NULL: none) */
+  const char *const *units;      /*!< column units (udunits strings) */
+  const struct nc_attr *attrs;   /*!< global attributes */
+  int nattrs;                    /*!< their number */
+};
+
 /**
- * @brief Write named double columns along one dimension atomically (e.g. particles.nc).
+ * @brief Write named double columns along one dimension atomically (e.g. particles.nc): the
+ *        file is built in memory and committed (ncout_commit).
  * @param[in] path file name
- * @param[in] title global attribute title (the file also gets Conventions = CF-1.8, source)
- * @param[in] dim dimension name
- * @param[in] n rows
- * @param[in] ncol columns
- * @param[in] names,units column names and units (udunits strings)
- * @param[in] long_names column descriptions (attribute long_name; NULL: none)
- * @param[in] cols column data
+ * @param[in] t the dimension, columns and attributes
+ * @param[in] cols column data (t->n rows each)
  * @param[in] ids optional int64 ids written as variable "id" and as the coordinate variable of
  *                dim, with CF point markup (featureType point, coordinates "x y z") (may be NULL)
- * @param[in] attrs,nattrs global attributes
  * @param[out] err,errlen message on failure
  * @return 0 on success
  */
-int ncout_columns(const char *path, const char *title, const char *dim, size_t n, int ncol,
-                  const char *const *names, const char *const *long_names, const char *const *units,
-                  const double *const *cols, const long long *ids, const struct nc_attr *attrs,
-                  int nattrs, char *err, size_t errlen);
+int ncout_columns(const char *path, const struct ncout_table *t, const double *const *cols,
+                  const long long *ids, char *err, size_t errlen);
+
+/**
+ * @brief ncout_columns() written by all ranks of MPI_COMM_WORLD together, each with its rows
+ *        lo .. lo+rows-1 of every column (and ids): the same dimension, variables and attributes
+ *        (rank 0's global attributes), no fill values. Parallel netCDF-4 (MPI-IO, collective
+ *        writes) into PATH.tmp, after rank 0 made sure the file fits (durable_probe); rank 0
+ *        then fsyncs it, renames it to path and fsyncs the directory. The ranks agree on every
+ *        step: each returns the same result and message (naming the file; an earlier path is
+ *        kept and no PATH.tmp is left on failure). Collective.
+ * @return 0 on success
+ */
+int ncout_columns_par(const char *path, const struct ncout_table *t, size_t lo, size_t rows,
+                      const double *const *cols, const long long *ids, char *err, size_t errlen);
 
 /**
  * @brief Define a variable with units and long_name attributes (CF).

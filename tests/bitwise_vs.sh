@@ -103,7 +103,7 @@ allstats=(--set time.t_end=0.6 --set output.t_average_start=0.1 --set stats.wind
   --set lagrangian.horizon=0.2 --set lagrangian.release_every=0.1 --set lagrangian.n_lags=10
   --set lagrangian.pdf_x=0.01)
 compare allstats 1 poiseuille3d.ini "${allstats[@]}"
-# two ranks (domain decomposition, parallel statistics, snapshots gathered by id): the 2-D
+# two ranks (domain decomposition, parallel statistics, particle files written by id block): the 2-D
 # case of tests/mpi_check.sh bitwise2d
 compare mpi2d_np2 2 poiseuille2d.ini --set domain.lx=2.0 --set time.t_end=1000 \
   --set time.max_steps=200 --set init.noise=0.3 --set init.modes=0.2 --set output.stats_every=5 \

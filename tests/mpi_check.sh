@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # MPI decomposition checks (issue 6): results bitwise identical on 1, 2, 3 and 4 ranks.
-# usage: mpi_check.sh CHANSPH SCENES RUNS CASE
+# usage: mpi_check.sh CHANSPH SCENES RUNS CASE [PYTHON]
 #   bitwise2d  2-D channel, 200 steps, every statistics engine, ranks 1-4
 #   bitwise3d  3-D LES (Smagorinsky, Reichardt wall law), 200 steps, every engine, ranks 1-4,
 #              and 2 ranks x 2 threads
@@ -36,15 +36,25 @@
 #                    resumed on 3 ranks: falls back to the previous one, same results
 #   ckpt_bench       les395_small (41 250 particles): checkpoint size, write and read times on 1
 #                    and 2 ranks (printed, not checked)
+#   snapshots        3-D LES, 2 x 2 blocks, a snapshot every step (6): each rank writes its id
+#                    block of the snapshots and of particles.nc (parallel HDF5, netCDF-4); their
+#                    datasets equal the 1-rank run's (h5diff), the XDMF opens and its last
+#                    snapshot equals particles.nc (snapshot_check.py --les; PYTHON, the 5th argument)
+#   particles_write_fail  2 ranks: particles.nc rewritten by a resume of the finished run under a
+#                    file-size limit between the sizes of stats.nc and particles.nc: exit 74, a
+#                    message naming the file, the earlier particles.nc intact, no .tmp left;
+#                    written once the limit is lifted
 # Compared: the data of particles.nc and stats.nc (ncdump -p 17,17 after "data:"; the headers
 # hold the scene text, which differs in the rank-related keys of some cases) and the content of
 # the final checkpoint (h5diff: datasets and attributes; a checkpoint of one rank is built by
 # the core driver, one of several ranks by the MPI-IO driver, so their bytes differ; files of
-# 2, 3 or 4 ranks are byte-identical among themselves).
+# 2, 3 or 4 ranks are byte-identical among themselves). The same holds for the snapshots
+# (h5diff) and particles.nc (its data), which the ranks also write together, each its id block.
 set -uo pipefail
 # the runs compared here share one identity (issue 13: DIR/run_id, stored in every file)
 export CHANSPH_RUN_ID=compare-test
-chansph=$1 scenes=$2 runs=$3 case=$4
+chansph=$1 scenes=$2 runs=$3 case=$4 py=${5:-python3}
+here=$(cd "$(dirname "$0")" && pwd)
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMP_NUM_THREADS=1
 work=$runs/mpi_$case
 rm -rf "$work" && mkdir -p "$work" && cd "$work" || exit 1
@@ -113,16 +123,18 @@ case $case in
       grep -h "^decomposition" r$np.txt
     done
     for np in 2 3 4; do compare r1 r$np 200; done
-    if [ "$case" = bitwise2d ]; then # particle snapshots, gathered by id on rank 0
+    if [ "$case" = bitwise2d ]; then # particle snapshots, each rank writing its id block
       snaps=$(cd r1/snapshots 2> /dev/null && ls snap_*.h5)
       [ -n "$snaps" ] || { echo "FAIL: no snapshots written"; fail=1; }
-      for np in 2 3 4; do
+      for np in 2 3 4; do # serial file of 1 rank, parallel HDF5 of several: the same content
         for f in $snaps; do
-          cmp -s "r1/snapshots/$f" "r$np/snapshots/$f" ||
-            { echo "FAIL: r$np/snapshots/$f differs"; fail=1; }
+          h5diff "r1/snapshots/$f" "r$np/snapshots/$f" > /dev/null ||
+            { echo "FAIL: r$np/snapshots/$f differs (h5diff)"; fail=1; }
+          [ "$np" = 2 ] || cmp -s "r2/snapshots/$f" "r$np/snapshots/$f" ||
+            { echo "FAIL: r$np/snapshots/$f differs in bytes from 2 ranks"; fail=1; }
         done
       done
-      echo "snapshots $(echo $snaps) byte-identical on 1-4 ranks"
+      echo "snapshots $(echo $snaps): 1-4 ranks equal (h5diff), 2-4 ranks byte-identical"
     fi
     if [ "$case" = bitwise3d ]; then # hybrid: 2 ranks x 2 threads
       OMP_NUM_THREADS=2 mpi 2 run "$scene" --out r2x2 --overwrite "${args[@]}" > r2x2.txt 2>&1 ||
@@ -426,6 +438,48 @@ with h5py.File('dup.nc', 'r+') as f:
       grep -h "^checkpoint .*h5 (step [1-4]," b$np/log.txt | sed "s/^/  write: /"
       grep -h "^resume: from" b$np/log.txt | sed "s/^/  read:  /"
     done
+    ;;
+  snapshots) # each rank writes its id block of the snapshots and of particles.nc: no gather
+    scene=$scenes/les395_smoke.ini
+    args=(--set domain.lx=2.4 --set domain.lz=1.6 --set time.max_steps=6 --set output.stats_every=5
+      --set snapshots.every=0.0001)
+    mpi 1 run "$scene" --out r1 --overwrite "${args[@]}" > r1.txt 2>&1 || { tail r1.txt; echo "FAIL: 1 rank"; exit 1; }
+    mpi 4 run "$scene" --out r2,2 --overwrite "${args[@]}" --set run.ranks=2,2 > r2,2.txt 2>&1 ||
+      { tail r2,2.txt; echo "FAIL: 2 x 2 blocks"; exit 1; }
+    snaps=$(cd r1/snapshots && ls snap_*.h5)
+    [ "$(echo $snaps | wc -w)" = 6 ] || { echo "FAIL: snapshots of 1 rank: $snaps"; fail=1; }
+    [ "$snaps" = "$(cd r2,2/snapshots && ls snap_*.h5)" ] || { echo "FAIL: other snapshot files"; fail=1; }
+    for f in $snaps; do
+      h5diff "r1/snapshots/$f" "r2,2/snapshots/$f" > /dev/null ||
+        { echo "FAIL: r2,2/snapshots/$f differs from r1 (h5diff)"; fail=1; }
+    done
+    echo "ok: snapshots $(echo $snaps) of 2 x 2 blocks equal 1 rank (h5diff)"
+    "$py" "$here/snapshot_check.py" "r2,2" --les || { echo "FAIL: snapshot_check.py r2,2"; fail=1; }
+    compare r1 r2,2 6 noscene
+    ;;
+  particles_write_fail) # a resume of a finished run writes only stats.nc and particles.nc (the
+    # final checkpoint exists, the final snapshot too: snapshots.every ends on the last step)
+    scene=$scenes/poiseuille2d.ini
+    args=(--set domain.lx=16 --set time.t_end=0.02 --set output.t_average_start=0 --set snapshots.every=0.02)
+    mpi 2 run "$scene" --out d --overwrite "${args[@]}" > d1.txt 2>&1 || { tail d1.txt; echo "FAIL: first job"; exit 1; }
+    cp d/particles.nc copy.nc
+    psize=$(stat -c %s d/particles.nc) ssize=$(stat -c %s d/stats.nc)
+    [ "$psize" -gt $((ssize * 3 / 2)) ] ||
+      { echo "FAIL: particles.nc ($psize bytes) not well above stats.nc ($ssize): no limit between"; exit 1; }
+    # a file-size limit between them (ulimit -f counts 1024-byte blocks in bash); PMIX_MCA_gds=hash:
+    # PMIx keeps its shared-memory store under the limit
+    out=$(ulimit -f $(((psize + ssize) / 2048)) && PMIX_MCA_gds=hash timeout 120 mpirun --oversubscribe \
+      -np 2 "$chansph" resume d 2>&1)
+    rc=$?
+    echo "$out" | grep -E "^error" | head -n 3
+    [ $rc -eq 74 ] || { echo "$out" | tail; echo "FAIL: exit status $rc, expected 74"; fail=1; }
+    [ "$(echo "$out" | grep -c "^error")" = 1 ] || { echo "FAIL: not one error message"; fail=1; }
+    echo "$out" | grep -Eq "^error: cannot write d/particles.nc.tmp [(]File too large.*an earlier d/particles.nc is kept" ||
+      { echo "FAIL: no message naming the file and the cause"; fail=1; }
+    cmp -s d/particles.nc copy.nc || { echo "FAIL: the earlier particles.nc changed"; fail=1; }
+    [ ! -e d/particles.nc.tmp ] || { echo "FAIL: d/particles.nc.tmp left behind"; fail=1; }
+    mpi 2 resume d > d2.txt 2>&1 || { tail d2.txt; echo "FAIL: resume after the limit is lifted"; fail=1; }
+    [ "$(data d/particles.nc)" = "$(data copy.nc)" ] || { echo "FAIL: particles.nc rewritten differs"; fail=1; }
     ;;
   *)
     echo "unknown case $case"
