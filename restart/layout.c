@@ -19,17 +19,6 @@
 #include "error.h"
 #include "restart.h"
 
-/* The rank whose id block holds id. */
-static int id_block_owner(int64_t id, int size, size_t N) {
-  int r = (int)((unsigned long long)id * (unsigned)size / N);
-  size_t lo, hi;
-  for (sim_id_block(r, size, N, &lo, &hi); (size_t)id >= hi; sim_id_block(++r, size, N, &lo, &hi)) {
-  }
-  for (; (size_t)id < lo; sim_id_block(--r, size, N, &lo, &hi)) {
-  }
-  return r;
-}
-
 /* The checkpoint's particle datasets: id and kind, then the allocated PF_CKPT fields of the
    table (part.h) in its order; S->gather holds them in that order (G_FIELDS onwards), then the
    wall values. Returns the number of fields, their table indices in idx. */
@@ -60,7 +49,7 @@ static void block_state(struct sim *S, size_t lo, size_t hi) {
   const double *f[SIM_GATHER];
   for (int c = 0; c < nf; c++) f[c] = part_field_ptr(P, &part_fields[idx[c]]);
   for (size_t a = 0; a < n; a++) {
-    dest[a] = id_block_owner(P->id[a], size, N);
+    dest[a] = dd_id_owner(P->id[a], size, N);
     double *r = rec + a * R;
     memcpy(&r[G_ID], &P->id[a], sizeof(double));
     r[G_KIND] = P->kind[a];

@@ -112,8 +112,11 @@ static int check_memory(const struct scene *sc, const struct dd *d) {
   output_stats_bytes(sc, &bytes[M_EULER], &bytes[M_CORR], &bytes[M_LAGR]);
   bytes[M_SOURCE] = init_source_bytes(sc, d->size, &src);
   char what[M_N][160];
-  snprintf(what[M_PARTS], sizeof what[0], "%.4g particles (of %.4g) with their halo",
-           n * dd_share(d), n);
+  if (d->size > 1)
+    snprintf(what[M_PARTS], sizeof what[0], "%.4g particles (this rank's block and halo of %.4g)",
+             n * dd_share(d), n);
+  else
+    snprintf(what[M_PARTS], sizeof what[0], "%.4g particles", n);
   snprintf(what[M_EULER], sizeof what[0],
            "the Eulerian statistics of %d bins (x %d cell columns, per window with the "
            "Reynolds-stress budgets)",
@@ -185,13 +188,13 @@ int sim_create(struct sim *S, const struct scene *sc, int resume) {
   S->rss_before = mem_peak_resident(); /* the log's start-up memory (output.c) */
   /* the blocks and the grid first: each rank builds only its part of the particles */
   if (dd_init(&S->dd, sc, sim_reserve, S)) return CHANSPH_ERR;
+  if (check_memory(sc, &S->dd)) { /* before the grid, whose cells a huge scene cannot hold */
+    dd_free(&S->dd);
+    return CHANSPH_ERR;
+  }
   const struct nbr_range r = dd_range(&S->dd);
   nbr_init(&S->nb, sc, 0, &r); /* sized in sim_distribute, for this rank's part */
   S->grid = 1;
-  if (check_memory(sc, &S->dd)) {
-    sim_free(S);
-    return CHANSPH_ERR;
-  }
   sph_model_init(&S->M, sc);
   /* a fresh start: the lattice particles of this rank's block; a resume: the slots of its
      checkpoint id block (sim_state reads them; sim_restored migrates them to their owners) */

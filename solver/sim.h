@@ -117,8 +117,8 @@ static inline void sim_id_block(int r, int size, size_t N, size_t *lo, size_t *h
 }
 
 /**
- * @brief After the fields of sim_state() were filled from a checkpoint (into sim_create()'s
- *        full state): split the particles over the ranks (each rank's id block migrates to
+ * @brief After the fields of sim_state() were filled from a checkpoint (into the slots of this
+ *        rank's id block, sim_create(S, sc, 1)): split the particles over the ranks (each rank's id block migrates to
  *        the owners of its columns), re-sort them
  *        (order by cell, then id), rebuild the neighbour list and the quantities derived from
  *        the stored state (pressure, sound speed, volumes, wall values), bitwise as the step

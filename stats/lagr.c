@@ -954,16 +954,19 @@ static int engine_init_scene(void *self, const struct stats_scene *sc) {
   return 1;
 }
 
-/* The records lagr_init allocates (sums, the release slots' sums, the PDFs), before any, twice:
-   they and their copy in a checkpoint (built in memory, restart/ckpt.c). */
+/* The records lagr_init allocates (sums, the release slots' sums, the PDFs), before any, and
+   the history of T_L that the run will have (nl x 3 values and a time per release completed by
+   t_end), twice: they and their copy in a checkpoint (built in memory, restart/ckpt.c). */
 static double engine_estimate(const struct stats_scene *sc) {
   struct lagr_config c;
   if (!config_of(sc, &c)) return 0.0;
   const double nl = c.n_levels, nlag = c.n_lags + 1.0, nst = c.n_stations ? c.n_stations : 1;
   const double slots = ceil(c.horizon / c.release_every - 1e-9) + 1.0;
+  const double span = sc->t_end - c.t_start - c.horizon;
+  const double releases = span > 0.0 && isfinite(span) ? floor(span / c.release_every) + 1.0 : 0.0;
   return 2.0 * sizeof(double) *
          (nl * nlag * LG_LEN * (1.0 + slots) + slots * SL_LEN + nl * 3 * SCAL_LEN +
-          nl * nst * (c.pdf_bins + 3.0));
+          nl * nst * (c.pdf_bins + 3.0) + releases * (nl * 3.0 + 1.0));
 }
 
 STATS_ENGINE_ADAPTERS(lagr)
