@@ -77,7 +77,7 @@ static inline __attribute__((always_inline)) struct cons_parts cons_parts_op(
     if (kgc) { /* p: sum ig V_b p_b F r; n: sum ig V_b B_b F r; k: sum ig V_b F r */
       const struct v3 pp = pressure_kgc_pair(&g, vol[b], pr2[b], rho[b]);
       px += ig * pp.x, py += ig * pp.y, pz += ig * pp.z;
-      const double bb[6] = {bxx[b], bxy[b], bxz[b], byy[b], byz[b], bzz[b]};
+      const struct sym3 bb = {bxx[b], bxy[b], bxz[b], byy[b], byz[b], bzz[b]};
       const struct v3 pb = pressure_kgc_matrix_pair(&g, vol[b], bb);
       nx += ig * pb.x, ny += ig * pb.y, nz += ig * pb.z;
       const double vf = ig * vol[b] * g.f;
