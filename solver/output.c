@@ -448,7 +448,8 @@ static void log_blocks(struct output *o, const struct sim *S) {
    before sim_create: binary, MPI, libraries), and that part per owned + ghost particle. */
 static void log_memory(struct output *o, const struct sim *S) {
   const double peak = mem_peak_resident(), local = (double)(S->P.n + S->P.n_ghost);
-  const double x[3] = {peak, peak - S->rss_before, (peak - S->rss_before) / (local > 0 ? local : 1)};
+  const double x[3] = {peak, peak - S->rss_before,
+                       (peak - S->rss_before) / (local > 0 ? local : 1)};
   double mx[3], sum[3];
   CHECK_MPI(MPI_Allreduce(x, mx, 3, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD));
   CHECK_MPI(MPI_Allreduce(x, sum, 3, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD));

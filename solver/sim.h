@@ -117,12 +117,11 @@ static inline void sim_id_block(int r, int size, size_t N, size_t *lo, size_t *h
 }
 
 /**
- * @brief After the fields of sim_state() were filled from a checkpoint (into the slots of this
- *        rank's id block, sim_create(S, sc, 1)): split the particles over the ranks (each rank's id block migrates to
- *        the owners of its columns), re-sort them
- *        (order by cell, then id), rebuild the neighbour list and the quantities derived from
- *        the stored state (pressure, sound speed, volumes, wall values), bitwise as the step
- *        that produced them.
+ * @brief After the fields of sim_state() were filled from a checkpoint (into the slots of
+ *        this rank's id block, sim_create(S, sc, 1)): split the particles over the ranks (each
+ *        rank's id block migrates to the owners of its columns), re-sort them (order by cell,
+ *        then id), rebuild the neighbour list and the quantities derived from the stored state
+ *        (pressure, sound speed, volumes, wall values), bitwise as the step that produced them.
  * @return 0, or the number of wall values that differ from the stored ones (not bitwise)
  */
 size_t sim_restored(struct sim *S);
