@@ -156,12 +156,6 @@ static size_t local_fluid(const struct particles *P) {
   return a;
 }
 
-/** The rank's slice [*lo, *hi) of n items (as the checkpoint's id blocks, sim.h). */
-static void slice(int r, int size, size_t n, size_t *lo, size_t *hi) {
-  *lo = (size_t)((unsigned long long)r * n / (unsigned)size);
-  *hi = (size_t)((unsigned long long)(r + 1) * n / (unsigned)size);
-}
-
 /** The ranks agree on the first error in the file (smallest key over the ranks; LONG_MAX:
     none here), whose text the rank that found it gives rank 0 to print. Collective. */
 static int first_error(const struct init_owner *own, long key, const char *text) {
@@ -223,7 +217,7 @@ static int read_columns(const char *path, struct source *src, char **text,
     ok = *text && !nc_get_att_text(nc, NC_GLOBAL, "scene", *text);
   }
   src->total = n;
-  slice(own->rank, own->size, n, &src->first, &n);
+  dd_id_block(own->rank, own->size, n, &src->first, &n); /* the particle files' blocks */
   n -= src->first, src->n = n;
   const size_t start[1] = {src->first}, count[1] = {n};
   char miss[1024] = "";
@@ -347,19 +341,14 @@ static int check_source(const char *path, const struct source *src, const struct
       if (key == LONG_MAX) key = (long)(src->first + k), bad_id = id;
       continue;
     }
-    size_t lo, hi;
-    int r = (int)((unsigned long long)id * (unsigned)own->size / N);
-    for (slice(r, own->size, N, &lo, &hi); (size_t)id >= hi; slice(++r, own->size, N, &lo, &hi)) {
-    }
-    for (; (size_t)id < lo; slice(--r, own->size, N, &lo, &hi)) {
-    }
-    dest[m] = r, rec[2 * m] = (double)(src->first + k), rec[2 * m + 1] = (double)id, m++;
+    dest[m] = dd_id_owner(id, own->size, N), rec[2 * m] = (double)(src->first + k),
+    rec[2 * m + 1] = (double)id, m++;
   }
   size_t got;
   double *in = send_records(own, dest, m, rec, 2, &got);
   free(dest), free(rec);
   size_t lo, hi;
-  slice(own->rank, own->size, N, &lo, &hi);
+  dd_id_block(own->rank, own->size, N, &lo, &hi);
   double *first = mem_alloc(1, (hi > lo ? hi - lo : 1) * sizeof *first, "initial state");
   for (size_t i = lo; i < hi; i++) first[i - lo] = -1.0;
   for (size_t k = 0; k < got; k++) { /* the smallest index of each id; a larger one repeats it */

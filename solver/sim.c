@@ -168,18 +168,16 @@ double sim_memory_estimate(const struct scene *sc) {
   return part_bytes(sc, &n) + init_bytes(sc) + init_source_bytes(sc, 1, &src) + e + c + l;
 }
 
-/* Whether this rank owns the cell column of a position (part_select, init_owner). */
-static int owns_position(const void *ctx, double x, double z) {
-  const struct sim *S = ctx;
-  nbr_wrap_position(&S->nb, &x, &z);
-  return dd_owner(&S->dd, nbr_column(&S->nb, x), nbr_plane(&S->nb, z)) == S->dd.rank;
-}
-
 /* The rank that owns the cell column of a position (init_owner). */
 static int owner_of_position(const void *ctx, double x, double z) {
   const struct sim *S = ctx;
   nbr_wrap_position(&S->nb, &x, &z);
   return dd_owner(&S->dd, nbr_column(&S->nb, x), nbr_plane(&S->nb, z));
+}
+
+/* Whether this rank owns the cell column of a position (part_select). */
+static int owns_position(const void *ctx, double x, double z) {
+  return owner_of_position(ctx, x, z) == ((const struct sim *)ctx)->dd.rank;
 }
 
 int sim_create(struct sim *S, const struct scene *sc, int resume) {
