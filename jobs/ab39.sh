@@ -47,6 +47,8 @@ declare -A sets=(
   [delta_0.2_morris]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set sph.viscous=morris"
   [delta_0.2_rho0]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set init.density=rho0"
   [delta_0.2_kgc]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set sph.pressure_gradient=kgc"
+  [delta_0.2_shift_cons_0.02]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set sph.shifting=fickian --set sph.shift_velocity=conservative --set sph.shift_coefficient=0.02"
+  [delta_0.2_shift_cons_0.05]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set sph.shifting=fickian --set sph.shift_velocity=conservative --set sph.shift_coefficient=0.05"
 )
 names=("$@")
 [ ${#names[@]} -gt 0 ] || names=(reference damper_0.1 delta_0.1)

@@ -10,6 +10,12 @@
 #   --set k=v   passed to every bench run (e.g. --set sph.precision=double)
 #   --new-set k=v  passed to the new build's runs only (e.g. HEAD against the working tree with
 #               --new-set sph.precision=mixed: one build, two settings)
+#   --callgrind count instructions instead of timing: each case once per build under
+#               `valgrind --tool=callgrind --toggle-collect=sim_step` (the step only, not the
+#               set-up), 1 thread, 3 steps; deterministic, so it resolves differences far below
+#               the run-to-run noise of a shared machine (valgrind runs the AVX2 path, not
+#               AVX-512). Prints the instructions per particle-step of each build and the ratio
+#               new / old.
 #
 # Cases: the default bench case, jobs/scenes/les395_small.ini (LES), the same scene without
 # the model (les.model=none: the LES / quasi-DNS cost ratio) and jobs/scenes/qdns180_small.ini.
@@ -19,14 +25,15 @@
 # new / old of particle-steps/s. Run it on an idle machine.
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
-old="" new="." reps=3 threads=2 sets=() new_sets=()
+old="" new="." reps=3 threads=2 sets=() new_sets=() callgrind=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --reps) reps=$2; shift 2 ;;
     --threads) threads=$2; shift 2 ;;
     --set) sets+=(--set "$2"); shift 2 ;;
     --new-set) new_sets+=(--set "$2"); shift 2 ;;
-    -h|--help) sed -n '2,20p' "$0"; exit 0 ;;
+    --callgrind) callgrind=1; shift ;;
+    -h|--help) sed -n '2,26p' "$0"; exit 0 ;;
     *) if [ -z "$old" ]; then old=$1; else new=$1; fi; shift ;;
   esac
 done
@@ -63,6 +70,34 @@ S=$here/jobs/scenes
 cases=("default|" "les395_small|$S/les395_small.ini" "les395_small_qdns|$S/les395_small.ini --set les.model=none"
        "qdns180_small|$S/qdns180_small.ini")
 steps=(40 40 40 20)
+
+if [ $callgrind = 1 ]; then # instruction counts of sim_step, one run per build and case
+  command -v valgrind > /dev/null || { echo "bench_compare: --callgrind needs valgrind" >&2; exit 1; }
+  export OMP_NUM_THREADS=1
+  echo "old: $(git -C "$here" rev-parse --short "$old")  new: $new_name  callgrind, sim_step, 1 thread, 3 steps ${sets[*]} new: ${new_sets[*]}"
+  printf '%-20s %16s %16s %10s\n' case "old instr/p-step" "new instr/p-step" "new / old"
+  for i in "${!cases[@]}"; do
+    name=${cases[$i]%%|*} args=${cases[$i]#*|}
+    declare -A ir=()
+    for which in old new; do
+      bin=$old_bin extra=()
+      [ $which = new ] && bin=$new_bin extra=("${new_sets[@]}")
+      cg=$work/callgrind.$name.$which
+      # shellcheck disable=SC2086
+      valgrind --tool=callgrind --toggle-collect=sim_step --callgrind-out-file="$cg" \
+        "$bin" bench $args --steps 3 "${sets[@]}" "${extra[@]}" > "$cg.log" 2>&1 ||
+        { tail -5 "$cg.log"; echo "bench_compare: $which failed on $name under valgrind" >&2; exit 1; }
+      # the fluid particles of the case (bench's first line) times 3 steps
+      np=$(sed -n 's/^chansph bench: [23]D, \([0-9]*\) fluid.*/\1/p' "$cg.log" | head -1)
+      ir[$which]=$(awk '/^(summary|totals):/ {print $2; exit}' "$cg")
+      [ -n "${ir[$which]}" ] && [ -n "$np" ] || { tail -5 "$cg.log"; echo "bench_compare: no count for $which on $name" >&2; exit 1; }
+      ir[$which]=$(echo "${ir[$which]} $np" | awk '{printf "%.1f", $1 / ($2 * 3)}')
+    done
+    printf '%-20s %16s %16s %10s\n' "$name" "${ir[old]}" "${ir[new]}" \
+      "$(echo "${ir[new]} ${ir[old]}" | awk '{printf "%.4f", $1 / $2}')"
+  done
+  exit 0
+fi
 export OMP_NUM_THREADS=$threads
 log=$work/runs.log
 : > "$log"
