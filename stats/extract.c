@@ -489,7 +489,9 @@ static void usage(FILE *f) {
           "re-averaged\n"
           "    over its windows in the range, or copied whole from a file without its window "
           "records;\n"
-          "    the other groups left out):\n"
+          "    the other groups left out; of joined segments, over the whole range, groups "
+          "lagrangian and\n"
+          "    quadrants pooled over the segments' completed releases and windows):\n"
           "    what `chansph compare` and `extract` read, e.g. a long run's developed range\n");
 }
 
@@ -907,24 +909,25 @@ static int put_origin(const struct stored *s, size_t r1, int out) {
   return rc;
 }
 
-/* Whether the file path holds group name (notes of the joins below). */
-static int has_group(const char *path, const char *name) {
-  int ncid, g, have = 0;
-  if (nc_open(path, NC_NOWRITE, &ncid) != NC_NOERR) return 0;
-  have = nc_inq_ncid(ncid, name, &g) == NC_NOERR;
-  nc_close(ncid);
+/* Whether any segment of a join holds group name (else the engine was off: no note). */
+static int any_segment_has(const struct extract_args *a, const char *name) {
+  int have = 0;
+  for (int k = 0; k < a->npaths && !have; k++) {
+    int ncid, g;
+    if (nc_open(a->paths[k], NC_NOWRITE, &ncid) != NC_NOERR) continue;
+    have = nc_inq_ncid(ncid, name, &g) == NC_NOERR;
+    nc_close(ncid);
+  }
   return have;
 }
 
-/* Why group name of segment k (path) is left out of the joined file: r as the engines' readers
-   return it (1: no group, else why says), joined: 1 if the configurations differ. Silent if no
-   segment holds the group (the engine was off). */
-static void left_out(const struct extract_args *a, int k, const char *name, int r, int joined,
+/* Why group name of segment k is left out of the joined file: r as the engines' readers return
+   it (1: no group; else why says), differ: 1 if its configuration differs from the first
+   segment's (why says how). Silent if no segment holds the group. */
+static void left_out(const struct extract_args *a, int k, const char *name, int r, int differ,
                      const char *why) {
-  int any = 0;
-  for (int j = 0; j < a->npaths; j++) any |= has_group(a->paths[j], name);
-  if (!any) return;
-  if (joined)
+  if (!any_segment_has(a, name)) return;
+  if (differ)
     fprintf(stderr, "note: %s: group %s gathered otherwise than in %s (%s): left out of %s\n",
             a->paths[k], name, a->paths[0], why, a->nc_out);
   else
@@ -974,7 +977,8 @@ static int join_lagrangian(const struct extract_args *a, int out, int *joined, c
     *joined = rc == NC_NOERR;
     fprintf(stderr,
             "note: group lagrangian: the %.0f releases completed within the segments pooled; "
-            "a release in flight at the end of a segment is in none (its samples are lost)\n",
+            "a release in flight at the end of a segment before the last is in none (its "
+            "samples are lost)\n",
             g.releases);
   }
   lagr_free(&g);
@@ -1019,7 +1023,7 @@ static int join_quadrants(const struct extract_args *a, int out, int *joined, ch
 static int join_groups(const struct extract_args *a, int whole, int out, char *err, size_t errlen) {
   char groups[64] = "eulerian";
   int rc = NC_NOERR, joined = 0;
-  if (!whole)
+  if (!whole && (any_segment_has(a, "lagrangian") || any_segment_has(a, "quadrants")))
     fprintf(stderr,
             "note: --window restricts the joined range: groups lagrangian and quadrants (they "
             "have no window records) are left out\n");
