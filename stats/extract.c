@@ -16,9 +16,11 @@
 #include "engine.h"
 #include "euler.h"
 #include "euler_rs.h"
+#include "lagr.h"
 #include "moments.h"
 #include "ncutil.h"
 #include "pdf.h"
+#include "quad.h"
 
 /** How a profile scales: velocity, stress, pressure, length, or not at all. */
 enum unit_class { UC_NONE, UC_VEL, UC_STRESS, UC_PRESSURE, UC_LENGTH, UC_VISC, UC_BUDGET };
@@ -487,7 +489,9 @@ static void usage(FILE *f) {
           "re-averaged\n"
           "    over its windows in the range, or copied whole from a file without its window "
           "records;\n"
-          "    the other groups left out):\n"
+          "    the other groups left out; of joined segments, over the whole range, groups "
+          "lagrangian and\n"
+          "    quadrants pooled over the segments' completed releases and windows):\n"
           "    what `chansph compare` and `extract` read, e.g. a long run's developed range\n");
 }
 
@@ -905,6 +909,134 @@ static int put_origin(const struct stored *s, size_t r1, int out) {
   return rc;
 }
 
+/* Whether any segment of a join holds group name (else the engine was off: no note). */
+static int any_segment_has(const struct extract_args *a, const char *name) {
+  int have = 0;
+  for (int k = 0; k < a->npaths && !have; k++) {
+    int ncid, g;
+    if (nc_open(a->paths[k], NC_NOWRITE, &ncid) != NC_NOERR) continue;
+    have = nc_inq_ncid(ncid, name, &g) == NC_NOERR;
+    nc_close(ncid);
+  }
+  return have;
+}
+
+/* Why group name of segment k is left out of the joined file: r as the engines' readers return
+   it (1: no group; else why says), differ: 1 if its configuration differs from the first
+   segment's (why says how). Silent if no segment holds the group. */
+static void left_out(const struct extract_args *a, int k, const char *name, int r, int differ,
+                     const char *why) {
+  if (!any_segment_has(a, name)) return;
+  if (differ)
+    fprintf(stderr, "note: %s: group %s gathered otherwise than in %s (%s): left out of %s\n",
+            a->paths[k], name, a->paths[0], why, a->nc_out);
+  else
+    fprintf(stderr, "note: %s: %s: group %s left out of %s\n", a->paths[k],
+            r == 1 ? "no group (the engine was off)" : why, name, a->nc_out);
+}
+
+/* Open segment k of a join; its reached time into *t (NaN if absent). Nonzero if unreadable. */
+static int open_segment(const struct extract_args *a, int k, int *ncid, double *t) {
+  if (nc_open(a->paths[k], NC_NOWRITE, ncid) != NC_NOERR) return 1;
+  *t = get_num(*ncid, "t_reached");
+  return 0;
+}
+
+/* Group lagrangian of the joined segments (--nc): the completed releases of all segments
+   pooled as one run's (lagr_join: sums added, per-release Welford records merged, the history
+   of T_L concatenated on the joined time axis, each segment's times shifted by the reached
+   times of those before it, as join_stored shifts the windows), written by the engine's own
+   writer, so that the values and *_stderr come from the code of a run. A segment without the
+   group, without its raw records (an earlier version) or configured otherwise: a note, and
+   the group is left out. *joined: 1 if written. A netCDF status (err: the failing call). */
+static int join_lagrangian(const struct extract_args *a, int out, int *joined, char *err,
+                           size_t errlen) {
+  struct lagr g, b;
+  char why[256] = "";
+  double offset = 0.0, t = NAN;
+  int k = 0, r = 0, differ = 0, ncid;
+  *joined = 0;
+  memset(&g, 0, sizeof g), memset(&b, 0, sizeof b);
+  for (; k < a->npaths; k++) {
+    if (open_segment(a, k, &ncid, &t)) {
+      r = -1, snprintf(why, sizeof why, "cannot open it");
+      break;
+    }
+    r = lagr_nc_read(k ? &b : &g, ncid, why, sizeof why);
+    nc_close(ncid);
+    if (!r && k) r = differ = lagr_join(&g, &b, offset, why, sizeof why);
+    lagr_free(&b);
+    if (r) break; /* k: the segment that left the group out */
+    offset += t;
+  }
+  int rc = NC_NOERR;
+  if (r) {
+    left_out(a, k, "lagrangian", r, differ, why);
+  } else {
+    rc = lagr_nc_write(&g, out, err, errlen);
+    *joined = rc == NC_NOERR;
+    fprintf(stderr,
+            "note: group lagrangian: the %.0f releases completed within the segments pooled; "
+            "a release in flight at the end of a segment before the last is in none (its "
+            "samples are lost)\n",
+            g.releases);
+  }
+  lagr_free(&g);
+  return rc;
+}
+
+/* Group quadrants of the joined segments (--nc): the sums and samples of all segments added,
+   the Welford records of their complete averaging windows merged (quad_join), written by the
+   engine's own writer. The window open at a segment's end is in its sums, not a batch (its
+   sums are not in stats.nc). Left out as group lagrangian (join_lagrangian). */
+static int join_quadrants(const struct extract_args *a, int out, int *joined, char *err,
+                          size_t errlen) {
+  struct quad q, b;
+  char why[256] = "";
+  double t;
+  int k = 0, r = 0, differ = 0, ncid;
+  *joined = 0;
+  memset(&q, 0, sizeof q), memset(&b, 0, sizeof b);
+  for (; k < a->npaths; k++) {
+    if (open_segment(a, k, &ncid, &t)) {
+      r = -1, snprintf(why, sizeof why, "cannot open it");
+      break;
+    }
+    r = quad_nc_read(k ? &b : &q, ncid, why, sizeof why);
+    nc_close(ncid);
+    if (!r && k) r = differ = quad_join(&q, &b, why, sizeof why);
+    quad_free(&b);
+    if (r) break; /* k: the segment that left the group out */
+  }
+  int rc = NC_NOERR;
+  if (r)
+    left_out(a, k, "quadrants", r, differ, why);
+  else
+    rc = quad_nc_write(&q, out, err, errlen), *joined = rc == NC_NOERR;
+  quad_free(&q);
+  return rc;
+}
+
+/* The groups of several segments joined (--nc) besides eulerian: lagrangian and quadrants
+   pooled over all segments if the range is whole (whole: they have no windows to restrict to
+   --window), then a note of the groups joined. A netCDF status. */
+static int join_groups(const struct extract_args *a, int whole, int out, char *err, size_t errlen) {
+  char groups[64] = "eulerian";
+  int rc = NC_NOERR, joined = 0;
+  if (!whole && (any_segment_has(a, "lagrangian") || any_segment_has(a, "quadrants")))
+    fprintf(stderr,
+            "note: --window restricts the joined range: groups lagrangian and quadrants (they "
+            "have no window records) are left out\n");
+  if (whole && (rc = join_lagrangian(a, out, &joined, err, errlen)) == NC_NOERR && joined)
+    strcat(groups, ", lagrangian");
+  if (whole && rc == NC_NOERR && (rc = join_quadrants(a, out, &joined, err, errlen)) == NC_NOERR &&
+      joined)
+    strcat(groups, ", quadrants");
+  fprintf(stderr, "note: %d segments joined: group%s %s (the other groups are left out)\n",
+          a->npaths, strchr(groups, ',') ? "s" : "", groups);
+  return rc;
+}
+
 /* The windows r0 .. r1-1 of s as the state of an engine that gathered only them (its last row
    open if that window is), written by the engine's own writer to a.nc_out (through a
    temporary file, renamed when complete). */
@@ -935,11 +1067,7 @@ static int write_range(const struct extract_args *a, const struct stored *s, siz
   const long long ns = (long long)snaps;
   struct corr_range k = {0};
   int in = -1, out = -1, rc = nc_open(a->path, NC_NOWRITE, &in);
-  if (a->npaths > 1)
-    fprintf(stderr,
-            "note: %d segments joined: group eulerian only (the other groups are left out)\n",
-            a->npaths);
-  else if (rc == NC_NOERR && corr_prepare(a, in, &k)) {
+  if (a->npaths == 1 && rc == NC_NOERR && corr_prepare(a, in, &k)) {
     nc_close(in), euler_free(&e);
     return 1;
   }
@@ -951,6 +1079,8 @@ static int write_range(const struct extract_args *a, const struct stored *s, siz
   if (rc == NC_NOERR && a->npaths > 1) rc = put_segments(a, out);
   if (rc == NC_NOERR) rc = put_origin(s, r1, out);
   if (rc == NC_NOERR) rc = euler_engine.write(&e, t_end, out, err, sizeof err);
+  if (rc == NC_NOERR && a->npaths > 1)
+    rc = join_groups(a, r0 == 0 && r1 == s->rows, out, err, sizeof err);
   if (rc == NC_NOERR) rc = corr_output(&k, in, out, err, sizeof err);
   if (k.have == 1) corr_free(&k.c);
   if (out >= 0 && nc_close(out) != NC_NOERR && rc == NC_NOERR) rc = NC_EHDFERR;

@@ -795,6 +795,113 @@ done:
   return rc;
 }
 
+/* A labelled slot axis (dimension dim, coordinate of string labels, ncout_labels) of n slots:
+   first n_pre labels "PRE_k" (k = 0 .. n_pre - 1), then n - n_pre labels from tail. */
+static int slot_axis(int gr, const char *dim, const char *long_name, size_t n, size_t n_pre,
+                     const char *pre, const char *const *tail, int *dimid) {
+  char *text = mem_alloc(n, 32, "Lagrangian statistics");
+  const char **lab = mem_alloc(n, sizeof *lab, "Lagrangian statistics");
+  for (size_t i = 0; i < n; i++) {
+    if (i < n_pre)
+      snprintf(text + 32 * i, 32, "%s_%zu", pre, i);
+    else
+      snprintf(text + 32 * i, 32, "%s", tail[i - n_pre]);
+    lab[i] = text + 32 * i;
+  }
+  int rc = nc_def_dim(gr, dim, n, dimid);
+  if (rc == NC_NOERR) rc = ncout_labels(gr, dim, *dimid, long_name, lab);
+  free(lab), free(text);
+  return rc;
+}
+
+/* The labels of the sums of a record (LG_*) into lab[LG_LEN][24]. */
+static void sum_labels(char lab[LG_LEN][24]) {
+  static const char *const vel[3] = {"u", "v", "w"}, *const acc[3] = {"ax", "ay", "az"};
+  static const char *const pos[3] = {"x", "y", "z"};
+  static const char *const pair[5] = {"sum_%s0", "sum_%st", "sum_%s0^2", "sum_%st^2",
+                                      "sum_%s0*%st"};
+  snprintf(lab[LG_N], 24, "n");
+  snprintf(lab[LG_TAU], 24, "sum_tau");
+  for (int i = 0; i < 3; i++) {
+    for (int j = 0; j < 5; j++) {
+      snprintf(lab[LG_VEL + 5 * i + j], 24, pair[j], vel[i], vel[i]);
+      snprintf(lab[LG_ACC + 5 * i + j], 24, pair[j], acc[i], acc[i]);
+    }
+    for (int j = 0; j < 3; j++)
+      snprintf(lab[LG_STRUCT + 3 * i + j], 24, "sum_d%s^%d", vel[i], j + 2);
+    snprintf(lab[LG_DISP + i], 24, "sum_d%s^2", pos[i]);
+    snprintf(lab[LG_DR + i], 24, "sum_d%s", pos[i]);
+    snprintf(lab[LG_RATE + 2 * i], 24, "sum_d%s/tau", pos[i]);
+    snprintf(lab[LG_RATE + 2 * i + 1], 24, "sum_(d%s/tau)^2", pos[i]);
+  }
+}
+
+/* The names of the rows of lagr_functions (LF_*) into lab[LF_LEN][32]. */
+static void function_labels(char lab[LF_LEN][32]) {
+  for (size_t j = 0; j < sizeof lagr_rows / sizeof lagr_rows[0]; j++)
+    for (int i = 0; i < 3; i++)
+      snprintf(lab[lagr_rows[j].row + i], 32, lagr_rows[j].fmt, lagr_rows[j].letters[i]);
+  snprintf(lab[LF_N], 32, "n_tracks");
+  snprintf(lab[LF_TAU], 32, "lag_time_mean");
+}
+
+/* The raw state of the completed releases, as the engine keeps it (what chansph extract pools
+   when it joins segments): sums, per-release Welford records of the lag functions and of T_L,
+   and with stations the PDF counts and sums and their per-release Welford records. Written
+   after the other variables; dl, dk, dc: dimensions level, lag, component. No units: records of
+   mixed quantities. */
+static int write_raw(const struct lagr *g, int gr, int dl, int dk, int dc, char *err,
+                     size_t errlen) {
+  const size_t nb = (size_t)g->cfg.pdf_bins;
+  static const char *const welford[SCAL_LEN] = {"n", "mean", "M2"};
+  static const char *const pdf_tail[3] = {"n", "sum_y", "sum_y^2"};
+  static const char *const val_tail[2] = {"mu_y", "var_y"};
+  char sl[LG_LEN][24], fl[LF_LEN][32];
+  const char *slp[LG_LEN], *flp[LF_LEN];
+  sum_labels(sl), function_labels(fl);
+  for (int i = 0; i < LG_LEN; i++) slp[i] = sl[i];
+  for (int i = 0; i < LF_LEN; i++) flp[i] = fl[i];
+  int rc = NC_NOERR, dw, ds, df, dst, dp, dv, v;
+  CK(nc_def_dim(gr, "welford_slot", SCAL_LEN, &dw));
+  CK(ncout_labels(gr, "welford_slot", dw, "slot of a Welford record: count, mean, M2", welford));
+  CK(slot_axis(gr, "sum_slot", "slot of the raw sums of a level and lag", LG_LEN, 0, "", slp, &ds));
+  CK(slot_axis(gr, "lag_function", "lag function of a release (a batch)", LF_LEN, 0, "", flp, &df));
+  const int d_sums[3] = {dl, dk, ds}, d_rb[4] = {dl, df, dk, dw}, d_tl[3] = {dl, dc, dw};
+  CK(ncout_def(gr, "raw_sums", NC_DOUBLE, 3, d_sums, NULL,
+               "raw sums over the completed releases' samples of each level and lag", &v));
+  CK(ncout_fill(gr, v)); /* NaN: a sum not kept by a checkpoint of an earlier format */
+  CK(ncout_put_filled(gr, v, NULL, NULL, g->sums, (size_t)g->cfg.n_levels * g->nlag * LG_LEN));
+  CK(ncout_def(gr, "release_welford", NC_DOUBLE, 4, d_rb, NULL,
+               "raw Welford records (count, mean, M2) over the completed releases of each "
+               "release's own lag functions: the batches of the *_stderr",
+               &v));
+  CK(nc_put_var_double(gr, v, g->rb));
+  CK(ncout_def(gr, "T_L_welford", NC_DOUBLE, 3, d_tl, NULL,
+               "raw Welford records (count, mean, M2) of the finite T_L of the completed "
+               "releases: T_L_release_mean, T_L_stderr",
+               &v));
+  CK(nc_put_var_double(gr, v, g->tl));
+  if (g->cfg.n_stations <= 0) goto done;
+  CK(nc_inq_dimid(gr, "station", &dst));
+  CK(slot_axis(gr, "pdf_slot", "slot of the raw PDF record: bin counts, n, sum y, sum y^2", nb + 3,
+               nb, "count", pdf_tail, &dp));
+  CK(slot_axis(gr, "pdf_value", "value of a release's PDF (a batch): pdf_y bins, mu_y, var_y",
+               nb + 2, nb, "pdf_y", val_tail, &dv));
+  const int d_pdf[3] = {dl, dst, dp}, d_pb[4] = {dl, dst, dv, dw};
+  CK(ncout_def(gr, "raw_pdf", NC_DOUBLE, 3, d_pdf, NULL,
+               "raw counts of the crossings per bin, then their count, sum of y [m] and of y^2 "
+               "[m^2] (all tracks, also of releases in flight)",
+               &v));
+  CK(nc_put_var_double(gr, v, g->pdf));
+  CK(ncout_def(gr, "pdf_release_welford", NC_DOUBLE, 4, d_pb, NULL,
+               "raw Welford records (count, mean, M2) over the completed releases of each "
+               "release's own pdf_y, mu_y and var_y: the batches of the pdf *_stderr",
+               &v));
+  CK(nc_put_var_double(gr, v, g->pdf_rb));
+done:
+  return rc;
+}
+
 int lagr_nc_write(const struct lagr *g, int ncid, char *err, size_t errlen) {
   const struct lagr_config *c = &g->cfg;
   const int nl = c->n_levels, ns = c->n_stations, nb = c->pdf_bins;
@@ -844,11 +951,122 @@ int lagr_nc_write(const struct lagr *g, int ncid, char *err, size_t errlen) {
   /* each names its own failing call in err */
   if ((rc = write_integral_times(g, gr, dl, dc, tl, err, errlen)) != NC_NOERR ||
       (rc = write_history(g, gr, dl, dc, err, errlen)) != NC_NOERR ||
-      (ns > 0 && (rc = write_pdfs(g, gr, dl, tmp, err, errlen)) != NC_NOERR))
+      (ns > 0 && (rc = write_pdfs(g, gr, dl, tmp, err, errlen)) != NC_NOERR) ||
+      (rc = write_raw(g, gr, dl, dk, dc, err, errlen)) != NC_NOERR)
     goto done;
 done:
   free(fn), free(tl), free(tmp);
   return rc;
+}
+
+/* Read variable name of group g, of n doubles in all, into out, _FillValue back to NaN;
+   nonzero if absent, of another size or unreadable. */
+static int read_raw(int g, const char *name, size_t n, double *out) {
+  int v, nd, dims[NC_MAX_VAR_DIMS];
+  size_t len, total = 1;
+  if (nc_inq_varid(g, name, &v) || nc_inq_var(g, v, NULL, NULL, &nd, dims, NULL)) return 1;
+  for (int i = 0; i < nd; i++) {
+    if (nc_inq_dimlen(g, dims[i], &len)) return 1;
+    total *= len;
+  }
+  if (total != n || (n && nc_get_var_double(g, v, out) != NC_NOERR)) return 1;
+  for (size_t i = 0; i < n; i++)
+    if (out[i] == NCOUT_FILL) out[i] = NAN;
+  return 0;
+}
+
+/* The length of dimension name of group g (0 if absent). */
+static size_t dim_len(int g, const char *name) {
+  int d;
+  size_t n = 0;
+  return nc_inq_dimid(g, name, &d) || nc_inq_dimlen(g, d, &n) ? 0 : n;
+}
+
+/* The configuration of group lagrangian g (ncid: the file, for delta): what its writer needs. */
+static int read_config(int ncid, int g, struct lagr_config *c) {
+  memset(c, 0, sizeof *c);
+  const size_t nl = dim_len(g, "level"), nlag = dim_len(g, "lag"), ns = dim_len(g, "station");
+  if (nl < 1 || nl > LAGR_MAX_LEVELS || nlag < 3 || ns > LAGR_MAX_STATIONS) return 1;
+  c->n_levels = (int)nl, c->n_lags = (int)nlag - 1, c->n_stations = (int)ns;
+  c->pdf_bins = ns ? (int)dim_len(g, "pdf_bin") : 0; /* not written without stations */
+  return read_raw(g, "level", nl, c->y) || read_raw(g, "y_plus", nl, c->y_plus) ||
+         (ns && read_raw(g, "station", ns, c->station)) ||
+         nc_get_att_double(g, NC_GLOBAL, "x0", &c->x0) ||
+         nc_get_att_double(g, NC_GLOBAL, "horizon", &c->horizon) ||
+         nc_get_att_double(g, NC_GLOBAL, "release_every", &c->release_every) ||
+         nc_get_att_double(ncid, NC_GLOBAL, "delta", &c->delta) || !(c->horizon > 0.0) ||
+         !(c->release_every > 0.0);
+}
+
+/* The history of T_L of group g into the engine (its rows and their completion times). */
+static int read_history(struct lagr *g, int gr) {
+  const size_t n = dim_len(gr, "release"), row = (size_t)g->cfg.n_levels * 3;
+  reserve_history(g, n ? n : 1);
+  g->n_rel = n;
+  return read_raw(gr, "release", n, g->tl_rel_t) || read_raw(gr, "T_L_release", n * row, g->tl_rel);
+}
+
+int lagr_nc_read(struct lagr *g, int ncid, char *err, size_t errlen) {
+  struct lagr_config c;
+  int gr;
+  memset(g, 0, sizeof *g);
+  if (nc_inq_ncid(ncid, "lagrangian", &gr) != NC_NOERR) {
+    snprintf(err, errlen, "no group 'lagrangian'");
+    return 1;
+  }
+  if (read_config(ncid, gr, &c)) {
+    snprintf(err, errlen, "group 'lagrangian' has no readable configuration");
+    return -1;
+  }
+  lagr_init(g, &c);
+  const size_t nl = (size_t)c.n_levels, ns = (size_t)c.n_stations, nb = (size_t)c.pdf_bins;
+  if (read_raw(gr, "raw_sums", nl * g->nlag * LG_LEN, g->sums) ||
+      read_raw(gr, "release_welford", nl * LF_LEN * g->nlag * SCAL_LEN, g->rb) ||
+      read_raw(gr, "T_L_welford", nl * 3 * SCAL_LEN, g->tl) ||
+      (ns && (read_raw(gr, "raw_pdf", nl * ns * (nb + 3), g->pdf) ||
+              read_raw(gr, "pdf_release_welford", nl * ns * (nb + 2) * SCAL_LEN, g->pdf_rb))) ||
+      read_history(g, gr) || nc_get_att_double(gr, NC_GLOBAL, "releases", &g->releases)) {
+    snprintf(err, errlen,
+             "group 'lagrangian' has no raw sums and per-release records (raw_sums, "
+             "release_welford, T_L_welford: written before stats.nc held them)");
+    lagr_free(g);
+    return 2;
+  }
+  return 0;
+}
+
+/* Whether two configurations gather the same statistics (levels, lags, releases, stations). */
+static int same_config(const struct lagr_config *x, const struct lagr_config *y) {
+  int same = x->n_levels == y->n_levels && x->n_lags == y->n_lags && x->x0 == y->x0 &&
+             x->horizon == y->horizon && x->release_every == y->release_every &&
+             x->n_stations == y->n_stations && x->pdf_bins == y->pdf_bins;
+  for (int l = 0; same && l < x->n_levels; l++) same = x->y_plus[l] == y->y_plus[l];
+  for (int s = 0; same && s < x->n_stations; s++) same = x->station[s] == y->station[s];
+  return same;
+}
+
+int lagr_join(struct lagr *g, const struct lagr *b, double offset, char *why, size_t len) {
+  if (!same_config(&g->cfg, &b->cfg)) {
+    snprintf(why, len,
+             "other release levels, lags, horizon, release_every, x0, stations or pdf bins");
+    return 1;
+  }
+  const struct lagr_config *c = &g->cfg;
+  const size_t nl = (size_t)c->n_levels, nst = n_st(c), nb = (size_t)c->pdf_bins;
+  for (size_t i = 0; i < nl * g->nlag * LG_LEN; i++) g->sums[i] += b->sums[i];
+  for (size_t i = 0; i < nl * nst * (nb + 3); i++) g->pdf[i] += b->pdf[i];
+  for (size_t i = 0; i < nl * LF_LEN * g->nlag; i++)
+    scal_merge(g->rb + i * SCAL_LEN, b->rb + i * SCAL_LEN);
+  for (size_t i = 0; i < nl * nst * (nb + 2); i++)
+    scal_merge(g->pdf_rb + i * SCAL_LEN, b->pdf_rb + i * SCAL_LEN);
+  for (size_t i = 0; i < nl * 3; i++) scal_merge(g->tl + i * SCAL_LEN, b->tl + i * SCAL_LEN);
+  /* the history: b's releases after g's, their completion times on the joined time axis */
+  const size_t row = nl * 3;
+  reserve_history(g, g->n_rel + b->n_rel);
+  memcpy(g->tl_rel + g->n_rel * row, b->tl_rel, b->n_rel * row * sizeof(double));
+  for (size_t r = 0; r < b->n_rel; r++) g->tl_rel_t[g->n_rel + r] = b->tl_rel_t[r] + offset;
+  g->n_rel += b->n_rel, g->releases += b->releases;
+  return 0;
 }
 
 /* The engine's scene keys, section [lagrangian] (docs/scenes.md is generated from them). */

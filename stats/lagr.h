@@ -192,6 +192,26 @@ double lagr_tl(const double *rho, size_t nlag, double dtau);
 /** @brief Write group "lagrangian" into an open netCDF-4 file; returns a netCDF status. */
 int lagr_nc_write(const struct lagr *g, int ncid, char *err, size_t errlen);
 
+/**
+ * @brief Read the raw state of group `lagrangian` of a stats.nc (ncid: the file): the
+ *        configuration its writer needs, the completed releases' sums (raw_sums), their
+ *        per-release Welford records (release_welford, T_L_welford, pdf_release_welford), the
+ *        PDF sums (raw_pdf), the history of T_L and the count of releases. The releases in
+ *        flight are not in the file: the engine read has none.
+ * @return 0 (g set up; lagr_free it), 1 no group (engine off), 2 no raw records (a file of an
+ *         earlier version), -1 not this layout; err says why
+ */
+int lagr_nc_read(struct lagr *g, int ncid, char *err, size_t errlen);
+
+/**
+ * @brief Pool the completed releases of b (a later segment of the run, whose times start at 0)
+ *        into g: sums and PDF sums added, the per-release Welford records merged pairwise
+ *        (scal_merge), b's history of T_L appended with its completion times shifted by offset,
+ *        the release counts added. Nonzero if b was configured otherwise (why says how); g is
+ *        then unchanged.
+ */
+int lagr_join(struct lagr *g, const struct lagr *b, double offset, char *why, size_t len);
+
 /** The Lagrangian engine's table of operations (engine.h; lagr.c). */
 extern const struct stats_engine lagr_engine;
 

@@ -106,4 +106,24 @@ static inline void scal_add(double *restrict a, double x) {
   a[SCAL_N] = n;
 }
 
+/**
+ * @brief Merge scalar record b into record a (a := a + b), the pairwise update of Chan, Golub
+ *        & LeVeque (1979): n = na + nb, delta = mean_b - mean_a, mean = mean_a + delta nb / n,
+ *        M2 = M2a + M2b + delta^2 na nb / n. Exact in exact arithmetic (the batches of two
+ *        segments pooled, chansph extract); b empty leaves a bitwise unchanged, a empty
+ *        becomes b.
+ */
+static inline void scal_merge(double *restrict a, const double *restrict b) {
+  const double na = a[SCAL_N], nb = b[SCAL_N];
+  if (nb == 0.0) return;
+  if (na == 0.0) {
+    for (int k = 0; k < SCAL_LEN; k++) a[k] = b[k];
+    return;
+  }
+  const double n = na + nb, d = b[SCAL_MEAN] - a[SCAL_MEAN];
+  a[SCAL_M2] += b[SCAL_M2] + d * d * na * nb / n;
+  a[SCAL_MEAN] += d * nb / n;
+  a[SCAL_N] = n;
+}
+
 #endif

@@ -174,6 +174,44 @@ static void quad_stderr(const struct quad *q, double *se, double *nwin) {
   }
 }
 
+/* The labels of the batch values (QB_*) and of the slots of a Welford record (SCAL_*). */
+static const char *const batch_label[QB_LEN] = {"uv_Q1",
+                                                "uv_Q2",
+                                                "uv_Q3",
+                                                "uv_Q4",
+                                                "uv_fraction_Q1",
+                                                "uv_fraction_Q2",
+                                                "uv_fraction_Q3",
+                                                "uv_fraction_Q4",
+                                                "time_fraction_Q1",
+                                                "time_fraction_Q2",
+                                                "time_fraction_Q3",
+                                                "time_fraction_Q4"};
+static const char *const welford_label[SCAL_LEN] = {"n", "mean", "M2"};
+
+/* The raw Welford records of the closed windows' values, [level][batch_value][welford_slot]
+   (q->batch as the engine keeps it): what chansph extract pools when it joins segments. */
+static int write_raw_batches(const struct quad *q, int g, int dl, char *err, size_t errlen) {
+  int rc = NC_NOERR, d[3] = {dl, 0, 0}, v;
+  NC_TRY(nc_def_dim(g, "batch_value", QB_LEN, &d[1]), done);
+  NC_TRY(
+      ncout_labels(g, "batch_value", d[1], "value of an averaging window (a batch)", batch_label),
+      done);
+  NC_TRY(nc_def_dim(g, "welford_slot", SCAL_LEN, &d[2]), done);
+  NC_TRY(ncout_labels(g, "welford_slot", d[2], "slot of a Welford record: count, mean, M2",
+                      welford_label),
+         done);
+  NC_TRY(ncout_def(g, "batch_welford", NC_DOUBLE, 3, d, NULL, /* mixed record: no units */
+                   "raw Welford records (count, mean, sum of squared deviations M2) over the "
+                   "complete averaging windows of each window's uv, uv_fraction and "
+                   "time_fraction: the batches of the *_stderr",
+                   &v),
+         done);
+  NC_TRY(nc_put_var_double(g, v, q->batch), done);
+done:
+  return rc;
+}
+
 int quad_nc_write(const struct quad *q, int ncid, char *err, size_t errlen) {
   const size_t nl = (size_t)q->cfg.n_levels;
   double *r = mem_alloc(6 * 4 * nl + nl, sizeof(double), "quadrants"), *se = r + 12 * nl;
@@ -242,9 +280,68 @@ int quad_nc_write(const struct quad *q, int ncid, char *err, size_t errlen) {
            done);
     NC_TRY(nc_put_var_double(g, v, q->acc), done);
   }
+  NC_TRY(write_raw_batches(q, g, dl, err, errlen), done);
 done:
   free(r);
   return rc;
+}
+
+/* Read variable name of group g, of n doubles in all, into out; nonzero if absent or another
+   size. */
+static int read_raw(int g, const char *name, size_t n, double *out) {
+  int v, nd, dims[NC_MAX_VAR_DIMS];
+  size_t len, total = 1;
+  if (nc_inq_varid(g, name, &v) || nc_inq_var(g, v, NULL, NULL, &nd, dims, NULL)) return 1;
+  for (int i = 0; i < nd; i++) {
+    if (nc_inq_dimlen(g, dims[i], &len)) return 1;
+    total *= len;
+  }
+  return total != n || nc_get_var_double(g, v, out) != NC_NOERR;
+}
+
+int quad_nc_read(struct quad *q, int ncid, char *err, size_t errlen) {
+  struct quad_config c;
+  int g, d;
+  size_t nl = 0;
+  memset(q, 0, sizeof *q), memset(&c, 0, sizeof c);
+  if (nc_inq_ncid(ncid, "quadrants", &g) != NC_NOERR) {
+    snprintf(err, errlen, "no group 'quadrants'");
+    return 1;
+  }
+  if (nc_inq_dimid(g, "level", &d) || nc_inq_dimlen(g, d, &nl) || nl < 1 || nl > QUAD_MAX_LEVELS ||
+      read_raw(g, "level", nl, c.y) || read_raw(g, "y_plus", nl, c.y_plus) ||
+      nc_get_att_double(g, NC_GLOBAL, "window_length", &c.window) ||
+      nc_get_att_double(ncid, NC_GLOBAL, "delta", &c.delta)) {
+    snprintf(err, errlen, "group 'quadrants' has no levels or no window_length");
+    return -1;
+  }
+  c.n_levels = (int)nl;
+  quad_init(q, &c);
+  if (read_raw(g, "sums", nl * QS_LEN, q->acc) || read_raw(g, "samples", nl, q->samples) ||
+      read_raw(g, "batch_welford", nl * QB_LEN * SCAL_LEN, q->batch)) {
+    snprintf(err, errlen,
+             "group 'quadrants' has no raw sums and window batches (batch_welford: written "
+             "before stats.nc held them)");
+    quad_free(q);
+    return 2;
+  }
+  return 0;
+}
+
+int quad_join(struct quad *q, const struct quad *b, char *why, size_t len) {
+  const struct quad_config *x = &q->cfg, *y = &b->cfg;
+  int same = x->n_levels == y->n_levels && x->window == y->window;
+  for (int l = 0; same && l < x->n_levels; l++) same = x->y_plus[l] == y->y_plus[l];
+  if (!same) {
+    snprintf(why, len, "other levels (quadrants.y_plus) or window length");
+    return 1;
+  }
+  const size_t nl = (size_t)x->n_levels;
+  for (size_t i = 0; i < nl * QS_LEN; i++) q->acc[i] += b->acc[i];
+  for (size_t l = 0; l < nl; l++) q->samples[l] += b->samples[l];
+  for (size_t i = 0; i < nl * QB_LEN; i++)
+    scal_merge(q->batch + i * SCAL_LEN, b->batch + i * SCAL_LEN);
+  return 0;
 }
 
 /* The engine's scene key, section [quadrants] (docs/scenes.md is generated from it). */

@@ -73,6 +73,22 @@ void quad_state(struct quad *q, struct state_list *L);
 /** @brief Define and write the group `quadrants` of stats.nc (netCDF status, message in err). */
 int quad_nc_write(const struct quad *q, int ncid, char *err, size_t errlen);
 
+/**
+ * @brief Read the raw state of group `quadrants` of a stats.nc (ncid: the file): configuration
+ *        (levels, window length, delta), sums, samples and the window batches (batch_welford).
+ *        The open window is not in the file: the engine read holds none.
+ * @return 0 (q set up; quad_free it), 1 no group (engine off), 2 no raw batches (a file of an
+ *         earlier version), -1 not this layout; err says why
+ */
+int quad_nc_read(struct quad *q, int ncid, char *err, size_t errlen);
+
+/**
+ * @brief Pool the engine b (a later segment of the run) into q: sums and samples added, the
+ *        window batches merged pairwise (scal_merge). Nonzero if b was configured otherwise
+ *        (why says how); q is then unchanged.
+ */
+int quad_join(struct quad *q, const struct quad *b, char *why, size_t len);
+
 /** The quadrant engine's table of operations (engine.h; quad.c). */
 extern const struct stats_engine quad_engine;
 

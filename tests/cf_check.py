@@ -3,8 +3,9 @@
 libudunits2 parses (through ctypes: the Debian runtime library and its XML database), every
 variable has a long_name or standard_name, the file declares Conventions, and the attributes
 that count or flag are integers. Records of mixed quantities (eulerian/windows, moments,
-snapshot_u) carry no units. Provenance: history (a "DATE: chansph ..." line per run and resume,
-newest first), date_created (ISO 8601), source (version and git commit), ranks and threads.
+snapshot_u, the raw sums and Welford records of the quadrant and Lagrangian groups) carry no
+units. Provenance: history (a "DATE: chansph ..." line per run and resume, newest first),
+date_created (ISO 8601), source (version and git commit), ranks and threads.
 Axes: every dimension a variable uses has a coordinate variable of that name in the variable's
 own group (so xarray labels the axis; exempt: bnds), the
 bin coordinates y and pdf_bin have CF bounds (contiguous, holding the centre), time has units
@@ -36,7 +37,8 @@ from chansph_stats.ncfile import open_nc  # noqa: E402
 INTEGER_ATTRS = ("dimension", "steps", "n_fluid", "n_snapshots", "n_windows", "fold", "les",
                  "step", "releases", "ranks", "threads")
 STAMP = r"\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ"
-MIXED = ("windows", "moments", "snapshot_u", "sums")
+MIXED = ("windows", "moments", "snapshot_u", "sums", "raw_sums", "raw_pdf", "release_welford",
+         "pdf_release_welford", "T_L_welford", "batch_welford")
 NO_COORD = ("bnds",)
 POSITION = ("x", "y", "z")
 BINNED = ("y", "pdf_bin")

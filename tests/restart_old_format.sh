@@ -15,8 +15,8 @@
 #     completed); the log says what was lacking.
 #   lagr16, lagr18, lagr19: group lagrangian bit for bit, except the variables the old records
 #     cannot give: rate_var_* (and for 1.8 lag_time_mean, for 1.6 also disp_mean_*,
-#     disp_var_*), fill values where the stored sums had samples (at least one) and otherwise
-#     equal.
+#     disp_var_*), and the slots of the raw sums (raw_sums) the old records lack, fill values
+#     where the stored sums had samples (at least one) and otherwise equal.
 #   stats111: the root group: stresses about the bin mean (local_mean 0; uu .. vw equal to
 #     uu_bin .. vw_bin, which equal the uninterrupted run's bit for bit), the means bit for
 #     bit; groups lagrangian and quadrants bit for bit except their standard errors and batch
@@ -101,10 +101,12 @@ BATCHES = ("release_batches", "pdf_release_batches", "n_batches")
 
 
 def batched(k):
-    """A standard error or batch count of the per-release or per-window batches of format
-    1.12 (T_L's batches are older): after a resume from an older format they count only the
-    batches completed after it."""
-    return k in BATCHES or (k.endswith("_stderr") and k != "T_L_stderr")
+    """A standard error, batch count or raw Welford record (release_welford,
+    pdf_release_welford, batch_welford) of the per-release or per-window batches of format
+    1.12 (T_L's batches, T_L_stderr and T_L_welford, are older): after a resume from an older
+    format they count only the batches completed after it."""
+    return k in BATCHES or (k.endswith(("_stderr", "_welford")) and
+                            k not in ("T_L_stderr", "T_L_welford"))
 
 
 def fewer_batches(a, b, names):
@@ -242,7 +244,7 @@ if mode == "stats111":
 elif mode == "corr17":
     ok = corr(fa.groups["correlations"], fb.groups["correlations"])
 else:
-    unknown = [] if mode == "lagr112" else ["rate_var_"] + \
+    unknown = [] if mode == "lagr112" else ["rate_var_", "raw_sums"] + \
         (["lag_time_mean"] if mode != "lagr19" else []) + \
         (["disp_mean_", "disp_var_"] if mode == "lagr16" else [])
     ok = lagr(fa.groups["lagrangian"], fb.groups["lagrangian"], unknown)
