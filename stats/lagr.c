@@ -959,22 +959,6 @@ done:
   return rc;
 }
 
-/* Read variable name of group g, of n doubles in all, into out, _FillValue back to NaN;
-   nonzero if absent, of another size or unreadable. */
-static int read_raw(int g, const char *name, size_t n, double *out) {
-  int v, nd, dims[NC_MAX_VAR_DIMS];
-  size_t len, total = 1;
-  if (nc_inq_varid(g, name, &v) || nc_inq_var(g, v, NULL, NULL, &nd, dims, NULL)) return 1;
-  for (int i = 0; i < nd; i++) {
-    if (nc_inq_dimlen(g, dims[i], &len)) return 1;
-    total *= len;
-  }
-  if (total != n || (n && nc_get_var_double(g, v, out) != NC_NOERR)) return 1;
-  for (size_t i = 0; i < n; i++)
-    if (out[i] == NCOUT_FILL) out[i] = NAN;
-  return 0;
-}
-
 /* The length of dimension name of group g (0 if absent). */
 static size_t dim_len(int g, const char *name) {
   int d;
@@ -989,8 +973,8 @@ static int read_config(int ncid, int g, struct lagr_config *c) {
   if (nl < 1 || nl > LAGR_MAX_LEVELS || nlag < 3 || ns > LAGR_MAX_STATIONS) return 1;
   c->n_levels = (int)nl, c->n_lags = (int)nlag - 1, c->n_stations = (int)ns;
   c->pdf_bins = ns ? (int)dim_len(g, "pdf_bin") : 0; /* not written without stations */
-  return read_raw(g, "level", nl, c->y) || read_raw(g, "y_plus", nl, c->y_plus) ||
-         (ns && read_raw(g, "station", ns, c->station)) ||
+  return ncout_get_raw(g, "level", nl, c->y) || ncout_get_raw(g, "y_plus", nl, c->y_plus) ||
+         (ns && ncout_get_raw(g, "station", ns, c->station)) ||
          nc_get_att_double(g, NC_GLOBAL, "x0", &c->x0) ||
          nc_get_att_double(g, NC_GLOBAL, "horizon", &c->horizon) ||
          nc_get_att_double(g, NC_GLOBAL, "release_every", &c->release_every) ||
@@ -1003,7 +987,8 @@ static int read_history(struct lagr *g, int gr) {
   const size_t n = dim_len(gr, "release"), row = (size_t)g->cfg.n_levels * 3;
   reserve_history(g, n ? n : 1);
   g->n_rel = n;
-  return read_raw(gr, "release", n, g->tl_rel_t) || read_raw(gr, "T_L_release", n * row, g->tl_rel);
+  return ncout_get_raw(gr, "release", n, g->tl_rel_t) ||
+         ncout_get_raw(gr, "T_L_release", n * row, g->tl_rel);
 }
 
 int lagr_nc_read(struct lagr *g, int ncid, char *err, size_t errlen) {
@@ -1020,11 +1005,12 @@ int lagr_nc_read(struct lagr *g, int ncid, char *err, size_t errlen) {
   }
   lagr_init(g, &c);
   const size_t nl = (size_t)c.n_levels, ns = (size_t)c.n_stations, nb = (size_t)c.pdf_bins;
-  if (read_raw(gr, "raw_sums", nl * g->nlag * LG_LEN, g->sums) ||
-      read_raw(gr, "release_welford", nl * LF_LEN * g->nlag * SCAL_LEN, g->rb) ||
-      read_raw(gr, "T_L_welford", nl * 3 * SCAL_LEN, g->tl) ||
-      (ns && (read_raw(gr, "raw_pdf", nl * ns * (nb + 3), g->pdf) ||
-              read_raw(gr, "pdf_release_welford", nl * ns * (nb + 2) * SCAL_LEN, g->pdf_rb))) ||
+  if (ncout_get_raw(gr, "raw_sums", nl * g->nlag * LG_LEN, g->sums) ||
+      ncout_get_raw(gr, "release_welford", nl * LF_LEN * g->nlag * SCAL_LEN, g->rb) ||
+      ncout_get_raw(gr, "T_L_welford", nl * 3 * SCAL_LEN, g->tl) ||
+      (ns &&
+       (ncout_get_raw(gr, "raw_pdf", nl * ns * (nb + 3), g->pdf) ||
+        ncout_get_raw(gr, "pdf_release_welford", nl * ns * (nb + 2) * SCAL_LEN, g->pdf_rb))) ||
       read_history(g, gr) || nc_get_att_double(gr, NC_GLOBAL, "releases", &g->releases)) {
     snprintf(err, errlen,
              "group 'lagrangian' has no raw sums and per-release records (raw_sums, "

@@ -365,3 +365,17 @@ int ncout_columns_par(const char *path, const struct ncout_table *t, size_t lo, 
   if (me == 0 && rc && !renamed) kept(err, errlen, path), remove(tmp);
   return durable_agree(rc, err, errlen);
 }
+
+int ncout_get_raw(int g, const char *name, size_t n, double *out) {
+  int v, nd, dims[NC_MAX_VAR_DIMS];
+  size_t len, total = 1;
+  if (nc_inq_varid(g, name, &v) || nc_inq_var(g, v, NULL, NULL, &nd, dims, NULL)) return 1;
+  for (int i = 0; i < nd; i++) {
+    if (nc_inq_dimlen(g, dims[i], &len)) return 1;
+    total *= len;
+  }
+  if (total != n || (n && nc_get_var_double(g, v, out) != NC_NOERR)) return 1;
+  for (size_t i = 0; i < n; i++)
+    if (out[i] == NCOUT_FILL) out[i] = NAN;
+  return 0;
+}

@@ -125,6 +125,14 @@ int ncout_put_filled(int ncid, int varid, const size_t *start, const size_t *cou
                      size_t n);
 
 /**
+ * @brief Read variable name of group g, n doubles in all (any shape), into out, _FillValue
+ *        (NCOUT_FILL) back to NaN: the raw records chansph extract re-combines.
+ * @return 0, or nonzero if the variable is absent, holds another number of values or cannot be
+ *         read.
+ */
+int ncout_get_raw(int g, const char *name, size_t n, double *out);
+
+/**
  * @brief A categorical axis: the string coordinate variable named like dimension dim (one
  *        label per index), so that xarray shows labelled axes.
  */

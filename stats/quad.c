@@ -286,19 +286,6 @@ done:
   return rc;
 }
 
-/* Read variable name of group g, of n doubles in all, into out; nonzero if absent or another
-   size. */
-static int read_raw(int g, const char *name, size_t n, double *out) {
-  int v, nd, dims[NC_MAX_VAR_DIMS];
-  size_t len, total = 1;
-  if (nc_inq_varid(g, name, &v) || nc_inq_var(g, v, NULL, NULL, &nd, dims, NULL)) return 1;
-  for (int i = 0; i < nd; i++) {
-    if (nc_inq_dimlen(g, dims[i], &len)) return 1;
-    total *= len;
-  }
-  return total != n || nc_get_var_double(g, v, out) != NC_NOERR;
-}
-
 int quad_nc_read(struct quad *q, int ncid, char *err, size_t errlen) {
   struct quad_config c;
   int g, d;
@@ -309,7 +296,7 @@ int quad_nc_read(struct quad *q, int ncid, char *err, size_t errlen) {
     return 1;
   }
   if (nc_inq_dimid(g, "level", &d) || nc_inq_dimlen(g, d, &nl) || nl < 1 || nl > QUAD_MAX_LEVELS ||
-      read_raw(g, "level", nl, c.y) || read_raw(g, "y_plus", nl, c.y_plus) ||
+      ncout_get_raw(g, "level", nl, c.y) || ncout_get_raw(g, "y_plus", nl, c.y_plus) ||
       nc_get_att_double(g, NC_GLOBAL, "window_length", &c.window) ||
       nc_get_att_double(ncid, NC_GLOBAL, "delta", &c.delta)) {
     snprintf(err, errlen, "group 'quadrants' has no levels or no window_length");
@@ -317,8 +304,9 @@ int quad_nc_read(struct quad *q, int ncid, char *err, size_t errlen) {
   }
   c.n_levels = (int)nl;
   quad_init(q, &c);
-  if (read_raw(g, "sums", nl * QS_LEN, q->acc) || read_raw(g, "samples", nl, q->samples) ||
-      read_raw(g, "batch_welford", nl * QB_LEN * SCAL_LEN, q->batch)) {
+  if (ncout_get_raw(g, "sums", nl * QS_LEN, q->acc) ||
+      ncout_get_raw(g, "samples", nl, q->samples) ||
+      ncout_get_raw(g, "batch_welford", nl * QB_LEN * SCAL_LEN, q->batch)) {
     snprintf(err, errlen,
              "group 'quadrants' has no raw sums and window batches (batch_welford: written "
              "before stats.nc held them)");
