@@ -8,6 +8,11 @@ and docs/perf/node16.sh write it). Prints per build and layout: runs, ms/step, p
 efficiency against 1 x 1 of the same build, and the per-phase seconds per step of rank 0 (the
 sort: "sort" + "sort:permute"; the halo: every "halo*" phase, of which "halo:wait" is the time
 in MPI waits), each a median over the runs. --csv writes one row per run.
+
+Then, per build, the serial fractions on two cores: the sort's from 1 x 1 and 1 x 2 (Amdahl: a
+phase of time T1 on one thread and T2 on two has the serial fraction f = 2 T2 / T1 - 1 of its
+time; f T1 / step(1 x 1) of the one-thread step), and the halo's on 2 x 1 (work the one-rank
+run does not do at all: its own work, without the MPI waits, and with them, over the step).
 """
 import re
 import statistics
@@ -89,6 +94,46 @@ def main():
         print(f"| {key[0]} | {key[1]} x {key[2]} | {len(rs)} | {med([r['ms'] for r in rs]):.1f} | "
               f"{ps / 1e6:.3f} M | {100 * eff:.0f}% | {sort:.1f} | {halo:.1f} ({wait:.1f}) | "
               f"{nb:.1f} | {fo:.1f} | {rest:.1f} |")
+    serial_fractions(g)
+
+
+def serial_fractions(g):
+    """The sort's and the halo's serial fractions on two cores, per build (see the doc)."""
+    rows = []
+    for b in sorted({k[0] for k in g}):
+        one, two, ranks = g.get((b, 1, 1)), g.get((b, 1, 2)), g.get((b, 2, 1))
+        if not one:
+            continue
+
+        def ph(rs, sel):
+            return med([sum(v for n, v in r["phases"].items() if sel(n)) * 1e3 / r["steps"]
+                        for r in rs])
+        step1 = med([r["ms"] for r in one])
+        row = [b, f"{step1:.1f}"]
+        if two:
+            t1, t2 = ph(one, lambda n: n.startswith("sort")), ph(two, lambda n: n.startswith("sort"))
+            f = 2 * t2 / t1 - 1 if t1 > 0 else float("nan")
+            row += [f"{t1:.2f} / {t2:.2f}", f"{100 * f:.0f}%", f"{100 * f * t1 / step1:.2f}%"]
+        else:
+            row += ["-"] * 3
+        if ranks:
+            step2 = med([r["ms"] for r in ranks])
+            halo = ph(ranks, lambda n: n.startswith("halo"))
+            wait = ph(ranks, lambda n: n == "halo:wait")
+            row += [f"{halo - wait:.2f} / {wait:.2f}", f"{100 * (halo - wait) / step2:.2f}%",
+                    f"{100 * halo / step2:.2f}%"]
+        else:
+            row += ["-"] * 3
+        rows.append(row)
+    if not rows:
+        return
+    print()
+    print("| build | 1 x 1 ms/step | sort ms/step 1 x 1 / 1 x 2 | sort serial fraction | "
+          "of the 1-thread step | halo work / MPI wait ms/step (2 x 1) | halo work / step | "
+          "halo with waits / step |")
+    print("|---|---|---|---|---|---|---|---|")
+    for row in rows:
+        print("| " + " | ".join(row) + " |")
 
 
 main()

@@ -14,6 +14,7 @@
 # Then: a B without the raw records (renamed: a file of an earlier version) or with another
 # horizon leaves group lagrangian out with a note naming it, the eulerian part still joined
 # (exit 0); --window restricting the range leaves both groups out; one file --nc has neither.
+# Last: chansph-stats lagr_table on J (the blocked T_L errors of one release = T_L_stderr).
 # usage: extract_join_groups_check.sh CHANSPH SCENE WORK   (SCENE: poiseuille3d.ini)
 set -u
 chansph=$1 scene=$2 work=$3
@@ -210,4 +211,14 @@ rm -f "$work/one.nc"
 "$chansph" extract "$a" --nc "$work/one.nc" > /dev/null 2>&1 || { echo "FAIL: extract A --nc"; exit 1; }
 got=$(/usr/bin/python3 -c "import netCDF4, sys; print(','.join(sorted(netCDF4.Dataset(sys.argv[1]).groups)))" "$work/one.nc")
 [ "$got" = "eulerian" ] || { echo "FAIL: one file --nc has groups $got, not eulerian (as before)"; exit 1; }
+# chansph-stats lagr_table reads the joined file: its blocks of one release are the file's
+# T_L_stderr (the same formula, from the history), and every quadrant row is printed
+root=$(cd "$(dirname "$0")/.." && pwd)
+tab=$("$root/stats/python/chansph-stats" lagr_table "$j" 2>&1) ||
+  { echo "$tab"; echo "FAIL: chansph-stats lagr_table on the joined file"; exit 1; }
+echo "$tab" | awk -F'|' '$3 ~ /^ [uvw] $/ && $5 !~ /nan/ {n++; if ($5 + 0 != $9 + 0) bad++}
+  END {exit !(n >= 1 && !bad)}' ||
+  { echo "$tab"; echo "FAIL: lagr_table: blocks of 1 release differ from T_L_stderr"; exit 1; }
+[ "$(echo "$tab" | grep -c "share of u'v'")" = 2 ] ||
+  { echo "$tab"; echo "FAIL: lagr_table: not 2 quadrant levels"; exit 1; }
 echo "PASS: groups lagrangian and quadrants of two segments joined"

@@ -32,6 +32,7 @@ TOOLS = {
     "skewflat_compare": ("skewflat_compare", "skewness and flatness profiles against MKM 180"),
     "rs_budget": ("budget_compare", "Reynolds-stress budgets (rsb_*) against the MKM 180 balances"),
     "lagr_check": ("lagr_check", "the Lagrangian engine against exact dispersion laws"),
+    "lagr_table": ("lagr_table", "Lagrangian and quadrant statistics with their errors (tables)"),
     "figures": ("figures", "the five profiles in one figure and the budgets, redrawn from stats.nc"),
     "summary": ("summary", "one screen: is a run turbulent, its peaks against a DNS (quick-start)"),
 }
