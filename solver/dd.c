@@ -86,6 +86,68 @@ static inline void wire_unpack(const struct wire *w, size_t a, const double *r) 
   }
 }
 
+/* The share [i0, i1) of thread t of nt in n items. */
+static void thread_share(size_t n, int t, int nt, size_t *i0, size_t *i1) {
+  *i0 = n * (size_t)t / (size_t)nt, *i1 = n * (size_t)(t + 1) / (size_t)nt;
+}
+
+/* wire_pack of the slots slots[0 .. n-1] into records of len values at buf, field by field
+   (each field's loop over the particles is a plain strided copy; the per-record loop over the
+   fields, with a type test per field, took 4-5 times the instructions). Called by each thread
+   on its share. */
+static void wire_pack_list(const struct wire *w, const size_t *restrict slots, size_t n,
+                           double *restrict buf, int len) {
+  int off = 0;
+  for (int i = 0; i < w->n; i++) {
+    const int W = w->width[i];
+    double *restrict r = buf + off;
+    if (w->type[i] == PT_I64) {
+      const int64_t *restrict arr = w->arr[i];
+      for (size_t j = 0; j < n; j++) memcpy(r + j * len, arr + slots[j], sizeof(double));
+    } else if (w->type[i] == PT_U8) {
+      const uint8_t *restrict arr = w->arr[i];
+      for (size_t j = 0; j < n; j++) r[j * len] = arr[slots[j]];
+    } else if (!w->arr[i]) {
+      for (size_t j = 0; j < n; j++)
+        for (int k = 0; k < W; k++) r[j * len + k] = 0.0;
+    } else if (W == 1) {
+      const double *restrict arr = w->arr[i];
+      for (size_t j = 0; j < n; j++) r[j * len] = arr[slots[j]];
+    } else {
+      const double *restrict arr = w->arr[i];
+      for (size_t j = 0; j < n; j++)
+        for (int k = 0; k < W; k++) r[j * len + k] = arr[slots[j] * W + k];
+    }
+    off += W;
+  }
+}
+
+/* wire_unpack of records of len values at buf into the slots slots[0 .. n-1] (or first + j
+   where slots is NULL), field by field; a field not live is skipped. Each thread its share. */
+static void wire_unpack_list(const struct wire *w, const size_t *restrict slots, size_t first,
+                             size_t n, const double *restrict buf, int len) {
+  int off = 0;
+  for (int i = 0; i < w->n; i++) {
+    const int W = w->width[i];
+    const double *restrict r = buf + off;
+    off += W;
+    if (w->type[i] == PT_I64) {
+      int64_t *restrict arr = w->arr[i];
+      for (size_t j = 0; j < n; j++)
+        memcpy(arr + (slots ? slots[j] : first + j), r + j * len, sizeof(double));
+    } else if (w->type[i] == PT_U8) {
+      uint8_t *restrict arr = w->arr[i];
+      for (size_t j = 0; j < n; j++) arr[slots ? slots[j] : first + j] = (uint8_t)r[j * len];
+    } else if (w->arr[i]) {
+      double *restrict arr = w->arr[i];
+      for (size_t j = 0; j < n; j++) {
+        const size_t a = slots ? slots[j] : first + j;
+        for (int k = 0; k < W; k++) arr[a * W + k] = r[j * len + k];
+      }
+    }
+  }
+}
+
 static void pack(const struct particles *P, size_t a, double *r, int role) {
   struct wire w;
   wire_fields(P, role, &w);
@@ -363,11 +425,16 @@ void dd_migrate(struct dd *d, struct particles *P, const struct nbr *nb) {
   const size_t n0 = P->n;
   int *dest = mem_alloc(1, (n0 ? n0 : 1) * sizeof(int), "domain decomposition");
   size_t *leave = mem_alloc(1, (n0 ? n0 : 1) * sizeof(size_t), "domain decomposition");
+  /* a local copy of the grid and the owned range: the stores of the wrapped positions cannot
+     alias them, so the loop keeps them in registers */
+  const struct nbr g = *nb;
+  const int c0 = d->fx[d->bx], c1 = d->fx[d->bx + 1], z0 = d->fz[d->bz], z1 = d->fz[d->bz + 1];
+  double *restrict px = P->x, *restrict pz = P->z;
 #pragma omp parallel for schedule(static)
   for (size_t a = 0; a < n0; a++) {
-    nbr_wrap_position(nb, &P->x[a], &P->z[a]);
-    const int col = nbr_column(nb, P->x[a]), plane = nbr_plane(nb, P->z[a]);
-    dest[a] = owned(d, col, plane) ? -1 : dd_owner(d, col, plane);
+    nbr_wrap_position(&g, &px[a], &pz[a]);
+    const int col = nbr_column(&g, px[a]), plane = nbr_plane(&g, pz[a]);
+    dest[a] = col >= c0 && col < c1 && plane >= z0 && plane < z1 ? -1 : dd_owner(d, col, plane);
   }
   size_t leaving;
   split_slots(dest, n0, leave, &leaving);
@@ -417,8 +484,13 @@ void dd_migrate(struct dd *d, struct particles *P, const struct nbr *nb) {
   d->reserve(d->ctx, P->n + arriving);
   struct wire w;
   wire_fields(P, PF_MIGRATE, &w);
-#pragma omp parallel for schedule(static)
-  for (size_t i = 0; i < arriving; i++) wire_unpack(&w, P->n + i, d->rbuf + i * (size_t)rl);
+  const size_t first = P->n;
+#pragma omp parallel
+  {
+    size_t i0, i1;
+    thread_share(arriving, omp_get_thread_num(), omp_get_num_threads(), &i0, &i1);
+    wire_unpack_list(&w, NULL, first + i0, i1 - i0, d->rbuf + i0 * (size_t)rl, rl);
+  }
   P->n += arriving;
   for (int r = 0; r < np; r++)
     if (scount[r]) d->messages++;
@@ -497,10 +569,10 @@ static void edge_slots(struct dd *d, const struct nbr *nb, int k, int side) {
 }
 
 /* Send nf values per entry of direction k's send lists to both its neighbours and receive
-   theirs into d->rbuf (the lower side's first). pack_fn fills a record for slot a; the threads
-   pack. */
-static void exchange(struct dd *d, int k, int nf, void (*pack_fn)(const void *, size_t, double *),
-                     const void *arg) {
+   theirs into d->rbuf (the lower side's first). pack_fn fills the records of n slots; each
+   thread packs its share. */
+typedef void (*pack_list_fn)(const void *arg, const size_t *slots, size_t n, double *buf, int nf);
+static void exchange(struct dd *d, int k, int nf, pack_list_fn pack_fn, const void *arg) {
   struct dd_dir *D = &d->dir[k];
   const int tlo = k ? TAG_ZLO : TAG_LEFT, thi = k ? TAG_ZHI : TAG_RIGHT;
   const size_t ns = D->nsend[0] + D->nsend[1], nr = D->nrecv[0] + D->nrecv[1];
@@ -515,8 +587,13 @@ static void exchange(struct dd *d, int k, int nf, void (*pack_fn)(const void *, 
   for (int s = 0, off = 0; s < 2; off += (int)D->nsend[s], s++) {
     const size_t *restrict slots = D->send[s];
     double *restrict buf = d->sbuf + (size_t)off * nf;
-#pragma omp parallel for schedule(static)
-    for (size_t i = 0; i < D->nsend[s]; i++) pack_fn(arg, slots[i], buf + i * nf);
+    const size_t ns_s = D->nsend[s];
+#pragma omp parallel
+    {
+      size_t i0, i1;
+      thread_share(ns_s, omp_get_thread_num(), omp_get_num_threads(), &i0, &i1);
+      pack_fn(arg, slots + i0, i1 - i0, buf + i0 * nf, nf);
+    }
     /* the lower message goes while the upper one is packed */
     CHECK_MPI(MPI_Isend(buf, (int)(D->nsend[s] * nf), MPI_DOUBLE, s == 0 ? D->lo : D->hi,
                         s == 0 ? tlo : thi, MPI_COMM_WORLD, &req[2 + s]));
@@ -532,8 +609,8 @@ static void exchange(struct dd *d, int k, int nf, void (*pack_fn)(const void *, 
    search and kernel sums, id and kind). Density, pressure and the model terms follow in the
    refreshes (dd_refresh); nothing reads a ghost's kernel sum or acceleration, and its gamma
    only the budget's conservative split (PR_BUDGET). */
-static void pack_ghost(const void *arg, size_t a, double *r) {
-  wire_pack(arg, a, r);
+static void pack_ghost(const void *arg, const size_t *slots, size_t n, double *buf, int nf) {
+  wire_pack_list(arg, slots, n, buf, nf);
 }
 
 /* Exchange the particles per edge cell of direction k with both neighbours: what the lower
@@ -605,8 +682,12 @@ static size_t halo_dir(struct dd *d, struct particles *P, struct nbr *nb, int k,
   struct wire w;
   wire_fields(P, PF_GHOST, &w);
   exchange(d, k, hl, pack_ghost, &w);
-#pragma omp parallel for schedule(static)
-  for (size_t g = 0; g < ng; g++) wire_unpack(&w, ghost[g], d->rbuf + g * (size_t)hl);
+#pragma omp parallel
+  {
+    size_t g0, g1;
+    thread_share(ng, omp_get_thread_num(), omp_get_num_threads(), &g0, &g1);
+    wire_unpack_list(&w, ghost + g0, 0, g1 - g0, d->rbuf + g0 * (size_t)hl, hl);
+  }
   P->n_ghost = end - P->n;
   return end;
 }
@@ -631,12 +712,20 @@ struct fields {
   double *f[32];
 };
 
-static void pack_fields(const void *arg, size_t a, double *r) {
+static void pack_fields(const void *arg, const size_t *restrict slots, size_t n,
+                        double *restrict buf, int nf) {
   const struct fields *F = arg;
-  for (int k = 0; k < F->np; k++) r[k] = F->f[k][a];
-  const int vertex = F->P->kind[a] == KIND_VERTEX;
-  const size_t slot = vertex ? part_vertex_slot(F->P, F->P->id[a]) : 0;
-  for (int k = F->np; k < F->np + F->nw; k++) r[k] = vertex ? F->f[k][slot] : 0.0;
+  for (int k = 0; k < F->np; k++) { /* field by field */
+    const double *restrict f = F->f[k];
+    for (size_t j = 0; j < n; j++) buf[j * nf + k] = f[slots[j]];
+  }
+  if (F->nw == 0) return;
+  for (size_t j = 0; j < n; j++) {
+    const size_t a = slots[j];
+    const int vertex = F->P->kind[a] == KIND_VERTEX;
+    const size_t slot = vertex ? part_vertex_slot(F->P, F->P->id[a]) : 0;
+    for (int k = F->np; k < nf; k++) buf[j * nf + k] = vertex ? F->f[k][slot] : 0.0;
+  }
 }
 
 /* The allocated arrays of the tables marked for stage. */
@@ -664,14 +753,21 @@ void dd_refresh(struct dd *d, const struct particles *P, const struct walls *W, 
     if (!D->width) continue;
     exchange(d, k, nf, pack_fields, &F);
     const size_t ng = D->nrecv[0] + D->nrecv[1], *ghost = d->ghost + (D->first - P->n);
-#pragma omp parallel for schedule(static)
-    for (size_t g = 0; g < ng; g++) {
-      const size_t a = ghost[g];
-      const double *r = d->rbuf + g * (size_t)nf;
-      for (int j = 0; j < F.np; j++) F.f[j][a] = r[j];
-      if (F.nw == 0 || P->kind[a] != KIND_VERTEX) continue;
-      const size_t slot = part_vertex_slot(P, P->id[a]);
-      for (int j = F.np; j < nf; j++) F.f[j][slot] = r[j];
+    const double *restrict rbuf = d->rbuf;
+#pragma omp parallel
+    {
+      size_t g0, g1;
+      thread_share(ng, omp_get_thread_num(), omp_get_num_threads(), &g0, &g1);
+      for (int j = 0; j < F.np; j++) { /* field by field */
+        double *restrict f = F.f[j];
+        for (size_t g = g0; g < g1; g++) f[ghost[g]] = rbuf[g * (size_t)nf + j];
+      }
+      for (size_t g = g0; g < g1 && F.nw; g++) {
+        const size_t a = ghost[g];
+        if (P->kind[a] != KIND_VERTEX) continue;
+        const size_t slot = part_vertex_slot(P, P->id[a]);
+        for (int j = F.np; j < nf; j++) F.f[j][slot] = rbuf[g * (size_t)nf + j];
+      }
     }
   }
   d->seconds += MPI_Wtime() - t0;

@@ -215,15 +215,18 @@ void nbr_sort(struct nbr *nb, struct particles *P) {
   const size_t n = P->n;
   int *restrict cell = nb->cell;
   int stray = 0;
+  const struct nbr g = *nb; /* a local copy: the position stores cannot alias it */
+  double *restrict px = P->x, *restrict pz = P->z;
+  const double *restrict py = P->y;
 #pragma omp parallel for schedule(static) reduction(max : stray)
   for (size_t a = 0; a < n; a++) {
-    nbr_wrap_position(nb, &P->x[a], &P->z[a]);
-    /* clamped in floating point first: a NaN or huge coordinate (a failing run, reported by
-       the health check after this step) must not overflow the integer conversion */
-    const int lc = nbr_column(nb, P->x[a]) - nb->ix0, lz = nbr_plane(nb, P->z[a]) - nb->iz0;
-    const int iy = clampi((int)fmin(fmax(P->y[a] * nb->cy, 0.0), nb->ny), nb->ny);
-    if (lc < 0 || lc >= nb->nxo || lz < 0 || lz >= nb->nzo) stray = 1;
-    cell[a] = (int)nbr_owned_cell(nb, clampi(lc, nb->nxo), iy, clampi(lz, nb->nzo));
+    nbr_wrap_position(&g, &px[a], &pz[a]);
+    /* clamped before the integer conversion (nbr_cell_index): a NaN or huge coordinate of a
+       failing run must not overflow it */
+    const int lc = nbr_column(&g, px[a]) - g.ix0, lz = nbr_plane(&g, pz[a]) - g.iz0;
+    const int iy = nbr_cell_index(py[a] * g.cy, g.ny);
+    if (lc < 0 || lc >= g.nxo || lz < 0 || lz >= g.nzo) stray = 1;
+    cell[a] = (int)nbr_owned_cell(&g, clampi(lc, g.nxo), iy, clampi(lz, g.nzo));
   }
   if (stray) die("nbr_sort: a particle outside this rank's block (migration missed it)");
   sort_cells(nb, P, n);

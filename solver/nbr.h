@@ -128,17 +128,22 @@ void nbr_set_range(struct nbr *nb, const struct nbr_range *r);
 /** @brief Make the per-particle arrays hold at least n slots. */
 void nbr_reserve(struct nbr *nb, size_t n);
 
+/** @brief The cell index of the scaled coordinate v = position / cell size among n cells,
+    clamped to 0 .. n-1 before the integer conversion, so that a NaN (to 0) or a huge value of
+    a failing run (reported by the health check after the step) cannot overflow it. Plain
+    comparisons: fmin and fmax are calls into libm without -ffinite-math-only. */
+static inline int nbr_cell_index(double v, int n) {
+  return !(v > 0.0) ? 0 : v >= (double)n ? n - 1 : (int)v;
+}
+
 /** @brief Global column of the position x (already wrapped into [0, lx)). */
 static inline int nbr_column(const struct nbr *nb, double x) {
-  const int ix = (int)fmin(fmax(x * nb->cx, 0.0), nb->nx);
-  return ix < 0 ? 0 : ix >= nb->nx ? nb->nx - 1 : ix;
+  return nbr_cell_index(x * nb->cx, nb->nx);
 }
 
 /** @brief Global plane of the position z (already wrapped into [0, lz); 0 in 2-D). */
 static inline int nbr_plane(const struct nbr *nb, double z) {
-  if (nb->dim != 3) return 0;
-  const int iz = (int)fmin(fmax(z * nb->cz, 0.0), nb->nz);
-  return iz < 0 ? 0 : iz >= nb->nz ? nb->nz - 1 : iz;
+  return nb->dim == 3 ? nbr_cell_index(z * nb->cz, nb->nz) : 0;
 }
 
 /** @brief Global pencil (column and plane: every cell along y) of a position, x-major:
