@@ -64,6 +64,11 @@ expect figures_missing "missing.nc: cannot open statistics file: No such file" "
 expect figures_no_var "particles.nc: no variable 'y_mean'" "$tool" figures "$part"
 expect figures_no_window "stats.nc: no positive u_tau" "$tool" figures "$nowin"
 expect ab_table_no_window "stats.nc: no averaging window" "$tool" ab_table "$run"
+expect lagr_table_missing "missing.nc: cannot open: No such file" "$tool" lagr_table "$missing"
+expect lagr_table_not_netcdf "text.nc: cannot open as netCDF" "$tool" lagr_table "$w/text.nc"
+expect lagr_table_no_group "particles.nc: no lagrangian or quadrants group" "$tool" lagr_table "$part"
+expect lagr_table_lags "argument --lags: -1: must be larger than 0" "$tool" lagr_table "$nowin" \
+  --lags 18 -1
 expect ab_table_from "argument --from: 'x' is not a number" "$tool" ab_table "$run" --from x
 expect window_peaks_spec "nowin: expected LABEL=RUN_DIR" "$tool" window_peaks --dns "$dns" "$run"
 expect window_peaks_span "A=.*@2:1: 2:1: expected T0:T1 with T0 <= T1" "$tool" window_peaks \
