@@ -412,6 +412,21 @@ static size_t migrate_near(struct dd *d, const int *scount, const int *sdisp) {
   return total;
 }
 
+/* The rank each of the n0 owned particles goes to (-1: stays), positions wrapped. A local copy
+   of the grid and the owned range: the stores of the wrapped positions cannot alias them. */
+static void migrate_dest(const struct dd *d, struct particles *P, const struct nbr *nb, size_t n0,
+                         int *dest) {
+  const struct nbr g = *nb;
+  const int c0 = d->fx[d->bx], c1 = d->fx[d->bx + 1], z0 = d->fz[d->bz], z1 = d->fz[d->bz + 1];
+  double *restrict px = P->x, *restrict pz = P->z;
+#pragma omp parallel for schedule(static)
+  for (size_t a = 0; a < n0; a++) {
+    nbr_wrap_position(&g, &px[a], &pz[a]);
+    const int col = nbr_column(&g, px[a]), plane = nbr_plane(&g, pz[a]);
+    dest[a] = col >= c0 && col < c1 && plane >= z0 && plane < z1 ? -1 : dd_owner(d, col, plane);
+  }
+}
+
 void dd_migrate(struct dd *d, struct particles *P, const struct nbr *nb) {
   P->n_ghost = 0;
   if (d->size == 1) return;
@@ -425,17 +440,7 @@ void dd_migrate(struct dd *d, struct particles *P, const struct nbr *nb) {
   const size_t n0 = P->n;
   int *dest = mem_alloc(1, (n0 ? n0 : 1) * sizeof(int), "domain decomposition");
   size_t *leave = mem_alloc(1, (n0 ? n0 : 1) * sizeof(size_t), "domain decomposition");
-  /* a local copy of the grid and the owned range: the stores of the wrapped positions cannot
-     alias them, so the loop keeps them in registers */
-  const struct nbr g = *nb;
-  const int c0 = d->fx[d->bx], c1 = d->fx[d->bx + 1], z0 = d->fz[d->bz], z1 = d->fz[d->bz + 1];
-  double *restrict px = P->x, *restrict pz = P->z;
-#pragma omp parallel for schedule(static)
-  for (size_t a = 0; a < n0; a++) {
-    nbr_wrap_position(&g, &px[a], &pz[a]);
-    const int col = nbr_column(&g, px[a]), plane = nbr_plane(&g, pz[a]);
-    dest[a] = col >= c0 && col < c1 && plane >= z0 && plane < z1 ? -1 : dd_owner(d, col, plane);
-  }
+  migrate_dest(d, P, nb, n0, dest);
   size_t leaving;
   split_slots(dest, n0, leave, &leaving);
   for (size_t i = 0; i < leaving; i++) scount[dest[leave[i]]] += rl;
