@@ -103,11 +103,26 @@ static size_t file_count(const struct state_field *f) {
   return n;
 }
 
+/* Rows of a chunk of a field whose rows weigh row bytes: at most CHUNK_BYTES (write_field). */
+static size_t chunk_rows(const struct state_field *f, size_t row) {
+  const size_t n0 = f->rank ? (f->total ? f->total : f->dims[0]) : 1;
+  const size_t rows = CHUNK_BYTES / (row ? row : 1);
+  return n0 > rows ? (rows ? rows : 1) : n0;
+}
+
 size_t ckpt_state_bytes(const struct state_list *L) {
   size_t b = 0;
-  for (int i = 0; i < L->n; i++)
-    b += L->f[i].type == STATE_TEXT ? strlen(*(char **)L->f[i].data)
-                                    : file_count(&L->f[i]) * type_size(L->f[i].type);
+  for (int i = 0; i < L->n; i++) {
+    const struct state_field *f = &L->f[i];
+    if (f->type == STATE_TEXT) {
+      b += strlen(*(char **)f->data) + 1 + 4;
+      continue;
+    }
+    const size_t n = file_count(f), n0 = f->rank ? (f->total ? f->total : f->dims[0]) : 1;
+    if (n == 0) continue;
+    const size_t row = n / n0 * type_size(f->type), c = chunk_rows(f, row);
+    b += (n0 + c - 1) / c * (c * row + 4); /* whole chunks, each with its Fletcher32 sum */
+  }
   return b;
 }
 
@@ -204,8 +219,7 @@ static int write_field(hid_t file, const struct state_field *f, hid_t gcpl, int 
   const hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
   CHECK_H5(H5Pset_obj_track_times(dcpl, 0));
   if (n > 0) {
-    const size_t rows = CHUNK_BYTES / (row ? row : 1);
-    if (chunk[0] > rows) chunk[0] = rows ? rows : 1;
+    chunk[0] = chunk_rows(f, row);
     CHECK_H5(H5Pset_chunk(dcpl, rank, chunk));
     CHECK_H5(H5Pset_fletcher32(dcpl));
     /* parallel HDF5 allocates chunks when the dataset is created: no fill-value writes */
@@ -249,8 +263,17 @@ struct wctx {
   size_t errlen;
 };
 
+/* What a checkpoint of a list weighs on disk, at least: its data in whole chunks, the scene and
+   room for the metadata (4 kB a dataset, 1 MB). The in-memory image starts at this size: the
+   core driver grows an image by whole increments, zero-filled, so an image that does not fit
+   would double the memory a checkpoint takes. */
+static size_t file_bytes(const struct state_list *L, const char *scene) {
+  return ckpt_state_bytes(L) + (scene ? strlen(scene) : 0) + 4096 * (size_t)(L->n + 1) +
+         ((size_t)1 << 20);
+}
+
 /* The file access properties: MPI-IO for a collective write, else one in-memory image of the
-   whole file (the state plus room for the metadata), written on close. */
+   whole file (file_bytes), written on close. */
 static hid_t file_access(const struct state_list *L, const char *scene, int par) {
   const hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
   CHECK_H5(H5Pset_libver_bounds(fapl, H5F_LIBVER_V18, H5F_LIBVER_V18)); /* checksummed metadata */
@@ -259,8 +282,7 @@ static hid_t file_access(const struct state_list *L, const char *scene, int par)
     CHECK_H5(H5Pset_all_coll_metadata_ops(fapl, 1));
     CHECK_H5(H5Pset_coll_metadata_write(fapl, 1));
   } else {
-    CHECK_H5(H5Pset_fapl_core(
-        fapl, ckpt_state_bytes(L) + (scene ? strlen(scene) : 0) + ((size_t)1 << 20), 1));
+    CHECK_H5(H5Pset_fapl_core(fapl, file_bytes(L, scene), 1));
   }
   return fapl;
 }
@@ -340,11 +362,9 @@ static int write_file(const char *path, const char *format, const struct state_l
   const hid_t gcpl = H5Pcreate(H5P_GROUP_CREATE);
   CHECK_H5(H5Pset_obj_track_times(fcpl, 0));
   CHECK_H5(H5Pset_obj_track_times(gcpl, 0));
-  if (par) { /* rank 0 makes sure it fits first (durable_probe): the state, the scene and room
-                for the metadata (4 kB a dataset, 64 kB) */
-    const size_t need = ckpt_state_bytes(L) + (scene ? strlen(scene) : 0) +
-                        4096 * (size_t)(L->n + 1) + ((size_t)1 << 16);
-    if (ckpt_agree(me == 0 ? durable_probe(tmp, need, w.noun, err, errlen) : 0, err, errlen)) {
+  if (par) { /* rank 0 makes sure it fits first (durable_probe) */
+    if (ckpt_agree(me == 0 ? durable_probe(tmp, file_bytes(L, scene), w.noun, err, errlen) : 0, err,
+                   errlen)) {
       H5Pclose(fcpl), H5Pclose(fapl), H5Pclose(gcpl);
       return 1;
     }

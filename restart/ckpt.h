@@ -122,7 +122,8 @@ int ckpt_info(const char *path, struct ckpt_info *info, char *err, size_t errlen
  */
 int ckpt_read(const char *path, struct state_list *L, char *err, size_t errlen);
 
-/** @brief Bytes a list occupies in memory (what a checkpoint of it roughly weighs). */
+/** @brief Bytes of a checkpoint's data for a list: every field in whole chunks with their
+    checksums, as write_field lays it out (the metadata not included). */
 size_t ckpt_state_bytes(const struct state_list *L);
 
 #endif
