@@ -8,6 +8,10 @@
 # each with its standard error). Two start states (two "seeds"), 7.5 turnovers apart:
 #   s16   jobs/states/mfu180w_dr6c4_t16.nc   (t = 16 of the converged C4 run)
 #   s8.5  jobs/states/mfu180w_dr6c4_t8.5.nc  (t = 8.5 of the same run)
+#   d5    jobs/states/mfu180w_dr6c4d_s3_t5.nc (the delta-SPH run's third segment at its end:
+#         the start of the LES against the quasi-DNS on that scheme, *_les and *_dr9)
+# Candidates *_dr9 run at dr+ = 9 (domain.dr = delta/20, 44 000 particles, the start state
+# interpolated onto the coarser lattice) and average from t = 1 on: give T = 3 or more.
 # Each run is a batch job through jobs/chain.sh (checkpoints; start the script again to go on),
 # about 15 minutes a turnover with 2 threads on an idle 2-core machine.
 # usage: jobs/ab39.sh OUTDIR START [T] [CANDIDATE...]   e.g. jobs/ab39.sh runs/ab39 s16 1 damper_0.1
@@ -22,7 +26,8 @@ scene=jobs/scenes/mfu180w_dr6_c4_ab.ini
 case $start in
   s16) state=$root/jobs/states/mfu180w_dr6c4_t16.nc ;;
   s8.5) state=$root/jobs/states/mfu180w_dr6c4_t8.5.nc ;;
-  *) echo "error: START must be s16 or s8.5 (got '$start')" >&2; exit 1 ;;
+  d5) state=$root/jobs/states/mfu180w_dr6c4d_s3_t5.nc ;;
+  *) echo "error: START must be s16, s8.5 or d5 (got '$start')" >&2; exit 1 ;;
 esac
 # shellcheck disable=SC2034  # read by name in campaign_candidates
 declare -A sets=(
@@ -48,6 +53,9 @@ declare -A sets=(
   [delta_0.2_rho0]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set init.density=rho0"
   [delta_0.2_kgc]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set sph.pressure_gradient=kgc"
   [delta_0.2_shift_cons_0.02]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set sph.shifting=fickian --set sph.shift_velocity=conservative --set sph.shift_coefficient=0.02"
+  [delta_0.2_les]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set les.model=smagorinsky"
+  [delta_0.2_dr9]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set domain.dr=0.05 --set output.t_average_start=1"
+  [delta_0.2_les_dr9]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set les.model=smagorinsky --set domain.dr=0.05 --set output.t_average_start=1"
   [delta_0.2_shift_cons_0.05]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set sph.shifting=fickian --set sph.shift_velocity=conservative --set sph.shift_coefficient=0.05"
 )
 names=("$@")
