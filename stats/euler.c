@@ -20,7 +20,8 @@
    m a_x of each part of the acceleration, of m and m u by the positions before the step
    (HB_MU0), of m u and m u v by the sampled positions, then the same sums weighted by the
    particle's offset from its bin centre in bin widths, phi (add_particle, budget_planes; the
-   weighted m u v is not used). */
+   weighted m u v is not used); then the same two records for the total (EU_PART_TL: the whole
+   acceleration in the first part's place, every snapshot; euler.h, TL_FORCES). */
 enum { HB_MASS = STATS_PARTS, HB_MU, HB_MU0, HB_UV, HB_LEN };
 enum {
   EU_PART_U = MOM_LEN,
@@ -28,7 +29,8 @@ enum {
   EU_PART_PL,
   EU_PART_PL1 = EU_PART_PL + 2 * HB_LEN,
   EU_PART_RS = EU_PART_PL1 + 2 * HB_LEN, /* the Reynolds-stress budget (euler_rs.h) */
-  EU_PART = EU_PART_RS + RSP_LEN
+  EU_PART_TL = EU_PART_RS + RSP_LEN,     /* the total of the momentum budget */
+  EU_PART = EU_PART_TL + 4 * HB_LEN
 };
 
 /* Scratch of euler_sample. The columns are merged over a fixed binary tree on the global
@@ -197,6 +199,19 @@ const struct euler_meta euler_prof_meta[EP_NPROF] = {
                        "standard error of advective_stress (batch means)"},
     [EP_SE_TAU + 6] = {"total_stress_stderr", "m^2/s^2",
                        "standard error of total_stress (batch means)"},
+    [EP_ALL_TOTAL] = {"total_stress_all", "m^2/s^2",
+                      "total shear stress from every statistics snapshot: the particles' kinetic "
+                      "flux and the flux of all the forces through the plane (the force pass's "
+                      "whole acceleration), where total_stress sums the parts of the budget "
+                      "snapshots (every stats.budget_every-th); their difference is the parts' "
+                      "sampling"},
+    [EP_ALL_EXPECTED] = {"total_stress_expected_all", "m^2/s^2",
+                         "total_stress_expected over every statistics snapshot"},
+    [EP_ALL_INERTIA] = {"momentum_change_all", "m^2/s^2",
+                        "momentum_change over every statistics snapshot (first to last): "
+                        "total_stress_all + momentum_change_all = total_stress_expected_all"},
+    [EP_ALL_SE] = {"total_stress_all_stderr", "m^2/s^2",
+                   "standard error of total_stress_all (batch means)"},
     [EP_UU_BIN + 0] = {"uu_bin", "m^2/s^2",
                        "<u'u'> about the bin mean: includes the spread of the mean velocity over "
                        "the bin (compare --binned)"},
@@ -257,6 +272,9 @@ static const struct euler_array euler_arrays[EULER_ARRAYS] = {
     {"stats/eulerian/planes_kinetic", KN_LEN, 0, 1, offsetof(struct euler, kin), 1, NULL},
     /* format 1.6: before it, rows without the Reynolds-stress budget */
     {"stats/eulerian/reynolds_budget", RW_LEN, 0, 1, offsetof(struct euler, rsb), 1, NULL},
+    /* format 1.14: before it, the total from the budget samples' parts only */
+    {"stats/eulerian/planes_total", PL_LEN, 0, 1, offsetof(struct euler, tpl), 1, NULL},
+    {"stats/eulerian/planes_total_kinetic", KN_LEN, 0, 1, offsetof(struct euler, tkn), 1, NULL},
 };
 
 /* The array a of e (a pointer to its member). */
@@ -423,13 +441,13 @@ static double plane_width(const struct euler_config *c, double ya, double w) {
    stress convention, force on the fluid below). In a steady state they balance the body force
    on that fluid. The net pair force on a whole side (zero for a momentum-conserving scheme)
    is the momentum source. */
-static void budget_planes(const struct euler_config *c, const double *snap, double fx, double t,
-                          double dt, double *pl, double *kin) {
+static void budget_planes(const struct euler_config *c, const double *snap, int off, double fx,
+                          double t, double dt, double *pl, double *kin) {
   const int nb = c->nb;
   double tot[2][HB_LEN] = {{0}}, below[2][HB_LEN] = {{0}}, prev[PL_LEN] = {0}, mu0_prev = 0.0;
   for (int b = 0; b < nb; b++)
     for (int k = 0; k < 2 * HB_LEN; k++)
-      tot[k / HB_LEN][k % HB_LEN] += snap[(size_t)b * EU_PART + EU_PART_PL + k];
+      tot[k / HB_LEN][k % HB_LEN] += snap[(size_t)b * EU_PART + (size_t)off + k];
   const double norm = c->rho0 * c->area * (c->fold ? 2.0 : 1.0), w = (c->y1 - c->y0) / nb;
   for (int e = 0; e <= nb; e++) { /* edge e: the bins below it are in `below` */
     double at[PL_LEN] = {0}, mu0_at = 0.0;
@@ -454,7 +472,7 @@ static void budget_planes(const struct euler_config *c, const double *snap, doub
     if (e > 0) {
       /* the first moments of bin e - 1, both sides (one is empty unless the bin holds the
          centre): in the stress convention the same sign on either side */
-      const double *m1 = snap + (size_t)(e - 1) * EU_PART + EU_PART_PL1;
+      const double *m1 = snap + (size_t)(e - 1) * EU_PART + (size_t)off + 2 * HB_LEN;
       double corr[PL_LEN] = {0}, mu0_corr = 0.0;
       for (int s = 0; s < 2; s++, m1 += HB_LEN) {
         for (int k = 0; k < STATS_PARTS; k++) corr[PL_PRESSURE + k] -= m1[k] / norm;
@@ -465,7 +483,7 @@ static void budget_planes(const struct euler_config *c, const double *snap, doub
          PL_MU_LAST) that the step's displacements alone made, over dt, which makes the budget
          of every step an identity; without it -(sum of m u v over the bin) / (rho0 A w),
          either side, w the width of the planes through the bin (budget_bin) */
-      const double *hb = snap + (size_t)(e - 1) * EU_PART + EU_PART_PL;
+      const double *hb = snap + (size_t)(e - 1) * EU_PART + (size_t)off;
       const double wb = plane_width(c, c->y0 + e * w - w, w);
       const double mu_now = 0.5 * (prev[PL_MU_LAST] + at[PL_MU_LAST]) + corr[PL_MU_LAST];
       const double mu_before = 0.5 * (mu0_prev + mu0_at) + mu0_corr;
@@ -488,7 +506,7 @@ static void budget_planes(const struct euler_config *c, const double *snap, doub
     mu0_prev = mu0_at;
     if (e < nb)
       for (int k = 0; k < 2 * HB_LEN; k++)
-        below[k / HB_LEN][k % HB_LEN] += snap[(size_t)e * EU_PART + EU_PART_PL + k];
+        below[k / HB_LEN][k % HB_LEN] += snap[(size_t)e * EU_PART + (size_t)off + k];
   }
 }
 
@@ -508,10 +526,10 @@ static void advance_window(struct euler *e, double t) {
   }
 }
 
-/* The budget sums (EU_PART_PL) of the bin and side of a particle at y (folded if the
-   statistics fold) in the per-bin partials P, and its phi: the fraction of the planes through
-   the bin that have it on their centre side, less 1/2 (budget_planes); folded, the bin that
-   holds the centre has planes only up to delta. */
+/* The budget sums of the bin and side of a particle at y (folded if the statistics fold) in
+   the per-bin partials P (from the record on: EU_PART_PL or EU_PART_TL), and its phi: the
+   fraction of the planes through the bin that have it on their centre side, less 1/2
+   (budget_planes); folded, the bin that holds the centre has planes only up to delta. */
 static double *budget_bin(const struct euler_config *c, double *P, double y, int upper,
                           double *phi) {
   const double scale = c->nb / (c->y1 - c->y0);
@@ -519,7 +537,43 @@ static double *budget_bin(const struct euler_config *c, double *P, double y, int
   hb = hb < 0 ? 0 : hb >= c->nb ? c->nb - 1 : hb;
   const double ya = c->y0 + hb / scale;
   *phi = (y - ya) / plane_width(c, ya, 1.0 / scale) - 0.5;
-  return P + (size_t)hb * EU_PART + EU_PART_PL + (size_t)(!c->fold && upper) * HB_LEN;
+  return P + (size_t)hb * EU_PART + (size_t)(!c->fold && upper) * HB_LEN;
+}
+
+/* Particle a's momentum budget into the per-bin partials P (EU_PART a bin, from the record
+   on: EU_PART_PL, the parts of its x-acceleration f[0 .. np); EU_PART_TL, the whole one,
+   np = 1): m times each at the position before the step yf, with its mass and momentum
+   there (HB_MU0), and its momentum and m u v at the sampled position, each with its offset
+   weight phi (budget_planes). The momentum is that of the sampled state. The half of the
+   channel each goes to (folded: mirrored into the lower one): a particle within 1e-9 delta of
+   the centre counts half in each, so that the centre layer of a mirror-symmetric flow, whose v
+   is 0 up to rounding, is not sent to one side or the other by that rounding (its momentum and
+   forces are on the centre side of every plane). */
+static void budget_add(const struct euler_config *c, const struct stats_snapshot *s, size_t a,
+                       double yf, const double *f, int np, double *P) {
+  const double ma = s->m ? s->m[a] : 1.0, mu = ma * s->u[a];
+  for (int side = 0; side < 2; side++) {
+    const double wf = euler_side_weight(yf, c->delta, side);
+    if (wf > 0.0) {
+      double phi_f;
+      const double yb = c->fold && side ? 2.0 * c->delta - yf : yf;
+      double *Hf = budget_bin(c, P, yb, side, &phi_f), *Hf1 = Hf + 2 * HB_LEN;
+      for (int k = 0; k < np; k++) {
+        const double fk = wf * ma * f[k];
+        Hf[k] += fk, Hf1[k] += fk * phi_f;
+      }
+      const double mf = wf * ma, muf = wf * mu;
+      Hf[HB_MASS] += mf, Hf1[HB_MASS] += mf * phi_f, Hf[HB_MU0] += muf, Hf1[HB_MU0] += muf * phi_f;
+    }
+    const double wh = euler_side_weight(s->y[a], c->delta, side);
+    if (wh > 0.0) {
+      double phi;
+      const double yb = c->fold && side ? 2.0 * c->delta - s->y[a] : s->y[a];
+      const double vb = c->fold && side ? -s->v[a] : s->v[a], muh = wh * mu;
+      double *H = budget_bin(c, P, yb, side, &phi), *H1 = H + 2 * HB_LEN;
+      H[HB_MU] += muh, H1[HB_MU] += muh * phi, H[HB_UV] += muh * vb;
+    }
+  }
 }
 
 /* Particle a of the snapshot into its column's per-bin partials P (EU_PART a bin). */
@@ -538,41 +592,14 @@ static void add_particle(const struct euler *e, const struct stats_snapshot *s, 
                               y,
                               s->nu_t ? s->nu_t[a] : 0.0,
                               s->k_r ? s->k_r[a] : 0.0};
-  if (s->sx) { /* the momentum budget */
-    const double ma = s->m ? s->m[a] : 1.0, mu = ma * s->u[a];
+  if (s->sx || s->ax) { /* the momentum budget: its parts, its total */
     /* the forces and the body force acted at the positions before the step: y - dt v, less
-       the shift (symplectic Euler, docs/theory.md); the momentum is that of the sampled state,
-       and also taken at those positions for the kinetic flux (budget_planes) */
+       the shift (symplectic Euler, docs/theory.md) */
     const double yf =
         s->dt > 0.0 ? s->y[a] - s->dt * s->v[a] - (s->shift_dy ? s->shift_dy[a] : 0.0) : s->y[a];
-    /* the half of the channel each goes to (folded: mirrored into the lower one); a particle
-       within 1e-9 delta of the centre counts half in each, so that the centre layer of a
-       mirror-symmetric flow, whose v is 0 up to rounding, is not sent to one side or the other
-       by that rounding (its momentum and forces are on the centre side of every plane) */
-    for (int side = 0; side < 2; side++) {
-      const double wf = euler_side_weight(yf, c->delta, side);
-      if (wf > 0.0) { /* forces, body force and momentum at the positions before the step */
-        double phi_f;
-        const double yb = c->fold && side ? 2.0 * c->delta - yf : yf;
-        double *Hf = budget_bin(c, P, yb, side, &phi_f), *Hf1 = Hf + 2 * HB_LEN; /* EU_PART_PL1 */
-        for (int k = 0; k < STATS_PARTS; k++) {
-          const double f = wf * ma * s->sx[a * STATS_ACC + k];
-          Hf[k] += f, Hf1[k] += f * phi_f;
-        }
-        const double mf = wf * ma, muf = wf * mu;
-        Hf[HB_MASS] += mf, Hf1[HB_MASS] += mf * phi_f, Hf[HB_MU0] += muf,
-            Hf1[HB_MU0] += muf * phi_f;
-      }
-      const double wh = euler_side_weight(s->y[a], c->delta, side);
-      if (wh > 0.0) { /* the momentum of the sampled state */
-        double phi;
-        const double yb = c->fold && side ? 2.0 * c->delta - s->y[a] : s->y[a];
-        const double vb = c->fold && side ? -s->v[a] : s->v[a], muh = wh * mu;
-        double *H = budget_bin(c, P, yb, side, &phi), *H1 = H + 2 * HB_LEN;
-        H[HB_MU] += muh, H1[HB_MU] += muh * phi, H[HB_UV] += muh * vb;
-      }
-    }
-    if (s->dt > 0.0) euler_rs_add(c, s, a, yf, P, EU_PART, EU_PART_RS);
+    if (s->sx) budget_add(c, s, a, yf, s->sx + a * STATS_ACC, STATS_PARTS, P + EU_PART_PL);
+    if (s->ax) budget_add(c, s, a, yf, s->ax + a, 1, P + EU_PART_TL);
+    if (s->sx && s->dt > 0.0) euler_rs_add(c, s, a, yf, P, EU_PART, EU_PART_RS);
   }
   if (c->method == EULER_SPH) {
     /* Eq. 5.56 averaged over the plane y = y_i: every profile point within 2h takes the
@@ -632,6 +659,16 @@ static double *merge_columns(struct euler *e, struct spar *par) {
   return k->mine;
 }
 
+/* Whether the merged snapshot holds the total's sums (some rank's particles carried their
+   accelerations): the same answer on every rank, whether or not this rank had any. */
+static int total_sampled(const double *snap, size_t nb) {
+  double mass = 0.0;
+  for (size_t b = 0; b < nb; b++)
+    for (int side = 0; side < 2; side++)
+      mass += snap[b * EU_PART + EU_PART_TL + side * HB_LEN + HB_MASS];
+  return mass > 0.0;
+}
+
 void euler_sample(struct euler *e, const struct stats_snapshot *s) {
   const struct euler_config *c = &e->cfg;
   if (s->t < c->t_start) return;
@@ -669,8 +706,11 @@ void euler_sample(struct euler *e, const struct stats_snapshot *s) {
     if (R[EU_PART_N] > 0.0) scal_add(srow + b * SCAL_LEN, R[EU_PART_U] / R[EU_PART_N]);
   }
   if (s->sx)
-    budget_planes(c, snap, s->fx, s->t, s->dt, e->pln + e->nwin * nb * PL_LEN,
+    budget_planes(c, snap, EU_PART_PL, s->fx, s->t, s->dt, e->pln + e->nwin * nb * PL_LEN,
                   e->kin + e->nwin * nb * KN_LEN);
+  if (total_sampled(snap, nb)) /* the total, every snapshot with accelerations */
+    budget_planes(c, snap, EU_PART_TL, s->fx, s->t, s->dt, e->tpl + e->nwin * nb * PL_LEN,
+                  e->tkn + e->nwin * nb * KN_LEN);
   if (s->sx && s->dt > 0.0)
     euler_rs_snapshot(c, snap, EU_PART, EU_PART_RS, s->t, s->dt,
                       euler_rs_last_time(c, e->rsb, e->nwin), e->rsb + e->nwin * nb * RW_LEN);
@@ -765,6 +805,44 @@ static void local_stresses(const struct euler_config *cfg, const double *mom, co
   }
 }
 
+/* The sums of bin b's plane records pln and kinetic records kin (NULL or short in files of
+   earlier versions) over rows [r0, r1): sum (PL_LEN: the sums, and the momentum and time of
+   the range's first and last snapshot) and ksum (KN_N, KN_SUM); with the kinetic records of
+   every row, the range's fluxes without its first snapshot, which the momentum change starts
+   from. Returns whether the kinetic records were complete (the advective part is known). */
+static int range_sums(int nb, int b, const double *pln, const double *kin, size_t r0, size_t r1,
+                      double *sum, double *ksum) {
+  const double *K0 = NULL; /* the kinetic record of the range's first row with snapshots */
+  int first = 0, has_kin = kin != NULL;
+  memset(sum, 0, PL_LEN * sizeof *sum), ksum[KN_N] = ksum[KN_SUM] = 0.0;
+  for (size_t r = r0; r < r1; r++) {
+    const double *p = pln + (r * (size_t)nb + (size_t)b) * PL_LEN;
+    const double *K = kin ? kin + (r * (size_t)nb + (size_t)b) * KN_LEN : NULL;
+    for (int k = 0; k <= PL_SOURCE; k++) sum[k] += p[k];
+    if (K && K[KN_N] == p[PL_N] && (K[KN_FIRST] == 1.0 || p[PL_N] == 0.0))
+      ksum[KN_N] += K[KN_N], ksum[KN_SUM] += K[KN_SUM];
+    else
+      has_kin = 0;
+    if (p[PL_N] > 0.0) { /* the unsteady term: first and last snapshots of the range */
+      if (!first)
+        sum[PL_MU_FIRST] = p[PL_MU_FIRST], sum[PL_T_FIRST] = p[PL_T_FIRST], first = 1, K0 = K;
+      sum[PL_MU_LAST] = p[PL_MU_LAST], sum[PL_T_LAST] = p[PL_T_LAST];
+    }
+  }
+  /* with the kinetic records: the range's fluxes without its first snapshot, the balance of
+     the momentum change from that snapshot to the last */
+  if (has_kin && K0 && K0[KN_FIRST] == 1.0 && sum[PL_N] >= 2.0) {
+    for (int k = PL_PRESSURE; k <= PL_DRIVE; k++) sum[k] -= K0[KN_F + k - PL_PRESSURE];
+    sum[PL_N] -= 1.0, ksum[KN_SUM] -= K0[KN_F_KINETIC], ksum[KN_N] -= 1.0;
+  }
+  return has_kin;
+}
+
+/* The standard error of a batch-mean record (NaN below two batches). */
+static double batch_stderr(const double *w) {
+  return w[SCAL_N] >= 2.0 ? sqrt(w[SCAL_M2] / (w[SCAL_N] - 1.0) / w[SCAL_N]) : NAN;
+}
+
 /* Profiles of the momentum budget over rows [r0, r1) (pln: the plane sums; kin: the kinetic
    flux, NULL or short in files of earlier versions): the mean of each part, the Reynolds part
    -<u'v'>, the rest of the particles' kinetic flux as the advective part (NaN, and left out
@@ -777,22 +855,11 @@ static int budget_profiles(const struct euler_config *cfg, const double *mom, co
   const int nb = cfg->nb;
   int any = 0;
   for (int b = 0; b < nb; b++) {
-    double sum[PL_LEN] = {0}, ksum[KN_LEN] = {0}, batch[7][SCAL_LEN] = {{0}};
-    const double *K0 = NULL; /* the kinetic record of the range's first row with snapshots */
-    int first = 0, has_kin = kin != NULL;
+    double sum[PL_LEN], ksum[KN_LEN], batch[7][SCAL_LEN] = {{0}};
+    const int has_kin = range_sums(nb, b, pln, kin, r0, r1, sum, ksum);
     for (size_t r = r0; r < r1; r++) {
       const double *p = pln + (r * (size_t)nb + (size_t)b) * PL_LEN;
       const double *K = kin ? kin + (r * (size_t)nb + (size_t)b) * KN_LEN : NULL;
-      for (int k = 0; k <= PL_SOURCE; k++) sum[k] += p[k];
-      if (K && K[KN_N] == p[PL_N] && (K[KN_FIRST] == 1.0 || p[PL_N] == 0.0))
-        ksum[KN_N] += K[KN_N], ksum[KN_SUM] += K[KN_SUM];
-      else
-        has_kin = 0;
-      if (p[PL_N] > 0.0) { /* the unsteady term: first and last snapshots of the range */
-        if (!first)
-          sum[PL_MU_FIRST] = p[PL_MU_FIRST], sum[PL_T_FIRST] = p[PL_T_FIRST], first = 1, K0 = K;
-        sum[PL_MU_LAST] = p[PL_MU_LAST], sum[PL_T_LAST] = p[PL_T_LAST];
-      }
       const double *m = mom + (r * (size_t)nb + (size_t)b) * MOM_LEN;
       if (!complete[r] || p[PL_N] <= 0.0 || m[MOM_N] <= 0.0) continue;
       /* in the order of EP_TAU_*: Reynolds, viscous, model, pair, wall, advective; the total */
@@ -809,12 +876,6 @@ static int budget_profiles(const struct euler_config *cfg, const double *mom, co
       continue;
     }
     any = 1;
-    /* with the kinetic records: the range's fluxes without its first snapshot, the balance of
-       the momentum change from that snapshot to the last */
-    if (has_kin && K0 && K0[KN_FIRST] == 1.0 && sum[PL_N] >= 2.0) {
-      for (int k = PL_PRESSURE; k <= PL_DRIVE; k++) sum[k] -= K0[KN_F + k - PL_PRESSURE];
-      sum[PL_N] -= 1.0, ksum[KN_SUM] -= K0[KN_F_KINETIC], ksum[KN_N] -= 1.0;
-    }
     const double n = sum[PL_N];
     double *const *pr = res->prof;
     pr[EP_TAU_REYNOLDS][b] = -pr[EP_UV][b];
@@ -829,12 +890,35 @@ static int budget_profiles(const struct euler_config *cfg, const double *mom, co
     const double span = sum[PL_T_LAST] - sum[PL_T_FIRST];
     pr[EP_TAU_INERTIA][b] = span > 0.0 ? (sum[PL_MU_LAST] - sum[PL_MU_FIRST]) / span : NAN;
     for (int k = 0; k < 7; k++)
-      pr[EP_SE_TAU + k][b] =
-          batch[k][SCAL_N] >= 2.0 && (k != 5 || has_kin)
-              ? sqrt(batch[k][SCAL_M2] / (batch[k][SCAL_N] - 1.0) / batch[k][SCAL_N])
-              : NAN;
+      pr[EP_SE_TAU + k][b] = k != 5 || has_kin ? batch_stderr(batch[k]) : NAN;
   }
   return any;
+}
+
+/* The total of the momentum budget from every snapshot (tpl, tkn: euler.h, TL_FORCES) over
+   rows [r0, r1), where the range has them with the kinetic flux in every row (else NaN): the
+   total (the kinetic flux and the flux of all forces), its expected value, the momentum change
+   over the same snapshots and the total's standard error. */
+static void total_profiles(const struct euler_config *cfg, const double *tpl, const double *tkn,
+                           const int *complete, size_t r0, size_t r1, struct euler_result *res) {
+  const int nb = cfg->nb;
+  for (int b = 0; b < nb; b++) {
+    double sum[PL_LEN], ksum[KN_LEN], batch[SCAL_LEN] = {0};
+    double *const *pr = res->prof;
+    pr[EP_ALL_TOTAL][b] = pr[EP_ALL_EXPECTED][b] = pr[EP_ALL_INERTIA][b] = pr[EP_ALL_SE][b] = NAN;
+    if (!tpl || !tkn || !range_sums(nb, b, tpl, tkn, r0, r1, sum, ksum) || sum[PL_N] <= 0.0)
+      continue;
+    for (size_t r = r0; r < r1; r++) {
+      const double *p = tpl + (r * (size_t)nb + (size_t)b) * PL_LEN;
+      const double *K = tkn + (r * (size_t)nb + (size_t)b) * KN_LEN;
+      if (complete[r] && p[PL_N] > 0.0) scal_add(batch, (K[KN_SUM] + p[TL_FORCES]) / p[PL_N]);
+    }
+    const double n = sum[PL_N], span = sum[PL_T_LAST] - sum[PL_T_FIRST];
+    pr[EP_ALL_TOTAL][b] = ksum[KN_SUM] / ksum[KN_N] + sum[TL_FORCES] / n;
+    pr[EP_ALL_EXPECTED][b] = sum[PL_DRIVE] / n;
+    pr[EP_ALL_INERTIA][b] = span > 0.0 ? (sum[PL_MU_LAST] - sum[PL_MU_FIRST]) / span : NAN;
+    pr[EP_ALL_SE][b] = batch_stderr(batch);
+  }
 }
 
 /* Batch moments per bin: 5 means, 6 stresses, the skewness and flatness of u, v, w. */
@@ -879,9 +963,9 @@ static int bin_profiles(const struct euler_config *cfg, int b, const double *m, 
 /* The shear-stress balance (Eq. 5.11-5.13; the momentum budget where the snapshots carried
    the forces) and its largest error over the interior bins. */
 static void stress_balance(const struct euler_config *cfg, const double *mom, const double *pln,
-                           const double *kin, const int *complete, size_t r0, size_t r1,
-                           const int *ok, const double *grad, double tw_force,
-                           struct euler_result *res) {
+                           const double *kin, const double *tpl, const double *tkn,
+                           const int *complete, size_t r0, size_t r1, const int *ok,
+                           const double *grad, double tw_force, struct euler_result *res) {
   const int nb = cfg->nb;
   const double nan = NAN;
   /* shear-stress balance (Eq. 5.11-5.13): nu dU/dy - <u'v'> = tau_w/rho (1 - y/delta) */
@@ -899,6 +983,7 @@ static void stress_balance(const struct euler_config *cfg, const double *mom, co
   if (!res->budget)
     for (int k = EP_TAU_REYNOLDS; k < EP_SE_TAU_END; k++)
       for (int b = 0; b < nb; b++) res->prof[k][b] = nan;
+  total_profiles(cfg, tpl, tkn, complete, r0, r1, res);
   for (int b = 0; b < nb; b++) {
     if (b > 0 && b < nb - 1 && ok[b] && tw_force > 0.0) {
       const double err = fabs(res->prof[EP_TOTAL][b] - res->prof[EP_TOTAL_EXPECTED][b]) / tw_force;
@@ -938,7 +1023,8 @@ static void corr_times(int nb, const double *sn, const double *within, double pe
 
 void euler_finalise(const struct euler_config *cfg, const double *win, const double *mom,
                     const double *snp, const double *pln, const double *kin, const double *rsb,
-                    const int *complete, size_t r0, size_t r1, struct euler_result *res) {
+                    const double *tpl, const double *tkn, const int *complete, size_t r0, size_t r1,
+                    struct euler_result *res) {
   const int nb = cfg->nb;
   memset(res, 0, sizeof *res);
   res->nb = nb;
@@ -1006,7 +1092,7 @@ void euler_finalise(const struct euler_config *cfg, const double *win, const dou
                                 (2.0 * res->u_tau_wall)
                           : nan;
   res->re_tau = res->u_tau * cfg->delta / cfg->nu;
-  stress_balance(cfg, mom, pln, kin, complete, r0, r1, ok, grad, tw_force, res);
+  stress_balance(cfg, mom, pln, kin, tpl, tkn, complete, r0, r1, ok, grad, tw_force, res);
   res->rs_budget = euler_rs_profiles(cfg, rsb, complete, r0, r1, res);
   if (!(tw_force > 0.0)) res->balance_error = nan;
   free(ok), free(grad), free(tot), free(bm), free(sn), free(within);
@@ -1064,6 +1150,7 @@ void euler_running_result(const struct euler *e, struct euler_result *res) {
   const size_t rows = euler_rows(e);
   int *complete = mem_calloc(rows ? rows : 1, sizeof *complete, "Eulerian statistics");
   for (size_t r = 0; r < rows; r++) complete[r] = r < e->nwin;
-  euler_finalise(&e->cfg, e->win, e->mom, e->snp, e->pln, e->kin, e->rsb, complete, 0, rows, res);
+  euler_finalise(&e->cfg, e->win, e->mom, e->snp, e->pln, e->kin, e->rsb, e->tpl, e->tkn, complete,
+                 0, rows, res);
   free(complete);
 }

@@ -52,6 +52,16 @@ enum {
     since the one before, and the momentum changes from the first snapshot on. */
 enum { KN_N, KN_SUM, KN_FIRST, KN_F, KN_F_KINETIC = KN_F + PL_DRIVE - PL_PRESSURE + 1, KN_LEN };
 
+/** Per window and bin (format 1.14; optional, so that earlier checkpoints stay readable): the
+    total of the momentum budget from every statistics snapshot, not only the budget ones. The
+    records are those of the parts (PL_LEN and KN_LEN, the same sums and the same first
+    snapshot apart) with the whole acceleration of the force pass in place of its parts:
+    PL_PRESSURE holds the flux of all the forces, PL_VISCOUS, PL_MODEL, PL_WALL are zero. The
+    force pass gives the whole acceleration on every step; its split into parts needs another
+    pass over the pairs (stats.budget_every). total_stress_all and momentum_change_all come
+    from these: a budget that closes over every snapshot while the parts are sampled sparsely. */
+enum { TL_FORCES = PL_PRESSURE };
+
 /** Per-window scalars: nominal interval, snapshots, sums over snapshots. */
 enum { WIN_T0, WIN_T1, WIN_NSNAP, WIN_SUM_FX, WIN_SUM_TW0, WIN_SUM_TW1, WIN_LEN };
 
@@ -85,9 +95,9 @@ extern const struct scene_key_def euler_key_eulerian, euler_key_budget_every, eu
     euler_key_fold, euler_key_method, euler_key_u_tau_ref, euler_key_target_stderr,
     euler_key_target_profiles, euler_key_target_corr_ratio, euler_key_target_windows;
 
-/** The per-window arrays of struct euler (win, mom, snp, pln, kin, rsb), in the order of their
-    table in euler.c (checkpoint names, record widths, formats). */
-enum { EULER_ARRAYS = 6 };
+/** The per-window arrays of struct euler (win, mom, snp, pln, kin, rsb, tpl, tkn), in the order
+    of their table in euler.c (checkpoint names, record widths, formats). */
+enum { EULER_ARRAYS = 8 };
 
 struct euler;
 /** What the checkpoint callbacks of one per-window array receive: the engine and the array's
@@ -108,6 +118,8 @@ struct euler {
   double *pln;               /*!< [row][nb][PL_LEN] momentum budget sums (enum above) */
   double *kin;               /*!< [row][nb][KN_LEN] kinetic flux of the budget (enum above) */
   double *rsb;               /*!< [row][nb][RW_LEN] Reynolds-stress budget sums (euler_rs.h) */
+  double *tpl;               /*!< [row][nb][PL_LEN] the budget's total, every snapshot */
+  double *tkn;               /*!< [row][nb][KN_LEN] its kinetic flux, every snapshot */
   void *work;                /*!< scratch of euler_sample across ranks (euler.c) */
   size_t nsub;               /*!< column subtrees gathered at the last snapshot (diagnostic) */
   double w1[EULER_W1_N + 1]; /*!< plane-averaged kernel W1(q), q = |y_a - y_i| / h (SPH) */
@@ -188,6 +200,10 @@ enum {
   EP_CORR_TIME,             /* the bin's correlation time of its bin means of u [s] */
   EP_NEFF,                  /* effective number of independent windows of its batch means */
   EP_SHORT,                 /* 1: the windows are shorter than the bin's correlation time */
+  EP_ALL_TOTAL,             /* the momentum budget's total from every snapshot (TL_FORCES), */
+  EP_ALL_EXPECTED,          /* its expected value, */
+  EP_ALL_INERTIA,           /* the momentum change over the same snapshots */
+  EP_ALL_SE,                /* and the total's standard error */
   EP_NPROF
 };
 
@@ -251,14 +267,16 @@ void euler_sample(struct euler *e, const struct stats_snapshot *s);
  *        force), the total shear stress of Eq. 5.11-5.13.
  *        Standard errors from the batch means of the complete windows in the range.
  * @param[in] cfg configuration (bins, delta, nu, rho0, area)
- * @param[in] win,mom,snp,pln,kin,rsb raw rows, as in struct euler (pln may be NULL: no budget;
- *            kin may be NULL: no advective part; rsb may be NULL: no Reynolds-stress budget)
+ * @param[in] win,mom,snp,pln,kin,rsb,tpl,tkn raw rows, as in struct euler (pln may be NULL: no
+ *            budget; kin may be NULL: no advective part; rsb may be NULL: no Reynolds-stress
+ *            budget; tpl, tkn may be NULL or without snapshots: no total_stress_all)
  * @param[in] complete per-row flag: 1 for a closed window (batch), 0 for a partial one
  * @param[out] res result (allocated; free with euler_result_free)
  */
 void euler_finalise(const struct euler_config *cfg, const double *win, const double *mom,
                     const double *snp, const double *pln, const double *kin, const double *rsb,
-                    const int *complete, size_t r0, size_t r1, struct euler_result *res);
+                    const double *tpl, const double *tkn, const int *complete, size_t r0, size_t r1,
+                    struct euler_result *res);
 
 /** @brief Free a result. */
 void euler_result_free(struct euler_result *res);

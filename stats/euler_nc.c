@@ -190,6 +190,61 @@ fail:
   return rc ? rc : NC_EINVAL;
 }
 
+/* The per-bin records of group g (window dw, y dy, their fields fd of field_axes): the moments
+   and the budgets' sums of every window. */
+static int write_records(const struct euler *e, int g, int dw, int dy, const int *fd, char *err,
+                         size_t errlen) {
+  int rc = NC_NOERR;
+  const int dm = fd[1], ds = fd[2], dp = fd[3], dk = fd[4], dr = fd[5];
+  const struct {
+    const char *name;
+    int field; /* its dimension of fields */
+    const double *data;
+    const char *long_name;
+  } rec[] = {
+      {"moments", dm, e->mom,
+       "per window and bin: count, means of u v w p rho y nu_t k_r, co-moments uu vv ww uv uw "
+       "vw, third and fourth central moments of u v w (sums, not divided by count)"},
+      {"snapshot_u", ds, e->snp,
+       "per window and bin: count, mean and M2 of the per-snapshot bin means of u"},
+      {"planes", dp, e->pln,
+       "per window and plane y (bin centre): snapshots with forces, sums over them of the "
+       "momentum flux through the plane by the pressure, viscous and eddy-viscous pair forces "
+       "and the walls, of the body force it balances and of the momentum source, per unit area "
+       "and rho0 [m^2/s^2] (docs/stats-format.md, momentum budget)"},
+      {"planes_kinetic", dk, e->kin,
+       "per window and bin: snapshots with forces and the sum over them of the particles' "
+       "kinetic flux through the bin's planes, -(sum of m u v over the bin) / (rho0 A w) "
+       "[m^2/s^2]; then 1 and the window's first snapshot's values of the planes fields "
+       "sum_pair_stress .. sum_drive and of the kinetic flux (docs/stats-format.md, momentum "
+       "budget)"},
+      {"reynolds_budget", dr, e->rsb,
+       "per window and bin: the sums behind the Reynolds-stress budgets, all samples and the "
+       "window's first apart, weighted by the time since the previous sample: mass, m ub_i A_j "
+       "and m A_j of each part of the acceleration, the quantities m (1, u_i, u_i u_j) the "
+       "displacements carried in; the state's quantities at the first and last sample and "
+       "their times (docs/stats-format.md, Reynolds-stress budgets)"},
+      {"planes_total", dp, e->tpl,
+       "per window and plane: the planes record of every snapshot (not only those with the "
+       "budget's parts) with the flux of all the forces in sum_pair_stress and zero in the "
+       "other parts' fields: total_stress_all and momentum_change_all (docs/stats-format.md, "
+       "momentum budget)"},
+      {"planes_total_kinetic", dk, e->tkn,
+       "per window and bin: the planes_kinetic record of every snapshot, with planes_total "
+       "(docs/stats-format.md, momentum budget)"}};
+  enum { NREC = sizeof rec / sizeof rec[0] };
+  int vrec[NREC];
+  for (int k = 0; k < NREC; k++) {
+    const int d3[3] = {dw, dy, rec[k].field};
+    CK(ncout_def(g, rec[k].name, NC_DOUBLE, 3, d3, NULL, rec[k].long_name, &vrec[k]));
+  }
+  if (euler_rows(e))
+    for (int k = 0; k < NREC; k++) CK(nc_put_var_double(g, vrec[k], rec[k].data));
+  return NC_NOERR;
+fail:
+  return rc ? rc : NC_EINVAL;
+}
+
 /* The group eulerian: the raw per-window records (the complete accumulator state, which
    chansph extract re-averages), with a coordinate variable for every dimension. */
 static int write_raw_windows(const struct euler *e, const struct euler_result *rp, int ncid,
@@ -197,7 +252,7 @@ static int write_raw_windows(const struct euler *e, const struct euler_result *r
   const struct euler_result r = *rp;
   const size_t nb = (size_t)e->cfg.nb, rows = euler_rows(e);
   int rc = NC_NOERR, dy;
-  int g, dw, vw, vm, vs, vp, vk, vr, vc, v0, v1;
+  int g, dw, vw, vc, v0, v1;
   CK(nc_def_grp(ncid, "eulerian", &g));
   static const char desc[] =
       "raw per-window moment records of the wall-normal bins; re-average any range of windows "
@@ -212,45 +267,17 @@ static int write_raw_windows(const struct euler *e, const struct euler_result *r
   /* the fields of the records: dimensions with labels (field_axes) */
   int fd[6];
   if ((rc = field_axes(g, fd, err, errlen)) != NC_NOERR) goto fail; /* names its call */
-  const int dwf = fd[0], dm = fd[1], ds = fd[2], dp = fd[3], dk = fd[4], dr = fd[5];
+  const int dwf = fd[0];
   CK(def_y(&e->cfg, g, dy, r.prof[EP_Y], lo, hi));
   if ((rc = def_window_axis(e, g, dw, err, errlen)) != NC_NOERR) goto fail; /* names its call */
   CK(ncout_def(g, "window_start", NC_DOUBLE, 1, &dw, "s", "start of the averaging window", &v0));
   CK(ncout_def(g, "window_end", NC_DOUBLE, 1, &dw, "s", "end of the averaging window", &v1));
   CK(ncout_def(g, "window_complete", NC_INT, 1, &dw, "1", "1: closed window, 0: still open", &vc));
-  const int d2[2] = {dw, dwf}, d3m[3] = {dw, dy, dm}, d3s[3] = {dw, dy, ds}, d3p[3] = {dw, dy, dp},
-            d3k[3] = {dw, dy, dk}, d3r[3] = {dw, dy, dr};
+  const int d2[2] = {dw, dwf};
   CK(ncout_def(g, "windows", NC_DOUBLE, 2, d2, NULL,
                "per window: t_start [s], t_end [s], snapshots, sum of body force [m/s^2], sums "
                "of tau_w/rho at y=0 and y=2delta [m^2/s^2]",
                &vw));
-  CK(ncout_def(g, "moments", NC_DOUBLE, 3, d3m, NULL,
-               "per window and bin: count, means of u v w p rho y nu_t k_r, co-moments uu vv ww "
-               "uv uw vw, third and fourth central moments of u v w (sums, not divided by count)",
-               &vm));
-  CK(ncout_def(g, "snapshot_u", NC_DOUBLE, 3, d3s, NULL,
-               "per window and bin: count, mean and M2 of the per-snapshot bin means of u", &vs));
-  CK(ncout_def(g, "planes", NC_DOUBLE, 3, d3p, NULL,
-               "per window and plane y (bin centre): snapshots with forces, sums over them of the "
-               "momentum flux through the plane by the pressure, viscous and eddy-viscous pair "
-               "forces and the walls, of the body force it balances and of the momentum source, "
-               "per unit area and rho0 [m^2/s^2] (docs/stats-format.md, momentum budget)",
-               &vp));
-  CK(ncout_def(g, "planes_kinetic", NC_DOUBLE, 3, d3k, NULL,
-               "per window and bin: snapshots with forces and the sum over them of the "
-               "particles' kinetic flux through the bin's planes, -(sum of m u v over the bin) / "
-               "(rho0 A w) [m^2/s^2]; then 1 and the window's first snapshot's values of the "
-               "planes fields sum_pair_stress .. sum_drive and of the kinetic flux "
-               "(docs/stats-format.md, momentum budget)",
-               &vk));
-  CK(ncout_def(g, "reynolds_budget", NC_DOUBLE, 3, d3r, NULL,
-               "per window and bin: the sums behind the Reynolds-stress budgets, all samples "
-               "and the window's first apart, weighted by the time since the previous sample: "
-               "mass, m ub_i A_j and m A_j of each part of the acceleration, the quantities "
-               "m (1, u_i, u_i u_j) the displacements carried in; the state's quantities at the "
-               "first and last sample and their times (docs/stats-format.md, Reynolds-stress "
-               "budgets)",
-               &vr));
   for (size_t w = 0; w < rows; w++) {
     const size_t st[1] = {w}, ct[1] = {1};
     const int cpl = w < e->nwin;
@@ -260,12 +287,8 @@ static int write_raw_windows(const struct euler *e, const struct euler_result *r
   }
   if (rows) {
     CK(nc_put_var_double(g, vw, e->win));
-    CK(nc_put_var_double(g, vm, e->mom));
-    CK(nc_put_var_double(g, vs, e->snp));
-    CK(nc_put_var_double(g, vp, e->pln));
-    CK(nc_put_var_double(g, vk, e->kin));
-    CK(nc_put_var_double(g, vr, e->rsb));
   }
+  if ((rc = write_records(e, g, dw, dy, fd, err, errlen)) != NC_NOERR) goto fail; /* names it */
   return NC_NOERR;
 fail:
   return rc ? rc : NC_EINVAL;

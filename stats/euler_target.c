@@ -101,7 +101,8 @@ void euler_log(const struct euler *e, char *buf, size_t len) {
   const size_t rows = euler_rows(e), r0 = e->nwin > 0 ? e->nwin - 1 : 0; /* last complete */
   int *complete = mem_alloc(rows, sizeof(int), "Eulerian statistics");
   for (size_t w = 0; w < rows; w++) complete[w] = w < e->nwin;
-  euler_finalise(&e->cfg, e->win, e->mom, e->snp, e->pln, e->kin, e->rsb, complete, r0, r0 + 1, &r);
+  euler_finalise(&e->cfg, e->win, e->mom, e->snp, e->pln, e->kin, e->rsb, e->tpl, e->tkn, complete,
+                 r0, r0 + 1, &r);
   euler_turbulence(&e->cfg, &r, &last);
   euler_result_free(&r);
   free(complete);

@@ -77,6 +77,7 @@ struct stored {
   double *win, *mom, *snp, *pln; /* pln: NULL in a file without the momentum budget */
   double *kin;                   /* NULL in a file without its kinetic flux (before 1.4) */
   double *rsb;                   /* NULL without the Reynolds-stress budget (before 1.6) */
+  double *tpl, *tkn;             /* the total of every snapshot: NULL before 1.14 */
   int *complete;
   double t_reached; /* the run's reached time (global attribute t_reached; NaN if absent) */
   struct origin o;  /* what makes it one run's segment */
@@ -199,15 +200,20 @@ static int read_stored(const char *path, struct stored *s) {
                             read_records(g, "planes_kinetic", "kinetic_field", KN_LEN, len, 0, path,
                                          "the kinetic-flux records", &s->kin) ||
                             read_records(g, "reynolds_budget", "reynolds_budget_field", RW_LEN, len,
-                                         0, path, "the Reynolds-stress budget records", &s->rsb)));
+                                         0, path, "the Reynolds-stress budget records", &s->rsb) ||
+                            read_records(g, "planes_total", "plane_field", PL_LEN, len, 0, path,
+                                         "the total's records", &s->tpl) ||
+                            read_records(g, "planes_total_kinetic", "kinetic_field", KN_LEN, len, 0,
+                                         path, "the total's kinetic records", &s->tkn)));
+    if (!s->tpl || !s->tkn) free(s->tpl), free(s->tkn), s->tpl = s->tkn = NULL;
   }
   CHECK_NC(nc_close(ncid));
   return bad;
 }
 
 static void free_stored(struct stored *s) {
-  free(s->win), free(s->mom), free(s->snp), free(s->pln), free(s->kin), free(s->rsb),
-      free(s->complete), free(s->o.ids);
+  free(s->win), free(s->mom), free(s->snp), free(s->pln), free(s->kin), free(s->rsb), free(s->tpl),
+      free(s->tkn), free(s->complete), free(s->o.ids);
 }
 
 /* Whether segment b (path pb) was gathered as segment a (pa) was; prints what differs. */
@@ -380,7 +386,9 @@ static void shift_times(struct stored *s, size_t r0, size_t r1, double offset) {
     for (size_t b = 0; b < nb; b++) {
       double *P = s->pln ? s->pln + (r * nb + b) * PL_LEN : NULL;
       double *W = s->rsb ? s->rsb + (r * nb + b) * RW_LEN : NULL;
+      double *T = s->tpl ? s->tpl + (r * nb + b) * PL_LEN : NULL;
       if (P && P[PL_N] > 0.0) P[PL_T_FIRST] += offset, P[PL_T_LAST] += offset;
+      if (T && T[PL_N] > 0.0) T[PL_T_FIRST] += offset, T[PL_T_LAST] += offset;
       if (W && W[RW_SUM + RB_N] > 0.0) W[RW_T_FIRST] += offset, W[RW_T_LAST] += offset;
     }
   }
@@ -427,6 +435,13 @@ static int join_stored(struct stored *seg, int n, char *const *paths, int force)
               paths[k]);
       free(s->rsb), s->rsb = NULL;
     }
+    if (s->tpl && !b->tpl) {
+      fprintf(stderr,
+              "note: %s: no records of the total of every snapshot (before format 1.14): the "
+              "joined range takes its total from the budget snapshots' parts\n",
+              paths[k]);
+      free(s->tpl), free(s->tkn), s->tpl = s->tkn = NULL;
+    }
     const size_t nb = (size_t)s->cfg.nb, ra = s->rows, rb = b->rows;
     append_rows(&s->win, ra, b->win, rb, WIN_LEN);
     append_rows(&s->mom, ra, b->mom, rb, nb * MOM_LEN);
@@ -434,6 +449,8 @@ static int join_stored(struct stored *seg, int n, char *const *paths, int force)
     append_rows(&s->pln, ra, b->pln, rb, nb * PL_LEN);
     append_rows(&s->kin, ra, b->kin, rb, nb * KN_LEN);
     append_rows(&s->rsb, ra, b->rsb, rb, nb * RW_LEN);
+    append_rows(&s->tpl, ra, b->tpl, rb, nb * PL_LEN);
+    append_rows(&s->tkn, ra, b->tkn, rb, nb * KN_LEN);
     shift_times(s, ra, ra + rb, offset);
     s->complete = mem_realloc(s->complete, ra + rb, sizeof(int), "chansph extract");
     memcpy(s->complete + ra, b->complete, rb * sizeof(int));
@@ -1053,7 +1070,8 @@ static int write_range(const struct extract_args *a, const struct stored *s, siz
     size_t len;
   } rec[] = {{&e.win, s->win, WIN_LEN},       {&e.mom, s->mom, nb * MOM_LEN},
              {&e.snp, s->snp, nb * SCAL_LEN}, {&e.pln, s->pln, nb * PL_LEN},
-             {&e.kin, s->kin, nb * KN_LEN},   {&e.rsb, s->rsb, nb * RW_LEN}};
+             {&e.kin, s->kin, nb * KN_LEN},   {&e.rsb, s->rsb, nb * RW_LEN},
+             {&e.tpl, s->tpl, nb * PL_LEN},   {&e.tkn, s->tkn, nb * KN_LEN}};
   double snaps = 0.0;
   for (size_t r = r0; r < r1; r++) snaps += s->win[r * WIN_LEN + WIN_NSNAP];
   for (size_t k = 0; k < sizeof rec / sizeof rec[0]; k++) {
@@ -1188,7 +1206,8 @@ int extract_main(int argc, char **argv) {
     return 1;
   }
   struct euler_result res;
-  euler_finalise(&s.cfg, s.win, s.mom, s.snp, s.pln, s.kin, s.rsb, s.complete, r0, r1, &res);
+  euler_finalise(&s.cfg, s.win, s.mom, s.snp, s.pln, s.kin, s.rsb, s.tpl, s.tkn, s.complete, r0, r1,
+                 &res);
   extract_header(&a, &s, &res, r0, r1, cols, rms, nc);
   extract_rows(&a, &s, &res, cols, rms, nc);
   euler_result_free(&res);

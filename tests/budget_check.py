@@ -7,7 +7,8 @@ Asserts, in wall units of the force balance (u_tau_force^2):
   - total_stress is the sum of its parts (reynolds, viscous, model, pair, wall) to round-off;
   - the budget closes: max over every bin |total_stress - total_stress_expected| <= T
     (with --unsteady: |total_stress + momentum_change - total_stress_expected|, for a run that
-    is not yet statistically steady);
+    is not yet statistically steady); where the file has them (format 1.14), the same with the
+    total over every snapshot (total_stress_all, momentum_change_all, total_stress_expected_all);
   - with --laminar: the pressure pair stress and the Reynolds stress are below 0.005, and where
     no wall term acts (farther than 2h from the walls; not the end bins, where nu dU/dy is
     one-sided) the viscous pair stress equals the continuum nu dU/dy (viscous_stress) within
@@ -33,6 +34,7 @@ from chansph_stats.ncfile import attribute, attribute_or_nan, open_nc  # noqa: E
 
 PARTS = ("reynolds_stress", "viscous_pair_stress", "model_pair_stress", "pair_stress",
          "wall_term_stress", "advective_stress")
+ALL = ("total_stress_all", "momentum_change_all", "total_stress_expected_all")
 
 
 def main():
@@ -57,7 +59,7 @@ def read_budget(a):
     """y and the budget profiles of a.stats (of the windows in a.window if given), in u_tau^2 of
     the force balance. InputError if the file has no budget or no averaging window."""
     names = PARTS + ("total_stress", "total_stress_expected", "viscous_stress",
-                     "pair_momentum_source", "momentum_change")
+                     "pair_momentum_source", "momentum_change") + ALL
     with open_nc(a.stats) as d:
         need = ("pair_stress", "total_stress", "total_stress_expected", "pair_momentum_source") + \
             (("momentum_change",) if a.unsteady else ()) + \
@@ -120,6 +122,13 @@ def check(a, y, v):
     if not err[worst] <= a.tol:
         print("FAIL: the budget does not close")
         fail = 1
+    if all(n in v and np.isfinite(v[n]).any() for n in ALL):  # format 1.14: every snapshot
+        lhs = v["total_stress_all"] + (v["momentum_change_all"] if a.unsteady else 0.0)
+        err = np.nanmax(np.abs(lhs - v["total_stress_expected_all"]))
+        print(f"closure over every snapshot (total_stress_all): max {err:.3g} u_tau^2")
+        if not err <= a.tol:
+            print("FAIL: the budget over every snapshot does not close")
+            fail = 1
     if a.laminar:
         for n in ("pair_stress", "reynolds_stress"):
             m = np.nanmax(np.abs(v[n]))

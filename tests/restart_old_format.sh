@@ -8,7 +8,8 @@
 # (stats/lagrangian/sums and slot_sums: 53 -> 47 per record), <= 1.8 also those of the actual
 # lags (-> 46), <= 1.7 the correlation engine's window records (stats/correlations/windows,
 # window_samples, window_spectra_1d), <= 1.6 the sums of the displacements (-> 43); every
-# mode (<= 1.12) the history of T_L (stats/lagrangian/tl_release, tl_release_time; 1.13).
+# mode (<= 1.12) the history of T_L (stats/lagrangian/tl_release, tl_release_time; 1.13) and the
+# every-snapshot total of the momentum budget (stats/eulerian/planes_total*, 1.14).
 #   lagr112: group lagrangian bit for bit (the batches too), except the history of T_L
 #     (T_L_release, release), which holds only the releases completed after the resume: the
 #     last rows of the uninterrupted run's, bit for bit, fewer (N1 after the first release
@@ -55,7 +56,10 @@ import numpy as np
 path, minor = sorted(glob.glob(sys.argv[1] + "/checkpoints/ckpt_*.h5"))[-1], int(sys.argv[2])
 done = []
 with h5py.File(path, "a") as h:
-    assert h.attrs["format_version_minor"] == 13, h.attrs["format_version_minor"]
+    assert h.attrs["format_version_minor"] == 14, h.attrs["format_version_minor"]
+    for k in ("planes_total", "planes_total_kinetic"):
+        del h["stats/eulerian/" + k]
+    done.append("no every-snapshot total of the momentum budget (1.14)")
     for k in ("tl_release", "tl_release_time"):
         del h["stats/lagrangian/" + k]
     done.append("no history of T_L")
@@ -220,8 +224,10 @@ def stats111(a, b):
             same = np.all((y == 0) | np.isnan(y)) and np.any(y == 0)
         elif k.startswith(("rsb_", "reynolds_stress", "advective_stress", "total_stress")) or \
                 k.endswith("_stderr") or k in ("viscous_stress", "correlation_time_bin",
-                                               "n_eff_windows", "short_windows"):
-            continue  # functions of the stresses, or of the batches: about the bin mean now
+                                               "n_eff_windows", "short_windows",
+                                               "momentum_change_all"):
+            continue  # functions of the stresses, or of the batches: about the bin mean now;
+            # the every-snapshot total (format 1.14): from the resume on
         else:
             same = np.array_equal(x, y, equal_nan=True)
         bad += [] if same else [k]

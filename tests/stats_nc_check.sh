@@ -28,7 +28,8 @@ def walk(g):
         v[:]
         # mixed quantities and string labels of record fields: no units
         if v.name not in ("windows", "moments", "snapshot_u", "planes", "planes_kinetic",
-                          "reynolds_budget") and v.dtype != str:
+                          "reynolds_budget", "planes_total", "planes_total_kinetic") \
+                and v.dtype != str:
             getattr(v, "units")
     for c in g.groups.values():
         walk(c)

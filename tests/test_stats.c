@@ -86,7 +86,8 @@ static void finalise(const struct euler *e, struct euler_result *r) {
   const size_t rows = euler_rows(e);
   int *complete = calloc(rows, sizeof *complete);
   for (size_t i = 0; i < rows; i++) complete[i] = i < e->nwin;
-  euler_finalise(&e->cfg, e->win, e->mom, e->snp, e->pln, e->kin, e->rsb, complete, 0, rows, r);
+  euler_finalise(&e->cfg, e->win, e->mom, e->snp, e->pln, e->kin, e->rsb, e->tpl, e->tkn, complete,
+                 0, rows, r);
   free(complete);
 }
 

@@ -100,7 +100,7 @@ def read_run(path, u_tau="wall", binned=False):
                                      np.maximum(nwin / np.where(n_eff > 0, n_eff, 1), 1.0), 1.0))
             se = {n: x * widen for n, x in se.items()}
         budget = {n: v(n) for n in BUDGET + ("total_stress", "total_stress_expected",
-                                             "momentum_change")
+                                             "momentum_change") + ALL
                   if n in d.variables} if "pair_stress" in d.variables else {}
         nu, delta = (float(attribute(d, k, path)) for k in ("nu", "delta"))
         if u_tau == "wall" and "u_tau_wall" not in a:  # no wall stress: the file's u_tau
@@ -133,6 +133,8 @@ def read_run(path, u_tau="wall", binned=False):
 
 BUDGET = ("reynolds_stress", "viscous_pair_stress", "model_pair_stress", "pair_stress",
           "wall_term_stress", "advective_stress")
+# the budget's total from every snapshot (format 1.14), the parts from the budget snapshots
+ALL = ("total_stress_all", "total_stress_expected_all", "momentum_change_all")
 
 
 def print_budget(ours):
@@ -144,9 +146,15 @@ def print_budget(ours):
     tot, exp = ours["budget:total_stress"], ours["budget:total_stress_expected"]
     # the unsteady term: total + d/dt = expected in any window (absent in earlier files: 0)
     ddt = np.nan_to_num(ours.get("budget:momentum_change", np.zeros_like(tot)))
-    closure = tot + ddt - exp
+    every = all(np.any(np.isfinite(ours.get("budget:" + n, [np.nan]))) for n in ALL)
+    if every:  # the closure over every snapshot; the shares of the budget snapshots' parts
+        tot_c, ddt, exp = (ours["budget:" + n] for n in ALL)
+    else:
+        tot_c = tot
+    closure = tot_c + ddt - exp
     print("momentum budget (shares of total_stress; total, d/dt (momentum_change), expected and "
-          "closure = total + d/dt - expected in u_tau^2):")
+          "closure = total + d/dt - expected in u_tau^2%s):"
+          % (", the last four over every snapshot (the *_all fields)" if every else ""))
     print("%8s %8s " % ("y+", "y/delta") + " ".join("%10s" % n.replace("_stress", "")[:10]
                                                   for n in names) +
           " %9s %9s %9s %9s" % ("total", "d/dt", "expected", "closure"))
@@ -155,7 +163,7 @@ def print_budget(ours):
     for i in rows:
         print("%8.1f %8.3f " % (yp[i], ours["y_delta"][i]) +
               " ".join("%9.0f%%" % (100 * ours["budget:" + n][i] / tot[i]) for n in names) +
-              " %9.4f %9.4f %9.4f %9.4f" % (tot[i], ddt[i], exp[i], closure[i]))
+              " %9.4f %9.4f %9.4f %9.4f" % (tot_c[i], ddt[i], exp[i], closure[i]))
     worst = int(np.nanargmax(np.abs(closure)))
     print("budget closure: max |total + d/dt - expected| = %.4f u_tau^2 at y+ %.1f (over %d bins)"
           % (abs(closure[worst]), yp[worst], np.sum(np.isfinite(closure))))
