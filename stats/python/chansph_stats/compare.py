@@ -148,7 +148,8 @@ def print_budget(ours):
     ddt = np.nan_to_num(ours.get("budget:momentum_change", np.zeros_like(tot)))
     every = all(np.any(np.isfinite(ours.get("budget:" + n, [np.nan]))) for n in ALL)
     if every:  # the closure over every snapshot; the shares of the budget snapshots' parts
-        tot_c, ddt, exp = (ours["budget:" + n] for n in ALL)
+        tot_c, ddt, exp = (ours["budget:" + n] for n in ("total_stress_all", "momentum_change_all",
+                                                          "total_stress_expected_all"))
     else:
         tot_c = tot
     closure = tot_c + ddt - exp
