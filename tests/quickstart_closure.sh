@@ -15,7 +15,7 @@ chansph=$1 scenes=$2 runs=$3
 out=$runs/quickstart_closure
 "$chansph" run "$scenes/quickstart.ini" --out "$out" --overwrite > "$out.log" 2>&1 ||
   { tail -5 "$out.log"; echo "FAIL: the quick-start run"; exit 1; }
-/usr/bin/python3 - "$out/stats.nc" << 'PY'
+/usr/bin/python3 - "$out/stats.nc" << 'PY' || exit 1
 import sys
 import netCDF4
 import numpy as np
@@ -33,3 +33,11 @@ print("quick-start momentum budget: max |total + d/dt - expected| = %.4f u_tau^2
 ok = np.all(np.isfinite(close)) and worst <= 0.02 and parts <= 0.05
 sys.exit(0 if ok else "FAIL: not closed within 0.02, or the parts' sum off the total by > 0.05")
 PY
+# what the user reads: chansph compare prints the same closure (wall units of the wall stress)
+dns=$scenes/../../stats/dns/mkm1999/chan180.means
+line=$("$chansph" compare "$out/stats.nc" --dns "$dns" --out "$out/compare" --no-plots 2>&1 |
+  grep "^budget closure" | head -1)
+echo "chansph compare: $line"
+v=$(echo "$line" | sed -n 's/.*expected| = \([0-9.e+-]*\) u_tau^2.*/\1/p')
+awk -v v="$v" 'BEGIN {exit !(v != "" && v + 0 >= 0 && v + 0 <= 0.02)}' ||
+  { echo "FAIL: chansph compare's budget closure is not within 0.02"; exit 1; }
