@@ -56,6 +56,7 @@ declare -A sets=(
   [delta_0.2_les]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set les.model=smagorinsky"
   [delta_0.2_dr9]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set domain.dr=0.05 --set output.t_average_start=1"
   [delta_0.2_les_dr9]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set les.model=smagorinsky --set domain.dr=0.05 --set output.t_average_start=1"
+  [delta_0.2_c130]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set fluid.c0=130"
   [delta_0.2_shift_cons_0.05]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set sph.shifting=fickian --set sph.shift_velocity=conservative --set sph.shift_coefficient=0.05"
 )
 names=("$@")
