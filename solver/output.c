@@ -21,6 +21,7 @@
 #include "lagr.h"
 #include "ncout.h"
 #include "stats_nc.h"
+#include "term_diffusion.h"
 #include "timers.h"
 
 /** The `source` attribute of the output files: version and git commit of the build. */
@@ -469,9 +470,10 @@ void output_begin(struct output *o, struct sim *S) {
   o->t0 = S->t, o->last_step = o->step0 = S->step;
   output_log(o,
              "chansph %s: %zu fluid + %zu vertex particles, h = %.6g, dt limits: acoustic "
-             "%.3e s, viscous %.3e s; output in %s\n",
+             "%.3e s, viscous %.3e s, volume diffusion %.3e s; output in %s\n",
              CHANSPH_VERSION, S->P.n_fluid, S->P.n_vertex, S->M.h, S->sc->cfl * S->M.h / S->sc->c0,
-             S->sc->c_visc * S->M.h * S->M.h / S->sc->nu, o->dir);
+             S->sc->c_visc * S->M.h * S->M.h / S->sc->nu,
+             diffusion_dt_limit(&S->M, S->sc->c_diffusion), o->dir);
   output_log(o,
              "memory: the large allocations need at least %.4g GB per rank (checked before "
              "the start against 80%% of the machine's memory)\n",

@@ -306,6 +306,12 @@ static const struct key keys_head[] = {
       "Factor of the wall limit dt <= c_gamma / max|grad gamma . v| (thesis Eq. 2.163); 0 "
       "disables it."},
      OFF(c_gamma)},
+    {{"time", "c_diffusion", T_DOUBLE, "0.18", 0, 1, 0, NULL, "-",
+      "Factor of the volume diffusion's limit dt <= c_diffusion h^2 / D, D = delta h c0 for "
+      "sph.diffusion = delta_sph (c0 h / xi, its bound, for ferrand): the explicit diffusion's "
+      "stability; it binds only above delta = 0.18 / cfl (0.225 at cfl 0.8: delta = 0.3 blew up "
+      "without it; docs/theory.md, \"Time integration\"); 0 disables it."},
+     OFF(c_diffusion)},
     {{"time", "max_steps", T_LONG, "0", 0, 1e18, 0, NULL, "-",
       "Stop after this many steps even if t_end is not reached (0 = no limit)."},
      OFF(max_steps)},

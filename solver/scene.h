@@ -95,13 +95,14 @@ struct scene {
   double u_bulk;  /*!< target bulk velocity in flux mode [m/s] */
   int controller; /*!< enum flux_controller */
   /* [time] */
-  double t_end;    /*!< end time [s] */
-  double dt_fixed; /*!< fixed time step [s]; 0 = adaptive */
-  double cfl;      /*!< CFL factor of Eq. 2.160 [-] */
-  double c_visc;   /*!< factor of Eq. 2.161 [-] */
-  double c_force;  /*!< factor of Eq. 2.162 [-] */
-  double c_gamma;  /*!< factor of Eq. 2.163 [-]; 0 disables */
-  long max_steps;  /*!< stop after this many steps (0 = no limit) */
+  double t_end;       /*!< end time [s] */
+  double dt_fixed;    /*!< fixed time step [s]; 0 = adaptive */
+  double cfl;         /*!< CFL factor of Eq. 2.160 [-] */
+  double c_visc;      /*!< factor of Eq. 2.161 [-] */
+  double c_force;     /*!< factor of Eq. 2.162 [-] */
+  double c_gamma;     /*!< factor of Eq. 2.163 [-]; 0 disables */
+  double c_diffusion; /*!< factor of the volume diffusion's limit [-]; 0 disables */
+  long max_steps;     /*!< stop after this many steps (0 = no limit) */
   /* [init] */
   int init_profile;      /*!< enum init_profile */
   double init_wave;      /*!< amplitude of the wall-normal wave [m/s] */

@@ -18,6 +18,7 @@
 #include "records.h"
 #include "reduce.h"
 #include "shift.h"
+#include "term_diffusion.h"
 #include "term_viscous.h"
 #include "timers.h"
 #include "turb.h"
@@ -258,10 +259,11 @@ void sim_free(struct sim *S) {
 /* A fixed time step above a stability limit is a numerical failure: name the limit and the
    particle that sets it (largest acceleration, or fastest particle for the acoustic limit). */
 static void check_fixed_dt(struct sim *S, double dt) {
-  static const char *const names[4] = {"acoustic (Eq. 2.160)", "viscous (Eq. 2.161)",
-                                       "force (Eq. 2.162)", "wall (Eq. 2.163)"};
+  static const char *const names[SIM_DT_LIMITS] = {"acoustic (Eq. 2.160)", "viscous (Eq. 2.161)",
+                                                   "force (Eq. 2.162)", "wall (Eq. 2.163)",
+                                                   "volume diffusion (time.c_diffusion)"};
   int worst = -1;
-  for (int k = 0; k < 4; k++)
+  for (int k = 0; k < SIM_DT_LIMITS; k++)
     if (dt > S->dt_limits[k] * (1.0 + 1e-12) &&
         (worst < 0 || S->dt_limits[k] < S->dt_limits[worst]))
       worst = k;
@@ -303,23 +305,25 @@ static double time_step(struct sim *S, const struct force_info *fi) {
   S->dt_limits[1] = viscous_dt_limit(sc->c_visc, h, S->nu_max + S->M.damper_zeta / sc->rho0);
   S->dt_limits[2] = fi->amax > 0.0 ? sc->c_force * sqrt(h / fi->amax) : INFINITY;
   S->dt_limits[3] = sc->c_gamma > 0.0 && fi->gvmax > 0.0 ? sc->c_gamma / fi->gvmax : INFINITY;
+  S->dt_limits[4] = diffusion_dt_limit(&S->M, sc->c_diffusion);
   if (sc->dt_fixed > 0.0) {
     check_fixed_dt(S, sc->dt_fixed);
     return sc->dt_fixed;
   }
   int k = 0;
-  for (int j = 1; j < 4; j++)
+  for (int j = 1; j < SIM_DT_LIMITS; j++)
     if (S->dt_limits[j] < S->dt_limits[k]) k = j;
   const double dt = S->dt_limits[k];
   /* a zero or subnormal step, or one too small to advance t, never reaches t_end: a numerical
      failure (the step is taken; the run stops after it, exit 3) */
   if (!(dt >= DBL_MIN) || S->t + dt == S->t) {
-    static const char *const names[4] = {"acoustic cfl h / c0 (Eq. 2.160)",
-                                         "viscous (Eq. 2.161) with nu + nu_r %.6g m^2/s",
-                                         "force c_force sqrt(h / |a|) (Eq. 2.162) with |a| %.6g "
-                                         "m/s^2",
-                                         "wall (Eq. 2.163) with a wall rate %.6g 1/s"};
-    const double arg[4] = {0.0, S->nu_max, fi->amax, fi->gvmax};
+    static const char *const names[SIM_DT_LIMITS] = {
+        "acoustic cfl h / c0 (Eq. 2.160)", "viscous (Eq. 2.161) with nu + nu_r %.6g m^2/s",
+        "force c_force sqrt(h / |a|) (Eq. 2.162) with |a| %.6g m/s^2",
+        "wall (Eq. 2.163) with a wall rate %.6g 1/s",
+        "volume diffusion c_diffusion h^2 / D with D %.6g m^2/s"};
+    const double arg[SIM_DT_LIMITS] = {0.0, S->nu_max, fi->amax, fi->gvmax,
+                                       diffusion_diffusivity(&S->M)};
     char limit[160];
     snprintf(limit, sizeof limit, names[k], arg[k]);
     snprintf(S->violation, sizeof S->violation,

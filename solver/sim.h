@@ -16,24 +16,27 @@
 
 enum { SIM_GATHER = 16 }; /*!< arrays of this rank's checkpoint id block (sim_state) */
 
+enum { SIM_DT_LIMITS = 5 }; /*!< time-step limits: acoustic, viscous, force, wall, diffusion */
+
 /** Everything a running simulation holds. */
 struct sim {
-  const struct scene *sc;   /*!< the validated scene */
-  struct model M;           /*!< discretisation constants */
-  struct particles P;       /*!< particles */
-  struct walls W;           /*!< wall values on the vertex lattice */
-  struct nbr nb;            /*!< cells and neighbour list */
-  struct dd dd;             /*!< decomposition across MPI ranks and the ghosts */
-  size_t cap;               /*!< slots of the per-particle scratch arrays below */
-  struct drive drive;       /*!< driving force state */
-  long step;                /*!< steps taken */
-  double t;                 /*!< simulated time [s] */
-  double dt;                /*!< last time step [s] */
-  double fx;                /*!< last streamwise body acceleration [m/s^2] */
-  double dt_limits[4];      /*!< last limits: acoustic, viscous, force, wall [s] */
-  double nu_max;            /*!< largest nu + nu_r of the current state [m^2/s] */
-  double *scratch[5];       /*!< per-particle scratch for deterministic sums */
-  double *ksum_new;         /*!< kernel sums at the new positions, from the neighbour pass */
+  const struct scene *sc;          /*!< the validated scene */
+  struct model M;                  /*!< discretisation constants */
+  struct particles P;              /*!< particles */
+  struct walls W;                  /*!< wall values on the vertex lattice */
+  struct nbr nb;                   /*!< cells and neighbour list */
+  struct dd dd;                    /*!< decomposition across MPI ranks and the ghosts */
+  size_t cap;                      /*!< slots of the per-particle scratch arrays below */
+  struct drive drive;              /*!< driving force state */
+  long step;                       /*!< steps taken */
+  double t;                        /*!< simulated time [s] */
+  double dt;                       /*!< last time step [s] */
+  double fx;                       /*!< last streamwise body acceleration [m/s^2] */
+  double dt_limits[SIM_DT_LIMITS]; /*!< last limits: acoustic, viscous, force, wall, volume
+                                        diffusion [s] */
+  double nu_max;                   /*!< largest nu + nu_r of the current state [m^2/s] */
+  double *scratch[5];              /*!< per-particle scratch for deterministic sums */
+  double *ksum_new;                /*!< kernel sums at the new positions, from the neighbour pass */
   double *wall_ax;          /*!< per particle x-acceleration from the walls (statistics only) */
   double wall_fx[2];        /*!< x-force of the walls y = 0, 2 delta on the fluid, last sampled
                                  force pass (NaN if not sampled) [N, N/m in 2-D] */

@@ -10,7 +10,9 @@
  * difference of Fourtakas et al. 2019); sph_density() adds dt D_a to gamma_a rho_a (Eq. 3.64:
  * no 1/gamma_a). Hooks: diffusion_init (the model's constants), diffusion_pair (summed by the
  * force loop over the fluid part of the list), diffusion_finish. It has no budget part (it
- * changes no momentum) and no time-step limit of its own.
+ * changes no momentum). Its time-step limit (diffusion_dt_limit) is that of an explicit
+ * diffusion of diffusivity D = c0 (2 h diff_lr + diff_lc) / (2 xi), delta h c0 for delta_sph:
+ * dt <= c_diffusion h^2 / D (time.c_diffusion).
  */
 #ifndef CHANSPH_TERM_DIFFUSION_H
 #define CHANSPH_TERM_DIFFUSION_H
@@ -43,6 +45,19 @@ static inline double diffusion_dgrav(const struct model *M) {
 /** D_a from the pair sum of particle a's fluid neighbours. */
 static inline double diffusion_finish(const struct model *M, double sum) {
   return sum * M->inv_xi;
+}
+
+/** The diffusivity of the volume diffusion, D = c0 (2 h lr + lc) / (2 xi) [m^2/s]: delta h c0 for
+    delta_sph (l_ab = 2 delta h xi), and its bound over the kernel support (r_ab <= 2 h) for
+    the thesis form. */
+static inline double diffusion_diffusivity(const struct model *M) {
+  return M->e.c0 * (2.0 * M->h * M->diff_lr + M->diff_lc) * M->inv_xi / 2.0;
+}
+
+/** The explicit diffusion's time-step limit c_diffusion h^2 / D [s] (INFINITY without one). */
+static inline double diffusion_dt_limit(const struct model *M, double c_diffusion) {
+  const double d = diffusion_diffusivity(M);
+  return c_diffusion > 0.0 && d > 0.0 ? c_diffusion * M->h * M->h / d : INFINITY;
 }
 
 #endif

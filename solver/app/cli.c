@@ -363,8 +363,10 @@ int cli_bench(const struct scene *sc, long steps) {
            nbr / (double)S.P.n_fluid);
     printf("set-up %.3f s; %d warm-up steps, then %ld timed steps in %.3f s (%.3f ms/step)\n",
            setup, warm, steps, wall, 1e3 * wall / steps);
-    printf("dt = %.4e s (limits: acoustic %.3e, viscous %.3e, force %.3e, wall %.3e)\n", S.dt,
-           S.dt_limits[0], S.dt_limits[1], S.dt_limits[2], S.dt_limits[3]);
+    printf(
+        "dt = %.4e s (limits: acoustic %.3e, viscous %.3e, force %.3e, wall %.3e, "
+        "diffusion %.3e)\n",
+        S.dt, S.dt_limits[0], S.dt_limits[1], S.dt_limits[2], S.dt_limits[3], S.dt_limits[4]);
     printf("wall seconds per simulated second: %.1f\n", simt > 0 ? wall / simt : 0.0);
     if (ranks > 1) {
       printf("particles per rank: max %.0f, mean %.1f (imbalance %.3f)\n", mx[3], sum[3] / ranks,
