@@ -110,6 +110,13 @@ static const struct key keys_head[] = {
     {{"sph", "delta", T_DOUBLE, "0.1", 0, 1, 0, NULL, "-",
       "delta of sph.diffusion = delta_sph (0.1 is the delta-SPH literature's value)."},
      OFF(diff_delta)},
+    {{"sph", "diffusion_substeps", T_INT, "1", 1, 16, 0, NULL, "-",
+      "Sub-steps of the volume diffusion in each time step: n > 1 applies the diffusion's rate "
+      "n times at dt / n, the last n - 1 at the new positions in a pass of their own, so that "
+      "time.c_diffusion limits dt / n instead of dt: a stronger sph.delta at the acoustic "
+      "step for one density pass per extra sub-step (docs/theory.md, \"Continuity\"). Not "
+      "with sph.acoustic_damper."},
+     OFF(diff_substeps)},
     {{"sph", "acoustic_damper", T_DOUBLE, "0", 0, 2, 0, NULL, "-",
       "Acoustic damper alpha (Sun, Pilloton, Antuono & Colagrossi 2023): a bulk viscosity "
       "zeta = alpha rho0 c0 h, applied as the pressure p - zeta div u with div u = -(1/rho) "
@@ -878,6 +885,11 @@ static void validate(struct parse_state *ps) {
   } else if (s->lz != 0.0) {
     inconsistent(ps, "domain.lz", "lz = %g is given for a 2-D scene (dimension = %g)", s->lz, 2.0);
   }
+  if (s->diff_substeps > 1 && s->damper > 0.0)
+    inconsistent(ps, "sph.diffusion_substeps",
+                 "sub-steps of the volume diffusion (%d) do not go with the acoustic damper "
+                 "(sph.acoustic_damper = %g), whose rate takes the whole step's diffusion",
+                 s->diff_substeps, s->damper);
   if (s->kernel == KERNEL_C4 && s->dim != 3)
     inconsistent(ps, "sph.kernel", "wendland_c4 needs a 3-D scene (dimension = %g)",
                  (double)s->dim);

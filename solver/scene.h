@@ -55,6 +55,7 @@ struct scene {
   double xi;          /*!< volume-diffusion constant [-]; 0 selects 1000 dr / (2 delta) */
   int diffusion;      /*!< enum diffusion_form: the volume diffusion's pair form */
   double diff_delta;  /*!< delta of the delta-SPH form [-] */
+  int diff_substeps;  /*!< sub-steps of the volume diffusion in a time step [-] */
   double damper;      /*!< acoustic damper alpha of zeta = alpha rho0 c0 h [-]; 0 = off */
   double wall_dmin;   /*!< delta r of Eq. 2.148 over dr [-] */
   double eta2;        /*!< regularisation of 1/r^2 in the viscous term, over h^2 [-] */

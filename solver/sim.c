@@ -78,6 +78,10 @@ static void update_state(struct sim *S, int restored, double dt) {
   /* the arrays may have moved (grown for the ghosts): take the pointers only now */
   sph_density(&S->M, P, restored ? P->ksum : S->ksum_new, dt);
   dd_refresh(&S->dd, P, &S->W, PR_DENSITY); /* fluid ghosts: what sph_walls reads */
+  for (int k = 1; dt > 0.0 && k < S->M.diff_substeps; k++) { /* sph.diffusion_substeps */
+    sph_diffusion_substep(&S->M, P, &S->nb, dt / S->M.diff_substeps);
+    dd_refresh(&S->dd, P, &S->W, PR_DENSITY);
+  }
   sph_walls(&S->M, P, &S->nb, &S->W);
   dd_refresh(&S->dd, P, &S->W, PR_WALLS); /* vertex ghosts and wall values */
   model_update(S);

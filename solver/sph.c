@@ -167,16 +167,25 @@ static inline double channel_gamma(const struct model *M, double y) {
   return wall_gamma_of(&M->k, y * ih) + wall_gamma_of(&M->k, (M->ly - y) * ih) - 1.0;
 }
 
+/* Pressure pa (the equation of state's, or the damper's), sound speed, p / rho^2 and volume of
+   fluid particle a from its density. */
+static inline void density_state(const struct model *M, struct particles *P, size_t a, double pa) {
+  const double r = P->rho[a];
+  P->p[a] = pa, P->c[a] = eos_sound(&M->e, r);
+  P->pr2[a] = pa / (r * r), P->vol[a] = P->m[a] / r;
+}
+
 void sph_density(const struct model *M, struct particles *P, const double *ksum_new, double dt) {
   timer_push("density");
-  const double *restrict y = P->y, *restrict m = P->m;
+  const double dtd = dt / M->diff_substeps; /* the force pass's D_a: the first sub-step */
+  const double *restrict y = P->y;
   const uint8_t *restrict kind = P->kind;
   double *restrict drate = M->damper_zeta > 0.0 ? P->drate : NULL;
 #pragma omp parallel for schedule(static)
   for (size_t a = 0; a < P->n; a++) {
     if (kind[a] != KIND_FLUID) continue;
     const double s = ksum_new[a], gam = channel_gamma(M, y[a]), r_old = P->rho[a];
-    if (dt > 0.0) P->rho[a] = (P->gam[a] * r_old + s - P->ksum[a] + dt * P->ddiff[a]) / gam;
+    if (dt > 0.0) P->rho[a] = (P->gam[a] * r_old + s - P->ksum[a] + dtd * P->ddiff[a]) / gam;
     P->ksum[a] = s;
     P->gam[a] = gam;
     const double r = P->rho[a];
@@ -185,8 +194,55 @@ void sph_density(const struct model *M, struct particles *P, const double *ksum_
       if (dt > 0.0) drate[a] = damper_rate(r_old, r, dt, P->ddiff[a], gam);
       pa = damper_pressure(pa, M->damper_zeta, drate[a]);
     }
-    P->p[a] = pa, P->c[a] = eos_sound(&M->e, r);
-    P->pr2[a] = pa / (r * r), P->vol[a] = m[a] / r;
+    density_state(M, P, a, pa);
+  }
+  timer_pop();
+}
+
+/* The volume diffusion's fluid-pair sum of particle a at the current state: the force pass's
+   diffusion_pair (forces.c) without the forces, for one kernel shape. */
+static inline __attribute__((always_inline)) double diffusion_sum(const struct model *M,
+                                                                  const struct particles *P,
+                                                                  const struct nbr *nb, size_t a,
+                                                                  const int shape) {
+  const struct pair_frame F = pair_frame_of(M);
+  const double *restrict x = P->x, *restrict y = P->y, *restrict z = P->z;
+  const double *restrict rho = P->rho, *restrict vol = P->vol, *restrict c = P->c;
+  const double dgrav = diffusion_dgrav(M), lr = M->diff_lr, lc = M->diff_lc;
+  const int32_t *restrict nl = pair_list(nb, a);
+  const double xa = x[a], ya = y[a], za = z[a], ra = rho[a], ca = c[a];
+  double sum = 0.0;
+#pragma omp simd reduction(+ : sum)
+  for (int j = 0; j < nb->nfluid[a]; j++) {
+    const int32_t b = nl[j];
+    const struct pair g = pair_at_shape(&F, shape, xa - x[b], ya - y[b], za - z[b]);
+    sum += diffusion_pair(&g, vol[b], ca, c[b], ra - rho[b], dgrav, lr, lc);
+  }
+  return sum;
+}
+
+/* D_a of every fluid particle into P->ddiff. */
+static CHANSPH_CLONES void diffusion_rates(const struct model *M, struct particles *P,
+                                           const struct nbr *nb) {
+  const int c4 = M->k.shape == KERNEL_C4;
+#pragma omp parallel for schedule(static)
+  for (size_t a = 0; a < P->n; a++) {
+    if (P->kind[a] != KIND_FLUID) continue;
+    const double sum =
+        c4 ? diffusion_sum(M, P, nb, a, KERNEL_C4) : diffusion_sum(M, P, nb, a, KERNEL_C2);
+    P->ddiff[a] = diffusion_finish(M, sum);
+  }
+}
+
+void sph_diffusion_substep(const struct model *M, struct particles *P, const struct nbr *nb,
+                           double dts) {
+  timer_push("diffusion sub-steps");
+  diffusion_rates(M, P, nb);
+#pragma omp parallel for schedule(static)
+  for (size_t a = 0; a < P->n; a++) {
+    if (P->kind[a] != KIND_FLUID) continue;
+    P->rho[a] += dts * P->ddiff[a] / P->gam[a];
+    density_state(M, P, a, eos_pressure(&M->e, P->rho[a]));
   }
   timer_pop();
 }

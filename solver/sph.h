@@ -29,6 +29,8 @@ struct model {
   /** the volume diffusion's pair length l_ab = diff_lr r_ab + diff_lc: (1, 0) for ferrand, (0,
       2 delta h xi) for delta_sph (term_diffusion.h) */
   double diff_lr, diff_lc;
+  int diff_substeps;  /*!< sub-steps of the volume diffusion in a time step (sph_diffusion_substep)
+                       */
   double damper_zeta; /*!< bulk viscosity zeta = alpha rho0 c0 h of the acoustic damper [Pa s] */
   double gy;          /*!< wall-normal body acceleration [m/s^2] */
   double wall_dmin;   /*!< delta r of Eq. 2.148 [m] */
@@ -124,14 +126,28 @@ double sph_violeau_moment(const struct model *M, double q);
 
 /**
  * @brief Density update of thesis Eq. 3.64 from the kernel sums at the current positions:
- *        gamma^n rho^n = gamma^(n-1) rho^(n-1) + S^n - S^(n-1) + dt D^(n-1),
+ *        gamma^n rho^n = gamma^(n-1) rho^(n-1) + S^n - S^(n-1) + (dt / n_d) D^(n-1),
  *        with gamma of the plane walls in closed form; then pressure and sound speed (Eq. 2.11).
+ *        n_d = sph.diffusion_substeps (1: the thesis); sph_diffusion_substep adds the rest.
  * @param[in] M model
  * @param[in,out] P particles (ksum, gam, rho, p, c of fluid particles)
  * @param[in] ksum_new kernel sums at the current positions (from nbr_build)
  * @param[in] dt the step that led here [s]; dt <= 0 only initialises S and gamma
  */
 void sph_density(const struct model *M, struct particles *P, const double *ksum_new, double dt);
+
+/**
+ * @brief One sub-step of the volume diffusion at the current positions and densities:
+ *        gamma_a rho_a += dts D_a (term_diffusion.h, the force pass's pair sum without the
+ *        forces), then pressure and sound speed. The caller refreshes the ghosts' densities
+ *        before and after (sph.diffusion_substeps: n_d - 1 of them after sph_density).
+ * @param[in] M model
+ * @param[in,out] P particles (ddiff: this sub-step's D_a; rho, p, c of fluid particles)
+ * @param[in] nb neighbour list of the current positions
+ * @param[in] dts the sub-step, dt / n_d [s]
+ */
+void sph_diffusion_substep(const struct model *M, struct particles *P, const struct nbr *nb,
+                           double dts);
 
 /**
  * @brief Wall values of the vertex particles by Shepard interpolation of the fluid:

@@ -25,6 +25,7 @@ static inline void diffusion_init(struct model *M, const struct scene *s) {
   const int delta = s->diffusion == DIFFUSION_DELTA_SPH;
   M->diff_lr = delta ? 0.0 : 1.0;
   M->diff_lc = delta ? 2.0 * s->diff_delta * M->h / M->inv_xi : 0.0;
+  M->diff_substeps = s->diff_substeps;
 }
 
 /** Volume diffusion of one fluid pair, to be divided by xi: V_b max(c_a, c_b) (drho - dgrav
@@ -54,10 +55,12 @@ static inline double diffusion_diffusivity(const struct model *M) {
   return M->e.c0 * (2.0 * M->h * M->diff_lr + M->diff_lc) * M->inv_xi / 2.0;
 }
 
-/** The explicit diffusion's time-step limit c_diffusion h^2 / D [s] (INFINITY without one). */
+/** The explicit diffusion's time-step limit n_d c_diffusion h^2 / D [s] (INFINITY without one):
+    each of the n_d sub-steps (sph.diffusion_substeps) within it. */
 static inline double diffusion_dt_limit(const struct model *M, double c_diffusion) {
   const double d = diffusion_diffusivity(M);
-  return c_diffusion > 0.0 && d > 0.0 ? c_diffusion * M->h * M->h / d : INFINITY;
+  return c_diffusion > 0.0 && d > 0.0 ? M->diff_substeps * (c_diffusion * M->h * M->h / d)
+                                      : INFINITY;
 }
 
 #endif

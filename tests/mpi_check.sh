@@ -13,6 +13,7 @@
 #              checked after every step: 2 ranks equal 1 rank
 #   damper     fast 2-D flow with the acoustic damper and the delta-SPH diffusion, 200 steps,
 #              ids checked after every step: 2 ranks equal 1 rank
+#   substeps   the same with the volume diffusion in 3 sub-steps (delta = 0.6): 2 ranks equal 1
 #   too_many   more ranks than the blocks allow: a message naming domain.lx and domain.lz, exit 1
 #   resume_too_many  a 1-rank checkpoint resumed on more ranks than its slabs allow: the same
 #                    message, exit 1, the checkpoints untouched
@@ -200,16 +201,20 @@ case $case in
       compare r1 r2 200
     done
     ;;
-  kgc | damper) # two terms that read state of other particles or steps, on 1 and 2 ranks:
+  kgc | damper | substeps) # terms that read state of other particles or steps, on 1 and 2 ranks:
     # kgc (sph.pressure_gradient = kgc): the force pass and the budget's conservative split read
     # the neighbours' correction matrices B at the ghosts (PR_KGC); statistics from the start,
     # so the budget parts are sampled too. damper (sph.acoustic_damper): migrating particles
-    # carry their density rate (term_damper.h), which the pressure of the next step reads
+    # carry their density rate (term_damper.h), which the pressure of the next step reads.
+    # substeps (sph.diffusion_substeps = 3): each sub-step reads the ghosts' densities, refreshed
+    # after the previous one (PR_DENSITY)
     scene=$scenes/poiseuille2d.ini
     args=(--set domain.lx=2.0 --set time.t_end=1000 --set time.max_steps=200 --set init.profile=laminar
       --set drive.force=4 --set init.noise=0.5 --set run.check_ids=1 --set output.log_every=100)
     if [ "$case" = kgc ]; then
       args+=(--set output.t_average_start=0 --set sph.pressure_gradient=kgc)
+    elif [ "$case" = substeps ]; then
+      args+=(--set sph.diffusion=delta_sph --set sph.delta=0.6 --set sph.diffusion_substeps=3)
     else
       args+=(--set sph.acoustic_damper=0.1 --set sph.diffusion=delta_sph)
     fi
