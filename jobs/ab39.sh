@@ -40,6 +40,8 @@ declare -A sets=(
   [delta_0.2]="--set sph.diffusion=delta_sph --set sph.delta=0.2"
   [delta_0.3]="--set sph.diffusion=delta_sph --set sph.delta=0.3"
   [delta_0.4]="--set sph.diffusion=delta_sph --set sph.delta=0.4"
+  [delta_0.4_sub2]="--set sph.diffusion=delta_sph --set sph.delta=0.4 --set sph.diffusion_substeps=2"
+  [delta_0.8_sub4]="--set sph.diffusion=delta_sph --set sph.delta=0.8 --set sph.diffusion_substeps=4"
   [damper_0.1_delta_0.1]="--set sph.acoustic_damper=0.1 --set sph.diffusion=delta_sph --set sph.delta=0.1"
   [morris]="--set sph.viscous=morris"
   [lapnorm_trace]="--set sph.laplacian_norm=trace"
