@@ -54,13 +54,14 @@ void lagr_init(struct lagr *g, const struct lagr_config *cfg) {
   g->n_slots = (int)ceil(cfg->horizon / cfg->release_every - 1e-9) + 1;
   const size_t nl = (size_t)cfg->n_levels;
   g->sums = mem_calloc(nl * g->nlag * LG_LEN, sizeof(double), "Lagrangian engine");
-  g->slot_sums =
-      mem_calloc((size_t)g->n_slots * nl * g->nlag * LG_LEN, sizeof(double), "Lagrangian engine");
+  /* the release slots: all in use after one horizon; resident from the start */
+  g->slot_sums = mem_calloc_resident((size_t)g->n_slots * nl * g->nlag * LG_LEN, sizeof(double),
+                                     "Lagrangian engine");
   g->slots = mem_calloc((size_t)g->n_slots * SL_LEN, sizeof(double), "Lagrangian engine");
   g->tl = mem_calloc(nl * 3 * SCAL_LEN, sizeof(double), "Lagrangian engine");
   g->rb = mem_calloc(nl * LF_LEN * g->nlag * SCAL_LEN, sizeof(double), "Lagrangian engine");
-  g->slot_pdf =
-      mem_calloc((size_t)g->n_slots * slot_pdf_len(g), sizeof(double), "Lagrangian engine");
+  g->slot_pdf = mem_calloc_resident((size_t)g->n_slots * slot_pdf_len(g), sizeof(double),
+                                    "Lagrangian engine");
   g->pdf_rb = mem_calloc(nl * n_st(cfg) * (size_t)(cfg->pdf_bins + 2) * SCAL_LEN, sizeof(double),
                          "Lagrangian engine");
   g->pdf =

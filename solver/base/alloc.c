@@ -27,6 +27,14 @@ void *mem_calloc(size_t n, size_t size, const char *label) {
   return p;
 }
 
+void *mem_calloc_resident(size_t n, size_t size, const char *label) {
+  char *p = mem_calloc(n, size, label);
+  volatile char *v = p; /* a store the compiler cannot drop after calloc */
+  const size_t bytes = n * size;
+  for (size_t i = 0; i < bytes; i += 4096) v[i] = 0;
+  return p;
+}
+
 void *mem_realloc(void *p, size_t n, size_t size, const char *label) {
   const size_t bytes = bytes_of(n, size, label);
   void *q = realloc(p, bytes);

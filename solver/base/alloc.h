@@ -24,6 +24,14 @@ void *mem_alloc(size_t n, size_t size, const char *label);
 void *mem_calloc(size_t n, size_t size, const char *label);
 
 /**
+ * @brief mem_calloc() whose pages are written at once: the memory is resident from the start
+ *        (the start-up memory check's estimate is then what the process holds, on any kernel),
+ *        not when a long run first reaches it. For buffers that a run fills within its first
+ *        horizon anyway (the Lagrangian engine's release slots).
+ */
+void *mem_calloc_resident(size_t n, size_t size, const char *label);
+
+/**
  * @brief realloc(p, n * size), or die.
  * @param[in] p memory from these helpers, or NULL
  * @return the memory (the first min(old, new) bytes kept)
