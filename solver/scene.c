@@ -115,7 +115,9 @@ static const struct key keys_head[] = {
       "n times at dt / n, the last n - 1 at the new positions in a pass of their own, so that "
       "time.c_diffusion limits dt / n instead of dt: a stronger sph.delta at the acoustic "
       "step for one density pass per extra sub-step (docs/theory.md, \"Continuity\"). Not "
-      "with sph.acoustic_damper."},
+      "with sph.acoustic_damper. An experiment, not for production: with delta = 0.4 and "
+      "n = 2 in the turbulent channel the pressure noise feeds particle-scale v and w "
+      "(docs/validation/scheme_ab.md); use time.c_diffusion's smaller step instead."},
      OFF(diff_substeps)},
     {{"sph", "acoustic_damper", T_DOUBLE, "0", 0, 2, 0, NULL, "-",
       "Acoustic damper alpha (Sun, Pilloton, Antuono & Colagrossi 2023): a bulk viscosity "
@@ -259,7 +261,7 @@ static const struct key keys_head[] = {
     {{"fluid", "zeta", T_DOUBLE, "7", 1, 10, 0, NULL, "-",
       "Exponent of the Tait equation of state (thesis Eq. 2.11)."},
      OFF(zeta)},
-    {{"fluid", "p_background", T_DOUBLE, "0.01", 0, 10, 0, NULL, "rho0 c0^2",
+    {{"fluid", "p_background", T_DOUBLE, "0.01", -0.01, 10, 0, NULL, "rho0 c0^2",
       "Background pressure added to the Tait equation of state, in units of rho0 c0^2; it "
       "gives the particle arrangement a restoring force and, with the lattice pressure wall "
       "weight, stops the transverse instability of the sheared lattice (docs/theory.md). "

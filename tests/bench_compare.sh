@@ -10,6 +10,11 @@
 #   --set k=v   passed to every bench run (e.g. --set sph.precision=double)
 #   --new-set k=v  passed to the new build's runs only (e.g. HEAD against the working tree with
 #               --new-set sph.precision=mixed: one build, two settings)
+#   --case 'NAME|SCENE [--set k=v ...]|STEPS'  a case of your own instead of the four below
+#               (repeatable; SCENE relative to the repository root), e.g. the volume diffusion
+#               in sub-steps against the default setting, one build:
+#               tests/bench_compare.sh HEAD --case 'dr9|jobs/scenes/mfu180w_dr6_c4_delta.ini
+#               --set domain.dr=0.05|20' --new-set sph.delta=0.4 --new-set sph.diffusion_substeps=2
 #   --callgrind count instructions instead of timing: each case once per build under
 #               `valgrind --tool=callgrind --toggle-collect=sim_step` (the step only, not the
 #               set-up), 1 thread, 3 steps; deterministic, so it resolves differences far below
@@ -25,7 +30,7 @@
 # new / old of particle-steps/s. Run it on an idle machine.
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
-old="" new="." reps=3 threads=2 sets=() new_sets=() callgrind=0
+old="" new="." reps=3 threads=2 sets=() new_sets=() callgrind=0 own_cases=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --reps) reps=$2; shift 2 ;;
@@ -33,7 +38,8 @@ while [ $# -gt 0 ]; do
     --set) sets+=(--set "$2"); shift 2 ;;
     --new-set) new_sets+=(--set "$2"); shift 2 ;;
     --callgrind) callgrind=1; shift ;;
-    -h|--help) sed -n '2,26p' "$0"; exit 0 ;;
+    --case) own_cases+=("$2"); shift 2 ;;
+    -h|--help) sed -n '2,30p' "$0"; exit 0 ;;
     *) if [ -z "$old" ]; then old=$1; else new=$1; fi; shift ;;
   esac
 done
@@ -70,6 +76,16 @@ S=$here/jobs/scenes
 cases=("default|" "les395_small|$S/les395_small.ini" "les395_small_qdns|$S/les395_small.ini --set les.model=none"
        "qdns180_small|$S/qdns180_small.ini")
 steps=(40 40 40 20)
+if [ ${#own_cases[@]} -gt 0 ]; then
+  cases=() steps=()
+  for c in "${own_cases[@]}"; do
+    IFS='|' read -r cname cargs csteps <<< "$c"
+    [ -n "$cname" ] && [ -n "$cargs" ] && [ -n "$csteps" ] ||
+      { echo "bench_compare: --case '$c': give NAME|SCENE [--set k=v ...]|STEPS" >&2; exit 1; }
+    case $cargs in /*) ;; *) cargs=$here/$cargs ;; esac
+    cases+=("$cname|$cargs") steps+=("$csteps")
+  done
+fi
 
 if [ $callgrind = 1 ]; then # instruction counts of sim_step, one run per build and case
   command -v valgrind > /dev/null || { echo "bench_compare: --callgrind needs valgrind" >&2; exit 1; }
