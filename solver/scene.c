@@ -266,7 +266,10 @@ static const struct key keys_head[] = {
       "gives the particle arrangement a restoring force and, with the lattice pressure wall "
       "weight, stops the transverse instability of the sheared lattice (docs/theory.md). "
       "For turbulence use 0: its pair stress destroys resolved turbulence within 0.15 "
-      "delta/u_tau (docs/validation/turbulent_channel.md)."},
+      "delta/u_tau (docs/validation/turbulent_channel.md). Negative values, for experiments, "
+      "lower the pressure of every density; a developed turbulent channel raises its mean "
+      "density back to the same mean pressure within 0.1 turnovers "
+      "(docs/validation/scheme_ab.md)."},
      OFF(p_background)},
     {{"fluid", "gravity_y", T_DOUBLE, "0", -ACCEL_MAX, ACCEL_MAX, 0, NULL, "m/s^2",
       "Wall-normal body acceleration; enters the momentum equation, the wall pressure "
