@@ -916,6 +916,22 @@ static int put_segments(const struct extract_args *a, int out) {
   return rc;
 }
 
+/* The time steps of the joined segments, summed (each file's attribute steps), where the
+   output holds their whole range: a join copies the first segment's attributes. */
+static int put_joined_steps(const struct extract_args *a, int out) {
+  long long total = 0;
+  for (int k = 0; k < a->npaths; k++) {
+    int ncid;
+    long long n = 0;
+    if (nc_open(a->paths[k], NC_NOWRITE, &ncid) != NC_NOERR) return NC_NOERR;
+    const int rc = nc_get_att_longlong(ncid, NC_GLOBAL, "steps", &n);
+    nc_close(ncid);
+    if (rc != NC_NOERR) return NC_NOERR; /* a segment without it: the first one's stays */
+    total += n;
+  }
+  return nc_put_att_longlong(out, NC_GLOBAL, "steps", NC_INT64, 1, &total);
+}
+
 /* The runs a file of several holds, and, if its range runs to the end (r1 = rows), the time
    its last one ended: what a later segment must continue (segment_run_ids, segment_end_time). */
 static int put_origin(const struct stored *s, size_t r1, int out) {
@@ -1095,6 +1111,7 @@ static int write_range(const struct extract_args *a, const struct stored *s, siz
     rc = nc_put_att_double(out, NC_GLOBAL, "t_reached", NC_DOUBLE, 1, &t_end);
   if (rc == NC_NOERR) rc = nc_put_att_longlong(out, NC_GLOBAL, "n_snapshots", NC_INT64, 1, &ns);
   if (rc == NC_NOERR && a->npaths > 1) rc = put_segments(a, out);
+  if (rc == NC_NOERR && a->npaths > 1 && r0 == 0 && r1 == s->rows) rc = put_joined_steps(a, out);
   if (rc == NC_NOERR) rc = put_origin(s, r1, out);
   if (rc == NC_NOERR) rc = euler_engine.write(&e, t_end, out, err, sizeof err);
   if (rc == NC_NOERR && a->npaths > 1)

@@ -3,7 +3,7 @@
 # with init.from, as a long run continued on another machine) joined into one stats.nc. Its raw
 # windows are A's then B's, B's times (window bounds, the budgets' first and last snapshot
 # times) shifted by A's reached time and A's last window (open at A's end) counted; the profiles of each part of J equal those of its segment alone, to the
-# printed digit; `chansph compare` reads J; a segment gathered otherwise (another window length)
+# printed digit; its steps are A's plus B's; `chansph compare` reads J; a segment gathered otherwise (another window length)
 # is an input error naming the file and the key (exit 1, no J left).
 # usage: extract_join_check.sh CHANSPH SCENE STATS_RUN DNS WORK
 #   STATS_RUN: the shared small run (SCENE to t = 1, averaging from 0.2 in windows of 0.1)
@@ -52,6 +52,8 @@ if ca[-1] != 0 or cj[na - 1] != 1 or not np.array_equal(cj[na:], cb):
     bad.append(f"completeness: A's last {ca[-1]} -> {cj[na - 1]}, B's {list(cb)} -> {list(cj[na:])}")
 if abs(float(J.t_reached) - ta - float(B.t_reached)) > 1e-12 or int(J.n_windows) != na + nb - 1:
     bad.append(f"t_reached {float(J.t_reached)} or n_windows {int(J.n_windows)} wrong")
+if int(J.steps) != int(A.steps) + int(B.steps):
+    bad.append(f"steps {int(J.steps)}: not A's {int(A.steps)} + B's {int(B.steps)}")
 if "correlations" in J.groups:
     bad.append("group correlations kept although only group eulerian is joined")
 sys.exit("FAIL: " + "; ".join(bad) if bad else 0)

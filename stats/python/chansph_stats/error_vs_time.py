@@ -3,7 +3,9 @@
 usage: chansph-stats error_vs_time --dns FILE [--dns FILE2] [--group T] [--out DIR]
                                       LABEL=RUN_DIR[+RUN_DIR...] ...
 
-Each series is one or more run directories (stats.nc, log.txt), the later ones continuing the
+Each series is one or more run directories (stats.nc, log.txt; without log.txt the particle-steps
+come from stats.nc's steps and n_fluid, spread evenly over its time, and the wall seconds are
+unknown: a shipped segment), the later ones continuing the
 earlier (a run started from an earlier one's particles with its time restarting at 0 is shifted
 to follow it). The averaging windows of stats.nc are grouped into consecutive groups of length T
 in delta/u_tau (default 0.25); for each group the profiles of U+, u_rms+, v_rms+, w_rms+ and
@@ -35,10 +37,30 @@ from .merge import merged_profile
 from .ncfile import read_windows
 
 
+def stats_cost(run):
+    """(t, particle-steps, wall seconds) from stats.nc alone (a shipped segment without its
+    log): the file's steps times n_fluid, spread evenly over 0 .. t_reached (the time step
+    varies by a few percent); wall seconds unknown (NaN)."""
+    from .ncfile import open_nc
+    with open_nc(os.path.join(run, "stats.nc")) as d:
+        attrs = d.ncattrs()
+        if not all(k in attrs for k in ("steps", "n_fluid", "t_reached")):
+            raise InputError(f"{run}: no log.txt, and stats.nc has no steps, n_fluid, t_reached")
+        steps, n = float(d.getncattr("steps")), float(d.getncattr("n_fluid"))
+        t1 = float(d.getncattr("t_reached"))
+    print(f"note: {run}: no log.txt; particle-steps from stats.nc ({steps:.0f} steps x "
+          f"{n:.0f} particles over t = 0 .. {t1:.4g}), wall seconds unknown")
+    return np.array([0.0, t1]), np.array([0.0, steps * n]), np.array([math.nan, math.nan])
+
+
 def log_cost(run):
-    """Arrays (t, cumulative particle-steps, cumulative wall seconds) at the log's step lines."""
+    """Arrays (t, cumulative particle-steps, cumulative wall seconds) at the log's step lines;
+    from stats.nc alone where the run directory has no log.txt (stats_cost)."""
+    path = os.path.join(run, "log.txt")
+    if not os.path.exists(path) and os.path.exists(os.path.join(run, "stats.nc")):
+        return stats_cost(run)
     try:
-        log = open(os.path.join(run, "log.txt"), encoding="utf-8").read()
+        log = open(path, encoding="utf-8").read()
     except OSError as e:
         raise InputError(f"{run}/log.txt: {e.strerror}")
     nfl = re.search(r"(\d+) fluid", log)
