@@ -25,6 +25,18 @@ expect "error: --at -1: y+ -1 outside the channel of the run" "$tool" skewflat_c
 expect "error: --at 5,1e6: y+ 1e+06 outside the channel" "$tool" skewflat_compare "$run/stats.nc" --at 5,1e6
 "$tool" error_vs_time --dns "$dns" "A=$run" --cumulative 0.3 --out "$out" | grep -q "0.30- 1.00" ||
   { echo "FAIL: --cumulative 0.3 gives no row"; status=1; }
+# a shipped segment, stats.nc without its log: particle-steps from stats.nc (steps x n_fluid,
+# spread evenly over 0 .. t_reached), read at the end of the last group
+mkdir -p "$out/nolog" && cp "$run/stats.nc" "$out/nolog/"
+"$tool" error_vs_time --dns "$dns" "A=$out/nolog" --cumulative 0.3 --out "$out" | grep -q "no log.txt" &&
+  /usr/bin/python3 - "$run/stats.nc" "$out/error_vs_time.csv" << 'PY' ||
+import sys, netCDF4
+d = netCDF4.Dataset(sys.argv[1])
+last = open(sys.argv[2]).read().splitlines()[-1].split(",")
+want = float(d.steps) * float(d.n_fluid) * float(last[3]) / float(d.t_reached)
+sys.exit(0 if abs(float(last[4]) - want) <= 1e-6 * want else f"{last[4]} particle-steps, not {want}")
+PY
+  { echo "FAIL: error_vs_time on stats.nc without log.txt"; status=1; }
 rm -rf "$out"
 [ $status -eq 0 ] && echo "PASS: tool arguments that select nothing are refused"
 exit $status
