@@ -233,7 +233,9 @@ static inline __attribute__((always_inline)) void diffusion_range(const struct m
 
 /* One function per kernel shape, called per chunk from the parallel loop, as the force loops
    (forces.c): with both shapes inlined into the parallel loop's body GCC 12 left the pair loop
-   scalar (its branches not converted), 3.3 times the instructions of the vectorised loop. */
+   scalar in every clone; so the x86-64-v4 clone runs it in 64-byte vectors (the others stay
+   scalar: not profitable by GCC's cost model). The pass took as long either way (17 ms a step
+   at dr+ = 9 on 2 threads): it waits on memory (docs/validation/scheme_ab.md). */
 typedef void (*diffusion_loop)(const struct model *M, struct particles *P, const struct nbr *nb,
                                size_t a0, size_t a1);
 static CHANSPH_CLONES void diffusion_range_C2(const struct model *M, struct particles *P,
