@@ -66,6 +66,7 @@ struct origin {
   double from_t;     /* init_from_time [s], NaN if absent */
   char *ids;         /* segment_run_ids, else run_id ("" if absent): "; " between runs */
   double end_t;      /* the time its last segment ended (segment_end_time, else t_reached) */
+  double steps;      /* the time steps of its segments (steps; summed by a join), NaN if absent */
   char drive[16];    /* drive_mode */
   double dim, lx, lz, dr, force; /* dimension, the box, body_force (force mode: constant) */
 };
@@ -136,6 +137,7 @@ static void read_origin(int ncid, struct stored *s) {
   get_text(ncid, "drive_mode", o->drive, sizeof o->drive);
   o->from_t = get_num(ncid, "init_from_time"), o->end_t = get_num(ncid, "segment_end_time");
   if (isnan(o->end_t)) o->end_t = s->t_reached;
+  o->steps = get_num(ncid, "steps");
   o->dim = get_num(ncid, "dimension"), o->lx = get_num(ncid, "lx"), o->lz = get_num(ncid, "lz");
   o->dr = get_num(ncid, "dr"), o->force = get_num(ncid, "body_force");
   size_t n = 0;
@@ -458,7 +460,7 @@ static int join_stored(struct stored *seg, int n, char *const *paths, int force)
     const size_t la = strlen(s->o.ids), lb = strlen(b->o.ids);
     s->o.ids = mem_realloc(s->o.ids, la + lb + 3, 1, "chansph extract");
     memcpy(s->o.ids + la, "; ", 2), memcpy(s->o.ids + la + 2, b->o.ids, lb + 1);
-    s->o.end_t = b->o.end_t;
+    s->o.end_t = b->o.end_t, s->o.steps += b->o.steps;
   }
   for (int k = 1; k < n; k++) free_stored(&seg[k]);
   return bad;
@@ -916,29 +918,17 @@ static int put_segments(const struct extract_args *a, int out) {
   return rc;
 }
 
-/* The time steps of the joined segments, summed (each file's attribute steps), where the
-   output holds their whole range: a join copies the first segment's attributes. */
-static int put_joined_steps(const struct extract_args *a, int out) {
-  long long total = 0;
-  for (int k = 0; k < a->npaths; k++) {
-    int ncid;
-    long long n = 0;
-    if (nc_open(a->paths[k], NC_NOWRITE, &ncid) != NC_NOERR) return NC_NOERR;
-    const int rc = nc_get_att_longlong(ncid, NC_GLOBAL, "steps", &n);
-    nc_close(ncid);
-    if (rc != NC_NOERR) return NC_NOERR; /* a segment without it: the first one's stays */
-    total += n;
-  }
-  return nc_put_att_longlong(out, NC_GLOBAL, "steps", NC_INT64, 1, &total);
-}
-
 /* The runs a file of several holds, and, if its range runs to the end (r1 = rows), the time
-   its last one ended: what a later segment must continue (segment_run_ids, segment_end_time). */
-static int put_origin(const struct stored *s, size_t r1, int out) {
+   its last one ended: what a later segment must continue (segment_run_ids, segment_end_time);
+   if it holds them whole, their time steps summed (steps). */
+static int put_origin(const struct stored *s, size_t r0, size_t r1, int out) {
   if (!strchr(s->o.ids, ';')) return NC_NOERR; /* one run: run_id and t_reached say it */
   int rc = nc_put_att_text(out, NC_GLOBAL, "segment_run_ids", strlen(s->o.ids), s->o.ids);
   if (rc == NC_NOERR && r1 == s->rows && isfinite(s->o.end_t))
     rc = nc_put_att_double(out, NC_GLOBAL, "segment_end_time", NC_DOUBLE, 1, &s->o.end_t);
+  const long long steps = (long long)s->o.steps; /* a join copied the first segment's */
+  if (rc == NC_NOERR && r0 == 0 && r1 == s->rows && isfinite(s->o.steps))
+    rc = nc_put_att_longlong(out, NC_GLOBAL, "steps", NC_INT64, 1, &steps);
   return rc;
 }
 
@@ -1111,8 +1101,7 @@ static int write_range(const struct extract_args *a, const struct stored *s, siz
     rc = nc_put_att_double(out, NC_GLOBAL, "t_reached", NC_DOUBLE, 1, &t_end);
   if (rc == NC_NOERR) rc = nc_put_att_longlong(out, NC_GLOBAL, "n_snapshots", NC_INT64, 1, &ns);
   if (rc == NC_NOERR && a->npaths > 1) rc = put_segments(a, out);
-  if (rc == NC_NOERR && a->npaths > 1 && r0 == 0 && r1 == s->rows) rc = put_joined_steps(a, out);
-  if (rc == NC_NOERR) rc = put_origin(s, r1, out);
+  if (rc == NC_NOERR) rc = put_origin(s, r0, r1, out);
   if (rc == NC_NOERR) rc = euler_engine.write(&e, t_end, out, err, sizeof err);
   if (rc == NC_NOERR && a->npaths > 1)
     rc = join_groups(a, r0 == 0 && r1 == s->rows, out, err, sizeof err);
