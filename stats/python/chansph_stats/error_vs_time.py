@@ -34,14 +34,13 @@ from . import cli
 from .cli import InputError
 from .dns import QUANTITIES, read_dns, rel_l2
 from .merge import merged_profile
-from .ncfile import read_windows
+from .ncfile import open_nc, read_windows
 
 
 def stats_cost(run):
     """(t, particle-steps, wall seconds) from stats.nc alone (a shipped segment without its
     log): the file's steps times n_fluid, spread evenly over 0 .. t_reached (the time step
     varies by a few percent); wall seconds unknown (NaN)."""
-    from .ncfile import open_nc
     with open_nc(os.path.join(run, "stats.nc")) as d:
         attrs = d.ncattrs()
         if not all(k in attrs for k in ("steps", "n_fluid", "t_reached")):
