@@ -23,6 +23,9 @@ profiles and over the run's averaging range for the budgets:
   v_rms+, w_rms+, -u'v'+ peaks
                  of the profile over the windows taken, and its deviation from the DNS peak of
                  --dns (default: the same-box mesh DNS stats/dns/samebox/box_2x2x1.4.txt);
+  u_rms+ y+ ... -u'v'+ y+ (a table of their own)
+                 the peaks' positions: the vertex of the parabola through the largest bin and
+                 its two neighbours, and the DNS's the same way;
   p mean, p' wall
                  from the run's particles.nc (its last state): the mean pressure and the standard
                  deviation of the particle pressure within 0.1 delta of the walls, over rho0
@@ -50,7 +53,7 @@ from . import cli
 from .ab_table import cost, table
 from .cli import InputError
 from .dns import read_dns
-from .merge import merged_profile, window_values
+from .merge import merged_profile, peak_position, window_values
 from .ncfile import read_windows
 from .twopoint import DNS_ROOT
 
@@ -138,6 +141,10 @@ def window_scores(run, t0, t1, dns):
     out = {}
     prof = merged_profile(r, sel)
     each = [merged_profile(r, [i]) for i in sel]
+    for q in ("u_rms+", "v_rms+", "w_rms+", "-u'v'+"):
+        per = np.array([peak_position(p["yplus"], p[q]) for p in each])
+        out[q + " y+"] = (peak_position(prof["yplus"], prof[q]),
+                          float(np.std(per, ddof=1) / math.sqrt(len(per))))
     for q in ("v_rms+", "w_rms+", "-u'v'+"):
         pk = float(np.nanmax(prof[q]))
         per = np.array([np.nanmax(p[q]) for p in each])
@@ -160,6 +167,8 @@ def window_scores(run, t0, t1, dns):
 COLUMNS = ("redist 20-40", "noise/visc 10-30", "noise/visc 28", "vv visc/MKM 10-30", "pair 12",
            "pair 30", "v_rms+ pk", "v_rms+ dev", "w_rms+ pk", "w_rms+ dev", "-u'v'+ pk",
            "-u'v'+ dev", "p mean", "p' wall", "Mp-st/ETT", "s/ETT")
+# the peak positions, in a table of their own (and in the CSV)
+POSITIONS = ("u_rms+ y+", "v_rms+ y+", "w_rms+ y+", "-u'v'+ y+")
 
 
 def fmt(name, v):
@@ -170,7 +179,7 @@ def fmt(name, v):
         return f"{100 * value:+.0f}±{100 * se:.0f}%"
     if name.endswith("/ETT"):
         return f"{value:.0f}"
-    if name in ("p mean", "p' wall"):
+    if name in ("p mean", "p' wall") or name.endswith("y+"):
         return f"{value:.1f}"
     return f"{value:.3f}±{se:.3f}" if math.isfinite(se) else f"{value:.3f}"
 
@@ -186,7 +195,7 @@ def main(argv, prog):
     a = ap.parse_args(argv)
     dns = read_dns(a.dns)
     mkm = bc.read_dns()
-    rows, recs = [], []
+    rows, rows_pos, recs = [], [], []
     for run in a.runs:
         scores, (w0, w1, nw) = window_scores(run, a.t0, a.t1, dns)
         b = budget_scores(os.path.join(run, "stats.nc"), mkm)
@@ -196,18 +205,25 @@ def main(argv, prog):
         scores.update(b)
         name = os.path.basename(run.rstrip("/"))
         rows.append([name] + [fmt(c, scores[c]) for c in COLUMNS])
+        rows_pos.append([name] + [f"{scores[c][0]:.1f}±{scores[c][1]:.1f}" for c in POSITIONS])
         recs.append((name, scores))
         print(f"# {run}: windows {w0:.3g}-{w1:.3g} ({nw})", file=sys.stderr)
     print(f"Scores in force units (u_tau^2 = delta f); dev: peak against {dns['source']}; "
           f"MKM's redistributed fraction over 20 <= y+ <= 40: {mkm_redistribution(mkm):.3f}")
     table(["run"] + list(COLUMNS), rows, a.markdown)
+    print(f"\nPeak positions (the parabola through the largest bin and its neighbours; +- the "
+          f"scatter of the windows' positions over sqrt(windows)); {dns['source']}: "
+          + ", ".join(f"{c} {peak_position(dns['yplus'], dns[c.rsplit(' ', 1)[0]]):.1f}"
+                      for c in POSITIONS))
+    table(["run"] + list(POSITIONS), rows_pos, a.markdown)
     if a.csv:
         try:
             with open(a.csv, "w", newline="") as f:
                 w = csv.writer(f)
-                w.writerow(["run"] + [x for c in COLUMNS for x in (c, c + " se")])
+                cols = COLUMNS + POSITIONS
+                w.writerow(["run"] + [x for c in cols for x in (c, c + " se")])
                 for name, s in recs:
-                    w.writerow([name] + [f"{x:.6g}" for c in COLUMNS for x in s[c]])
+                    w.writerow([name] + [f"{x:.6g}" for c in cols for x in s[c]])
         except OSError as e:
             raise InputError(f"{a.csv}: cannot write: {e.strerror}")
     return 0

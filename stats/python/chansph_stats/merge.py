@@ -154,6 +154,27 @@ def merged_profile(r, sel):
             "-u'v'+": -uv / ut**2}
 
 
+def peak_position(yplus, f):
+    """y+ of the maximum of the binned profile f: the vertex of the parabola through the largest
+    bin and its two neighbours (bins of any spacing), or the largest bin's y+ where it is the
+    first or the last finite one or the three points do not bend downwards."""
+    yplus, f = np.asarray(yplus, dtype=float), np.asarray(f, dtype=float)
+    ok = np.flatnonzero(np.isfinite(f))
+    if ok.size == 0:
+        return math.nan
+    j = int(np.argmax(f[ok]))
+    if j == 0 or j == ok.size - 1:
+        return float(yplus[ok[j]])
+    (x0, x1, x2), (f0, f1, f2) = yplus[ok[j - 1:j + 2]], f[ok[j - 1:j + 2]]
+    d01, d12 = (f1 - f0) / (x1 - x0), (f2 - f1) / (x2 - x1)
+    curv = (d12 - d01) / (x2 - x0)
+    if not curv < 0:
+        return float(x1)
+    # f = f1 + d (x - x1) + curv (x - x1)^2 with d the slope at x1 of the parabola
+    d = d01 + curv * (x1 - x0)
+    return float(x1 - d / (2 * curv))
+
+
 def pooled_windows(dirs, t0, t1, units="force"):
     """The completed windows inside [t0, t1] of a series, pooled: its runs' window records (a
     later run's time follows the earlier one's last window, as error_vs_time does). Returns
