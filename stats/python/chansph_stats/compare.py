@@ -43,6 +43,7 @@ from . import budget_compare, cli
 from .budget_compare import read_budgets
 from .cli import InputError
 from .dns import QUANTITIES, read_dns, through_bins
+from .merge import peak_position
 from .ncfile import attribute, attribute_or_nan, need, open_nc
 
 RANGES = (("viscous sublayer", "y+ < 5"), ("buffer layer", "5 <= y+ < 30"),
@@ -314,7 +315,9 @@ def references(ours, dns, binned, path):
 def peak_table(ours, dns, refs, inside, lo=10.0, hi=150.0):
     """The deviation relative to the DNS peak over lo < y+ < hi (issue 24's measure): per
     quantity max |ours - DNS| / max |DNS| and our largest standard error over the range
-    relative to the same peak, with the y+ of the largest deviation."""
+    relative to the same peak, with the y+ of the largest deviation; for the stresses also
+    both peaks and their positions (merge.peak_position: the parabola through the largest bin
+    and its neighbours)."""
     sel = inside & (ours["yplus"] > lo) & (ours["yplus"] < hi)
     if not sel.any():
         return
@@ -330,9 +333,14 @@ def peak_table(ours, dns, refs, inside, lo=10.0, hi=150.0):
         k = int(np.nanargmax(diff))
         se = ours.get(q + "_se")
         se_max = float(np.nanmax(se[sel])) / peak if se is not None else math.nan
-        print("  %-7s %6.1f%% at y+ %5.1f   stderr %s"
+        where = ""
+        if q != "U+":  # the stresses' peaks and where they are (U+ peaks at the centre)
+            where = "   peak %.3f at y+ %5.1f (DNS %.3f at y+ %5.1f)" % (
+                float(np.nanmax(ours[q])), peak_position(ours["yplus"], ours[q]),
+                float(np.nanmax(dns[q])), peak_position(dns["yplus"], dns[q]))
+        print("  %-7s %6.1f%% at y+ %5.1f   stderr %s%s"
               % (q, 100 * diff[k] / peak, ours["yplus"][sel][k],
-                 "%5.1f%%" % (100 * se_max) if math.isfinite(se_max) else "    -"))
+                 "%5.1f%%" % (100 * se_max) if math.isfinite(se_max) else "    -", where))
 
 
 def plot_title(ours):
