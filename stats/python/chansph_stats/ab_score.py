@@ -179,7 +179,7 @@ def fmt(name, v):
         return f"{100 * value:+.0f}±{100 * se:.0f}%"
     if name.endswith("/ETT"):
         return f"{value:.0f}"
-    if name in ("p mean", "p' wall") or name.endswith("y+"):
+    if name in ("p mean", "p' wall"):
         return f"{value:.1f}"
     return f"{value:.3f}±{se:.3f}" if math.isfinite(se) else f"{value:.3f}"
 
