@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Quick start: set up, run the turbulent channel jobs/scenes/quickstart.ini (quasi-DNS at
-# Re_tau = 180, dr+ = 4.5, minimal-flow unit, from a developed turbulent state in jobs/states/,
-# 0.2 eddy turnover times, 3-6 minutes on 2 cores) into runs/quickstart/, compare it with the
+# Re_tau = 180, dr+ = 6, the converged run's scene and scheme in its 2 x 2 x 1.4 delta box, from
+# that run's developed end state in jobs/states/, 0.2 eddy turnover times, 3-4 minutes on 2 cores) into runs/quickstart/, compare it with the
 # DNS of Moser, Kim & Mansour (1999) and end with one screen: is it turbulent (the evidence),
 # its peaks and largest deviations against the DNS beside those of the shipped converged run,
 # where the plots and the details are, what to run next. The details (the full comparison
@@ -17,13 +17,13 @@ cd "$here"
 out=${QUICKSTART_OUT:-runs/quickstart}
 scene=${QUICKSTART_SCENE:-jobs/scenes/quickstart.ini}
 dns=stats/dns/mkm1999/chan180.means
-long=jobs/states/mfu180w_dr6c4_stats.nc
+long=jobs/states/mfu180w_dr6c4d_stats.nc
 stats=stats/python/chansph-stats
 chansph=${CHANSPH:-build/chansph}
 took=""
 if [ "${1:-}" != "--report" ]; then
   jobs/setup.sh
-  echo "quickstart: running $scene into $out/ (3-6 minutes on 2 cores)"
+  echo "quickstart: running $scene into $out/ (3-4 minutes on 2 idle cores)"
   start=$(date +%s)
   "$chansph" run "$scene" --out "$out" --overwrite
   took=" in $(($(date +%s) - start)) s"
@@ -56,8 +56,8 @@ echo
 echo "quickstart: ran $scene$took; chansph-stats summary of its stats.nc:"
 "$stats" summary "$out/stats.nc" --dns "$dns" "${with_long[@]}"
 if [ "$scene" = jobs/scenes/quickstart.ini ]; then
-  echo "A minimal-flow unit bursts: 0.2 turnovers of one show that the flow is turbulent, not what"
-  echo "it converges to; the long run (dr+ = 6, Wendland C4, 2 x 2 x 1.4 delta) is the converged answer."
+  echo "0.2 turnovers show that the flow is turbulent, not what it converges to; the long run (the"
+  echo "same scene, 14.4 turnovers after the first) is the converged answer."
 fi
 cat <<TXT
 Plots:   $out/compare/profiles.png (the five profiles), rs_budget_{uu,vv,ww,uv,k}.png

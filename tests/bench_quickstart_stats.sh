@@ -2,7 +2,8 @@
 # The statistics' share of the quick-start's step, two builds each with its own quick-start
 # scene (issue 43: <= 3% as shipped), interleaved REPS times (default 3) on an otherwise idle
 # machine: OMP_NUM_THREADS=2 chansph run SCENE --set time.max_steps=STEPS (default 200)
-# --set output.write_every=0, from the shipped state. The share is the run's own timers: the
+# --set output.write_every=0, from the scene's own shipped state (a relative init.from is taken
+# against jobs/scenes/, so that a scene copied out of the repository still finds it). The share is the run's own timers: the
 # statistics phases (stats: sampling; budget: the split of the pair forces and its halo
 # refresh) over the rest of the wall time; prints each run and the medians.
 # usage: tests/bench_quickstart_stats.sh OLD_CHANSPH OLD_SCENE NEW_CHANSPH NEW_SCENE [STEPS] [REPS]
@@ -17,8 +18,10 @@ shares=("" "")
 for r in $(seq "$reps"); do
   for k in 0 1; do
     log=$work/$k.log
+    from=$(sed -n 's/^from *= *\([^ ;]*\).*/\1/p' "${scenes[$k]}" | head -1)
+    case $from in /*) ;; *) from=$root/jobs/scenes/$from ;; esac
     OMP_NUM_THREADS=2 "${bins[$k]}" run "${scenes[$k]}" --out "$work/$k" --overwrite \
-      --set init.from="$root/jobs/states/mfu180_dr45_t4.5.nc" --set time.max_steps="$steps" \
+      --set init.from="$from" --set time.max_steps="$steps" \
       --set output.write_every=0 > "$log" 2>&1 ||
       { tail -3 "$log"; echo "FAIL: run ${bins[$k]}"; exit 1; }
     t=$(sed -n 's/^finished: .* in \([0-9.]*\) s wall.*/\1/p' "$log")

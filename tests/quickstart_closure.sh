@@ -1,14 +1,15 @@
 #!/usr/bin/env bash
-# Issue 42 point 9: the quick-start's momentum budget closes. jobs/scenes/quickstart.ini as
-# shipped (0.2 delta/u_tau from the developed state at t = 4.5, a decelerating burst), then the
-# closure jobs/quickstart.sh prints: max over the bins of |total_stress_all +
-# momentum_change_all - total_stress_expected_all| / u_tau_force^2 <= 0.02, the total from every
-# statistics snapshot (the force pass's whole acceleration) while the parts are split on one
-# snapshot in five (stats.budget_every = 5). With the total of the budget snapshots alone (about
-# 24, irregularly spaced) the fluxes missed the momentum change over the span by 0.048; the
-# scene then sampled the parts with every snapshot (0.0068, 119 snapshots; 2026-12-04), at 8% of
-# the step. Also: the parts' sum (total_stress) is the every-snapshot total within 0.05.
-# About 6 minutes on 2 cores.
+# The quick-start's momentum budget closes. jobs/scenes/quickstart.ini as shipped (0.2
+# delta/u_tau from the developed end state of the converged dr+ = 6 run), then the closure
+# jobs/quickstart.sh prints: max over the bins of |total_stress_all + momentum_change_all -
+# total_stress_expected_all| / u_tau_force^2 <= 0.02, the total from every statistics snapshot
+# (the force pass's whole acceleration). And the parts' sum (total_stress, the split of the
+# pair forces by term) against that total: where the parts are split on every snapshot
+# (stats.budget_every = 1, as the scene ships: 34 snapshots, 2026-12-07, closure 0.0128) they
+# are the same sums regrouped, equal to round-off (<= 1e-9); where on fewer, within 0.05 (their
+# sampling: the earlier minimal-unit scene split 24 of 119 snapshots and met it, the wide box's
+# 18 of 85 missed it by 0.03 in the bin at the centre, whose kinetic flux is the noisiest).
+# About 4 minutes on 2 cores.
 # usage: quickstart_closure.sh CHANSPH SCENES RUNS
 set -u
 chansph=$1 scenes=$2 runs=$3
@@ -30,8 +31,10 @@ print("quick-start momentum budget: max |total + d/dt - expected| = %.4f u_tau^2
       "(%d snapshots, the parts split on %d); the parts' sum within %.4f of the total"
       % (worst, close.size, int(np.sum(g["planes_total"][:, 0, 0])),
          int(np.sum(g["planes"][:, 0, 0])), parts))
-ok = np.all(np.isfinite(close)) and worst <= 0.02 and parts <= 0.05
-sys.exit(0 if ok else "FAIL: not closed within 0.02, or the parts' sum off the total by > 0.05")
+every = int(np.sum(g["planes"][:, 0, 0])) == int(np.sum(g["planes_total"][:, 0, 0]))
+tol = 1e-9 if every else 0.05
+ok = np.all(np.isfinite(close)) and worst <= 0.02 and parts <= tol
+sys.exit(0 if ok else "FAIL: not closed within 0.02, or the parts' sum off the total by > %g" % tol)
 PY
 # what the user reads: chansph compare prints the same closure (wall units of the wall stress)
 dns=$scenes/../../stats/dns/mkm1999/chan180.means
