@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The A/B of issue 24 (docs/validation/turbulent_channel.md): numerical settings against the
+# The A/B at dr+ = 6 (docs/validation/turbulent_channel.md): numerical settings against the
 # reference at dr+ = 6 in the minimal unit (jobs/scenes/mfu180_dr6_dev.ini, 74 340 particles),
 # each run from a developed start for T turnovers (default 3) with the Reynolds-stress budgets,
 # averaged from t = 1 on; then the table (chansph-stats ab_table: sustain, peaks, numerical

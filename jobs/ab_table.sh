@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The A/B table of issue 12 (docs/validation/turbulent_channel.md): each numerical setting
+# The first A/B table (docs/validation/turbulent_channel.md): each numerical setting
 # against the reference of jobs/scenes/mfu180_ab.ini (background pressure 0, h = 1.6 dr), all
 # from the same synthetic-eddy start, to t u_tau/delta = T (default 0.6), then the table over
 # the second half. usage: jobs/ab_table.sh [OUTDIR] [T]   (about 1 minute a run when idle)

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# The LES of issue 24, point 3 (docs/validation/turbulent_channel.md "Issue 24, point 3"): the
+# The LES against the quasi-DNS from a developed field (docs/validation/turbulent_channel.md,
+# "The LES against the quasi-DNS from a developed field"): the
 # quasi-DNS against the LES (Smagorinsky + Yoshizawa + van Driest, with and without the
 # Reichardt wall law) at one resolution, each from the same developed field: the wide-box
 # dr+ = 6 state jobs/states/mfu180w_dr6_t12.nc (2 x 2 x 1.4 delta, t = 12.1 of the converged

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The report of a long turbulent run (issue 24, docs/validation/turbulent_channel.md): its
+# The report of a long turbulent run (docs/validation/turbulent_channel.md): its
 # developed range T0..T1 written as a stats.nc of its own (chansph extract --nc), the profiles
 # against MKM Re_tau = 180 (chansph compare: L2 per layer, the deviation relative to each DNS
 # peak over 10 < y+ < 150 with the standard errors, plots), the Reynolds-stress budgets against

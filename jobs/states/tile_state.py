@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """Stack two shipped states of the same channel side by side in z: a start for a box of twice
-the span (issue 24: the converged run in lz = 2 x 0.7 delta, where the minimal unit's bursting
+the span (the converged run in lz = 2 x 0.7 delta, where the minimal unit's bursting
 is weaker).
 
 usage: python3 jobs/states/tile_state.py A.nc B.nc OUT.nc [--perturb EPS] [--seed N]
