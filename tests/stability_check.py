@@ -4,14 +4,20 @@ chansph, prints its numbers and exits 1 unless the case ends with a correct resu
 specific error it must give.
 
   viscous      Re = 0.1 Poiseuille, dt set by the viscous limit: profile within --max-l2
-  impact       a particle thrown at a wall at c0/2: no penetration, gamma sane, run healthy
+  impact       a particle thrown at a wall at c0/2 (--speed): no penetration, gamma sane, run
+               healthy; or (--expect-through) exit 3 naming that particle
   mach         the same channel at Ma = 0.1 and 0.3: density variation reported, no blow-up
   flux-step    a flux-driven channel whose target doubles (and halves) suddenly: converges
   les5200      coarse LES at Re_tau = 5200: 1000 steps with finite fields
   nan          a NaN injected into one particle after step 60: exit 3 at that step's health
                check, naming step, particle id and position; stats.nc written before is kept
+
+--set KEY=VALUE (repeatable) runs a case with another scheme, e.g. the turbulent runs' (Wendland
+C4 at h = 2 dr with the volume diffusion at the delta-SPH strength): every run of the case gets
+it, and the viscous case's time-step limit is computed with its h.
 """
 import argparse
+import hashlib
 import os
 import re
 import sys
@@ -24,7 +30,8 @@ import poiseuille_check as pc  # noqa: E402  (shared run helper and profile erro
 
 
 def run(args, scene, name, sets, extra=(), expect=0):
-    out, _, res = pc.run_cmd(args, scene, "stability_" + name, sets, extra, expect)
+    out, _, res = pc.run_cmd(args, scene, "stability_" + name, list(sets) + args.sets, extra,
+                             expect)
     return out, res
 
 
@@ -44,7 +51,11 @@ def cmd_viscous(args):
                     "output.t_average_start=0.08", "output.log_every=100000"])
     dt = series(out, "dt")
     err = profile_error(out)
-    h = 1.3 * 0.05
+    h_over_dr = 1.3  # the default of sph.h_over_dr; poiseuille2d.ini has dr = 0.05
+    for kv in args.sets:
+        if kv.startswith("sph.h_over_dr="):
+            h_over_dr = float(kv.split("=", 1)[1])
+    h = h_over_dr * 0.05
     print("Re = 0.1: dt = %.3e s (viscous limit 0.125 h^2/nu = %.3e s, acoustic %.3e s), "
           "%d steps, relative L2 error of u_mean %.3e (limit %.3g)"
           % (dt[-1], 0.125 * h * h / 10, 0.8 * h / 10, round(0.1 / dt[-1]), err, args.max_l2))
@@ -52,10 +63,15 @@ def cmd_viscous(args):
 
 
 def cmd_impact(args):
-    base, _ = run(args, args.scene, "impact_base", ["time.t_end=0.0052", "output.t_average_start=0",
-                                                    "output.log_every=1"])
+    # the files of this variant (speed, expectation, overrides) apart from the others': tests
+    # of one scene run in parallel
+    tag = "%g%s" % (args.speed, "_through" if args.expect_through else "")
+    base, _ = run(args, args.scene, "impact_base_" + tag,
+                  ["time.t_end=0.0052", "output.t_average_start=0", "output.log_every=1"])
     src = os.path.join(base, "particles.nc")
-    mod = os.path.join(args.runs, "stability_impact_start.nc")
+    tag += "_" + hashlib.md5(" ".join(args.sets).encode()).hexdigest()[:8]
+    mod = os.path.join(args.runs, "stability_impact_start_%s.nc" % tag)
+    c0 = 10.0
     with netCDF4.Dataset(src) as d, netCDF4.Dataset(mod, "w") as o:
         for k in d.ncattrs():
             o.setncattr(k, d.getncattr(k))
@@ -67,18 +83,26 @@ def cmd_impact(args):
             v[:] = var[:]
         y = d["y"][:]
         who = int(np.argmin(y))
-        c0 = 10.0
-        o["v"][who] = -0.5 * c0  # straight at the wall y = 0 at half the speed of sound
+        o["v"][who] = -args.speed * c0  # straight at the wall y = 0
         pid, y0 = int(d["id"][who]), float(y[who])
-    out, res = run(args, args.scene, "impact",
-                   ["init.from=" + mod, "time.t_end=0.2", "output.t_average_start=0",
-                    "output.log_every=1"])
+    what = "particle %d at y = %.4f thrown at the wall at %g c0 = %g m/s" % (
+        pid, y0, args.speed, args.speed * c0)
+    sets = ["init.from=" + mod, "time.t_end=0.2", "output.t_average_start=0",
+            "output.log_every=1"]
+    if args.expect_through:  # the scheme cannot stop it: a clear report, not a silent state
+        out, res = run(args, args.scene, "impact_" + tag, sets, expect=3)
+        text = res.stderr + res.stdout
+        m = re.search(r"particle through a wall at step (\d+) \(t = [^)]*\): particle id (\d+) "
+                      r"at \([^)]*\), velocity \([^)]*\)", text)
+        print("%s: %s" % (what, m.group(0) if m else text[-500:]))
+        return bool(m) and int(m.group(2)) == pid
+    out, res = run(args, args.scene, "impact_" + tag, sets)
     gmin = series(out, "min_gamma")
     with netCDF4.Dataset(os.path.join(out, "particles.nc")) as d:
         ymin = float(d["y"][:].min())
-    print("particle %d at y = %.4f thrown at the wall at c0/2 = 5 m/s: no health report, "
-          "smallest y at the end %.4e m, min gamma over the run %.4f"
-          % (pid, y0, ymin, np.nanmin(gmin)))
+    refl = re.findall(r"reached the (?:lower|upper) wall", res.stderr)
+    print("%s: no health report, %d wall reflections, smallest y at the end %.4e m, min gamma "
+          "over the run %.4f" % (what, len(refl), ymin, np.nanmin(gmin)))
     return ymin > 0.0 and np.nanmin(gmin) > 0.5
 
 
@@ -150,6 +174,12 @@ def main():
     p.add_argument("scene")
     p.add_argument("--max-l2", type=float, default=0.01)
     p.add_argument("--max-rel", type=float, default=1e-3)
+    p.add_argument("--speed", type=float, default=0.5,
+                   help="impact: the thrown particle's speed towards the wall in units of c0")
+    p.add_argument("--expect-through", action="store_true",
+                   help="impact: the scheme cannot stop it; expect exit 3 naming the particle")
+    p.add_argument("--set", action="append", default=[], dest="sets", metavar="KEY=VALUE",
+                   help="a scene override for every run of the case (repeatable)")
     args = p.parse_args()
     os.makedirs(args.runs, exist_ok=True)
     ok = globals()["cmd_" + args.what.replace("-", "_")](args)
