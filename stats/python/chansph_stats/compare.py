@@ -332,7 +332,8 @@ def peak_table(ours, dns, refs, inside, lo=10.0, hi=150.0):
             continue
         k = int(np.nanargmax(diff))
         se = ours.get(q + "_se")
-        se_max = float(np.nanmax(se[sel])) / peak if se is not None else math.nan
+        se_max = (float(np.nanmax(se[sel])) / peak
+                  if se is not None and np.isfinite(se[sel]).any() else math.nan)
         where = ""
         if q != "U+":  # the stresses' peaks and where they are (U+ peaks at the centre)
             where = "   peak %.3f at y+ %5.1f (DNS %.3f at y+ %5.1f)" % (
