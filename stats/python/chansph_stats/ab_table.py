@@ -104,7 +104,7 @@ def table(cols, rows, markdown):
             print("  ".join(x.rjust(w[i]) for i, x in enumerate(r)))
 
 
-# the budget columns (issue 24): the redistribution into v and w against MKM (pressure + wall
+# the budget columns: the redistribution into v and w against MKM (pressure + wall
 # for vv, whose wall part holds the wall layer's wall-normal pressure; pressure for ww; MKM's
 # pressure-strain + pressure-diffusion), at y+ = 15 and 40, and the pressure noise as a share
 # of the viscous term of k at y+ = 30

@@ -313,7 +313,7 @@ def references(ours, dns, binned, path):
 
 
 def peak_table(ours, dns, refs, inside, lo=10.0, hi=150.0):
-    """The deviation relative to the DNS peak over lo < y+ < hi (issue 24's measure): per
+    """The deviation relative to the DNS peak over lo < y+ < hi (the converged run's measure): per
     quantity max |ours - DNS| / max |DNS| and our largest standard error over the range
     relative to the same peak, with the y+ of the largest deviation; for the stresses also
     both peaks and their positions (merge.peak_position: the parabola through the largest bin

@@ -1,4 +1,4 @@
-"""The resolution a turbulent channel series extrapolates to, for issue 12's acceptance targets.
+"""The resolution a turbulent channel series extrapolates to, for the resolution series' targets.
 
 usage: chansph-stats resolution_extrapolate --dns FILE [--window T0:T1] [--units wall|force]
            --developed RUN_DIR[+...] --developed-dr DR [--developed-window T0:T1]
@@ -15,7 +15,7 @@ Two steps, both printed:
    that rate: the resolution needed is dr+_dev (target / |e_dev|)^(1/p). Where a quantity's own
    rate is missing (p <= 0.05), the slower of the two peaks' rates is printed beside it.
 
-Measures (the acceptance of issue 12, item 3): for -u'v'+ and u_rms+, the relative deviation of
+Measures (the targets the resolution series was set): for -u'v'+ and u_rms+, the relative deviation of
 the peak from the DNS peak (target 15%); for v_rms+ and w_rms+, the largest relative deviation
 from the DNS over 20 < y+ < 150 (target 20%). Wall units: u_tau from the mean wall shear stress
 of the windows taken (default; the same numbers as `chansph extract --units wall`), or from the

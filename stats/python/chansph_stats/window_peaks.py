@@ -8,7 +8,7 @@ error_vs_time) are merged from their raw sums (old and new stats.nc formats alik
 units of the windows' mean wall shear stress (default, as `chansph extract --units wall`) or of
 the force balance (u_tau^2 = delta f). Printed: the peaks of -u'v'+, u_rms+, v_rms+ and w_rms+ with
 their deviation from the DNS peak, and the range of the relative deviation of v_rms+ and w_rms+
-over 20 < y+ < 150 (issue 12's acceptance measures). With --plot FILE, the profiles of U+,
+over 20 < y+ < 150 (the resolution series' measures). With --plot FILE, the profiles of U+,
 u_rms+, v_rms+, w_rms+ and -u'v'+ of every spec against the DNS in one PNG. Used for the LES
 against quasi-DNS rows and the profile figure of docs/validation/turbulent_channel.md.
 """
