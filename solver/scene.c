@@ -90,9 +90,9 @@ static const struct key keys_head[] = {
       "Smoothing length over particle spacing (kernel support radius is 2h). The neighbour "
       "number grows as its cube, and with it the cost of a step and the accuracy on a "
       "disordered arrangement: in the turbulent channel with wendland_c4 the numerical pair "
-      "stress falls about as N^-0.8 (h = 2.5 dr halves it against 2 dr at 1.8 times the "
-      "step's cost; docs/validation/scheme_ab.md), which refining dr at a fixed h/dr does not "
-      "do."},
+      "stress falls about as N^-0.8 (h = 2.5 dr halves it against 2 dr at 1.9 times the "
+      "step's cost; refining dr+ from 6 to 4.5 at h = 2 dr lowers it by a quarter near the "
+      "wall at 3.2 times the cost a turnover; docs/validation/scheme_ab.md)."},
      OFF(h_over_dr)},
     {{"sph", "kernel", T_CHOICE, "wendland_c2", 0, 0, 0, names_sph_kernel, "-",
       "Kernel, support 2h: the Wendland C2 (thesis Eq. 2.63) or the Wendland C4 of Dehnen & Aly "
