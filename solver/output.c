@@ -708,6 +708,9 @@ int output_finish(struct output *o, struct sim *S) {
     sim_diag(S, &d);
   if (S->step != o->last_step) log_progress(o, S, &d);
   const double wall = timer_now() - o->wall0;
+  /* the run ends: a window whose end it has reached is complete (t_end at a window boundary),
+     as the next snapshot would have made it; a resume continues with the same records */
+  stats_close(&o->st, S->t);
   char line[1024];
   stats_convergence_line(&o->st, line, sizeof line);
   output_log(o, "%s", line);
@@ -736,6 +739,7 @@ int output_finish(struct output *o, struct sim *S) {
 
 int output_stop(struct output *o, struct sim *S, const char *why) {
   const double wall = timer_now() - o->wall0;
+  stats_close(&o->st, S->t); /* as at the end (output_finish) */
   TRY(write_stats(o, S));
   output_log(o, "stopped at step %ld, t = %.9g s (%s) after %.2f s wall\n", S->step, S->t, why,
              wall);

@@ -551,6 +551,10 @@ static double engine_estimate(const struct stats_scene *sc) {
 
 STATS_ENGINE_ADAPTERS(corr)
 
+static void engine_close(void *self, double t) {
+  corr_win_close(self, t);
+}
+
 static size_t engine_bytes(const void *self) {
   const struct corr *c = self;
   const size_t d = sizeof(double);
@@ -574,6 +578,7 @@ const struct stats_engine corr_engine = {.name = "two-point correlations",
                                          .init = engine_init,
                                          .free = engine_free,
                                          .sample = engine_sample,
+                                         .close = engine_close,
                                          .state = engine_state,
                                          .bytes = engine_bytes,
                                          .write = engine_write,

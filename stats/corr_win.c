@@ -35,18 +35,23 @@ void corr_win_init(struct corr *c) {
 
 /* Same rule as the PDF engine (pdf.c): a window with snapshots is closed and the next one
    opened at its end; an empty one just moves by one window length. */
-void corr_win_advance(struct corr *c, double t) {
-  /* whole-run sums but no window records: resumed from a checkpoint of format 1.7 or older,
-     whose windows are unknown; the window of the resume holds only part of its snapshots */
-  double run = 0.0;
-  for (int l = 0; l < c->cfg.n_levels; l++) run += c->samples[l];
-  const int legacy = c->nwin == 0 && c->win[CW_NSNAP] == 0.0 && run > 0.0;
+void corr_win_close(struct corr *c, double t) {
+  if (c->cfg.n_levels <= 0 || t < c->cfg.t_start) return;
   while (t >= c->win[c->nwin * CW_LEN + CW_T1]) {
     const double t1 = c->win[c->nwin * CW_LEN + CW_T1];
     if (c->win[c->nwin * CW_LEN + CW_NSNAP] > 0.0) corr_win_reserve(c, ++c->nwin + 1);
     double *o = c->win + c->nwin * CW_LEN;
     o[CW_T0] = t1, o[CW_T1] = t1 + c->cfg.window;
   }
+}
+
+void corr_win_advance(struct corr *c, double t) {
+  /* whole-run sums but no window records: resumed from a checkpoint of format 1.7 or older,
+     whose windows are unknown; the window of the resume holds only part of its snapshots */
+  double run = 0.0;
+  for (int l = 0; l < c->cfg.n_levels; l++) run += c->samples[l];
+  const int legacy = c->nwin == 0 && c->win[CW_NSNAP] == 0.0 && run > 0.0;
+  corr_win_close(c, t);
   double *o = c->win + c->nwin * CW_LEN;
   if (legacy) o[CW_PARTIAL] = 1.0;
   o[CW_NSNAP] += 1.0;

@@ -42,6 +42,11 @@ struct stats_engine {
   void (*free)(void *self);
   /** Accumulate one snapshot (collective across the ranks: merged in a fixed order). */
   void (*sample)(void *self, const struct stats_snapshot *s);
+  /** Close the open averaging window if t, the time the run has reached, lies at or past its
+      end: no later snapshot can fall in it, so it is complete without waiting for the next
+      one (stats.nc written at a window boundary, e.g. at t_end); what a later snapshot would
+      do, so the records are the same. NULL for an engine without windows. */
+  void (*close)(void *self, double t);
   /** Add the accumulators to a checkpoint's state list (state.h). */
   void (*state)(void *self, struct state_list *L);
   /** Bytes the accumulators hold. */

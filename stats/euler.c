@@ -669,6 +669,10 @@ static int total_sampled(const double *snap, size_t nb) {
   return mass > 0.0;
 }
 
+void euler_close(struct euler *e, double t) {
+  if (t >= e->cfg.t_start) advance_window(e, t);
+}
+
 void euler_sample(struct euler *e, const struct stats_snapshot *s) {
   const struct euler_config *c = &e->cfg;
   if (s->t < c->t_start) return;

@@ -261,6 +261,10 @@ size_t euler_sample_bytes(int nb, int ncol);
  */
 void euler_sample(struct euler *e, const struct stats_snapshot *s);
 
+/** @brief Close the open window if t (the time the run reached) lies at or past its end, as
+ *         the next snapshot would (engine.h, close). */
+void euler_close(struct euler *e, double t);
+
 /**
  * @brief Statistics of rows [r0, r1) merged in row order (bitwise reproducible).
  *        Implements: means and Reynolds stresses of Sec. 5.2.3.1, u_tau (Eq. 5.14 and the wall

@@ -524,6 +524,10 @@ static void sample(void *self, const struct stats_snapshot *s) {
   euler_sample(self, s);
 }
 
+static void close_open(void *self, double t) {
+  euler_close(self, t);
+}
+
 static void state(void *self, struct state_list *L) {
   euler_state(self, L);
 }
@@ -553,6 +557,7 @@ const struct stats_engine euler_engine = {.name = "Eulerian profiles",
                                           .init = init,
                                           .free = release,
                                           .sample = sample,
+                                          .close = close_open,
                                           .state = state,
                                           .bytes = bytes,
                                           .write = write,

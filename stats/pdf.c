@@ -138,6 +138,10 @@ static void pdf_snapshot(struct pdf *p, const struct stats_snapshot *s, double *
   spar_close(&par);
 }
 
+void pdf_close(struct pdf *p, double t) {
+  if (p->cfg.n_levels > 0 && t >= p->cfg.t_start) pdf_advance(p, t);
+}
+
 void pdf_sample(struct pdf *p, const struct stats_snapshot *s) {
   if (p->cfg.n_levels <= 0 || s->t < p->cfg.t_start) return;
   timer_push("stats: pdfs"); /* its own line of the phase report: the engine's overhead */

@@ -102,6 +102,9 @@ void pdf_reserve(struct pdf *p, size_t rows);
 /** @brief Add one snapshot (deterministic; a collective call on s->comm). */
 void pdf_sample(struct pdf *p, const struct stats_snapshot *s);
 
+/** @brief Close the open window if t lies at or past its end (engine.h, close). */
+void pdf_close(struct pdf *p, double t);
+
 /** @brief Expose the windows to a state list (checkpoints; optional fields). */
 void pdf_state(struct pdf *p, struct state_list *L);
 

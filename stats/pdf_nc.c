@@ -318,6 +318,10 @@ static int engine_init_scene(void *self, const struct stats_scene *sc) {
 
 STATS_ENGINE_ADAPTERS(pdf)
 
+static void engine_close(void *self, double t) {
+  pdf_close(self, t);
+}
+
 static size_t engine_bytes(const void *self) {
   const struct pdf *p = self;
   const size_t nl = (size_t)p->cfg.n_levels;
@@ -343,6 +347,7 @@ const struct stats_engine pdf_engine = {.name = "one-point PDFs",
                                         .init = engine_init,
                                         .free = engine_free,
                                         .sample = engine_sample,
+                                        .close = engine_close,
                                         .state = engine_state,
                                         .bytes = engine_bytes,
                                         .write = engine_write,

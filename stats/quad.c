@@ -110,6 +110,10 @@ static void close_window(struct quad *q, double t) {
   if (q->win_end <= t) q->win_end += c->window; /* rounding */
 }
 
+void quad_close(struct quad *q, double t) {
+  if (q->cfg.n_levels > 0 && t >= q->cfg.t_start) close_window(q, t);
+}
+
 void quad_sample(struct quad *q, const struct stats_snapshot *s) {
   if (q->cfg.n_levels <= 0 || s->t < q->cfg.t_start) return;
   close_window(q, s->t);
@@ -365,6 +369,10 @@ static int engine_init_scene(void *self, const struct stats_scene *sc) {
 
 STATS_ENGINE_ADAPTERS(quad)
 
+static void engine_close(void *self, double t) {
+  quad_close(self, t);
+}
+
 static size_t engine_bytes(const void *self) {
   const struct quad *q = self;
   return ((size_t)q->cfg.n_levels * (2 * QS_LEN + 2 + QB_LEN * SCAL_LEN) + q->ent_cap +
@@ -385,6 +393,7 @@ const struct stats_engine quad_engine = {.name = "quadrant analysis",
                                          .init = engine_init,
                                          .free = engine_free,
                                          .sample = engine_sample,
+                                         .close = engine_close,
                                          .state = engine_state,
                                          .bytes = engine_bytes,
                                          .write = engine_write,

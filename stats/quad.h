@@ -67,6 +67,9 @@ void quad_free(struct quad *q);
 /** @brief Add one snapshot (deterministic; a collective call on s->comm). */
 void quad_sample(struct quad *q, const struct stats_snapshot *s);
 
+/** @brief Close the open window if t lies at or past its end (engine.h, close). */
+void quad_close(struct quad *q, double t);
+
 /** @brief Expose the sums to a state list (checkpoints). */
 void quad_state(struct quad *q, struct state_list *L);
 

@@ -60,6 +60,11 @@ void stats_sample(struct stats *st, const struct stats_snapshot *s) {
   st->samples++;
 }
 
+void stats_close(struct stats *st, double t) {
+  for (int k = 0; k < stats_n_engines; k++)
+    if (st->self[k] && stats_engines[k]->close) stats_engines[k]->close(st->self[k], t);
+}
+
 void stats_state(struct stats *st, struct state_list *L) {
   state_add(L, "stats/samples", STATE_I64, 0, NULL, &st->samples, NULL);
   for (int k = 0; k < stats_n_engines; k++)

@@ -66,6 +66,12 @@ int stats_wanted(const struct stats *st);
  *         ends with the same state (docs/stats-format.md, "Statistics across ranks"). */
 void stats_sample(struct stats *st, const struct stats_snapshot *s);
 
+/** @brief Close every engine's open averaging window if t, the time the run has reached, lies
+ *         at or past its end (no later snapshot can fall in it): before stats.nc is written,
+ *         so that a run ending at a window boundary (t_end) has that window complete. The
+ *         records are those the next snapshot would have closed; the same on every rank. */
+void stats_close(struct stats *st, double t);
+
 /**
  * @brief Append the complete state of every requested engine to a state list (for the
  *        checkpoints). The arrays grow as windows close: build the list afresh right before
