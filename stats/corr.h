@@ -104,6 +104,7 @@ void corr_win_advance(struct corr *c, double t);
 
 /** @brief Close the open window if t lies at or past its end (engine.h, close). */
 void corr_win_close(struct corr *c, double t);
+
 /** @brief Add one plane's transforms U, V, W (fftw_complex, nx x (nz/2+1)) of level l to the
  *         open window's 1-D sums. */
 void corr_win_add(struct corr *c, int l, const double (*U)[2], const double (*V)[2],
