@@ -34,6 +34,7 @@ A run whose stats.nc has the Reynolds-stress budgets (rsb_*) also gets their tab
 MKM Re_tau = 180 balances at y+ = 10, 15, 30, 50, rs_budget.csv and (without --no-plots)
 rs_budget_<c>.png in the output directory (`chansph-stats rs_budget --help`).
 """
+import argparse
 import math
 import os
 
@@ -175,6 +176,17 @@ def region_masks(yp, yd):
     return (yp < 5, (yp >= 5) & (yp < 30), (yp >= 30) & (yd < 0.3), (yp >= 30) & (yd >= 0.3))
 
 
+def peak_range(text):
+    """LO:HI with 0 <= LO < HI: the y+ range of the peak table."""
+    try:
+        lo, hi = (float(x) for x in text.split(":"))
+    except ValueError:
+        raise argparse.ArgumentTypeError("'%s' is not LO:HI (two numbers, e.g. 10:100)" % text)
+    if not (0 <= lo < hi and math.isfinite(hi)):
+        raise argparse.ArgumentTypeError("'%s': need 0 <= LO < HI" % text)
+    return lo, hi
+
+
 def parse(argv, prog):
     p = cli.parser(prog, __doc__, raw=True)
     p.add_argument("stats", help="stats.nc of a run (or a DNS file)")
@@ -188,6 +200,9 @@ def parse(argv, prog):
                         "broadened by the mean shear over the bin) instead of its values at "
                         "the bins' mean positions")
     p.add_argument("--no-plots", action="store_true")
+    p.add_argument("--peak-range", default="10:150", metavar="LO:HI", type=peak_range,
+                   help="the y+ range of the deviation relative to the DNS peak (default 10:150; "
+                        "10:100 is the range of the same-box comparison)")
     p.add_argument("--max-error", type=cli.number(float, 0),
                    help="exit with status 1 if any L2 or Linf error exceeds this (tests)")
     return p.parse_args(argv)
@@ -271,7 +286,7 @@ def main(argv, prog="chansph compare"):
             rows.append((q, name, int(sel.sum()), l2, linf, l2 / scale if scale > 0 else math.nan,
                          se_rms))
             print("%-8s %-17s %6d %12.4e %12.4e %12.4e %12.4e" % rows[-1])
-    peak_table(ours, dns, refs, inside)
+    peak_table(ours, dns, refs, inside, *args.peak_range)
     worst = largest(rows)
     if worst:
         print("largest error: %s (wall units of %s)" % (worst, ours["u_tau_label"]))
