@@ -29,7 +29,7 @@
 
 /** Format version: a reader refuses a newer major version; minor versions only add
     (1.1: root attribute run_id). */
-enum { CKPT_VERSION_MAJOR = 1, CKPT_VERSION_MINOR = 14 };
+enum { CKPT_VERSION_MAJOR = 1, CKPT_VERSION_MINOR = 15 };
 
 /** Room for a run identity (a UUID has 36 characters; restart.h: rundir_*). */
 enum { CKPT_RUN_ID_MAX = 64 };

@@ -30,23 +30,32 @@ void corr_init(struct corr *c, const struct corr_config *cfg) {
   c->spec = mem_calloc((size_t)cfg->n_levels * nk * CS_LEN, sizeof(double), "correlation engine");
   c->samples = mem_calloc((size_t)cfg->n_levels, sizeof(double), "correlation engine");
   c->empty = mem_calloc((size_t)cfg->n_levels, sizeof(double), "correlation engine");
+  c->mspec =
+      mem_calloc((size_t)cfg->n_levels * (nk + CM_LEN), sizeof(double), "correlation engine");
   c->grid = fftw_malloc(4 * (size_t)nx * (size_t)nz * sizeof(double));
   c->out = fftw_malloc(3 * nk * sizeof(fftw_complex));
-  if (!c->grid || !c->out) die("out of memory: correlation engine (FFTW arrays)");
+  c->mgrid = fftw_malloc((size_t)nx * (size_t)nz * sizeof(double));
+  c->mout = fftw_malloc(nk * sizeof(fftw_complex));
+  if (!c->grid || !c->out || !c->mgrid || !c->mout)
+    die("out of memory: correlation engine (FFTW arrays)");
   /* three transforms of nx x nz at once; FFTW_ESTIMATE chooses the plan without timing, so
      the same sizes give the same plan, and the same sums, on every run and restart */
   const int n[2] = {nx, nz};
   c->plan = fftw_plan_many_dft_r2c(2, n, 3, c->grid, NULL, 1, nx * nz, c->out, NULL, 1, (int)nk,
                                    FFTW_ESTIMATE);
+  c->mplan = fftw_plan_dft_r2c_2d(nx, nz, c->mgrid, c->mout, FFTW_ESTIMATE); /* the mask */
   corr_win_init(c);
 }
 
 void corr_free(struct corr *c) {
   if (c->plan) fftw_destroy_plan(c->plan);
+  if (c->mplan) fftw_destroy_plan(c->mplan);
   if (c->grid) fftw_free(c->grid);
   if (c->out) fftw_free(c->out);
+  if (c->mgrid) fftw_free(c->mgrid);
+  if (c->mout) fftw_free(c->mout);
   free(c->spec), free(c->samples), free(c->empty), free(c->hits), free(c->ent), free(c->all);
-  free(c->win), free(c->wsamp), free(c->wspec);
+  free(c->mspec), free(c->win), free(c->wsamp), free(c->wspec), free(c->wmask);
   memset(c, 0, sizeof *c);
 }
 
@@ -102,9 +111,14 @@ static int add_plane(struct corr *c, int l, size_t pl, const double *E, size_t n
   for (size_t q = 0; q < np; q++) /* empty cells carry no fluctuation */
     for (int k = 0; k < 3; k++) g[k * np + q] = cnt[q] > 0 ? g[k * np + q] - mean[k] : 0.0;
   c->empty[l] += (double)np - filled;
+  for (size_t q = 0; q < np; q++) c->mgrid[q] = cnt[q] > 0 ? 1.0 : 0.0;
   fftw_execute(c->plan);
+  fftw_execute(c->mplan);
   const size_t nk = (size_t)nx * (size_t)c->nzh;
-  const fftw_complex *U = c->out, *V = U + nk, *W = V + nk;
+  const fftw_complex *U = c->out, *V = U + nk, *W = V + nk, *M = c->mout;
+  double *Sm = c->mspec + (size_t)l * (nk + CM_LEN);
+  for (size_t k = 0; k < nk; k++) Sm[k] += M[k][0] * M[k][0] + M[k][1] * M[k][1];
+  Sm[nk + CM_PLANES] += 1.0, Sm[nk + CM_EMPTY] += (double)np - filled;
   double *S = c->spec + (size_t)l * nk * CS_LEN;
   for (size_t k = 0; k < nk; k++) {
     double *sk = S + k * CS_LEN;
@@ -115,7 +129,8 @@ static int add_plane(struct corr *c, int l, size_t pl, const double *E, size_t n
     sk[CS_UV_IM] += U[k][0] * V[k][1] - U[k][1] * V[k][0];
   }
   c->samples[l] += 1.0;
-  corr_win_add(c, l, (const double(*)[2])U, (const double(*)[2])V, (const double(*)[2])W);
+  corr_win_add(c, l, (const double(*)[2])U, (const double(*)[2])V, (const double(*)[2])W,
+               (const double(*)[2])M, (double)np - filled);
   return 1;
 }
 
@@ -193,6 +208,12 @@ void corr_state(struct corr *c, struct state_list *L) {
   state_add(L, "stats/correlations/spectra", STATE_F64, 3, dims3, c->spec, NULL);
   state_add(L, "stats/correlations/samples", STATE_F64, 1, d1, c->samples, NULL);
   state_add(L, "stats/correlations/empty_cells", STATE_F64, 1, d1, c->empty, NULL);
+  /* optional (format 1.15): resumed without it, the mask sums cover only the planes after the
+     resume, and the results stay uncorrected (corr.h, Gaps) */
+  const size_t dm[2] = {d4[0], d4[1] * d4[2] + CM_LEN};
+  struct state_field *f =
+      state_add(L, "stats/correlations/mask_spectra", STATE_F64, 2, dm, c->mspec, NULL);
+  f->optional = 1;
   corr_win_state(c, L);
 }
 
@@ -200,6 +221,41 @@ void corr_state(struct corr *c, struct state_list *L) {
    conjugate partner (-kx, -kz) is not stored unless kz = 0 or kz = nz/2 (nz even). */
 static double weight(int iz, int nz) {
   return iz == 0 || (nz % 2 == 0 && iz == nz / 2) ? 1.0 : 2.0;
+}
+
+/* P(l) of level l from the 2-D mask sums through the c2r plan back (in, r its arrays): the
+   fraction of filled cell pairs at l_x along x (l_z = 0) and at l_z along z; returns 1 if the
+   level is to be corrected (its mask sums cover all its planes and it had empty cells). */
+static int pair_fraction_2d(const struct corr *c, int l, fftw_plan back, fftw_complex *in,
+                            double *r, double *px, double *pz) {
+  const int nx = c->cfg.nx, nz = c->cfg.nz;
+  const size_t nk = (size_t)nx * (size_t)c->nzh;
+  const double *Sm = c->mspec + (size_t)l * (nk + CM_LEN), N = (double)nx * (double)nz;
+  const double planes = Sm[nk + CM_PLANES];
+  if (!(planes > 0) || planes != c->samples[l]) {
+    for (int i = 0; i < nx; i++) px[i] = NAN;
+    for (int k = 0; k < nz; k++) pz[k] = NAN;
+    return 0;
+  }
+  for (size_t k = 0; k < nk; k++) in[k][0] = Sm[k], in[k][1] = 0.0;
+  fftw_execute_dft_c2r(back, in, r);
+  const double norm = 1.0 / (N * N * planes);
+  for (int i = 0; i < nx; i++) px[i] = r[(size_t)i * nz] * norm;
+  for (int k = 0; k < nz; k++) pz[k] = r[k] * norm;
+  return Sm[nk + CM_EMPTY] > 0;
+}
+
+void corr_pair_fraction(const struct corr *c, double *px, double *pz, int *corrected) {
+  const int nx = c->cfg.nx, nz = c->cfg.nz;
+  const size_t nk = (size_t)nx * (size_t)c->nzh, np = (size_t)nx * (size_t)nz;
+  fftw_complex *in = fftw_malloc(nk * sizeof(fftw_complex));
+  double *r = fftw_malloc(np * sizeof(double));
+  const int n[2] = {nx, nz};
+  fftw_plan back = fftw_plan_dft_c2r(2, n, in, r, FFTW_ESTIMATE);
+  for (int l = 0; l < c->cfg.n_levels; l++)
+    corrected[l] = pair_fraction_2d(c, l, back, in, r, px + (size_t)l * nx, pz + (size_t)l * nz);
+  fftw_destroy_plan(back);
+  fftw_free(in), fftw_free(r);
 }
 
 void corr_results(const struct corr *c, double *rx, double *rz, double *ex, double *ez) {
@@ -239,6 +295,37 @@ void corr_results(const struct corr *c, double *rx, double *rz, double *ex, doub
       for (int m = 0; m < nzh; m++) Ez[m] *= nz > 1 ? c->cfg.lz / two_pi : 1.0;
     }
   }
+  /* the gap correction (corr.h), the plan's arrays reused: every level's R is read out above */
+  double *p = mem_alloc((size_t)(nx + nz), sizeof(double), "correlation engine");
+  for (int l = 0; l < c->cfg.n_levels; l++)
+    if (pair_fraction_2d(c, l, back, in, r, p, p + nx))
+      corr_gap_correct(c, rx + (size_t)l * 4 * nx, rz + (size_t)l * 4 * nz,
+                       ex + (size_t)l * 3 * nxh, ez + (size_t)l * 3 * nzh, p, p + nx);
+  free(p);
   fftw_destroy_plan(back);
   fftw_free(in), fftw_free(r);
+}
+
+/* One-sided density of an even series R(l_i), i < n, over k = 2 pi m / L (corr_results'
+   normalisation: sum_m E(k_m) dk = R(0)): f_m (1/n) sum_i R_i cos(2 pi m i / n) L / (2 pi). */
+static void cosine_density(const double *R, int n, double L, double *E) {
+  for (int m = 0; m < n / 2 + 1; m++) {
+    double s = 0.0;
+    for (int i = 0; i < n; i++) s += R[i] * cos(two_pi * (double)(((long)m * i) % n) / n);
+    const double f = m == 0 || 2 * m == n ? 1.0 : 2.0;
+    E[m] = f * s / n * (n > 1 ? L / two_pi : 1.0);
+  }
+}
+
+void corr_gap_correct(const struct corr *c, double *rx, double *rz, double *ex, double *ez,
+                      const double *px, const double *pz) {
+  const int nx = c->cfg.nx, nz = c->cfg.nz, nzh = c->nzh, nxh = nx / 2 + 1;
+  for (int q = 0; q < 4; q++) {
+    for (int i = 0; i < nx; i++) rx[q * nx + i] = px[i] > 0 ? rx[q * nx + i] / px[i] : NAN;
+    for (int k = 0; k < nz; k++) rz[q * nz + k] = pz[k] > 0 ? rz[q * nz + k] / pz[k] : NAN;
+  }
+  for (int q = 0; q < 3; q++) {
+    cosine_density(rx + q * nx, nx, c->cfg.lx, ex + q * nxh);
+    cosine_density(rz + q * nz, nz, c->cfg.lz, ez + q * nzh);
+  }
 }

@@ -18,6 +18,18 @@
  * uv slots keep the phase), from which each window's own E(k_x), E(k_z), R(l_x) and R(l_z)
  * follow exactly; over the complete windows their batch means give the standard errors. The
  * whole-run sums are untouched (the 1-D sums are added beside them from the same transform).
+ *
+ * Gaps. A grid cell that holds no particle of the slab has no value: it is set to zero
+ * fluctuation, so the sums above hold the product of the field with the mask m (1 where a cell
+ * is filled). Their correlation is P(l) R(l), P(l) the fraction of cell pairs at separation l
+ * that are both filled (P(0) = p, about p^2 elsewhere): with a fifth of the cells empty it
+ * lowers R(l) by a third at every l != 0 and moves the lost part into a white floor of the
+ * spectra. The engine therefore also sums the mask's own spectrum |F m|^2 (2-D and per
+ * window, with the planes and empty cells it counted) and divides: R(l) = (sum over the planes
+ * of f'm f'm at l) / (sum of m m at l), the mean over the filled pairs only (the estimator of
+ * gappy records, e.g. laser-Doppler and PIV data), and the spectra are the cosine transforms
+ * of that R. Where no cell was empty, or the mask sums do not cover every plane (a resume
+ * from a checkpoint written before them), the results are the uncorrected ones.
  */
 #ifndef CHANSPH_CORR_H
 #define CHANSPH_CORR_H
@@ -32,6 +44,9 @@ struct stats_engine;
 enum { CORR_MAX_LEVELS = 8 };
 /** Spectrum slots per wavenumber: S_uu, S_vv, S_ww, Re S_uv, Im S_uv. */
 enum { CS_UU, CS_VV, CS_WW, CS_UV_RE, CS_UV_IM, CS_LEN };
+/** After the mask's spectrum sums (2-D: nk entries; per window: n1d), per level: the planes
+    whose mask was summed and the empty cells among them. */
+enum { CM_PLANES, CM_EMPTY, CM_LEN };
 /** Per-window scalars: nominal interval, snapshots, and 1 if the window is partial (it holds
     the resume of a checkpoint written without window records: not a batch). */
 enum { CW_T0, CW_T1, CW_NSNAP, CW_PARTIAL, CW_LEN };
@@ -56,9 +71,14 @@ struct corr {
   double *spec;    /*!< [level][nx][nzh][CS_LEN] summed spectra */
   double *samples; /*!< [level] planes accumulated */
   double *empty;   /*!< [level] empty grid cells met (diagnostic) */
+  double *mspec;   /*!< [level][nk + CM_LEN] summed |F m|^2 of the mask, then CM_PLANES, CM_EMPTY
+                        (format 1.15; zero when resumed from an older checkpoint) */
   double *grid;    /*!< fftw_malloc'd work: 3 planes nx*nz (+ counts) */
   void *out;       /*!< fftw_malloc'd complex output, 3 x nx*nzh */
   void *plan;      /*!< r2c plan (FFTW_ESTIMATE, fixed: deterministic) */
+  double *mgrid;   /*!< fftw_malloc'd mask plane nx*nz (1 filled, 0 empty) */
+  void *mout;      /*!< fftw_malloc'd complex output of the mask, nx*nzh */
+  void *mplan;     /*!< its r2c plan */
   void *hits;      /*!< scratch: this rank's slab particles of a snapshot */
   double *ent;     /*!< scratch: [entry][CORR_ENT] this rank's per-column partial sums */
   double *all;     /*!< scratch: the same gathered from all ranks */
@@ -70,6 +90,7 @@ struct corr {
   double *win;      /*!< [row][CW_LEN] */
   double *wsamp;    /*!< [row][level] planes accumulated */
   double *wspec;    /*!< [row][level][n1d][CS_LEN] 1-D sums of the spectra */
+  double *wmask;    /*!< [row][level][n1d + CM_LEN] 1-D sums of |F m|^2, CM_PLANES, CM_EMPTY */
   size_t rows;      /*!< rows of an engine read back or cut to a range (corr_nc.c; the last
                          closed too if rows == nwin); 0 in a running engine: nwin + 1 */
 };
@@ -105,10 +126,20 @@ void corr_win_advance(struct corr *c, double t);
 /** @brief Close the open window if t lies at or past its end (engine.h, close). */
 void corr_win_close(struct corr *c, double t);
 
-/** @brief Add one plane's transforms U, V, W (fftw_complex, nx x (nz/2+1)) of level l to the
- *         open window's 1-D sums. */
+/** @brief Add one plane's transforms U, V, W and its mask's M (fftw_complex, nx x (nz/2+1))
+ *         of level l, with its empty cells, to the open window's 1-D sums. */
 void corr_win_add(struct corr *c, int l, const double (*U)[2], const double (*V)[2],
-                  const double (*W)[2]);
+                  const double (*W)[2], const double (*M)[2], double empty);
+
+/**
+ * @brief The gap correction of one level's results: R(l) over the fraction P(l) of filled
+ *        cell pairs, the spectra recomputed as the cosine transforms of the corrected R.
+ * @param[in,out] rx [4][nx] R along x, rz [4][nz] along z (R_uu, R_vv, R_ww, R_uv)
+ * @param[out] ex [3][nx/2+1], ez [3][nz/2+1] the one-sided spectra of the corrected R
+ * @param[in] px [nx], pz [nz] P(l) along x and z (> 0; NaN R where it is not)
+ */
+void corr_gap_correct(const struct corr *c, double *rx, double *rz, double *ex, double *ez,
+                      const double *px, const double *pz);
 /** @brief Expose the window records to a state list (optional fields, format 1.8). */
 void corr_win_state(struct corr *c, struct state_list *L);
 /** @brief Make room for rows window records (new rows zeroed; corr_nc.c reads them back). */
@@ -130,6 +161,14 @@ void corr_state(struct corr *c, struct state_list *L);
 void corr_results(const struct corr *c, double *rx, double *rz, double *ex, double *ez);
 
 /**
+ * @brief The fraction P(l) of filled cell pairs along x and z behind corr_results, and
+ *        whether the results of each level are gap-corrected (corr.h, Gaps).
+ * @param[out] px [level][nx], pz [level][nz] (NaN where the mask sums do not cover the level)
+ * @param[out] corrected [level] 1 if corrected, 0 if not (no empty cell, or no mask sums)
+ */
+void corr_pair_fraction(const struct corr *c, double *px, double *pz, int *corrected);
+
+/**
  * @brief Batch-means standard errors of the results of corr_results(), same layouts; each
  *        complete window with planes at a level is one batch (its own normalised R and E).
  *        NaN where fewer than 2 batches.
@@ -147,6 +186,11 @@ size_t corr_nv(const struct corr *c);
  *         rows are all of them and none is partial (to round-off: corr_results uses the 2-D
  *         sums). */
 void corr_range_values(const struct corr *c, size_t r0, size_t r1, double *v);
+
+/** @brief P(l) along x [level][nx] and z [level][nz] of the window rows r0 .. r1-1 pooled, and
+ *         whether each level's results of corr_range_values are gap-corrected (corr.h, Gaps). */
+void corr_range_pair_fraction(const struct corr *c, size_t r0, size_t r1, double *px, double *pz,
+                              int *corrected);
 
 /** @brief Batch-means standard errors over the batches among rows r0 .. r1-1 (complete
  *         windows with planes at the level; each its own R, E and rho): se [level][corr_nv],

@@ -160,6 +160,35 @@ static int put_stderr(int g, const char *name, const char *of, const int d2[2], 
   return rc;
 }
 
+/* The gap correction's P(l) along x and z and the levels it corrected (corr.h, Gaps). d:
+   {level, separation_x, separation_z}. */
+static int write_pair_fraction(const struct corr *c, int g, const int d[3], const double *px,
+                               const double *pz, const int *corrected, char *err, size_t errlen) {
+  const int nl = c->cfg.n_levels;
+  int rc = NC_NOERR, v;
+  for (int dir = 0; dir < 2; dir++) {
+    const int d2[2] = {d[0], d[1 + dir]}, n = dir ? c->cfg.nz : c->cfg.nx;
+    CK(ncout_def(g, dir ? "pair_fraction_z" : "pair_fraction_x", NC_DOUBLE, 2, d2, "1",
+                 dir ? "fraction of the grid's cell pairs at separation l_z that are both "
+                       "filled (the gap correction divides R by it)"
+                     : "fraction of the grid's cell pairs at separation l_x that are both "
+                       "filled (the gap correction divides R by it)",
+                 &v));
+    CK(ncout_fill(g, v));
+    for (int l = 0; l < nl; l++) {
+      const size_t st[2] = {(size_t)l, 0}, ct[2] = {1, (size_t)n};
+      CK(ncout_put_filled(g, v, st, ct, (dir ? pz : px) + (size_t)l * n, (size_t)n));
+    }
+  }
+  CK(ncout_def(g, "gap_corrected", NC_INT, 1, &d[0], "1",
+               "1 if R, rho and E of the level are over the filled cell pairs only (some cells "
+               "were empty and the mask sums cover every plane), 0 if uncorrected",
+               &v));
+  CK(nc_put_var_int(g, v, corrected));
+done:
+  return rc;
+}
+
 /* The batch-means standard errors of R, rho and E (corr_range_stderr over every row) and the
    batches per level. d: {level, separation_x, separation_z, kx, kz}. */
 static int write_stderr(const struct corr *c, int g, const int d[5], char *err, size_t errlen) {
@@ -202,13 +231,17 @@ static const char *const cfg_att[] = {"lx",           "lz", "slab_half", "delta"
                                       "window_length"};
 enum { N_CFG_ATT = 6 };
 
-/* The results R along x and z [level][4][n], E over k_x and k_z [level][3][n]: of the 2-D
-   sums if the engine has them, else of the window records pooled (corr_range_values). */
-static void results_of(const struct corr *c, double *rx, double *rz, double *ex, double *ez) {
+/* The results R along x and z [level][4][n], E over k_x and k_z [level][3][n], the pair
+   fractions P along x and z [level][n] and the levels gap-corrected: of the 2-D sums if the
+   engine has them, else of the window records pooled (corr_range_values). */
+static void results_of(const struct corr *c, double *rx, double *rz, double *ex, double *ez,
+                       double *px, double *pz, int *corrected) {
   if (c->spec) {
     corr_results(c, rx, rz, ex, ez);
+    corr_pair_fraction(c, px, pz, corrected);
     return;
   }
+  corr_range_pair_fraction(c, 0, corr_rows(c), px, pz, corrected);
   const size_t nl = (size_t)c->cfg.n_levels, nx = (size_t)c->cfg.nx, nz = (size_t)c->cfg.nz;
   const size_t nxh = nx / 2 + 1, nzh = (size_t)c->nzh, nv = corr_nv(c);
   double *v = mem_alloc(nl * nv, sizeof(double), "correlations");
@@ -263,14 +296,18 @@ done:
    k_x and over k_z. d: {window, window_field, level, kx, kz, spectrum_slot}. */
 static int write_windows(const struct corr *c, int g, const int d[6], char *err, size_t errlen) {
   const size_t rows = corr_rows(c), nl = (size_t)c->cfg.n_levels, nzh = (size_t)c->nzh;
-  const size_t nxh = (size_t)c->cfg.nx / 2 + 1, n = rows * nl;
-  double *kx = mem_alloc(n * (nxh + nzh) * CS_LEN, sizeof(double), "correlations");
-  double *kz = kx + n * nxh * CS_LEN;
+  const size_t nxh = (size_t)c->cfg.nx / 2 + 1, n = rows * nl, lm = c->n1d + CM_LEN;
+  double *kx = mem_alloc(n * (nxh + nzh) * (CS_LEN + 1) + 2 * n, sizeof(double), "correlations");
+  double *kz = kx + n * nxh * CS_LEN, *mx = kz + n * nzh * CS_LEN, *mz = mx + n * nxh;
+  double *mp = mz + n * nzh, *me = mp + n;
   int rc = NC_NOERR, v;
   for (size_t i = 0; i < n; i++) { /* [row][level][n1d][slot] -> kx and kz parts */
-    const double *X = c->wspec + i * c->n1d * CS_LEN;
+    const double *X = c->wspec + i * c->n1d * CS_LEN, *XM = c->wmask + i * lm;
     memcpy(kx + i * nxh * CS_LEN, X, nxh * CS_LEN * sizeof(double));
     memcpy(kz + i * nzh * CS_LEN, X + nxh * CS_LEN, nzh * CS_LEN * sizeof(double));
+    memcpy(mx + i * nxh, XM, nxh * sizeof(double));
+    memcpy(mz + i * nzh, XM + nxh, nzh * sizeof(double));
+    mp[i] = XM[c->n1d + CM_PLANES], me[i] = XM[c->n1d + CM_EMPTY];
   }
   if ((rc = write_window_axes(c, g, d, err, errlen)) != NC_NOERR) goto done;
   const int ds[2] = {d[0], d[2]}, dx[4] = {d[0], d[2], d[3], d[5]},
@@ -287,6 +324,25 @@ static int write_windows(const struct corr *c, int g, const int d[6], char *err,
                "stored k_z >= 0 (uu, vv, ww, Re uv, Im uv)",
                &v));
   CK(nc_put_var_double(g, v, kz));
+  const int dmx[3] = {d[0], d[2], d[3]}, dmz[3] = {d[0], d[2], d[4]};
+  CK(ncout_def(g, "window_mask_kx", NC_DOUBLE, 3, dmx, "1",
+               "per window: raw sums over the planes and over k_z of |F m|^2, m the grid's mask "
+               "(1 filled, 0 empty), at k_x >= 0 (the -k_x partners folded in)",
+               &v));
+  CK(nc_put_var_double(g, v, mx));
+  CK(ncout_def(g, "window_mask_kz", NC_DOUBLE, 3, dmz, "1",
+               "per window: raw sums over the planes and over k_x of |F m|^2 at the stored "
+               "k_z >= 0",
+               &v));
+  CK(nc_put_var_double(g, v, mz));
+  CK(ncout_def(g, "window_mask_planes", NC_DOUBLE, 2, ds, "1",
+               "per window: planes whose mask was summed (fewer than window_samples: the "
+               "window began before a resume from a checkpoint without them)",
+               &v));
+  CK(nc_put_var_double(g, v, mp));
+  CK(ncout_def(g, "window_empty_cells", NC_DOUBLE, 2, ds, "1",
+               "per window: empty grid cells among those planes", &v));
+  CK(nc_put_var_double(g, v, me));
 done:
   free(kx);
   return rc;
@@ -304,8 +360,11 @@ static int write_header(const struct corr *c, int g, int d[9], char *err, size_t
   static const char range[] =
       "; re-averaged by chansph extract over the windows of the file: R and E from their 1-D "
       "sums (no 2-D sums: spectra and empty_cells left out)";
-  char text[sizeof desc + sizeof range];
-  snprintf(text, sizeof text, "%s%s", desc, c->spec ? "" : range);
+  static const char gaps[] =
+      "; R over the filled cell pairs only where cells were empty (gap_corrected, "
+      "pair_fraction_x, pair_fraction_z), E the cosine transform of that R";
+  char text[sizeof desc + sizeof gaps + sizeof range];
+  snprintf(text, sizeof text, "%s%s%s", desc, gaps, c->spec ? "" : range);
   CK(nc_put_att_text(g, NC_GLOBAL, "description", strlen(text), text));
   const double cv[N_CFG_ATT] = {c->cfg.lx,    c->cfg.lz,      c->cfg.half,
                                 c->cfg.delta, c->cfg.t_start, c->cfg.window};
@@ -361,8 +420,11 @@ int corr_nc_write(const struct corr *c, int ncid, char *err, size_t errlen) {
   double *ex = mem_alloc(1, (size_t)nl * 3 * nxh * sizeof(double), "correlations");
   double *ez = mem_alloc(1, (size_t)nl * 3 * nzh * sizeof(double), "correlations");
   double *tmp = mem_alloc(1, (size_t)(nx > nz ? nx : nz) * 4 * sizeof(double), "correlations");
+  double *px = mem_alloc(1, (size_t)nl * (size_t)(nx + nz) * sizeof(double), "correlations");
+  double *pz = px + (size_t)nl * nx;
+  int *corrected = mem_alloc(1, (size_t)nl * sizeof(int), "correlations");
   int rc = NC_NOERR, g, d[9];
-  results_of(c, rx, rz, ex, ez);
+  results_of(c, rx, rz, ex, ez, px, pz, corrected);
   CK(nc_def_grp(ncid, "correlations", &g));
   if ((rc = write_header(c, g, d, err, errlen)) != NC_NOERR) goto done;
   {
@@ -373,13 +435,14 @@ int corr_nc_write(const struct corr *c, int ncid, char *err, size_t errlen) {
     if ((rc = write_axes(c, g, da, tmp, err, errlen)) != NC_NOERR ||
         (rc = write_correlations(c, g, dc, rx, rz, tmp, err, errlen)) != NC_NOERR ||
         (rc = write_spectra(c, g, ds, ex, ez, err, errlen)) != NC_NOERR ||
+        (rc = write_pair_fraction(c, g, dc, px, pz, corrected, err, errlen)) != NC_NOERR ||
         (rc = write_stderr(c, g, de, err, errlen)) != NC_NOERR ||
         (rc = write_sums(c, g, d, err, errlen)) != NC_NOERR)
       goto done;
     rc = write_windows(c, g, dw, err, errlen);
   }
 done:
-  free(rx), free(rz), free(ex), free(ez), free(tmp);
+  free(rx), free(rz), free(ex), free(ez), free(tmp), free(px), free(corrected);
   return rc;
 }
 
@@ -387,9 +450,10 @@ int corr_nc_write_range(const struct corr *c, size_t r0, size_t r1, int ncid, ch
                         size_t errlen) {
   const size_t nl = (size_t)c->cfg.n_levels;
   struct corr s = *c; /* the rows r0 .. r1-1 only: their last open if it is the run's open one */
-  s.spec = s.samples = s.empty = NULL;
+  s.spec = s.samples = s.empty = s.mspec = NULL;
   s.win = c->win + r0 * CW_LEN, s.wsamp = c->wsamp + r0 * nl;
   s.wspec = c->wspec + r0 * nl * c->n1d * CS_LEN;
+  s.wmask = c->wmask + r0 * nl * (c->n1d + CM_LEN);
   s.nwin = r1 <= c->nwin ? r1 - r0 : r1 - r0 - 1, s.cap = s.rows = r1 - r0;
   return corr_nc_write(&s, ncid, err, errlen);
 }
@@ -438,6 +502,25 @@ static int read_windows(struct corr *c, int g, size_t rows) {
     memcpy(X + nxh * CS_LEN, kz + i * nzh * CS_LEN, nzh * CS_LEN * sizeof(double));
   }
   free(kx);
+  /* the mask sums (written since checkpoint format 1.15): a file without them stays
+     uncorrected (its rows keep zero planes) */
+  int vmx, vmz, vmp, vme;
+  if (!bad && !nc_inq_varid(g, "window_mask_kx", &vmx) &&
+      !nc_inq_varid(g, "window_mask_kz", &vmz) && !nc_inq_varid(g, "window_mask_planes", &vmp) &&
+      !nc_inq_varid(g, "window_empty_cells", &vme)) {
+    double *mx = mem_alloc(n * (nxh + nzh + 2), sizeof(double), "chansph extract");
+    double *mz = mx + n * nxh, *mp = mz + n * nzh, *me = mp + n;
+    bad = nc_get_var_double(g, vmx, mx) || nc_get_var_double(g, vmz, mz) ||
+          nc_get_var_double(g, vmp, mp) || nc_get_var_double(g, vme, me);
+    const size_t lm = c->n1d + CM_LEN;
+    for (size_t i = 0; i < n && !bad; i++) {
+      double *XM = c->wmask + i * lm;
+      memcpy(XM, mx + i * nxh, nxh * sizeof(double));
+      memcpy(XM + nxh, mz + i * nzh, nzh * sizeof(double));
+      XM[c->n1d + CM_PLANES] = mp[i], XM[c->n1d + CM_EMPTY] = me[i];
+    }
+    free(mx);
+  }
   return bad;
 }
 
@@ -464,8 +547,8 @@ int corr_nc_read(struct corr *c, int ncid, char *err, size_t errlen) {
     return -1;
   }
   corr_init(c, &cfg);
-  free(c->spec), free(c->samples), free(c->empty); /* the 2-D sums are not in stats.nc */
-  c->spec = c->samples = c->empty = NULL;
+  free(c->spec), free(c->samples), free(c->empty), free(c->mspec); /* 2-D sums: not in stats.nc */
+  c->spec = c->samples = c->empty = c->mspec = NULL;
   corr_win_reserve(c, rows);
   c->rows = rows, c->nwin = (size_t)nwin;
   if (read_windows(c, g, rows)) {
@@ -546,7 +629,8 @@ static double engine_estimate(const struct stats_scene *sc) {
   struct corr_config c;
   if (!config_of(sc, &c)) return 0.0;
   const double nk = (double)c.nx * (c.nz / 2 + 1);
-  return sizeof(double) * (c.n_levels * nk * CS_LEN + 4.0 * c.nx * c.nz + 6.0 * nk);
+  return sizeof(double) *
+         (c.n_levels * nk * (CS_LEN + 1) + 5.0 * c.nx * c.nz + 8.0 * nk); /* + mask */
 }
 
 STATS_ENGINE_ADAPTERS(corr)
@@ -559,9 +643,10 @@ static size_t engine_bytes(const void *self) {
   const struct corr *c = self;
   const size_t d = sizeof(double);
   const size_t nk = (size_t)c->cfg.nx * (size_t)c->nzh, np = (size_t)c->cfg.nx * c->cfg.nz;
-  return (size_t)c->cfg.n_levels * (nk * CS_LEN + 2) * d + 4 * np * d + 3 * nk * 2 * d +
-         (c->ent_cap + c->all_cap) * CORR_ENT * d + c->hits_cap * (4 * d + sizeof(size_t)) +
-         c->cap * (CW_LEN + (size_t)c->cfg.n_levels * (1 + c->n1d * CS_LEN)) * d;
+  return (size_t)c->cfg.n_levels * (nk * (CS_LEN + 1) + 2 + CM_LEN) * d + 5 * np * d +
+         4 * nk * 2 * d + (c->ent_cap + c->all_cap) * CORR_ENT * d +
+         c->hits_cap * (4 * d + sizeof(size_t)) +
+         c->cap * (CW_LEN + (size_t)c->cfg.n_levels * (1 + c->n1d * (CS_LEN + 1) + CM_LEN)) * d;
 }
 
 static int engine_write(const void *self, double t_reached, int ncid, char *err, size_t errlen) {

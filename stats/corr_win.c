@@ -17,12 +17,15 @@ void corr_win_reserve(struct corr *c, size_t rows) {
   if (rows <= c->cap) return;
   const size_t old = c->cap, cap = rows > 2 * old ? rows : 2 * old;
   const size_t nl = (size_t)c->cfg.n_levels, ns = nl * c->n1d * CS_LEN;
+  const size_t nm = nl * (c->n1d + CM_LEN);
   c->win = mem_realloc(c->win, cap * CW_LEN, sizeof(double), "correlation engine");
   c->wsamp = mem_realloc(c->wsamp, cap * nl, sizeof(double), "correlation engine");
   c->wspec = mem_realloc(c->wspec, cap * ns, sizeof(double), "correlation engine");
+  c->wmask = mem_realloc(c->wmask, cap * nm, sizeof(double), "correlation engine");
   memset(c->win + old * CW_LEN, 0, (cap - old) * CW_LEN * sizeof(double));
   memset(c->wsamp + old * nl, 0, (cap - old) * nl * sizeof(double));
   memset(c->wspec + old * ns, 0, (cap - old) * ns * sizeof(double));
+  memset(c->wmask + old * nm, 0, (cap - old) * nm * sizeof(double));
   c->cap = cap;
 }
 
@@ -63,11 +66,12 @@ static int self_conjugate(int iz, int nz) {
 }
 
 void corr_win_add(struct corr *c, int l, const double (*U)[2], const double (*V)[2],
-                  const double (*W)[2]) {
+                  const double (*W)[2], const double (*M)[2], double empty) {
   const int nx = c->cfg.nx, nz = c->cfg.nz, nzh = c->nzh, nxh = nx / 2 + 1;
   const size_t nl = (size_t)c->cfg.n_levels, row = c->nwin;
   double *X = c->wspec + ((row * nl + (size_t)l) * c->n1d) * CS_LEN;
   double *Z = X + (size_t)nxh * CS_LEN;
+  double *XM = c->wmask + (row * nl + (size_t)l) * (c->n1d + CM_LEN), *ZM = XM + nxh;
   for (int ix = 0; ix < nx; ix++)
     for (int iz = 0; iz < nzh; iz++) {
       const size_t k = (size_t)ix * (size_t)nzh + (size_t)iz;
@@ -75,15 +79,22 @@ void corr_win_add(struct corr *c, int l, const double (*U)[2], const double (*V)
           U[k][0] * U[k][0] + U[k][1] * U[k][1], V[k][0] * V[k][0] + V[k][1] * V[k][1],
           W[k][0] * W[k][0] + W[k][1] * W[k][1], U[k][0] * V[k][0] + U[k][1] * V[k][1],
           U[k][0] * V[k][1] - U[k][1] * V[k][0]};
+      const double sm = M[k][0] * M[k][0] + M[k][1] * M[k][1];
       double *z = Z + (size_t)iz * CS_LEN;
       for (int q = 0; q < CS_LEN; q++) z[q] += s[q];
-      if (ix < nxh)
+      ZM[iz] += sm;
+      if (ix < nxh) {
         for (int q = 0; q < CS_LEN; q++) X[(size_t)ix * CS_LEN + q] += s[q];
+        XM[ix] += sm;
+      }
       /* the partner (-kx, -kz) of a column that is not self-conjugate: conj(S) at -kx */
       const int p = (nx - ix) % nx;
-      if (!self_conjugate(iz, nz) && p < nxh)
+      if (!self_conjugate(iz, nz) && p < nxh) {
         for (int q = 0; q < CS_LEN; q++) X[(size_t)p * CS_LEN + q] += q == CS_UV_IM ? -s[q] : s[q];
+        XM[p] += sm;
+      }
     }
+  XM[c->n1d + CM_PLANES] += 1.0, XM[c->n1d + CM_EMPTY] += empty;
   c->wsamp[row * nl + (size_t)l] += 1.0;
 }
 
@@ -111,9 +122,16 @@ static void *reserve_spec(void *owner, int rank, const size_t *dims) {
   return reserve_rows(c, rank, dims, CS_LEN, &c->wspec);
 }
 
+static void *reserve_mask(void *owner, int rank, const size_t *dims) {
+  struct corr *c = owner;
+  if (rank != 3 || dims[1] != (size_t)c->cfg.n_levels) return NULL;
+  return reserve_rows(c, rank, dims, c->n1d + CM_LEN, &c->wmask);
+}
+
 void corr_win_state(struct corr *c, struct state_list *L) {
   const size_t rows = c->nwin + 1, nl = (size_t)c->cfg.n_levels;
   const size_t dw[2] = {rows, CW_LEN}, ds[2] = {rows, nl}, dp[3] = {rows, nl * c->n1d, CS_LEN};
+  const size_t dm[3] = {rows, nl, c->n1d + CM_LEN};
   /* optional (format 1.8): a checkpoint of 1.7 or older resumes without them (corr_win_advance) */
   struct state_field *f =
       state_add(L, "stats/correlations/windows", STATE_F64, 2, dw, c->win, NULL);
@@ -122,6 +140,10 @@ void corr_win_state(struct corr *c, struct state_list *L) {
   f->reserve = reserve_samp, f->owner = c, f->optional = 1;
   f = state_add(L, "stats/correlations/window_spectra_1d", STATE_F64, 3, dp, c->wspec, NULL);
   f->reserve = reserve_spec, f->owner = c, f->optional = 1;
+  /* optional (format 1.15): without it the windows before the resume have no mask sums and
+     stay uncorrected (corr.h, Gaps) */
+  f = state_add(L, "stats/correlations/window_mask_1d", STATE_F64, 3, dm, c->wmask, NULL);
+  f->reserve = reserve_mask, f->owner = c, f->optional = 1;
 }
 
 size_t corr_nv(const struct corr *c) {
@@ -142,9 +164,38 @@ static void rho_of(const struct corr *c, double *v) {
   }
 }
 
+/* P(l) along x and z of one level's 1-D mask sums XM (k_x entries, then k_z, then CM_LEN) into
+   px [nx], pz [nz]; returns 1 if they cover all ns planes and some cell was empty (the results
+   are then corrected), else 0 with NaN. */
+static int pair_fraction_1d(const struct corr *c, const double *XM, double ns, double *px,
+                            double *pz) {
+  const int nx = c->cfg.nx, nz = c->cfg.nz, nzh = c->nzh, nxh = nx / 2 + 1;
+  const double planes = XM[c->n1d + CM_PLANES], N = (double)nx * (double)nz;
+  if (!(planes > 0) || planes != ns) {
+    for (int i = 0; i < nx; i++) px[i] = NAN;
+    for (int k = 0; k < nz; k++) pz[k] = NAN;
+    return 0;
+  }
+  const double norm = 1.0 / (N * N * planes), *ZM = XM + nxh;
+  for (int i = 0; i < nx; i++) {
+    double s = 0.0;
+    for (int m = 0; m < nxh; m++)
+      s += (m == 0 || 2 * m == nx ? 1.0 : 2.0) * XM[m] * cos(two_pi * (double)((m * i) % nx) / nx);
+    px[i] = s * norm;
+  }
+  for (int k = 0; k < nz; k++) {
+    double s = 0.0;
+    for (int m = 0; m < nzh; m++)
+      s += (self_conjugate(m, nz) ? 1.0 : 2.0) * ZM[m] * cos(two_pi * (double)((m * k) % nz) / nz);
+    pz[k] = s * norm;
+  }
+  return XM[c->n1d + CM_EMPTY] > 0;
+}
+
 /* The results of one level's 1-D sums X (k_x entries, then k_z) of ns planes into v (the
-   layout of corr_nv). */
-static void values_of(const struct corr *c, const double *X, double ns, double *v) {
+   layout of corr_nv), gap-corrected by its mask sums XM where they allow it. */
+static void values_of(const struct corr *c, const double *X, double ns, const double *XM,
+                      double *v) {
   const int nx = c->cfg.nx, nz = c->cfg.nz, nzh = c->nzh, nxh = nx / 2 + 1;
   const double N = (double)nx * (double)nz;
   const double norm = 1.0 / (N * N * ns);
@@ -181,18 +232,43 @@ static void values_of(const struct corr *c, const double *X, double ns, double *
       ez[q * nzh + m] = (self_conjugate(m, nz) ? 1.0 : 2.0) * Z[(size_t)m * CS_LEN + q] * norm *
                         (nz > 1 ? c->cfg.lz / two_pi : 1.0);
   }
+  double *p = mem_alloc((size_t)(nx + nz), sizeof(double), "correlations");
+  if (pair_fraction_1d(c, XM, ns, p, p + nx)) corr_gap_correct(c, rx, rz, ex, ez, p, p + nx);
+  free(p);
   rho_of(c, v);
 }
 
 /* Row r's own results at level l into v. */
 static void window_values(const struct corr *c, size_t r, size_t l, double *v) {
   const size_t nl = (size_t)c->cfg.n_levels;
-  values_of(c, c->wspec + ((r * nl + l) * c->n1d) * CS_LEN, c->wsamp[r * nl + l], v);
+  values_of(c, c->wspec + ((r * nl + l) * c->n1d) * CS_LEN, c->wsamp[r * nl + l],
+            c->wmask + (r * nl + l) * (c->n1d + CM_LEN), v);
+}
+
+/* The window rows r0 .. r1-1 of level l: their 1-D mask sums added in row order into sum. */
+static void mask_sum(const struct corr *c, size_t r0, size_t r1, size_t l, double *sum) {
+  const size_t nl = (size_t)c->cfg.n_levels, len = c->n1d + CM_LEN;
+  memset(sum, 0, len * sizeof(double));
+  for (size_t r = r0; r < r1; r++)
+    for (size_t j = 0; j < len; j++) sum[j] += c->wmask[(r * nl + l) * len + j];
+}
+
+void corr_range_pair_fraction(const struct corr *c, size_t r0, size_t r1, double *px, double *pz,
+                              int *corrected) {
+  const size_t nl = (size_t)c->cfg.n_levels, nx = (size_t)c->cfg.nx, nz = (size_t)c->cfg.nz;
+  double *sum = mem_alloc(c->n1d + CM_LEN, sizeof(double), "correlations");
+  for (size_t l = 0; l < nl; l++) {
+    double ns = 0.0;
+    for (size_t r = r0; r < r1; r++) ns += c->wsamp[r * nl + l];
+    mask_sum(c, r0, r1, l, sum);
+    corrected[l] = pair_fraction_1d(c, sum, ns, px + l * nx, pz + l * nz);
+  }
+  free(sum);
 }
 
 void corr_range_values(const struct corr *c, size_t r0, size_t r1, double *v) {
   const size_t nl = (size_t)c->cfg.n_levels, len = c->n1d * CS_LEN, nv = corr_nv(c);
-  double *sum = mem_alloc(len, sizeof(double), "correlations");
+  double *sum = mem_alloc(len + c->n1d + CM_LEN, sizeof(double), "correlations");
   for (size_t l = 0; l < nl; l++) {
     double ns = 0.0;
     memset(sum, 0, len * sizeof(double));
@@ -201,7 +277,8 @@ void corr_range_values(const struct corr *c, size_t r0, size_t r1, double *v) {
       for (size_t j = 0; j < len; j++) sum[j] += X[j];
       ns += c->wsamp[r * nl + l];
     }
-    values_of(c, sum, ns > 0 ? ns : NAN, v + l * nv);
+    mask_sum(c, r0, r1, l, sum + len);
+    values_of(c, sum, ns > 0 ? ns : NAN, sum + len, v + l * nv);
   }
   free(sum);
 }

@@ -19,8 +19,12 @@ Checks, on a run with at least 3 complete windows (restart_bitwise_all_stats):
    file written before them): extract copies the group whole and says so on stderr.
 6. window records of another layout (more closed windows than rows): exit 1, an error naming
    the file and the group, no output file.
+7. the gap correction (docs/stats-format.md): where grid cells were empty, R over the filled
+   pairs (R / P, P from the window records' mask sums) and E its cosine transform, as numpy
+   computes them in 1-3; gap_corrected and pair_fraction_x, _z as numpy finds them. With
+   --gaps the run must have empty cells (every level corrected), else none.
 
-usage: corr_extract_check.py CHANSPH STATS.nc WORK
+usage: corr_extract_check.py CHANSPH STATS.nc WORK [--gaps]
 """
 import os
 import subprocess
@@ -31,6 +35,7 @@ import netCDF4
 import numpy as np
 
 chansph, stats, work = sys.argv[1:4]
+gaps = "--gaps" in sys.argv[4:]
 os.makedirs(work, exist_ok=True)
 COMP = ["uu", "vv", "ww", "uv"]
 TOL = 1e-12
@@ -52,9 +57,34 @@ def extract(path, rng, out):
     return r.stderr
 
 
+def inverse(half, n):
+    """The inverse DFT of a spectrum given at its stored k >= 0 (the rest its conjugates)."""
+    full = np.zeros((half.shape[0], n), complex)
+    m = np.arange(n)
+    stored = m < half.shape[1]
+    full[:, m[stored]] = half[:, m[stored]]
+    partner = ~stored  # the conjugates of the stored k >= 0
+    full[:, m[partner]] = np.conj(half[:, (n - m[partner]) % n])
+    return np.real(np.fft.ifft(full, axis=1)) * n
+
+
+def pair_fraction(g, rows):
+    """P(l) along x and z of the window rows pooled, and which levels are gap-corrected (their
+    mask sums cover all planes and some cell was empty)."""
+    ns = np.ma.filled(g["window_samples"][rows], np.nan).sum(axis=0)
+    planes = np.ma.filled(g["window_mask_planes"][rows], np.nan).sum(axis=0)
+    empty = np.ma.filled(g["window_empty_cells"][rows], np.nan).sum(axis=0)
+    nx, nz = g.dimensions["separation_x"].size, g.dimensions["separation_z"].size
+    norm = 1.0 / ((nx * nz) ** 2 * planes)
+    P = {d: inverse(np.ma.filled(g["window_mask_k" + d][rows], np.nan).sum(axis=0), n) *
+         norm[:, None] for d, n in (("x", nx), ("z", nz))}
+    return P, (planes == ns) & (planes > 0) & (empty > 0)
+
+
 def results(g, rows):
     """R, rho [name] (level, n) and E [name] (level, n) of the window rows pooled, as numpy
-    derives them from the 1-D sums (full spectrum from its Hermitian half, inverse DFT)."""
+    derives them from the 1-D sums (full spectrum from its Hermitian half, inverse DFT), gap-
+    corrected where the engine corrects: R / P, E the cosine transform of that R."""
     raw = {k: np.ma.filled(g[k][rows], np.nan)  # plain arrays: 0/0 is NaN, not masked
            for k in ("window_spectra_kx", "window_spectra_kz", "window_samples")}
     X = raw["window_spectra_kx"].sum(axis=0)  # (level, kx, slot)
@@ -63,22 +93,20 @@ def results(g, rows):
     nx, nz = g.dimensions["separation_x"].size, g.dimensions["separation_z"].size
     lx, lz = float(g.lx), float(g.lz)
     norm = 1.0 / ((nx * nz) ** 2 * ns)
+    P, corr = pair_fraction(g, rows)
     out = {}
     for d, S, n, L in (("x", X, nx, lx), ("z", Z, nz, lz)):
         for q, c in enumerate(COMP):
-            half = S[:, :, q] + (1j * S[:, :, 4] if q == 3 else 0)
-            full = np.zeros((S.shape[0], n), complex)
-            m = np.arange(n)
-            stored = m < S.shape[1]
-            full[:, m[stored]] = half[:, m[stored]]
-            partner = ~stored  # the conjugates of the stored k >= 0
-            full[:, m[partner]] = np.conj(half[:, (n - m[partner]) % n])
-            R = np.real(np.fft.ifft(full, axis=1)) * n * norm[:, None]
+            R = inverse(S[:, :, q] + (1j * S[:, :, 4] if q == 3 else 0), n) * norm[:, None]
+            R = np.where(corr[:, None], R / P[d], R)
             out["R_%s_%s" % (c, d)] = R
             if q < 3:
-                f = np.where((m[: S.shape[1]] == 0) | (2 * m[: S.shape[1]] == n), 1.0, 2.0)
+                m = np.arange(S.shape[1])
+                f = np.where((m == 0) | (2 * m == n), 1.0, 2.0)
                 scale = L / (2 * np.pi) if n > 1 else 1.0
-                out["E_%s_k%s" % (c, d)] = f * S[:, :, q] * norm[:, None] * scale
+                cosine = np.real(np.fft.fft(R, axis=1))[:, : S.shape[1]] / n
+                out["E_%s_k%s" % (c, d)] = f * np.where(corr[:, None], cosine,
+                                                        S[:, :, q] * norm[:, None]) * scale
         for q, c in enumerate(COMP):
             r0 = out["R_%s_%s" % (COMP[0] if q == 3 else c, d)][:, :1]
             with np.errstate(invalid="ignore", divide="ignore"):  # w' = 0 in 2-D: NaN
@@ -162,6 +190,16 @@ for sel, rng in (([a, b], "%.9g:%.9g" % (t0, t1)), ([b], "%.9g:%.9g" % tuple(run
     else:
         nan = all(np.all(np.ma.getmaskarray(sub[k][:])) for k in errors)
         check(nan, "extract --window %s: one batch, every *_stderr a fill value" % rng)
+
+# 7: the gap correction
+P, corr = pair_fraction(run, list(range(rows)))
+check(list(run["gap_corrected"][:]) == [int(c) for c in corr] and all(corr) == gaps and
+      (gaps or not any(corr)), "gap_corrected %s (%s)" % (list(run["gap_corrected"][:]),
+                                                          "empty cells" if gaps else "no gaps"))
+for d in "xz":
+    compare(run, {"pair_fraction_" + d: P[d]}, "pair_fraction_%s = numpy's from the mask sums" % d)
+if gaps:
+    print("P(l_x) at the first levels: %s" % np.round(P["x"][:, :3], 4).tolist())
 
 # 5: a file without window records
 old = work + "/old.nc"

@@ -44,7 +44,7 @@ rewrite "$w/v110" 10 136
 msg=$("$chansph" resume "$w/v110" 2>&1)
 rc=$?
 echo "$msg" | grep -E "error|skipped" | head -3
-echo "$msg" | grep -q "dataset /stats/eulerian/reynolds_budget has shape (3, 19, 136), this run needs ([0-9]*, 19, 252): written in checkpoint format 1.10, whose records this build (format 1.14) does not read; finish the run with the chansph version that started it, or start a new segment from its state with init.from" &&
+echo "$msg" | grep -q "dataset /stats/eulerian/reynolds_budget has shape (3, 19, 136), this run needs ([0-9]*, 19, 252): written in checkpoint format 1.10, whose records this build (format 1.15) does not read; finish the run with the chansph version that started it, or start a new segment from its state with init.from" &&
   [ $rc -eq 1 ] || { echo "FAIL: a format-1.10 checkpoint: exit $rc, not the versions and remedies"; status=1; }
 echo "$msg" | grep -q "another scene" && { echo "FAIL: still 'a checkpoint of another scene?'"; status=1; }
 cp -r "$w/a" "$w/v15"

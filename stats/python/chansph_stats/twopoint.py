@@ -53,6 +53,8 @@ def read_corr(path, u_tau="force"):
         n_cells = len(g.dimensions["separation_x"]) * len(g.dimensions["separation_z"])
         r["empty"] = (values(g.variables["empty_cells"]) / np.maximum(r["samples"], 1) / n_cells
                       if "empty_cells" in g.variables else np.full(len(r["samples"]), np.nan))
+        r["gap"] = (values(g.variables["gap_corrected"]).astype(int)
+                    if "gap_corrected" in g.variables else np.zeros(len(r["samples"]), int))
         r["eul"] = {k: values(nc.variables[k]) for k in ("y_mean", "n_samples", "uu", "vv", "ww")
                     if k in nc.variables}
         r["n_windows"] = int(nc.getncattr("n_windows")) if "n_windows" in nc.ncattrs() else 0

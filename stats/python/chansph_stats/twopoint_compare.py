@@ -116,8 +116,13 @@ class Spectra:
 
     @staticmethod
     def level_note(r, lev, yp):
-        print("# y+ %.1f: %.1f%% of the grid cells were empty (zero fluctuation there: the "
-              "spectra miss about that share of the variance)" % (yp, 100 * r["empty"][lev]))
+        share = ("%.1f%%" % (100 * r["empty"][lev]) if np.isfinite(r["empty"][lev])
+                 else "an unknown share (no empty_cells: a file of extract)")
+        print("# y+ %.1f: %s of the grid cells were empty; %s" %
+              (yp, share, "gap-corrected: R over the filled cell pairs, E its transform"
+               if r["gap"][lev] else "not gap-corrected (a file before checkpoint format "
+               "1.15, or no empty cell): zero-filled cells lower R(l) by the filled share "
+               "squared and add a white floor to E"))
 
     @staticmethod
     def engine(r, lev, c, d):
