@@ -292,6 +292,13 @@ done:
   return rc;
 }
 
+/* Define a double variable of group g and write all of data; a netCDF status. */
+static int def_put(int g, const char *name, int nd, const int *dims, const char *units,
+                   const char *long_name, const double *data) {
+  int v, rc = ncout_def(g, name, NC_DOUBLE, nd, dims, units, long_name, &v);
+  return rc != NC_NOERR ? rc : nc_put_var_double(g, v, data);
+}
+
 /* The per-window records (issue 25): planes per level and the 1-D sums of the spectra over
    k_x and over k_z. d: {window, window_field, level, kx, kz, spectrum_slot}. */
 static int write_windows(const struct corr *c, int g, const int d[6], char *err, size_t errlen) {
@@ -325,24 +332,19 @@ static int write_windows(const struct corr *c, int g, const int d[6], char *err,
                &v));
   CK(nc_put_var_double(g, v, kz));
   const int dmx[3] = {d[0], d[2], d[3]}, dmz[3] = {d[0], d[2], d[4]};
-  CK(ncout_def(g, "window_mask_kx", NC_DOUBLE, 3, dmx, "1",
-               "per window: raw sums over the planes and over k_z of |F m|^2, m the grid's mask "
-               "(1 filled, 0 empty), at k_x >= 0 (the -k_x partners folded in)",
-               &v));
-  CK(nc_put_var_double(g, v, mx));
-  CK(ncout_def(g, "window_mask_kz", NC_DOUBLE, 3, dmz, "1",
-               "per window: raw sums over the planes and over k_x of |F m|^2 at the stored "
-               "k_z >= 0",
-               &v));
-  CK(nc_put_var_double(g, v, mz));
-  CK(ncout_def(g, "window_mask_planes", NC_DOUBLE, 2, ds, "1",
-               "per window: planes whose mask was summed (fewer than window_samples: the "
-               "window began before a resume from a checkpoint without them)",
-               &v));
-  CK(nc_put_var_double(g, v, mp));
-  CK(ncout_def(g, "window_empty_cells", NC_DOUBLE, 2, ds, "1",
-               "per window: empty grid cells among those planes", &v));
-  CK(nc_put_var_double(g, v, me));
+  CK(def_put(g, "window_mask_kx", 3, dmx, "1",
+             "per window: raw sums over the planes and over k_z of |F m|^2, m the grid's mask (1 "
+             "filled, 0 empty), at k_x >= 0 (the -k_x partners folded in)",
+             mx));
+  CK(def_put(g, "window_mask_kz", 3, dmz, "1",
+             "per window: raw sums over the planes and over k_x of |F m|^2 at the stored k_z >= 0",
+             mz));
+  CK(def_put(g, "window_mask_planes", 2, ds, "1",
+             "per window: planes whose mask was summed (fewer than window_samples: the window "
+             "began before a resume from a checkpoint without them)",
+             mp));
+  CK(def_put(g, "window_empty_cells", 2, ds, "1", "per window: empty grid cells among those planes",
+             me));
 done:
   free(kx);
   return rc;

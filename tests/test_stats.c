@@ -355,20 +355,27 @@ static void test_round_trip(double *buf) {
   stats_free(&a);
 }
 
+/* One level at y = 0.3 (y+ 10) of an nx x nz grid over lx x lz, slab half 0.05, windows of
+   the given length (0: one window). */
+static struct corr_config one_level(int nx, int nz, double lx, double lz, double window) {
+  return (struct corr_config){.n_levels = 1,
+                              .y = {0.3},
+                              .y_plus = {10},
+                              .nx = nx,
+                              .nz = nz,
+                              .lx = lx,
+                              .lz = lz,
+                              .half = 0.05,
+                              .delta = 1.0,
+                              .window = window};
+}
+
 /* Acceptance 1: a field with a known sinusoidal correlation gives R(l) to 1e-6. */
 static void test_corr(void) {
   enum { NX = 16, NZ = 8, M = 3, NM = 1 };
   const double lx = 1.6, lz = 0.8, amp_a = 0.7, amp_b = 0.4, amp_c = 0.3, amp_d = 0.2;
   const double phi = 0.4, tp = 6.283185307179586;
-  const struct corr_config cfg = {.n_levels = 1,
-                                  .y = {0.3},
-                                  .y_plus = {10},
-                                  .nx = NX,
-                                  .nz = NZ,
-                                  .lx = lx,
-                                  .lz = lz,
-                                  .half = 0.05,
-                                  .delta = 1.0};
+  const struct corr_config cfg = one_level(NX, NZ, lx, lz, 0.0);
   struct corr c;
   corr_init(&c, &cfg);
   double x[NX * NZ], y[NX * NZ], z[NX * NZ], u[NX * NZ], v[NX * NZ], w[NX * NZ];
@@ -426,16 +433,7 @@ static void test_corr(void) {
 static void test_corr_gaps(void) {
   enum { NX = 16, NZ = 8, M = 3, N = 5, NXH = NX / 2 + 1, NZH = NZ / 2 + 1 };
   const double lx = 1.6, lz = 0.8, A = 0.7, C = 0.4, D = 0.2, tp = 6.283185307179586;
-  const struct corr_config cfg = {.n_levels = 1,
-                                  .y = {0.3},
-                                  .y_plus = {10},
-                                  .nx = NX,
-                                  .nz = NZ,
-                                  .lx = lx,
-                                  .lz = lz,
-                                  .half = 0.05,
-                                  .delta = 1.0,
-                                  .window = 0.5};
+  const struct corr_config cfg = one_level(NX, NZ, lx, lz, 0.5);
   struct corr c;
   corr_init(&c, &cfg);
   double x[NX * NZ], y[NX * NZ], z[NX * NZ], u[NX * NZ], v[NX * NZ], w[NX * NZ];
