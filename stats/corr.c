@@ -305,27 +305,3 @@ void corr_results(const struct corr *c, double *rx, double *rz, double *ex, doub
   fftw_destroy_plan(back);
   fftw_free(in), fftw_free(r);
 }
-
-/* One-sided density of an even series R(l_i), i < n, over k = 2 pi m / L (corr_results'
-   normalisation: sum_m E(k_m) dk = R(0)): f_m (1/n) sum_i R_i cos(2 pi m i / n) L / (2 pi). */
-static void cosine_density(const double *R, int n, double L, double *E) {
-  for (int m = 0; m < n / 2 + 1; m++) {
-    double s = 0.0;
-    for (int i = 0; i < n; i++) s += R[i] * cos(two_pi * (double)(((long)m * i) % n) / n);
-    const double f = m == 0 || 2 * m == n ? 1.0 : 2.0;
-    E[m] = f * s / n * (n > 1 ? L / two_pi : 1.0);
-  }
-}
-
-void corr_gap_correct(const struct corr *c, double *rx, double *rz, double *ex, double *ez,
-                      const double *px, const double *pz) {
-  const int nx = c->cfg.nx, nz = c->cfg.nz, nzh = c->nzh, nxh = nx / 2 + 1;
-  for (int q = 0; q < 4; q++) {
-    for (int i = 0; i < nx; i++) rx[q * nx + i] = px[i] > 0 ? rx[q * nx + i] / px[i] : NAN;
-    for (int k = 0; k < nz; k++) rz[q * nz + k] = pz[k] > 0 ? rz[q * nz + k] / pz[k] : NAN;
-  }
-  for (int q = 0; q < 3; q++) {
-    cosine_density(rx + q * nx, nx, c->cfg.lx, ex + q * nxh);
-    cosine_density(rz + q * nz, nz, c->cfg.lz, ez + q * nzh);
-  }
-}
