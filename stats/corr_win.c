@@ -217,8 +217,8 @@ static int pair_fraction_1d(const struct corr *c, const double *XM, double ns, d
 }
 
 /* The results of one level's 1-D sums X (k_x entries, then k_z) of ns planes into v (the
-   layout of corr_nv), gap-corrected by its mask sums XM where they allow it. */
-static void values_of(const struct corr *c, const double *X, double ns, const double *XM,
+   layout of corr_nv), gap-corrected by its mask sums XM where they allow it and allow is set. */
+static void values_of(const struct corr *c, const double *X, double ns, const double *XM, int allow,
                       double *v) {
   const int nx = c->cfg.nx, nz = c->cfg.nz, nzh = c->nzh, nxh = nx / 2 + 1;
   const double N = (double)nx * (double)nz;
@@ -257,16 +257,18 @@ static void values_of(const struct corr *c, const double *X, double ns, const do
                         (nz > 1 ? c->cfg.lz / two_pi : 1.0);
   }
   double *p = mem_alloc((size_t)(nx + nz), sizeof(double), "correlations");
-  if (pair_fraction_1d(c, XM, ns, p, p + nx)) corr_gap_correct(c, rx, rz, ex, ez, p, p + nx);
+  if (allow && pair_fraction_1d(c, XM, ns, p, p + nx))
+    corr_gap_correct(c, rx, rz, ex, ez, p, p + nx);
   free(p);
   rho_of(c, v);
 }
 
-/* Row r's own results at level l into v. */
-static void window_values(const struct corr *c, size_t r, size_t l, double *v) {
+/* Row r's own results at level l into v, gap-corrected only if allow (the range's results
+   are: a batch is then of the same estimator as the mean it scatters about). */
+static void window_values(const struct corr *c, size_t r, size_t l, int allow, double *v) {
   const size_t nl = (size_t)c->cfg.n_levels;
   values_of(c, c->wspec + ((r * nl + l) * c->n1d) * CS_LEN, c->wsamp[r * nl + l],
-            c->wmask + (r * nl + l) * (c->n1d + CM_LEN), v);
+            c->wmask + (r * nl + l) * (c->n1d + CM_LEN), allow, v);
 }
 
 /* The window rows r0 .. r1-1 of level l: their 1-D mask sums added in row order into sum. */
@@ -302,7 +304,7 @@ void corr_range_values(const struct corr *c, size_t r0, size_t r1, double *v) {
       ns += c->wsamp[r * nl + l];
     }
     mask_sum(c, r0, r1, l, sum + len);
-    values_of(c, sum, ns > 0 ? ns : NAN, sum + len, v + l * nv);
+    values_of(c, sum, ns > 0 ? ns : NAN, sum + len, 1, v + l * nv);
   }
   free(sum);
 }
@@ -314,29 +316,33 @@ static int is_batch(const struct corr *c, size_t r, size_t l) {
 }
 
 void corr_range_stderr(const struct corr *c, size_t r0, size_t r1, double *se, int *nb) {
-  const size_t nv = corr_nv(c);
+  const size_t nv = corr_nv(c), nl = (size_t)c->cfg.n_levels;
+  const size_t nx = (size_t)c->cfg.nx, nz = (size_t)c->cfg.nz;
   double *v = mem_alloc(2 * nv, sizeof(double), "correlations"), *mean = v + nv;
-  for (size_t l = 0; l < (size_t)c->cfg.n_levels; l++) {
+  double *p = mem_alloc(nl * (nx + nz), sizeof(double), "correlations");
+  int *allow = mem_alloc(nl, sizeof(int), "correlations");
+  corr_range_pair_fraction(c, r0, r1, p, p + nl * nx, allow); /* the range's estimator */
+  for (size_t l = 0; l < nl; l++) {
     int n = 0;
     double *ss = se + l * nv;
     memset(mean, 0, nv * sizeof(double));
     memset(ss, 0, nv * sizeof(double));
     for (size_t r = r0; r < r1; r++) /* two passes: the mean, then the squares about it */
       if (is_batch(c, r, l)) {
-        window_values(c, r, l, v);
+        window_values(c, r, l, allow[l], v);
         for (size_t j = 0; j < nv; j++) mean[j] += v[j];
         n++;
       }
     for (size_t j = 0; j < nv; j++) mean[j] /= n;
     for (size_t r = r0; r < r1; r++)
       if (is_batch(c, r, l)) {
-        window_values(c, r, l, v);
+        window_values(c, r, l, allow[l], v);
         for (size_t j = 0; j < nv; j++) ss[j] += (v[j] - mean[j]) * (v[j] - mean[j]);
       }
     for (size_t j = 0; j < nv; j++) ss[j] = n < 2 ? NAN : sqrt(ss[j] / (n - 1) / n);
     nb[l] = n;
   }
-  free(v);
+  free(v), free(p), free(allow);
 }
 
 void corr_stderr(const struct corr *c, double *rx, double *rz, double *ex, double *ez, int *nb) {
