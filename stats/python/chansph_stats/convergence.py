@@ -82,9 +82,28 @@ def peak_series(path):
     return out, [r["win"][i] for i in complete]
 
 
+def filled_share(g, planes):
+    """Per window and level the filled share of the grid's cells, P(0) of the gap correction
+    (docs/stats-format.md), the window's empty cells, and whether its mask sums cover its
+    planes (all False in files before checkpoint format 1.15)."""
+    if "window_mask_kx" not in g.variables:
+        return np.ones_like(planes), np.zeros_like(planes), np.zeros(planes.shape, bool)
+    mx = np.ma.filled(g["window_mask_kx"][:].astype(float), 0.0)
+    mp = np.ma.filled(g["window_mask_planes"][:].astype(float), 0.0)
+    me = np.ma.filled(g["window_empty_cells"][:].astype(float), 0.0)
+    nx, nz = g.dimensions["separation_x"].size, g.dimensions["separation_z"].size
+    m = np.arange(mx.shape[2])
+    f = np.where((m == 0) | (2 * m == nx), 1.0, 2.0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        p0 = (mx * f).sum(axis=2) / ((nx * nz) ** 2 * mp)
+    return p0, me, (mp == planes) & (mp > 0)
+
+
 def spectra_series(path):
     """{quantity: [(n, t_end, value, se)]} of the spectra's energies at each correlation level,
-    relative to their final value (empty without window records)."""
+    relative to their final value (empty without window records); gap-corrected as the engine
+    is (over the first n windows: their zero-filled energies over their filled shares, both
+    weighted by the planes)."""
     with open_nc(path) as d:
         if "correlations" not in d.groups:
             return {}
@@ -93,24 +112,33 @@ def spectra_series(path):
             return {}
         spec = np.ma.filled(g["window_spectra_kx"][:].astype(float), 0.0)
         planes = np.ma.filled(g["window_samples"][:].astype(float), 0.0)
+        share, empty, covered = filled_share(g, planes)
+        nx = g.dimensions["separation_x"].size
         comp = np.asarray(g["window_complete"][:]) > 0
         t_end = np.asarray(g["windows"][:, 1], float)
         yplus = np.asarray(g["y_plus"][:], float)
     out = {}
     rows = [i for i in range(len(comp)) if comp[i]]
+    m = np.arange(spec.shape[2])  # the k_x >= 0 entries, the others their partners: R(0)
+    f = np.where((m == 0) | (2 * m == nx), 1.0, 2.0)
     for lev, yp in enumerate(yplus):
+        use = [i for i in rows if planes[i, lev] > 0]
+        if len(use) < 2:
+            continue
+        w = np.array([planes[i, lev] for i in use])
+        # the engine's rule for the range: corrected if the mask sums cover every window's
+        # planes and some cell was empty (else the zero-filled energies, P(0) = 1)
+        fix = all(covered[i, lev] for i in use) and sum(empty[i, lev] for i in use) > 0
+        p0 = np.array([share[i, lev] if fix else 1.0 for i in use])
         for s, name in enumerate(("uu", "vv", "ww")):
-            use = [i for i in rows if planes[i, lev] > 0]
-            if len(use) < 2:
-                continue
-            e = np.array([spec[i, lev, :, s].sum() / planes[i, lev] for i in use])
-            w = np.array([planes[i, lev] for i in use])
-            final = float(np.sum(e * w) / np.sum(w))
+            e = np.array([(spec[i, lev, :, s] * f).sum() / planes[i, lev] for i in use])
+            final = float(np.sum(e * w) / np.sum(p0 * w))
             if not final > 0:
                 continue
             key = "E_%s(y+ %g)" % (name, yp)
-            out[key] = [(n, t_end[use[n - 1]], float(np.sum(e[:n] * w[:n]) / np.sum(w[:n])) / final,
-                         batch_se(e[:n] / final)) for n in range(2, len(use) + 1)]
+            out[key] = [(n, t_end[use[n - 1]],
+                         float(np.sum(e[:n] * w[:n]) / np.sum(p0[:n] * w[:n])) / final,
+                         batch_se(e[:n] / p0[:n] / final)) for n in range(2, len(use) + 1)]
     return out
 
 
