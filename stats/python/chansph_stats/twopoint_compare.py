@@ -110,9 +110,9 @@ class Spectra:
               "longer than lx = %g, lz = %g delta)" %
               (r["kx"][1] * r["delta"], r["kz"][1] * r["delta"], r["lx"] / r["delta"],
                r["lz"] / r["delta"]))
-        print("# %5s %6s %3s %4s %10s %10s %9s %7s %9s %8s %8s %7s %7s %7s  %s" %
+        print("# %5s %6s %3s %4s %10s %10s %9s %7s %9s %8s %8s %7s %7s %7s %8s  %s" %
               ("y+", "MKM y+", "dir", "comp", "Parseval", "W-K", "<u'2>+", "/Eul", "MKM",
-               "ratio", "err", "k0 run", "k0 MKM", "MKM>L", "verdict"))
+               "ratio", "err", "k0 run", "k0 MKM", "MKM>L", "+-", "verdict"))
 
     @staticmethod
     def level_note(r, lev, yp):
@@ -164,10 +164,13 @@ class Spectra:
         self.lost[d] = cv
         ratio, lost_share = var / var_d, Ed[lost].sum() * dkd / var_d
         agree = abs(ratio - 1) <= self.a.tol_energy and err <= self.a.tol_shape
+        se = r.get("R_%s%s_%s_stderr" % (c, c, d))
+        se = se[lev][0] / ut ** 2 if se is not None else math.nan
         row = ("  %5.1f %6g %3s %4s %10.2e %10.2e %9.4f %7.3f %9.4f %8.3f %8.3f %7.3f %7.3f "
-               "%7.3f  engine %s, DNS %s" %
+               "%7.3f %8s  engine %s, DNS %s" %
                (yp, near, d, c, num[0], num[1], var, var * ut ** 2 / eulerian_variance(r, lev, c),
                 var_d, ratio, err, E[0] * dk / var, Ed[0] * dkd / var_d, lost_share,
+                "%.4f" % se if math.isfinite(se) else "-",
                 "PASS" if ok else "FAIL", "agrees" if agree else "differs"))
         return row, cv
 
@@ -184,8 +187,9 @@ class Spectra:
         print("# Parseval: |sum E dk / R(0) - 1|; W-K: max |E - FT(R)| / max E; /Eul: energy / "
               "the Eulerian <u'2> profile at the level; ratio: energy / MKM <u'2>+; err: sum|E - "
               "E_MKM| / sum E_MKM over the held k; k0: share of the energy in the k = 0 mode; "
-              "MKM>L: MKM share at 0 < k < 2 pi / L (tolerances: engine %g, DNS energy %g, "
-              "shape %g)" % (EXACT, self.a.tol_energy, self.a.tol_shape))
+              "MKM>L: MKM share at 0 < k < 2 pi / L; +-: the standard error of <u'2>+ (batch "
+              "means over the complete windows, R_ii_stderr at l = 0; - without) (tolerances: "
+              "engine %g, DNS energy %g, shape %g)" % (EXACT, self.a.tol_energy, self.a.tol_shape))
 
     @staticmethod
     def draw(ax, cv, c, d, yp, near):
