@@ -47,9 +47,9 @@ def read_corr(path, u_tau="force"):
             for d in "xz":
                 r["R_%s%s_%s" % (c, c, d)] = values(need(g, "R_%s%s_%s" % (c, c, d), path))
                 r["E_%s%s_k%s" % (c, c, d)] = values(need(g, "E_%s%s_k%s" % (c, c, d), path))
-                se = "R_%s%s_%s_stderr" % (c, c, d)  # batch means (format 1.8 on)
-                if se in g.variables:
-                    r[se] = values(g.variables[se])
+                for se in ("R_%s%s_%s_stderr" % (c, c, d), "rho_%s%s_%s_stderr" % (c, c, d)):
+                    if se in g.variables:  # batch means (format 1.8 on)
+                        r[se] = values(g.variables[se])
         for k in ("delta", "nu", "lx", "lz"):
             r[k] = float(attribute(nc, k, path))
         r["u_tau"] = pick_u_tau(nc, path, u_tau)

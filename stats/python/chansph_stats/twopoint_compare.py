@@ -226,9 +226,9 @@ class Correlations:
 
     @staticmethod
     def head(r):
-        print("# %5s %6s %3s %4s %8s %8s %12s %12s %16s %16s %7s %7s %6s  %s" %
+        print("# %5s %6s %3s %4s %8s %8s %12s %12s %16s %16s %7s %7s %6s %6s  %s" %
               ("y+", "MKM y+", "dir", "comp", "R(0)+", "MKM", "l(rho=0.5)", "MKM",
-               "min rho at l", "MKM", "rho L/2", "MKM", "rms d", "verdict"))
+               "min rho at l", "MKM", "rho L/2", "MKM", "rms d", "se", "verdict"))
 
     @staticmethod
     def level_note(r, lev, yp):
@@ -272,18 +272,21 @@ class Correlations:
         hw, mn, lmn = numbers(l, rho)
         hwd, mnd, lmnd = numbers(ld[inside], rd[inside])
         endd = float(np.interp(l[-1], ld, rd))
+        se = r.get("rho_%s%s_%s_stderr" % (c, c, d))  # RMS over half the box, as rms d
+        se = math.sqrt(np.mean(se[lev][: len(l)] ** 2)) if se is not None else math.nan
         row = ("  %5.1f %6g %3s %4s %8.4f %8.4f %12s %12s %7.3f at %5.3f %7.3f at %5.3f "
-               "%7.3f %7.3f %6.3f  engine %s, DNS %s" %
+               "%7.3f %7.3f %6.3f %6s  engine %s, DNS %s" %
                (yp, near, d, c, r0, r0d, "%.3f" % hw if hw == hw else "> %.3g" % l[-1],
                 "%.3f" % hwd if hwd == hwd else "> %.3g" % l[-1], mn, lmn, mnd, lmnd,
-                rho[-1], endd, diff, self.engine_text(ok, sym),
-                "agrees" if diff <= self.a.tol else "differs"))
+                rho[-1], endd, diff, "%.3f" % se if math.isfinite(se) else "-",
+                self.engine_text(ok, sym), "agrees" if diff <= self.a.tol else "differs"))
         return row, (l, rho, ld, rd)
 
     @staticmethod
     def foot(r):
         print("# separations in delta; l(rho=0.5): first drop below 0.5; rho L/2: at half our "
-              "box (MKM interpolated there); rms d: RMS of rho - rho_MKM over half our box")
+              "box (MKM interpolated there); rms d: RMS of rho - rho_MKM over half our box; se: "
+              "RMS of rho's standard error there (batch means; - without)")
 
     @staticmethod
     def draw(ax, cv, c, d, yp, near):
