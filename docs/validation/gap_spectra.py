@@ -8,7 +8,6 @@ energy in the same bands; and a figure of the v and w spectra at four levels.
 
 usage: gap_spectra.py FINE_STATS.nc COARSE_STATS.nc OUT.png [OUT.csv]
 """
-import math
 import os
 import sys
 
@@ -18,6 +17,7 @@ import numpy as np
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "stats",
                                 "python"))
 from chansph_stats import twopoint as tp  # noqa: E402
+from chansph_stats.twopoint_compare import wiener_khinchin  # noqa: E402
 
 KC = 30.0  # k_z delta: lambda_z+ = 38 at Re_tau = 180
 
@@ -27,14 +27,6 @@ def load(path):
     g = netCDF4.Dataset(path)["correlations"]
     r["P"] = np.ma.filled(g["pair_fraction_z"][:], np.nan)
     return r
-
-
-def density(R, L):
-    """One-sided density over k = 2 pi m / L of an even R(l_i) (the engine's normalisation)."""
-    n = len(R)
-    nh = n // 2 + 1
-    f = np.where((np.arange(nh) == 0) | (2 * np.arange(nh) == n), 1.0, 2.0)
-    return f * np.real(np.fft.fft(R))[:nh] / n * L / (2 * np.pi)
 
 
 def main():
@@ -60,7 +52,7 @@ def main():
                 R = r["R_%s%s_z" % (c, c)][lev] / ut ** 2 * (r["P"][lev] if zero else 1.0)
                 k = r["kz"] * de
                 dk = k[1] - k[0]
-                E = density(R, r["lz"] / de)
+                E = wiener_khinchin(R, r["lz"] / de)
                 lo, hi = E[(k > 0) & (k < KC)].sum() * dk, E[k >= KC].sum() * dk
                 lod = Ed[(kd >= k[1] - 1e-9) & (kd < KC)].sum() * dkd
                 row = "%.1f,%s,%s,%.4f,%.3f,%.4f,%.4f,%.4f,%.4f" % (
