@@ -934,8 +934,11 @@ static void validate(struct parse_state *ps) {
               s->stats_keys[table[k].slot].n > 0;
   if (levels && u_tau_ref == 0.0 && (s->drive_mode == DRIVE_FLUX || s->force <= 0.0))
     inconsistent(ps, "stats.u_tau_ref",
-                 "y+ levels need stats.u_tau_ref > 0 unless a positive drive.force gives it "
-                 "(u_tau_ref = %g, force = %g)",
+                 s->drive_mode == DRIVE_FLUX
+                     ? "y+ levels need stats.u_tau_ref > 0 in flux mode (drive.force is only the "
+                       "initial force there; u_tau_ref = %g, force = %g)"
+                     : "y+ levels need stats.u_tau_ref > 0 unless a positive drive.force gives "
+                       "it (u_tau_ref = %g, force = %g)",
                  u_tau_ref, s->force);
   if (s->init_profile == INIT_SYNTHETIC) validate_synthetic(ps);
   if (s->dt_fixed > 0.0 && s->dt_fixed > s->t_end)
