@@ -9,6 +9,9 @@
 2. The per-window quantities on a real stats.nc: each window's -u'v'+ and u_rms+ peaks and U+
    at the centre as the tool forms them equal those of window_profile over that window alone
    (force units), and the command prints every quantity and exits 0.
+3. --blocks K: each block's quantities are those of window_profile over the block's whole
+   span, the reference's own errors (--dns, a same-box table) are its *_se over its value at its
+   peak, and the command prints both; --dns without --blocks is an input error (exit 1).
 
 usage: blocking_check.py ROOT STATS_RUN_DIR T0:T1
 """
@@ -21,7 +24,9 @@ import numpy as np
 
 ROOT, RUN, SPAN = sys.argv[1], sys.argv[2], sys.argv[3]
 sys.path.insert(0, os.path.join(ROOT, "stats", "python"))
-from chansph_stats.blocking import QUANTITIES, blocking, window_quantities  # noqa: E402
+from chansph_stats.blocking import (QUANTITIES, blocking, equal_blocks,  # noqa: E402
+                                    reference_errors, window_quantities)
+from chansph_stats.dns import read_dns  # noqa: E402
 from chansph_stats.merge import pooled_windows, window_profile  # noqa: E402
 from passfail import check, finish  # noqa: E402
 
@@ -58,4 +63,33 @@ out = subprocess.run([os.path.join(ROOT, "stats", "python", "chansph-stats"), "b
 print(out.stdout, end="")
 check(out.returncode == 0 and all(q in out.stdout for q in QUANTITIES),
       f"the command (exit {out.returncode}) prints all {len(QUANTITIES)} quantities {out.stderr}")
+
+# 3. equal blocks and the reference's own errors
+bv = equal_blocks(pool, len(times), 2)
+size = len(times) // 2
+worst = 0.0
+for b in range(2):
+    p, _ = window_profile(RUN, times[b * size][0], times[(b + 1) * size - 1][1], "force")
+    ref = [np.nanmax(p["-u'v'+"]), np.nanmax(p["u_rms+"]), np.nanmax(p["v_rms+"]),
+           np.nanmax(p["w_rms+"]), p["U+"][int(np.nanargmax(p["yplus"]))]]
+    got = [bv[b, 0], bv[b, 1], bv[b, 2], bv[b, 3], bv[b, 5]]
+    worst = max(worst, max(abs(g - r) / max(abs(r), 1e-300) for g, r in zip(got, ref)))
+check(worst < 1e-12, f"2 blocks of {size} windows: block quantities = window_profile over the "
+      f"block's span, worst {worst:.1e}")
+box = os.path.join(ROOT, "stats", "dns", "samebox", "box_2x2x1.4.txt")
+d = read_dns(box)
+kv = int(np.argmax(d["v_rms+"]))
+re = reference_errors(box)
+check(abs(re[2] - 100 * d["v_rms+_se"][kv] / d["v_rms+"][kv]) < 1e-12 and 1.0 < re[2] < 3.0,
+      f"same-box reference: v_rms+ se at its peak {re[2]:.3f}% = its table's")
+tool = os.path.join(ROOT, "stats", "python", "chansph-stats")
+out = subprocess.run([tool, "blocking", "--units", "force", "--min-blocks", "2", "--blocks", "2",
+                      "--dns", box, f"run={RUN}@{SPAN}"], capture_output=True, text=True)
+print(out.stdout, end="")
+check(out.returncode == 0 and "2 equal blocks" in out.stdout and "reference" in out.stdout,
+      f"--blocks 2 --dns: exit {out.returncode}, prints the blocks and the reference {out.stderr}")
+bad = subprocess.run([tool, "blocking", "--dns", box, f"run={RUN}@{SPAN}"],
+                     capture_output=True, text=True)
+check(bad.returncode == 1 and "--dns goes with --blocks" in bad.stderr,
+      f"--dns without --blocks: exit {bad.returncode}, {bad.stderr.strip()}")
 finish()
