@@ -33,6 +33,10 @@ the wall).
 A run whose stats.nc has the Reynolds-stress budgets (rsb_*) also gets their table against the
 MKM Re_tau = 180 balances at y+ = 10, 15, 30, 50, rs_budget.csv and (without --no-plots)
 rs_budget_<c>.png in the output directory (`chansph-stats rs_budget --help`).
+A run with the momentum budget also gets the numerical pair stress read as a viscosity
+(numvisc.py): nu_num / nu = pair+ / (dU+/dy+) at a few heights, and the deviations and peak
+positions over 10 < y < 60 in y+ and in the wall units of nu + nu_num, y*+
+(numerical_viscosity.csv).
 """
 import argparse
 import math
@@ -40,7 +44,7 @@ import os
 
 import numpy as np
 
-from . import budget_compare, cli
+from . import budget_compare, cli, numvisc
 from .budget_compare import read_budgets
 from .cli import InputError
 from .dns import QUANTITIES, read_dns, through_bins
@@ -299,7 +303,9 @@ def main(argv, prog="chansph compare"):
     if not args.no_plots:
         plots(ours, dns, out_dir, refs if args.binned else None)
     print_budget(ours)
-    print("wrote %s/compare.csv%s" % (out_dir, "" if args.no_plots else " and one PNG per quantity"))
+    nv = numvisc.report(ours, dns, out_dir, QUANTITIES)
+    print("wrote %s/compare.csv%s%s" % (out_dir, ", numerical_viscosity.csv" if nv else "",
+                                        "" if args.no_plots else " and one PNG per quantity"))
     budgets = read_budgets(args.stats, args.u_tau) if args.stats.endswith(".nc") else None
     if budgets is not None:  # the Reynolds-stress budgets (rsb_*) against the MKM balances
         budget_compare.report(budgets, budget_compare.read_dns(), budget_compare.DEFAULT_LEVELS,
