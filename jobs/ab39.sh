@@ -64,6 +64,7 @@ declare -A sets=(
   [delta_0.2_h1.5]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set sph.h_over_dr=1.5"
   [delta_0.2_h2.5]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set sph.h_over_dr=2.5"
   [delta_0.2_nu0.6]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set fluid.nu=0.003333333333333333"
+  [delta_0.2_nu0.6_flux]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set fluid.nu=0.003333333333333333 --set drive.mode=flux --set drive.u_bulk=14.5824 --set stats.u_tau_ref=1"
 )
 names=("$@")
 [ ${#names[@]} -gt 0 ] || names=(reference damper_0.1 delta_0.1)
