@@ -64,6 +64,7 @@ declare -A sets=(
   [delta_0.2_h1.5]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set sph.h_over_dr=1.5"
   [delta_0.2_h2.5]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set sph.h_over_dr=2.5"
   [delta_0.2_nu0.6]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set fluid.nu=0.003333333333333333"
+  [delta_0.2_nuprof]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set les.model=profile --set les.profile=$root/jobs/scenes/nu_num_dr6c4d.txt"
   [delta_0.2_nu0.6_flux]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set fluid.nu=0.003333333333333333 --set drive.mode=flux --set drive.u_bulk=14.5824 --set stats.u_tau_ref=1"
 )
 names=("$@")

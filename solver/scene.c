@@ -58,7 +58,7 @@ static const char *const names_sph_pressure_gradient[] = {"standard", "corrected
 static const char *const names_sph_shifting[] = {"none", "fickian", NULL};
 static const char *const names_sph_shift_velocity[] = {"keep", "taylor", "conservative", NULL};
 static const char *const names_sph_wall_collision[] = {"stop", "reflect", NULL};
-static const char *const names_les_model[] = {"none", "smagorinsky", NULL};
+static const char *const names_les_model[] = {"none", "smagorinsky", "profile", NULL};
 static const char *const names_les_strain[] = {"gradient", "violeau_issa", NULL};
 static const char *const names_wall_law[] = {"laminar", "log", "reichardt", NULL};
 static const char *const names_drive_mode[] = {"force", "flux", NULL};
@@ -208,9 +208,11 @@ static const struct key keys_head[] = {
       "Regularisation added to r^2 in the viscous term (thesis Sec. 2.3.3), in units of h^2."},
      OFF(eta2)},
     {{"les", "model", T_CHOICE, "none", 0, 0, 0, names_les_model, "-",
-      "Sub-grid model: none (quasi-DNS: no model term is computed) or the Smagorinsky eddy "
-      "viscosity nu_r = l_S^2 S (thesis Eq. 5.45-5.47); needs sph.viscous = violeau (Eq. 2.100 "
-      "with variable viscosity)."},
+      "Sub-grid model: none (quasi-DNS: no model term is computed), the Smagorinsky eddy "
+      "viscosity nu_r = l_S^2 S (thesis Eq. 5.45-5.47), or profile: a prescribed nu_r(y) read "
+      "from les.profile (a diagnostic: e.g. nu_r = -nu_num(y) takes a measured numerical "
+      "viscosity out of the mean flow; no k_r); needs sph.viscous = violeau (Eq. 2.100 with "
+      "variable viscosity)."},
      OFF(les)},
     {{"les", "cs", T_DOUBLE, "0.065", 0, 1, LO_OPEN, NULL, "-",
       "Smagorinsky constant C_S: 0.065 (Moin & Kim 1982, used in the thesis) or 0.158 (Lilly's "
@@ -243,6 +245,14 @@ static const struct key keys_head[] = {
       "Yoshizawa constant C_Y of the residual kinetic energy k_r = 2 C_Y (Delta_G S)^2 (thesis "
       "Eq. 5.49), added to the pressure as 2/3 rho k_r (Eq. 5.42); 0 leaves it out."},
      OFF(cy)},
+    {{"les", "profile", T_STRING, "", 0, 0, 0, NULL, "-",
+      "With model = profile: a text file of lines 'y nu_r/nu' (whitespace or comma between, '#' "
+      "comments and a header line allowed): the eddy viscosity over nu at the wall distance y "
+      "in units of delta, y increasing from 0, nu_r/nu > -1 (so that nu + nu_r > 0) and 0 at "
+      "y = 0 (the wall shear term takes the molecular viscosity), linear in between and "
+      "constant beyond the last point; at most 256 points. Read at every start and resume. A "
+      "relative path in a scene file is relative to the scene file's directory."},
+     OFF(les_profile)},
     {{"wall", "law", T_CHOICE, "laminar", 0, 0, 0, names_wall_law, "-",
       "Wall law of the wall shear term: laminar (thesis Eq. 2.146-2.148, the particle's own "
       "velocity), log law (Eq. 5.51, linear below y+ = 11.06) or Reichardt (Eq. 5.53); the "
@@ -869,6 +879,64 @@ static void validate_synthetic(struct parse_state *ps) {
                  (double)s->init_eddies, box);
 }
 
+/** les.model = profile (validate): the table of les.profile into s->nu_prof, every problem
+    named by file and line. A first line (after comments) that is not two numbers is a header. */
+static void read_nu_profile(struct parse_state *ps) {
+  struct scene *s = ps->s;
+  struct nu_profile *t = &s->nu_prof;
+  t->n = 0;
+  if (!s->les_profile[0]) {
+    inconsistent(ps, "les.model", "profile needs les.profile, the file of nu_r / nu against y");
+    return;
+  }
+  FILE *f = fopen(s->les_profile, "r");
+  if (!f) {
+    inconsistent(ps, "les.profile", "cannot open %s", s->les_profile);
+    return;
+  }
+  char line[512];
+  int ln = 0, data = 0, bad = 0; /* lines, lines that are not comments, an error seen */
+  while (!bad && fgets(line, sizeof line, f)) {
+    ln++;
+    char *c = line;
+    while (isspace((unsigned char)*c)) c++;
+    if (!*c || *c == '#') continue;
+    char *end = NULL;
+    const double y = strtod(c, &end);
+    char *c2 = end;
+    while (isspace((unsigned char)*c2) || *c2 == ',') c2++;
+    char *end2 = NULL;
+    const double v = end == c ? 0.0 : strtod(c2, &end2);
+    const int two = end != c && end2 && end2 != c2;
+    if (!two && data == 0) { /* the first line that is not a comment: a header */
+      data++;
+      continue;
+    }
+    data++;
+    const char *why = !two                                ? "is not two numbers 'y nu_r/nu'"
+                      : !isfinite(y) || !isfinite(v)      ? "has a value that is not finite"
+                      : y < 0.0                           ? "has y < 0"
+                      : t->n > 0 && !(y > t->y[t->n - 1]) ? "has y not above the line before"
+                      : !(v > -1.0)            ? "has nu_r/nu <= -1 (nu + nu_r not positive)"
+                      : t->n == NU_PROFILE_MAX ? "is past the 256 points allowed"
+                                               : NULL;
+    if (why) {
+      inconsistent(ps, "les.profile", "%s line %d %s", s->les_profile, ln, why);
+      bad = 1;
+    } else {
+      t->y[t->n] = y, t->v[t->n] = v, t->n++;
+    }
+  }
+  fclose(f);
+  if (!bad && t->n == 0)
+    inconsistent(ps, "les.profile", "%s has no points", s->les_profile);
+  else if (!bad && (t->y[0] != 0.0 || t->v[0] != 0.0))
+    inconsistent(ps, "les.profile",
+                 "%s starts at y = %g with nu_r/nu = %g: it must start at the wall, y = 0, with "
+                 "nu_r/nu = 0 (the wall shear term takes the molecular viscosity)",
+                 s->les_profile, t->y[0], t->v[0]);
+}
+
 static void validate(struct parse_state *ps) {
   const struct scene *s = ps->s;
   check_counts(ps);
@@ -909,6 +977,7 @@ static void validate(struct parse_state *ps) {
     inconsistent(ps, "les.model",
                  "the eddy viscosity needs the variable-viscosity operator: set sph.viscous = "
                  "violeau (thesis Eq. 2.100)");
+  if (s->les == LES_PROFILE) read_nu_profile(ps);
   if ((s->les != LES_NONE || s->wall_law != 0) && !(s->nu > 0.0))
     inconsistent(ps, "fluid.nu", "wall laws and LES need nu > 0 (got %g)", s->nu);
   if ((s->les != LES_NONE || s->wall_law != 0) && two_delta < 4.0 * h * (1.0 - 1e-12))
@@ -946,15 +1015,16 @@ static void validate(struct parse_state *ps) {
 }
 
 /**
- * A relative init.from written in a scene file names a file next to the scene (a shipped scene
- * finds its shipped state from any working directory); it becomes an absolute path, so
- * scene.used.ini and checkpoints hold a name that does not depend on where the run started.
- * On the command line (--set) a relative path stays relative to the working directory.
+ * A relative init.from (or les.profile) written in a scene file names a file next to the scene (a
+ * shipped scene finds its shipped state from any working directory); it becomes an absolute path,
+ * so scene.used.ini and checkpoints hold a name that does not depend on where the run started. On
+ * the command line (--set) a relative path stays relative to the working directory.
  */
-static void resolve_paths(struct parse_state *ps, const char *scene_path) {
+static void resolve_path(struct parse_state *ps, const char *scene_path, const char *sec,
+                         const char *key, char *value) {
   struct scene *s = ps->s;
-  const int k = find_key("init", "from");
-  if (ps->where[k] <= 0 || !s->init_from[0] || s->init_from[0] == '/') return;
+  const int k = find_key(sec, key);
+  if (ps->where[k] <= 0 || !value[0] || value[0] == '/') return;
   char dir[512], abs_dir[PATH_MAX], joined[PATH_MAX + 520];
   snprintf(dir, sizeof dir, "%s", scene_path);
   char *slash = strrchr(dir, '/');
@@ -965,11 +1035,16 @@ static void resolve_paths(struct parse_state *ps, const char *scene_path) {
   else
     *slash = '\0';
   if (!realpath(dir, abs_dir)) snprintf(abs_dir, sizeof abs_dir, "%s", dir);
-  snprintf(joined, sizeof joined, "%s/%s", abs_dir, s->init_from);
+  snprintf(joined, sizeof joined, "%s/%s", abs_dir, value);
   char clean[PATH_MAX];
-  const char *name = realpath(joined, clean) ? clean : joined; /* a missing file: init says so */
+  const char *name = realpath(joined, clean) ? clean : joined; /* a missing file: said later */
   const char *why = set_value(s, k, name);
   if (why) report_value(ps, k, ps->where[k], name, why);
+}
+
+static void resolve_paths(struct parse_state *ps, const char *scene_path) {
+  resolve_path(ps, scene_path, "init", "from", ps->s->init_from);
+  resolve_path(ps, scene_path, "les", "profile", ps->s->les_profile);
 }
 
 /* scene_load and scene_load_text: fp (if not NULL) is read and closed. file_paths: relative
@@ -1059,7 +1134,7 @@ int scene_les(const struct scene *s) {
 }
 
 int scene_strain_lag(const struct scene *s) {
-  return scene_les(s) && s->strain == STRAIN_GRADIENT && s->strain_lag;
+  return s->les == LES_SMAGORINSKY && s->strain == STRAIN_GRADIENT && s->strain_lag;
 }
 
 int scene_wall_tau(const struct scene *s) {

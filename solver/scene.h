@@ -29,7 +29,15 @@ enum init_profile {
 };
 /** init.density: the densities of an init.from state kept, or shifted to the mean rho0. */
 enum init_density { INIT_DENSITY_KEEP = 0, INIT_DENSITY_RHO0 = 1 };
-enum les_model { LES_NONE = 0, LES_SMAGORINSKY = 1 };
+enum les_model { LES_NONE = 0, LES_SMAGORINSKY = 1, LES_PROFILE = 2 };
+/** A prescribed eddy-viscosity profile (les.model = profile): nu_r / nu at wall distances y /
+    delta, linear in between and constant beyond the first and the last point. */
+enum { NU_PROFILE_MAX = 256 };
+struct nu_profile {
+  int n;                    /*!< points */
+  double y[NU_PROFILE_MAX]; /*!< wall distance over delta, increasing [-] */
+  double v[NU_PROFILE_MAX]; /*!< nu_r / nu there, > -1 [-] */
+};
 enum les_strain { STRAIN_GRADIENT = 0, STRAIN_VIOLEAU_ISSA = 1 };
 enum pressure_gradient { PGRAD_STANDARD = 0, PGRAD_CORRECTED = 1, PGRAD_KGC = 2 };
 /** Pair form of the volume diffusion (term_diffusion.h). */
@@ -77,6 +85,8 @@ struct scene {
   int van_driest;  /*!< van Driest damping on (1) or off (0) */
   double a_plus;   /*!< A+ of the damping [-] */
   double cy;       /*!< Yoshizawa constant C_Y [-]; 0 = no residual kinetic energy */
+  char les_profile[512];     /*!< les.model = profile: the file of nu_r / nu against y / delta */
+  struct nu_profile nu_prof; /*!< derived: that file's table, read by validate() */
   /* [wall] */
   int wall_law; /*!< enum wall_law (walllaw.h) */
   double kappa; /*!< von Karman constant [-] */

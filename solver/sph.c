@@ -40,12 +40,13 @@ void sph_model_init(struct model *M, const struct scene *s) {
   M->wall_weight = s->wall_weight;
   M->wall_pressure = s->wall_pressure;
   M->pgrad = s->pgrad;
-  M->les = scene_les(s);
+  M->les = s->les; /* enum les_model: non-zero with an eddy viscosity */
   M->strain = s->strain;
   M->strain_lag = scene_strain_lag(s);
   M->van_driest = s->van_driest;
   M->cs = s->cs, M->delta_g = s->filter_h * M->h, M->a_plus = s->a_plus;
-  M->cy = s->cy;
+  M->cy = s->les == LES_PROFILE ? 0.0 : s->cy; /* a prescribed nu_r has no k_r */
+  M->nu_prof = s->nu_prof;
   M->law = wall_law_make(s->wall_law, s->kappa, s->log_b);
   M->wall_tau = scene_wall_tau(s);
   M->shifting = s->shifting;

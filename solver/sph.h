@@ -45,6 +45,7 @@ struct model {
   int van_driest; /*!< damping on */
   double cs, delta_g, a_plus; /*!< C_S [-], Delta_G [m], A+ [-] */
   double cy;                  /*!< Yoshizawa C_Y [-]; 0 = off */
+  struct nu_profile nu_prof;  /*!< les = LES_PROFILE: nu_r / nu against y / delta */
   struct wall_law_def law;    /*!< wall law of the wall shear term */
   int wall_tau;               /*!< wall stresses carried to the vertices (turb.h) */
   /** Violeau's operator: its wall-normal second moment int y^2 F ((n+2) x_t^2/r^2 + 1) dV over

@@ -253,6 +253,40 @@ void turb_q_criterion(const struct model *M, const struct particles *P, const st
   }
 }
 
+double turb_profile_value(const struct nu_profile *t, double y) {
+  if (y <= t->y[0]) return t->v[0];
+  if (y >= t->y[t->n - 1]) return t->v[t->n - 1];
+  int lo = 0, hi = t->n - 1; /* t->y[lo] < y < t->y[hi] */
+  while (hi - lo > 1) {
+    const int mid = (lo + hi) / 2;
+    if (t->y[mid] <= y)
+      lo = mid;
+    else
+      hi = mid;
+  }
+  const double f = (y - t->y[lo]) / (t->y[hi] - t->y[lo]);
+  return t->v[lo] + f * (t->v[hi] - t->v[lo]);
+}
+
+/* les.model = profile: nu_r = nu f(d / delta) of the table, d the distance to the nearest
+   wall; no k_r. Returns the largest nu + nu_r. */
+static double profile_viscosity(const struct model *M, struct particles *P) {
+  const double nu = M->nu, idelta = 2.0 / M->ly;
+  const uint8_t *restrict kind = P->kind;
+  double *restrict nur = P->nur, *restrict kr = P->kr;
+  double numax = nu;
+#pragma omp parallel for schedule(static) reduction(max : numax)
+  for (size_t a = 0; a < P->n; a++) {
+    nur[a] = kr[a] = 0.0;
+    if (kind[a] != KIND_FLUID) continue;
+    int wall;
+    const double d = nearest_wall(M, P->y[a], &wall);
+    nur[a] = nu * turb_profile_value(&M->nu_prof, d * idelta);
+    if (nu + nur[a] > numax) numax = nu + nur[a];
+  }
+  return numax;
+}
+
 /* turb_eddy_viscosity at the current state (not les.strain_lag, or a run's first step): rate of
    strain, damping, nu_r and k_r of every owned particle; returns the largest nu + nu_r. */
 static double eddy_viscosity(const struct model *M, struct particles *P, const struct nbr *nb,
@@ -309,6 +343,8 @@ double turb_eddy_viscosity(const struct model *M, struct particles *P, const str
 #pragma omp parallel for schedule(static) reduction(max : numax)
     for (size_t a = 0; a < P->n; a++)
       if (P->kind[a] == KIND_FLUID && nu + nur[a] > numax) numax = nu + nur[a];
+  } else if (M->les == LES_PROFILE) {
+    numax = profile_viscosity(M, P);
   } else {
     numax = eddy_viscosity(M, P, nb, W);
   }

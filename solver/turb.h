@@ -13,7 +13,9 @@
  *  3. with LES: the rate of strain S, the local y+ from the wall stress at the foot of the
  *     nearest wall, nu_r = l_S^2 S and k_r; with les.strain_lag (the default) the force loop
  *     of the previous step formed them from the strain of its state (turb_model_chunk,
- *     turb_advance), one time step of lag, and this step only takes their maximum,
+ *     turb_advance), one time step of lag, and this step only takes their maximum;
+ *     les.model = profile instead sets nu_r = nu g(d / delta) from the table of les.profile
+ *     (turb_profile_value) and no k_r,
  *  4. with C_Y > 0, sph_kr_pressure (sph.h, which sets every pressure the forces read): k_r
  *     of the vertices (Shepard), and the pressure of fluid and vertex particles as seen by the
  *     forces becomes p + 2/3 rho k_r (Eq. 5.42: pr2 and the wall pressure; P->p stays the
@@ -47,6 +49,10 @@ void turb_wall_law(const struct model *M, struct particles *P, const struct nbr 
  */
 double turb_eddy_viscosity(const struct model *M, struct particles *P, const struct nbr *nb,
                            const struct walls *W);
+
+/** les.model = profile: the table's nu_r / nu at y (wall distance over delta), linear between
+    its points and constant beyond the first and the last. Exposed for the unit tests. */
+double turb_profile_value(const struct nu_profile *t, double y);
 
 /** Particles per call of turb_model_chunk (the force loop's chunk). */
 enum { TURB_CHUNK = 128 };

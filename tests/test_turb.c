@@ -18,6 +18,9 @@
  *    |g| (-(1/(rho_a gamma_a)) sum_b V_b (rho_a + rho_b)/2 y_ab^2 F_ab)^(1/2), summed here;
  *  - the wall-law stress of every near-wall particle is rho u_tau(U, max(d, dr))^2 along its
  *    velocity, with u_tau from walllaw.h (Reichardt);
+ *  - les.model = profile: the table of a file with comments, a header and a blank line at and
+ *    between its points and beyond the last, and nu_r = nu g(d / delta) of every fluid particle,
+ *    no k_r, the largest nu + nu_r;
  *  - Violeau's wall moment table (sph.c): -1 at the wall (half of the full-space -2) to 1e-8
  *    and 0 at q = 2.
  */
@@ -26,6 +29,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "sim.h"
 #include "turb.h"
@@ -223,6 +227,66 @@ static int check_channel(int damping, int strain) {
                          e3 < 1e-10 && worst_tau < 1e-12);
 }
 
+/* les.model = profile: the table read from a file with comments and a header (at the points,
+   between them by hand, beyond the last point), and nu_r = nu g(d / delta) of every fluid particle
+   with d its distance to the nearest wall, k_r = 0, the largest nu + nu_r returned. */
+static int check_profile(void) {
+  char path[] = "/tmp/test_turb_profile_XXXXXX";
+  const int fd = mkstemp(path);
+  FILE *f = fd >= 0 ? fdopen(fd, "w") : NULL;
+  if (!f) return 1;
+  fprintf(f, "# a test table\ny_over_delta, nu_r_over_nu\n0 0\n0.25, -0.5\n\n0.5 0.25\n");
+  fprintf(f, "# between\n0.75 0.5\n");
+  fclose(f);
+  char prof[600];
+  snprintf(prof, sizeof prof, "les.profile=%s", path);
+  char *set[] = {"domain.dimension=3",  "domain.lx=1",       "domain.lz=0.5", "domain.dr=0.05",
+                 "domain.delta=0.5",    "fluid.nu=1e-3",     "fluid.c0=10",   "time.t_end=1",
+                 "sph.viscous=violeau", "les.model=profile", "les.cy=0.05",   prof};
+  struct scene sc;
+  const int bad = scene_load(&sc, NULL, sizeof set / sizeof set[0], set);
+  remove(path);
+  if (bad) return 1;
+  const struct nu_profile *t = &sc.nu_prof;
+  const double probe[][2] = {{0.0, 0.0},  {0.125, -0.25}, {0.25, -0.5}, {0.375, -0.125},
+                             {0.6, 0.35}, {0.75, 0.5},    {1.0, 0.5},   {2.0, 0.5}};
+  double worst_table = 0.0;
+  for (size_t i = 0; i < sizeof probe / sizeof probe[0]; i++)
+    worst_table = fmax(worst_table, fabs(turb_profile_value(t, probe[i][0]) - probe[i][1]));
+  struct sim S;
+  if (sim_init(&S, &sc)) return 1;
+  struct particles *P = &S.P;
+  const struct model *M = &S.M;
+  const double numax = turb_eddy_viscosity(M, P, &S.nb, &S.W);
+  double worst = 0.0, kr_max = 0.0, want_max = M->nu;
+  int n = 0;
+  for (size_t a = 0; a < P->n; a++) {
+    if (P->kind[a] != KIND_FLUID) {
+      worst = fmax(worst, fabs(P->nur[a]));
+      continue;
+    }
+    const double s = fmin(P->y[a], M->ly - P->y[a]) / sc.delta;
+    double g = 0.5; /* beyond the last point */
+    if (s < 0.25)
+      g = -0.5 * s / 0.25;
+    else if (s < 0.5)
+      g = -0.5 + 0.75 * (s - 0.25) / 0.25;
+    else if (s < 0.75)
+      g = 0.25 + 0.25 * (s - 0.5) / 0.25;
+    worst = fmax(worst, fabs(P->nur[a] - M->nu * g) / M->nu);
+    kr_max = fmax(kr_max, fabs(P->kr[a]));
+    want_max = fmax(want_max, M->nu * (1.0 + g));
+    n++;
+  }
+  printf(
+      "les.model = profile: table error %.2e at 8 probes; %d fluid particles, nu_r / nu "
+      "error %.2e, max |k_r| %g, largest nu + nu_r %.17g (by hand %.17g)\n",
+      worst_table, n, worst, kr_max, numax, want_max);
+  sim_free(&S);
+  return !(worst_table < 1e-15 && n > 0 && worst < 1e-14 && kr_max == 0.0 &&
+           fabs(numax - want_max) < 1e-15 * want_max);
+}
+
 int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
   int fail = 0;
@@ -235,6 +299,7 @@ int main(int argc, char **argv) {
   fail |= v0 != 0.0 || fabs(v1 - (1.0 - exp(-1.0))) > 1e-15 || v2 != 1.0;
   for (int dmp = 0; dmp < 2; dmp++)
     for (int st = 0; st < 2; st++) fail |= check_channel(dmp, st);
+  fail |= check_profile();
   for (int dim = 2; dim <= 3; dim++) {
     struct model M = {.dim = dim};
     sph_violeau_table(&M);
