@@ -201,18 +201,22 @@ case $case in
       compare r1 r2 200
     done
     ;;
-  kgc | damper | substeps) # terms that read state of other particles or steps, on 1 and 2 ranks:
+  kgc | damper | substeps | les_profile) # terms that read state of other particles or steps, on 1 and 2 ranks:
     # kgc (sph.pressure_gradient = kgc): the force pass and the budget's conservative split read
     # the neighbours' correction matrices B at the ghosts (PR_KGC); statistics from the start,
     # so the budget parts are sampled too. damper (sph.acoustic_damper): migrating particles
     # carry their density rate (term_damper.h), which the pressure of the next step reads.
     # substeps (sph.diffusion_substeps = 3): each sub-step reads the ghosts' densities, refreshed
-    # after the previous one (PR_DENSITY)
+    # after the previous one (PR_DENSITY). les_profile (les.model = profile): the forces read the
+    # neighbours' prescribed nu_r at the ghosts (PR_MODEL); the budget's model part from the start
     scene=$scenes/poiseuille2d.ini
     args=(--set domain.lx=2.0 --set time.t_end=1000 --set time.max_steps=200 --set init.profile=laminar
       --set drive.force=4 --set init.noise=0.5 --set run.check_ids=1 --set output.log_every=100)
     if [ "$case" = kgc ]; then
       args+=(--set output.t_average_start=0 --set sph.pressure_gradient=kgc)
+    elif [ "$case" = les_profile ]; then
+      args+=(--set output.t_average_start=0 --set sph.viscous=violeau --set les.model=profile
+        --set les.profile="$scenes/nu_num_dr6c4d.txt")
     elif [ "$case" = substeps ]; then
       args+=(--set sph.diffusion=delta_sph --set sph.delta=0.6 --set sph.diffusion_substeps=3)
     else
