@@ -11,7 +11,8 @@
 #   d5    jobs/states/mfu180w_dr6c4d_s3_t5.nc (the delta-SPH run's third segment at its end:
 #         the start of the LES against the quasi-DNS on that scheme, *_les and *_dr9)
 # Candidates *_dr9 run at dr+ = 9 (domain.dr = delta/20, 44 000 particles, the start state
-# interpolated onto the coarser lattice) and average from t = 1 on: give T = 3 or more.
+# interpolated onto the coarser lattice) and *_dr7.2 at dr+ = 7.2 (delta/25, 87 500 particles),
+# and average from t = 1 on: give T = 3 or more.
 # Each run is a batch job through jobs/chain.sh (checkpoints; start the script again to go on),
 # about 15 minutes a turnover with 2 threads on an idle 2-core machine.
 # usage: jobs/ab39.sh OUTDIR START [T] [CANDIDATE...]   e.g. jobs/ab39.sh runs/ab39 s16 1 damper_0.1
@@ -57,6 +58,7 @@ declare -A sets=(
   [delta_0.2_shift_cons_0.02]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set sph.shifting=fickian --set sph.shift_velocity=conservative --set sph.shift_coefficient=0.02"
   [delta_0.2_les]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set les.model=smagorinsky"
   [delta_0.2_dr9]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set domain.dr=0.05 --set output.t_average_start=1"
+  [delta_0.2_dr7.2]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set domain.dr=0.04 --set output.t_average_start=1"
   [delta_0.2_les_dr9]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set les.model=smagorinsky --set domain.dr=0.05 --set output.t_average_start=1"
   [delta_0.2_c130]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set fluid.c0=130"
   [delta_0.2_shift_cons_0.05]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set sph.shifting=fickian --set sph.shift_velocity=conservative --set sph.shift_coefficient=0.05"

@@ -338,21 +338,28 @@ def cmd_restart_finer(args):
     return err <= args.max_l2
 
 
-def cmd_smagorinsky(args):
-    sets = ["les.model=smagorinsky", "sph.viscous=violeau"] + args.set
-    out, wall = run(args, args.scene, "smagorinsky_" + os.path.basename(args.scene)[:-4], sets)
+def model_channel(args, name, sets, exact, what):
+    """Run the steady channel with the extra keys sets and compare u_mean with exact(a, out, y)
+    (a: the stats.nc attributes); pass if the relative L2 error is within --max-l2 and the
+    model moves the profile from the laminar one by more than 5 times the error."""
+    out, wall = run(args, args.scene, name + "_" + os.path.basename(args.scene)[:-4], sets)
     with netCDF4.Dataset(os.path.join(out, "stats.nc")) as d:
         a = {k: d.getncattr(k) for k in d.ncattrs()}
         y, u = d["y_mean"][:].filled(np.nan), d["u_mean"][:].filled(np.nan)
-    ua = smagorinsky_profile(a, out, y)
+    ua = exact(a, out, y)
     ok = np.isfinite(u)
     err = math.sqrt(np.sum((u[ok] - ua[ok]) ** 2) / np.sum(ua[ok] ** 2))
     ul = laminar(a, y)
     shift = math.sqrt(np.sum((ul[ok] - ua[ok]) ** 2) / np.sum(ua[ok] ** 2))
-    print("Smagorinsky channel %dD (%s): relative L2 error of u_mean = %.3e (limit %.3g); the model "
-          "moves the profile by %.3e from the laminar one; %.1f s wall"
-          % (a["dimension"], " ".join(args.set), err, args.max_l2, shift, wall))
+    print("%s %dD (%s): relative L2 error of u_mean = %.3e (limit %.3g); the model moves the "
+          "profile by %.3e from the laminar one; %.1f s wall"
+          % (what, a["dimension"], " ".join(args.set), err, args.max_l2, shift, wall))
     return err <= args.max_l2 and shift > 5 * err
+
+
+def cmd_smagorinsky(args):
+    return model_channel(args, "smagorinsky", ["les.model=smagorinsky", "sph.viscous=violeau"]
+                         + args.set, smagorinsky_profile, "Smagorinsky channel")
 
 
 def cmd_profile(args):
@@ -368,24 +375,17 @@ def cmd_profile(args):
         f.write("# nu_r / nu = -1.6 s (1 - s) + 0.8 s^3, s = y / delta (poiseuille_check.py)\n"
                 "y_over_delta, nu_r_over_nu\n")
         f.writelines("%.17g, %.17g\n" % (a, b) for a, b in zip(yt, gt))
+
+    def exact(a, out, y):
+        f, delta, nu = a["body_force"], a["delta"], a["nu"]
+        yy = np.linspace(0.0, delta, 200001)
+        du = f * (delta - yy) / (nu * (1.0 + np.interp(yy / delta, yt, gt)))
+        uu = np.concatenate(([0.0], np.cumsum(0.5 * (du[1:] + du[:-1]) * np.diff(yy))))
+        return np.interp(np.minimum(y, 2 * delta - y), yy, uu)
+
     sets = ["les.model=profile", "les.profile=" + table, "sph.viscous=violeau"] + args.set
-    out, wall = run(args, args.scene, "profile_" + os.path.basename(args.scene)[:-4], sets)
-    with netCDF4.Dataset(os.path.join(out, "stats.nc")) as d:
-        a = {k: d.getncattr(k) for k in d.ncattrs()}
-        y, u = d["y_mean"][:].filled(np.nan), d["u_mean"][:].filled(np.nan)
-    f, delta, nu = a["body_force"], a["delta"], a["nu"]
-    yy = np.linspace(0.0, delta, 200001)
-    du = f * (delta - yy) / (nu * (1.0 + np.interp(yy / delta, yt, gt)))
-    uu = np.concatenate(([0.0], np.cumsum(0.5 * (du[1:] + du[:-1]) * np.diff(yy))))
-    ua = np.interp(np.minimum(y, 2 * delta - y), yy, uu)
-    ok = np.isfinite(u)
-    err = math.sqrt(np.sum((u[ok] - ua[ok]) ** 2) / np.sum(ua[ok] ** 2))
-    ul = laminar(a, y)
-    shift = math.sqrt(np.sum((ul[ok] - ua[ok]) ** 2) / np.sum(ua[ok] ** 2))
-    print("channel %dD with the prescribed nu_r(y) of %s: relative L2 error of u_mean = %.3e "
-          "(limit %.3g); the profile moves u by %.3e from the laminar one; %.1f s wall"
-          % (a["dimension"], table, err, args.max_l2, shift, wall))
-    return err <= args.max_l2 and shift > 5 * err
+    return model_channel(args, "profile", sets, exact,
+                         "channel with the prescribed nu_r(y) of " + table + ",")
 
 
 def main():
