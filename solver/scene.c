@@ -1138,7 +1138,7 @@ int scene_strain_lag(const struct scene *s) {
 }
 
 int scene_wall_tau(const struct scene *s) {
-  return scene_les(s) || s->wall_law != WALL_LAW_LAMINAR;
+  return s->les == LES_SMAGORINSKY || s->wall_law != WALL_LAW_LAMINAR;
 }
 
 int scene_bins(const struct scene *s) {

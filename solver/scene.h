@@ -212,7 +212,8 @@ int scene_les(const struct scene *s);
            les.strain_lag = 1). */
 int scene_strain_lag(const struct scene *s);
 
-/** @brief Wall stresses are carried to the vertices: LES or a turbulent wall law. */
+/** @brief Wall stresses are carried to the vertices: the Smagorinsky model (its van Driest
+           damping) or a turbulent wall law; a prescribed nu_r(y) needs none. */
 int scene_wall_tau(const struct scene *s);
 
 /** @brief Effective number of wall-normal bins. */
