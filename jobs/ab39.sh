@@ -10,9 +10,12 @@
 #   s8.5  jobs/states/mfu180w_dr6c4_t8.5.nc  (t = 8.5 of the same run)
 #   d5    jobs/states/mfu180w_dr6c4d_s3_t5.nc (the delta-SPH run's third segment at its end:
 #         the start of the LES against the quasi-DNS on that scheme, *_les and *_dr9)
+#   w45   jobs/states/mfu180w_dr45c4d_s3_t1.nc (the dr+ = 4.5 run's third segment at t = 1:
+#         the start of *_dr4, the finest point of the resolution series)
 # Candidates *_dr9 run at dr+ = 9 (domain.dr = delta/20, 44 000 particles, the start state
-# interpolated onto the coarser lattice) and *_dr7.2 at dr+ = 7.2 (delta/25, 87 500 particles),
-# and average from t = 1 on: give T = 3 or more.
+# interpolated onto the coarser lattice), *_dr7.2 at dr+ = 7.2 (delta/25, 87 500 particles)
+# and *_dr4 at dr+ = 4 (delta/45, 510 300 particles, from w45), and average from t = 1 on:
+# give T = 3 or more.
 # Each run is a batch job through jobs/chain.sh (checkpoints; start the script again to go on),
 # about 15 minutes a turnover with 2 threads on an idle 2-core machine.
 # usage: jobs/ab39.sh OUTDIR START [T] [CANDIDATE...]   e.g. jobs/ab39.sh runs/ab39 s16 1 damper_0.1
@@ -20,7 +23,7 @@
 #   --csv OUTDIR/ab_score.csv --markdown
 set -uo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-[ $# -ge 2 ] || { sed -n 2,16p "$0" >&2; exit 1; }
+[ $# -ge 2 ] || { sed -n 2,23p "$0" >&2; exit 1; }
 out=$1 start=$2 tend=${3:-1}
 shift $(($# >= 3 ? 3 : 2))
 scene=jobs/scenes/mfu180w_dr6_c4_ab.ini
@@ -28,7 +31,8 @@ case $start in
   s16) state=$root/jobs/states/mfu180w_dr6c4_t16.nc ;;
   s8.5) state=$root/jobs/states/mfu180w_dr6c4_t8.5.nc ;;
   d5) state=$root/jobs/states/mfu180w_dr6c4d_s3_t5.nc ;;
-  *) echo "error: START must be s16, s8.5 or d5 (got '$start')" >&2; exit 1 ;;
+  w45) state=$root/jobs/states/mfu180w_dr45c4d_s3_t1.nc ;;
+  *) echo "error: START must be s16, s8.5, d5 or w45 (got '$start')" >&2; exit 1 ;;
 esac
 # shellcheck disable=SC2034  # read by name in campaign_candidates
 declare -A sets=(
@@ -59,6 +63,7 @@ declare -A sets=(
   [delta_0.2_les]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set les.model=smagorinsky"
   [delta_0.2_dr9]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set domain.dr=0.05 --set output.t_average_start=1"
   [delta_0.2_dr7.2]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set domain.dr=0.04 --set output.t_average_start=1"
+  [delta_0.2_dr4]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set domain.dr=0.022222222222222223 --set output.t_average_start=1"
   [delta_0.2_les_dr9]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set les.model=smagorinsky --set domain.dr=0.05 --set output.t_average_start=1"
   [delta_0.2_c130]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set fluid.c0=130"
   [delta_0.2_shift_cons_0.05]="--set sph.diffusion=delta_sph --set sph.delta=0.2 --set sph.shifting=fickian --set sph.shift_velocity=conservative --set sph.shift_coefficient=0.05"
