@@ -14,7 +14,7 @@
 #         the start of *_dr4, the finest point of the resolution series)
 # Candidates *_dr9 run at dr+ = 9 (domain.dr = delta/20, 44 000 particles, the start state
 # interpolated onto the coarser lattice), *_dr7.2 at dr+ = 7.2 (delta/25, 87 500 particles)
-# and *_dr4 at dr+ = 4 (delta/45, 510 300 particles, from w45), and average from t = 1 on:
+# and *_dr4 at dr+ = 4 (delta/45, 504 630 particles, from w45), and average from t = 1 on:
 # give T = 3 or more.
 # Each run is a batch job through jobs/chain.sh (checkpoints; start the script again to go on),
 # about 15 minutes a turnover with 2 threads on an idle 2-core machine.

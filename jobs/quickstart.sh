@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Quick start: set up, run the turbulent channel jobs/scenes/quickstart.ini (quasi-DNS at
 # Re_tau = 180, dr+ = 6, the converged run's scene and scheme in its 2 x 2 x 1.4 delta box, from
-# that run's developed end state in jobs/states/, 0.2 eddy turnover times, 3-4 minutes on 2 cores) into runs/quickstart/, compare it with the
+# that run's developed end state in jobs/states/, 0.2 eddy turnover times, 2.5-4 minutes on 2 cores) into runs/quickstart/, compare it with the
 # DNS of Moser, Kim & Mansour (1999) and end with one screen: is it turbulent (the evidence),
 # its peaks and largest deviations against the DNS beside those of the shipped converged run,
 # where the plots and the details are, what to run next. The details (the full comparison

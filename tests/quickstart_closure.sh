@@ -5,11 +5,11 @@
 # total_stress_expected_all| / u_tau_force^2 <= 0.02, the total from every statistics snapshot
 # (the force pass's whole acceleration). And the parts' sum (total_stress, the split of the
 # pair forces by term) against that total: where the parts are split on every snapshot
-# (stats.budget_every = 1, as the scene ships: 34 snapshots, 2026-12-07, closure 0.0128) they
+# (stats.budget_every = 1, as the scene ships: 34 snapshots, 2026-12-07, closure 0.0128 in the force's units, 0.0119 in the wall stress's as chansph compare prints it) they
 # are the same sums regrouped, equal to round-off (<= 1e-9); where on fewer, within 0.05 (their
 # sampling: the earlier minimal-unit scene split 24 of 119 snapshots and met it, the wide box's
 # 18 of 85 missed it by 0.03 in the bin at the centre, whose kinetic flux is the noisiest).
-# About 4 minutes on 2 cores.
+# About 2.5-4 minutes on 2 cores (193 s in the CI of 2026-12-08).
 # usage: quickstart_closure.sh CHANSPH SCENES RUNS
 set -u
 chansph=$1 scenes=$2 runs=$3

@@ -75,9 +75,10 @@ void cli_usage(void) {
     if (commands[i].usage && commands[i].cmd != CMD_SCENE_DOC) printf("%s", commands[i].usage);
   printf(
       "  chansph scene-doc            print the scene key reference (docs/scenes.md)\n"
-      "  chansph extract STATS.nc [--var a,b] [--units wall|outer] [--format csv|tsv]\n"
-      "                  [--window T0:T1] [--pdfs]   print profiles, or the one-point PDFs\n"
-      "                  (docs/stats-format.md)\n"
+      "  chansph extract STATS.nc [LATER.nc ...] [--var a,b] [--units wall|outer]\n"
+      "                  [--format csv|tsv] [--window T0:T1] [--pdfs] [--nc OUT.nc] [--force]\n"
+      "                  print profiles or the one-point PDFs, or join a run's segments\n"
+      "                  into one file (docs/stats-format.md)\n"
       "  chansph compare STATS.nc --dns FILE [--out DIR]   errors against DNS, PNG plots\n"
       "  chansph --version | --help   (also: chansph COMMAND --help)\n"
       "%s",
