@@ -40,8 +40,9 @@ import math
 R = 2  # NBR_REACH: halo cells per side of a cut direction; a block needs 2 R where cut
 
 # measured (docs/parallel.md, "Measured on this machine")
-T_C_BENCH = 194.3e-3 / 99840  # s per particle-step per core, bench scene (1 x 1)
-T_C_LES = 107e-3 * 2 / 41250  # s per particle-step per core, les395_small LES (1 x 2 threads)
+# (docs/performance.md, "Cost of the turbulence models and of the turbulent scenes")
+T_C_MCF1 = 1.75 * 2 / 1659456  # s per particle-step per core, mcf1 (1 x 2 threads, 2026-12-01)
+T_C_LES = 39e-3 * 2 / 41250  # s per particle-step per core, les395_small LES (1 x 2 threads)
 T_C_C4 = 900.0 * 2 / 558e6  # wide box, Wendland C4 at h = 2 dr: 558 M particle-steps a turnover
 #                             in 900 s on 2 threads (docs/validation/scheme_ab.md, delta_0.2)
 # s per ghost per step: the halo's own work (migration, ghosts, refreshes; not the MPI waits) of
@@ -60,7 +61,7 @@ BW = 10e9
 ALPHA = 2e-6
 
 SCENES = {  # name: (lx, ly, lz, dr, h_over_dr, t_c)
-    "mcf1 (1.66 M, quasi-DNS)": (3.140625, 2.0, 1.0, 0.015625, 1.3, T_C_BENCH),
+    "mcf1 (1.66 M, quasi-DNS)": (3.140625, 2.0, 1.0, 0.015625, 1.3, T_C_MCF1),
     "wide box dr+ = 3 (1.21 M, C4)": (2.0, 2.0, 1.4, 1.0 / 60, 2.0, T_C_C4),
     "les550 (1.29 M, LES)": (2 * math.pi, 2.0, math.pi, 1.0 / 32, 1.3, T_C_LES),
 }
@@ -187,10 +188,10 @@ def main():
     if a.measured:
         measured(a.measured)
         return
-    print("constants: t_c %.3g us (bench), %.3g us (LES), %.3g us (C4) per particle-step; t_g "
+    print("constants: t_c %.3g us (mcf1), %.3g us (LES), %.3g us (C4) per particle-step; t_g "
           "%.3g us; %.0f / %.0f B per ghost and %.1f / %.1f messages per step (slabs / blocks); "
           "B = %.0f GB/s, alpha = %.0f us"
-          % (1e6 * T_C_BENCH, 1e6 * T_C_LES, 1e6 * T_C_C4, 1e6 * T_G, B_GHOST_SLAB, B_GHOST_BLOCK,
+          % (1e6 * T_C_MCF1, 1e6 * T_C_LES, 1e6 * T_C_C4, 1e6 * T_G, B_GHOST_SLAB, B_GHOST_BLOCK,
              MSG_SLAB, MSG_BLOCK, BW / 1e9, 1e6 * ALPHA))
     rows = table()
     wk = weak()

@@ -143,10 +143,10 @@ static const struct key keys_head[] = {
       "thesis (2.6% lattice error at h/dr = 1.3, docs/theory.md)."},
      OFF(lap_norm)},
     {{"sph", "wall_shear_weight", T_CHOICE, "discrete", 0, 0, 0, names_sph_wall_shear_weight, "-",
-      "Weight of the wall shear term of the Morris operator: |grad gamma_as| (analytic, thesis "
-      "Eq. 2.147) or the discrete first moment sum_b V_b (r_ab . n) F_ab, which makes the "
-      "operator exact for a linear velocity profile (docs/theory.md). Violeau always uses "
-      "the analytic weight."},
+      "Weight of the viscous wall shear term: |grad gamma_as| (analytic, thesis Eq. 2.147) or "
+      "the discrete first moment sum_b V_b (r_ab . n) F_ab (Morris; Violeau: half that of its "
+      "pair weight G_ab, per component), which makes the operator exact for a linear velocity "
+      "profile (docs/theory.md)."},
      OFF(wall_weight)},
     {{"sph", "wall_pressure_weight", T_CHOICE, "lattice", 0, 0, 0, names_sph_wall_pressure_weight,
       "-",
